@@ -1,0 +1,31 @@
+// Subcommands of the `swim` executable. Each is a thin driver over the tier libraries;
+// errors propagate as swim::InputError (exit 2) or swim::NumericalError (exit 3).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace swim::app {
+
+struct RunOptions {
+  std::string scene;
+  std::string tier = "1d";
+  std::string out;
+  std::vector<std::string> sets;
+  int progress = -1;  ///< -1 auto (terminal), 0 off, 1 on
+  bool plot = false;
+};
+
+int run(const RunOptions& o);
+int demo(const std::string& out, int progress);
+int screen(const std::string& sweep, const std::string& out, int jobs, int progress);
+int bench(const std::string& out, bool quick);
+int scenes();
+
+/// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
+std::string data_dir();
+/// Run a plotting script of tools/ with Debian's python3; returns false (with a warning on
+/// stderr) when plotting is unavailable. Plots are a convenience: their failure never fails a run.
+bool plot(const std::string& script, const std::vector<std::string>& args);
+
+}  // namespace swim::app

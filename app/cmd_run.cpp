@@ -1,0 +1,92 @@
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
+#include "app/app.hpp"
+#include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/progress.hpp"
+#include "common/scene.hpp"
+#include "reduced1d/report.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "reduced1d/solver.hpp"
+
+namespace swim::app {
+
+namespace fs = std::filesystem;
+
+std::string data_dir() {
+  if (const char* d = std::getenv("SWIM_DATA_DIR")) return d;
+  return SWIM_SOURCE_DIR "/data";
+}
+
+bool plot(const std::string& script, const std::vector<std::string>& args) {
+  std::string cmd = std::string("\"") + SWIM_PLOT_PYTHON + "\" \"" + SWIM_SOURCE_DIR + "/tools/" + script + "\"";
+  for (const auto& a : args) cmd += " \"" + a + "\"";
+  cmd += " 2>&1";
+  if (std::system(cmd.c_str()) != 0) {
+    std::fprintf(stderr, "swim: warning: plotting with %s failed (python3-matplotlib missing?); data files are complete\n",
+                 script.c_str());
+    return false;
+  }
+  return true;
+}
+
+int run(const RunOptions& o) {
+  // 1. Everything is read and validated before anything is written.
+  scene::json sc = scene::load_file(o.scene);
+  for (const auto& s : o.sets) scene::apply_override(sc, s);
+  if (o.tier == "3d")
+    throw InputError("--tier", "3d", "the 3D tier is not available in this build yet; use --tier 1d");
+  scene::json resolved;
+  const std::string scene_dir = fs::path(o.scene).parent_path().string();
+  const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir.empty() ? "." : scene_dir);
+  const std::string out = o.out.empty() ? "out/" + p.name + "-1d" : o.out;
+
+  // 2. Run.
+  output::make_dir(out);
+  const auto t0 = std::chrono::steady_clock::now();
+  Progress progress("1d " + p.name, reduced1d::end_time(p), o.progress);
+  const reduced1d::Result r = reduced1d::solve(p, [&](double t, double) { progress.update(t); });
+  progress.done();
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+
+  // 3. Write (partial results too), report.
+  const scene::json summary = reduced1d::write_run(out, p, resolved, r, wall);
+  if (o.plot) plot("plot_run.py", {out});
+  std::printf("%s (1d): displacement %.6g m, mean velocity %.6g m/s (%.4g body lengths/s), %d cycle(s), "
+              "pumped volume %.6g m^3, wall time %.3g s\n  -> %s/summary.json\n",
+              p.name.c_str(), summary["displacement_m"].get<double>(), summary["mean_velocity_m_per_s"].get<double>(),
+              summary["body_lengths_per_s"].get<double>(), summary["cycles_completed"].get<int>(),
+              summary["pumped_volume_m3"].get<double>(), wall, out.c_str());
+  if (r.failure) {
+    std::fprintf(stderr, "swim: %s\n  partial results kept in %s\n", r.failure->what(), out.c_str());
+    return 3;
+  }
+  return 0;
+}
+
+int demo(const std::string& out, int progress) {
+  RunOptions o;
+  o.scene = data_dir() + "/scenes/demo.json";
+  o.out = out.empty() ? "out/demo" : out;
+  o.progress = progress;
+  o.plot = true;
+  return run(o);
+}
+
+int scenes() {
+  std::vector<fs::path> files;
+  for (const auto& e : fs::directory_iterator(data_dir() + "/scenes"))
+    if (e.path().extension() == ".json") files.push_back(e.path());
+  std::sort(files.begin(), files.end());
+  for (const auto& f : files) {
+    const scene::json j = scene::load_file(f.string());
+    std::printf("%-34s %s\n", f.filename().string().c_str(), j.value("description", std::string("")).c_str());
+  }
+  return 0;
+}
+
+}  // namespace swim::app

@@ -1,0 +1,26 @@
+// Progress of long runs on stderr: percent of simulated time, simulation rate and the
+// estimated wall time left. Quiet when stderr is not a terminal unless forced on.
+#pragma once
+
+#include <chrono>
+#include <string>
+
+namespace swim {
+
+class Progress {
+ public:
+  /// enabled: -1 = only when stderr is a terminal, 0 = never, 1 = always.
+  Progress(std::string label, double t_end, int enabled = -1);
+  ~Progress();
+  void update(double t);
+  void done();
+
+ private:
+  std::string label_;
+  double t_end_;
+  bool on_;
+  bool finished_ = false;
+  std::chrono::steady_clock::time_point start_, last_;
+};
+
+}  // namespace swim

@@ -1,0 +1,152 @@
+#include "common/sweep.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "common/errors.hpp"
+#include "common/units.hpp"
+
+namespace swim::sweep {
+namespace {
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.8g", v);
+  return b;
+}
+
+/// SI value of a scene value for the CSV and plots: numbers as they are, strings as quantities.
+std::pair<double, std::string> si_of(const std::string& key, const json& v) {
+  if (v.is_number()) return {v.get<double>(), ""};
+  if (v.is_string()) return units::to_base(key, v.get<std::string>());
+  return {0.0, "?"};
+}
+
+Axis read_axis(const std::string& key, const json& spec) {
+  const std::string where = "vary." + key;
+  Axis a;
+  a.key = key;
+  if (spec.is_array()) {
+    a.values.assign(spec.begin(), spec.end());
+  } else if (spec.is_object() && spec.contains("values")) {
+    if (!spec["values"].is_array() || spec["values"].empty())
+      throw InputError(where + ".values", scene::show(spec["values"]), "must be a non-empty list of scene values");
+    for (auto it = spec.begin(); it != spec.end(); ++it)
+      if (it.key() != "values") throw InputError(where + "." + it.key(), scene::show(it.value()), "unknown key; allowed: values");
+    a.values.assign(spec["values"].begin(), spec["values"].end());
+  } else if (spec.is_object() && spec.contains("from")) {
+    for (auto it = spec.begin(); it != spec.end(); ++it)
+      if (it.key() != "from" && it.key() != "to" && it.key() != "count" && it.key() != "spacing")
+        throw InputError(where + "." + it.key(), scene::show(it.value()), "unknown key; allowed: from, to, count, spacing");
+    if (!spec.contains("to")) throw InputError(where + ".to", "(missing)", "a range needs from, to and count");
+    if (!spec.contains("count") || !spec["count"].is_number_integer() || spec["count"].get<long>() < 1 ||
+        spec["count"].get<long>() > 100000)
+      throw InputError(where + ".count", spec.contains("count") ? scene::show(spec["count"]) : "(missing)",
+                       "must be an integer in [1, 100000]");
+    const long n = spec["count"].get<long>();
+    const std::string spacing = spec.value("spacing", std::string("linear"));
+    if (spacing != "linear" && spacing != "log")
+      throw InputError(where + ".spacing", "\"" + spacing + "\"", "must be one of: linear, log");
+    double from = 0, to = 0;
+    std::string unit;
+    const json &f = spec["from"], &t = spec["to"];
+    if (f.is_number() && t.is_number()) {
+      from = f.get<double>();
+      to = t.get<double>();
+    } else if (f.is_string() && t.is_string()) {
+      auto [v, u] = units::split(where + ".from", f.get<std::string>());
+      from = v;
+      unit = u;
+      to = units::parse(where + ".to", t.get<std::string>(), unit).si;  // "to" expressed in from's unit
+    } else {
+      throw InputError(where, scene::show(spec), "from and to must both be numbers or both be quantity strings");
+    }
+    if (spacing == "log" && !(from > 0 && to > 0))
+      throw InputError(where + ".from", scene::show(f), "log spacing needs positive from and to");
+    for (long i = 0; i < n; ++i) {
+      const double s = n == 1 ? 0.0 : double(i) / double(n - 1);
+      const double v = spacing == "log" ? from * std::pow(to / from, s) : from + (to - from) * s;
+      if (unit.empty())
+        a.values.push_back(v);
+      else
+        a.values.push_back(num(v) + " " + unit);
+    }
+  } else {
+    throw InputError(where, scene::show(spec),
+                     "must be a list of values, {\"values\": [...]} or {\"from\": .., \"to\": .., \"count\": n}");
+  }
+  if (a.values.empty()) throw InputError(where, scene::show(spec), "gives no values");
+  for (const auto& v : a.values) {
+    auto [s, u] = si_of(where, v);
+    a.si.push_back(s);
+    a.si_unit = u;
+  }
+  return a;
+}
+
+}  // namespace
+
+size_t Sweep::count() const {
+  size_t n = 1;
+  for (const auto& a : axes) n *= a.values.size();
+  return n;
+}
+
+std::vector<size_t> Sweep::indices(size_t index) const {
+  std::vector<size_t> idx(axes.size());
+  for (size_t k = axes.size(); k-- > 0;) {
+    idx[k] = index % axes[k].values.size();
+    index /= axes[k].values.size();
+  }
+  return idx;
+}
+
+json Sweep::design(size_t index) const {
+  json s = base;
+  const auto idx = indices(index);
+  for (size_t k = 0; k < axes.size(); ++k) scene::apply_override(s, axes[k].key + "=" + axes[k].values[idx[k]].dump());
+  return s;
+}
+
+Sweep read_sweep(const std::string& path, const std::vector<std::string>& metrics) {
+  namespace fs = std::filesystem;
+  const json j = scene::load_file(path);
+  Sweep sw;
+  const fs::path dir = fs::path(path).parent_path();
+  for (auto it = j.begin(); it != j.end(); ++it)
+    if (it.key() != "base" && it.key() != "vary" && it.key() != "metric" && it.key() != "goal" &&
+        it.key() != "name" && it.key() != "description")
+      throw InputError(it.key(), scene::show(it.value()), "unknown key; allowed: name, description, base, vary, metric, goal");
+  if (!j.contains("base")) throw InputError("base", "(missing)", "a sweep needs a base scene (path or object)");
+  if (j["base"].is_string()) {
+    fs::path b = dir / j["base"].get<std::string>();
+    if (!fs::exists(b)) b = j["base"].get<std::string>();
+    sw.base = scene::load_file(b.string());
+    sw.base_dir = b.parent_path().string();
+  } else if (j["base"].is_object()) {
+    sw.base = j["base"];
+    sw.base_dir = dir.string();
+  } else {
+    throw InputError("base", scene::show(j["base"]), "must be a scene file path or an inline scene object");
+  }
+  if (sw.base_dir.empty()) sw.base_dir = ".";
+  if (!j.contains("vary") || !j["vary"].is_object() || j["vary"].empty())
+    throw InputError("vary", j.contains("vary") ? scene::show(j["vary"]) : "(missing)",
+                     "must be an object mapping scene keys to value lists or ranges");
+  for (auto it = j["vary"].begin(); it != j["vary"].end(); ++it) sw.axes.push_back(read_axis(it.key(), it.value()));
+  sw.metric = j.value("metric", std::string("mean_velocity_m_per_s"));
+  if (std::find(metrics.begin(), metrics.end(), sw.metric) == metrics.end()) {
+    std::string allowed;
+    for (const auto& m : metrics) allowed += (allowed.empty() ? "" : ", ") + m;
+    throw InputError("metric", "\"" + sw.metric + "\"", "must be one of: " + allowed);
+  }
+  const std::string goal = j.value("goal", std::string("max"));
+  if (goal != "max" && goal != "min") throw InputError("goal", "\"" + goal + "\"", "must be one of: max, min");
+  sw.maximize = goal == "max";
+  if (sw.count() > 1000000) throw InputError("vary", std::to_string(sw.count()) + " designs", "at most 1000000 designs");
+  return sw;
+}
+
+}  // namespace swim::sweep

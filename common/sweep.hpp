@@ -1,0 +1,44 @@
+// Design sweeps: a base scene and a grid of values for any scene keys.
+//
+//   { "base": "../scenes/demo.json",            // path (relative to the sweep file) or an inline scene
+//     "vary": { "swimmer.length": {"from": "0.2 um", "to": "0.8 um", "count": 4, "spacing": "linear"},
+//               "wave.contracted_ratio": {"values": [0.35, 0.55, 0.82]} },
+//     "metric": "mean_velocity_m_per_s", "goal": "max" }
+//
+// The designs are the Cartesian product of the axes, in row-major order (last axis fastest).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/scene.hpp"
+
+namespace swim::sweep {
+
+using scene::json;
+
+struct Axis {
+  std::string key;
+  std::vector<json> values;  ///< scene values as they are written into the scene ("0.3 um", 0.55)
+  std::vector<double> si;    ///< the same values in SI base units
+  std::string si_unit;       ///< base unit of si ("" for dimensionless, e.g. "m", "m-1.kg.s-1")
+};
+
+struct Sweep {
+  json base;                 ///< the base scene
+  std::string base_dir;      ///< directory for relative paths inside the base scene
+  std::vector<Axis> axes;
+  std::string metric;
+  bool maximize = true;
+  size_t count() const;
+  /// Scene of design `index`, with the axis values applied.
+  json design(size_t index) const;
+  /// Axis value indices of design `index`.
+  std::vector<size_t> indices(size_t index) const;
+};
+
+/// Read and validate a sweep file. `metrics` lists the allowed metric names.
+/// Throws InputError naming the key.
+Sweep read_sweep(const std::string& path, const std::vector<std::string>& metrics);
+
+}  // namespace swim::sweep

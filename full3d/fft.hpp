@@ -1,0 +1,83 @@
+// RAII wrappers around FFTW3 (double precision).
+//
+//   FftwBuffer  fftw_malloc'ed, SIMD-aligned array of doubles (move-only).
+//   FftwPlan    owns an fftw_plan; created once, executed many times, destroyed
+//               with fftw_destroy_plan (move-only).
+//
+// Planning goes through the functions below, which serialise the (non
+// thread-safe) FFTW planner behind one mutex and take the thread count
+// explicitly. fftw_init_threads() is called once per process (std::call_once);
+// that is FFTW's own global state, the only global touched here.
+// FFTW computes unnormalised transforms; callers divide by the logical size N
+// (product over dimensions: n for R2HC/HC2R and complex DFTs, 2n for
+// REDFT10/01 and RODFT10/01, 2(n+1) for RODFT00 of n points).
+#pragma once
+
+#include <fftw3.h>
+
+#include <array>
+#include <cstddef>
+
+namespace swim::full3d {
+
+enum class PlanRigor { Estimate, Measure };
+
+struct FftOptions {
+  int threads = 1;                        ///< FFTW threads per plan (>= 1)
+  PlanRigor rigor = PlanRigor::Estimate;  ///< FFTW_ESTIMATE or FFTW_MEASURE
+};
+
+class FftwBuffer {
+ public:
+  FftwBuffer() = default;
+  explicit FftwBuffer(std::size_t n_doubles);
+  ~FftwBuffer();
+  FftwBuffer(FftwBuffer&& o) noexcept;
+  FftwBuffer& operator=(FftwBuffer&& o) noexcept;
+  FftwBuffer(const FftwBuffer&) = delete;
+  FftwBuffer& operator=(const FftwBuffer&) = delete;
+
+  double* data() { return p_; }
+  const double* data() const { return p_; }
+  fftw_complex* complex() { return reinterpret_cast<fftw_complex*>(p_); }
+  std::size_t size() const { return n_; }
+  double& operator[](std::size_t i) { return p_[i]; }
+  double operator[](std::size_t i) const { return p_[i]; }
+
+ private:
+  double* p_ = nullptr;
+  std::size_t n_ = 0;
+};
+
+class FftwPlan {
+ public:
+  FftwPlan() = default;
+  /// Takes ownership; throws std::runtime_error if p is null (planning failed).
+  explicit FftwPlan(fftw_plan p);
+  ~FftwPlan();
+  FftwPlan(FftwPlan&& o) noexcept;
+  FftwPlan& operator=(FftwPlan&& o) noexcept;
+  FftwPlan(const FftwPlan&) = delete;
+  FftwPlan& operator=(const FftwPlan&) = delete;
+
+  void execute() const { fftw_execute(p_); }
+  /// New-array execution (arrays must be FftwBuffer-aligned, same layout as planned).
+  void execute_r2c(double* in, fftw_complex* out) const { fftw_execute_dft_r2c(p_, in, out); }
+  void execute_c2r(fftw_complex* in, double* out) const { fftw_execute_dft_c2r(p_, in, out); }
+  void execute_r2r(double* in, double* out) const { fftw_execute_r2r(p_, in, out); }
+  bool valid() const { return p_ != nullptr; }
+
+ private:
+  fftw_plan p_ = nullptr;
+};
+
+/// Initialises FFTW threads once per process; returns false if unavailable.
+bool fftw_threads_init_once();
+
+/// Plans on arrays of logical shape n = {n0, n1, n2}, n2 contiguous (C order).
+FftwPlan plan_r2r_3d(std::array<int, 3> n, double* in, double* out, std::array<fftw_r2r_kind, 3> kinds,
+                     const FftOptions& opt);
+FftwPlan plan_r2c_3d(std::array<int, 3> n, double* in, fftw_complex* out, const FftOptions& opt);
+FftwPlan plan_c2r_3d(std::array<int, 3> n, fftw_complex* in, double* out, const FftOptions& opt);
+
+}  // namespace swim::full3d

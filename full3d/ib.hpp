@@ -1,0 +1,34 @@
+// Immersed-boundary transfer between Lagrangian nodes and the MAC grid.
+//
+// Spreading (paper eq. 19, node forces F_k already integrated over the node's
+// Lagrangian patch, so the quadrature weights dq dr ds are inside F_k):
+//   f_c(x) = sum_k F_{k,c} D_h(x - X_k),  x on the c-faces,           N/m^3
+// Interpolation (paper eq. 20):
+//   U_{k,c} = sum_x h^3 u_c(x) D_h(x - X_k),                            m/s
+// with D_h(x) = prod_d phi(x_d/h)/h (eq. 17) and phi = peskin_4pt (eq. 18).
+// Each component is evaluated on its own staggered nodes (offsets 0 along its
+// face direction, 1/2 elsewhere). Both operations use identical weights, so
+// they are adjoint: sum_x h^3 f.u == sum_k F_k.U_k.
+//
+// Periodic directions wrap. At duct walls the stencil is truncated: kernel
+// points outside the fluid, and the wall faces of the wall-normal component
+// (held at zero by no-slip), are dropped in both operations (adjointness is
+// kept; the force that would land on them is absorbed by the wall). The
+// truncation only acts on nodes within 2h of a wall; for the swimmer (R0 = R_duct/2)
+// it never does.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "full3d/grid.hpp"
+
+namespace swim::full3d {
+
+/// f = spread(F) over the whole field (f is overwritten). X, F: 3 x N (m, N).
+void spread(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f);
+/// f += spread(F).
+void spread_add(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f);
+/// U = interpolate(u) at the nodes X (U resized to 3 x N).
+void interpolate(const MacGrid& g, const VectorField& u, const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd& U);
+
+}  // namespace swim::full3d

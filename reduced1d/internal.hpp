@@ -1,0 +1,34 @@
+// Internal entry points of the reduced 1D tier, shared by solver.cpp and the tests.
+// Not part of the product interface (reduced1d/solver.hpp is).
+#pragma once
+
+#include <vector>
+
+#include "reduced1d/solver.hpp"
+
+namespace swim::reduced1d::detail {
+
+/// Throws swim::InputError for parameters the solver cannot run with (the scene layer is
+/// expected to have rejected them already; this is the solver's own guard).
+void validate(const Params& p);
+
+/// Characteristic relaxation time of the tube, tau = 16 mu L^2 / (C1 R0^3): the linearised
+/// inertia-free wall-flow equation is R_t = (C1 R0^3 / 16 mu) R_zz.
+double relaxation_time(const Params& p);
+
+/// Prescribed Step/Sine wave: swimmer balance as quadratures (CVODE).
+Result solve_prescribed(const Params& p, const ProgressFn& progress);
+
+/// Force-driven wave under the Section-3 protocol (CVODE or IDA, root-located switches).
+Result solve_force_driven(const Params& p, const ProgressFn& progress);
+
+/// Force-driven machinery with a FIXED actuation pressure q_cells[i] (inward positive, Pa)
+/// on every cell and no protocol: integrates from R = R0 at rest to t_end. Used for the
+/// uniform-load (static calibration) check; the result has phase 0 throughout.
+Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
+                             const ProgressFn& progress = {});
+
+/// Protocol segment index of every cell (segment containing the cell centre).
+std::vector<int> segment_of_cells(const Params& p);
+
+}  // namespace swim::reduced1d::detail

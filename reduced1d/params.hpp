@@ -1,0 +1,116 @@
+// Typed, SI parameters of the reduced 1D lubrication fluid-structure model.
+//
+// The scene layer (reduced1d/scene1d.cpp) fills these from a scene file, after unit
+// conversion and validation; the solver never sees unit strings. Every field has its
+// default here, and the scene layer echoes every value it used.
+//
+// Model (docs/reduced1d.md has the derivation and the choices):
+//   tube wall   m R_tt + C1 (R - R0) = (p - p_ext) - q(z,t)          (30)/(36) with actuation q
+//   fluid       Q = -(pi R^4 / 8 mu) dp/dz,  d(pi R^2)/dt + dQ/dz = 0, p(0) = p(L) = p_ext
+//   swimmer     per area  : m   W = (pi rho / 8 mu L) int R^4 p_z dz - (1 / 2L) int_0^t int R   p_z dz dtau
+//               per length: m_l W = (pi rho / 8 mu L) int R^4 p_z dz - (pi / L) int_0^t int R^2 p_z dz dtau
+//               with m_l = 2 pi R0 m, and p_z either C1 R_z (tube-law closure, eq. 50) or the
+//               lubrication pressure gradient of the flow closure (notes section 3).
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace swim::reduced1d {
+
+/// How the radius wave R(z,t) is produced.
+enum class WaveKind {
+  Step,         ///< prescribed smoothed step (eq. 53) travelling in -z at speed s
+  Sine,         ///< prescribed contraction sinusoid travelling in -z
+  ForceDriven,  ///< radius evolves under the actuation protocol of Section 3 mapped to 1D
+};
+
+/// Pressure gradient used in the swimmer-velocity relation (45)/(51).
+enum class Closure {
+  TubeLaw,  ///< paper: dp/dz = C1 dR/dz (eq. 50)
+  Flow,     ///< notes section 3: dp/dz from lubrication flow with open ends
+};
+
+/// Which force balance defines W (notes section 4).
+enum class Balance { PerArea, PerLength };
+
+/// External drag on the swimmer body (notes section 5). Not in the paper.
+enum class ExternalDrag { None, ResistiveForce };
+
+struct Geometry {
+  double R0 = 0.125e-6;  ///< reference radius [m]
+  double L = 0.4e-6;     ///< length [m]
+};
+
+struct Fluid {
+  double mu = 1.2e-3;  ///< dynamic viscosity [Pa s]
+  double rho = 1.0e3;  ///< density [kg/m^3]
+};
+
+struct Wall {
+  double C1 = 4.06e6;    ///< wall stiffness: pressure per unit radial displacement [Pa/m]
+  double m = 1.0e-3;     ///< wall mass per unit wall area [kg/m^2]
+  bool inertia = false;  ///< keep m R_tt in the wall equation (force-driven wave only)
+};
+
+/// Prescribed smoothed step, eq. (53): R = R_min + (R0 - R_min) H((z*(t) - z)/w),
+/// z*(t) = L - s t, H(x) = (1 + tanh x)/2. R = R0 behind the front (z < z*), R_min ahead.
+struct StepWave {
+  double R_min = 0.55 * 0.125e-6;  ///< contracted radius [m]
+  double speed = 1.0e-5;           ///< front speed s > 0 (front moves towards -z) [m/s]
+  double width = 0.01e-6;          ///< smoothing width w [m]
+};
+
+/// Prescribed sinusoid: R = R0 - (a/2) (1 - cos(2 pi (z + s t) / lambda)), travelling in -z.
+struct SineWave {
+  double amplitude = 0.45 * 0.125e-6;  ///< a = R0 - R_min [m]
+  double wavelength = 0.4e-6;          ///< lambda [m]
+  double speed = 1.0e-5;               ///< s > 0 [m/s]
+};
+
+/// Force-driven protocol of Section 3 mapped to 1D (notes section 7).
+/// Segment k = 0..n-1 covers [z_k, z_{k+1}); the rightmost segment (k = n-1) is the first one
+/// driven and the shortest: its length is first_ratio times the length of each other segment.
+struct Protocol {
+  double R_f = 0.55 * 0.125e-6;  ///< target contracted radius [m]
+  double q = 0.32;               ///< actuation pressure F_ext / (wall area) [Pa], inward positive
+  int segments = 6;              ///< number of segments n >= 2
+  double first_ratio = 1.0 / 3.0;  ///< length of the first (rightmost) segment / other segments
+  double delta = 0.02 * 0.125e-6;  ///< radius tolerance delta [m]
+  double energy_tol = 1e-3;        ///< recovery ends when E < energy_tol * E_ref,
+                                   ///< E_ref = elastic energy of the tube uniformly at R_f
+  int cycles = 1;                  ///< number of contraction+recovery cycles (>= 1)
+};
+
+struct Swimmer {
+  Closure closure = Closure::TubeLaw;
+  Balance balance = Balance::PerArea;
+  bool thrust = true;  ///< keep the displaced-momentum (thrust) term of (45)
+  ExternalDrag drag = ExternalDrag::None;
+};
+
+struct Numerics {
+  int cells = 200;              ///< number of finite-volume cells along z
+  double rtol = 1e-6;           ///< relative tolerance of CVODE/IDA
+  double atol_scale = 1e-6;     ///< absolute tolerance as a fraction of each state's scale
+  double output_interval = 1e-3;  ///< series/radius output interval [s]
+  long max_steps = 2000000;     ///< integrator step budget for the whole run
+};
+
+struct Params {
+  std::string name = "unnamed";
+  Geometry geometry;
+  Fluid fluid;
+  Wall wall;
+  WaveKind wave = WaveKind::Step;
+  StepWave step;
+  SineWave sine;
+  Protocol protocol;
+  Swimmer swimmer;
+  Numerics numerics;
+  /// End time [s]. For prescribed waves the default is the wave transit time; for the
+  /// force-driven wave, <= 0 means "run until protocol.cycles cycles have completed".
+  double duration = 0.0;
+};
+
+}  // namespace swim::reduced1d

@@ -1,0 +1,24 @@
+// Scene -> 1D parameters. Reads the physical sections shared by both tiers (swimmer,
+// fluid, wall, wave, protocol, time) and the 1D sections (model1d, numerics1d); the 3D
+// section (full3d) is passed through unchanged. Every value used is echoed into `resolved`.
+#pragma once
+
+#include <string>
+
+#include "common/scene.hpp"
+#include "reduced1d/params.hpp"
+
+namespace swim::reduced1d {
+
+/// Throws swim::InputError naming the key, the value and what is allowed.
+/// `scene_dir` is used to find a calibration file given by a relative path.
+Params read_scene(const scene::json& scene, scene::json& resolved, const std::string& scene_dir = ".");
+
+/// Spring-network estimate of the wall stiffness: C1 = 2 k_s / (sqrt(3) R0^2), the in-plane
+/// Young modulus 2 k_s / sqrt(3) of an equilateral triangular spring lattice over R0^2.
+double c1_from_spring_constant(double k_s, double R0);
+
+/// Read C1 [Pa/m] from a calibration.json (key "C1_Pa_per_m"). Throws InputError for `key`.
+double c1_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir);
+
+}  // namespace swim::reduced1d

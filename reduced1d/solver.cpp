@@ -1,0 +1,129 @@
+#include "reduced1d/solver.hpp"
+
+#include <cmath>
+#include <sstream>
+#include <string>
+
+#include "reduced1d/internal.hpp"
+
+namespace swim::reduced1d {
+
+namespace detail {
+
+namespace {
+std::string num(double v) {
+  std::ostringstream s;
+  s.precision(6);
+  s << v;
+  return s.str();
+}
+void require(bool ok, const char* key, double value, const char* allowed) {
+  if (!ok || std::isnan(value)) throw InputError(key, num(value), allowed);
+}
+}  // namespace
+
+void validate(const Params& p) {
+  const double R0 = p.geometry.R0;
+  require(p.geometry.R0 > 0 && std::isfinite(R0), "geometry.R0", R0, "must be a positive length");
+  require(p.geometry.L > 0 && std::isfinite(p.geometry.L), "geometry.L", p.geometry.L,
+          "must be a positive length");
+  require(p.fluid.mu > 0 && std::isfinite(p.fluid.mu), "fluid.mu", p.fluid.mu, "must be positive");
+  require(p.fluid.rho >= 0 && std::isfinite(p.fluid.rho), "fluid.rho", p.fluid.rho, "must be >= 0");
+  require(p.wall.C1 > 0 && std::isfinite(p.wall.C1), "wall.C1", p.wall.C1, "must be positive");
+  require(p.wall.m > 0 && std::isfinite(p.wall.m), "wall.m", p.wall.m, "must be positive");
+  require(p.numerics.cells >= 2, "numerics.cells", p.numerics.cells, "must be >= 2");
+  require(p.numerics.rtol > 0 && p.numerics.rtol < 1, "numerics.rtol", p.numerics.rtol,
+          "must be in (0, 1)");
+  require(p.numerics.atol_scale > 0 && p.numerics.atol_scale < 1, "numerics.atol_scale",
+          p.numerics.atol_scale, "must be in (0, 1)");
+  require(p.numerics.output_interval > 0, "numerics.output_interval", p.numerics.output_interval,
+          "must be positive");
+  require(p.numerics.max_steps > 0, "numerics.max_steps", double(p.numerics.max_steps),
+          "must be positive");
+  require(p.duration >= 0 && std::isfinite(p.duration), "duration", p.duration, "must be >= 0");
+  switch (p.wave) {
+    case WaveKind::Step:
+      require(p.step.R_min > 0, "step.R_min", p.step.R_min, "must be positive");
+      require(p.step.speed > 0, "step.speed", p.step.speed, "must be positive");
+      require(p.step.width > 0, "step.width", p.step.width, "must be positive");
+      break;
+    case WaveKind::Sine:
+      require(p.sine.amplitude >= 0 && p.sine.amplitude < R0, "sine.amplitude", p.sine.amplitude,
+              "must be in [0, R0)");
+      require(p.sine.wavelength > 0, "sine.wavelength", p.sine.wavelength, "must be positive");
+      require(p.sine.speed > 0, "sine.speed", p.sine.speed, "must be positive");
+      break;
+    case WaveKind::ForceDriven: {
+      const auto& q = p.protocol;
+      require(q.R_f > 0 && q.R_f < R0, "protocol.R_f", q.R_f, "must be in (0, R0)");
+      require(q.q > 0 && std::isfinite(q.q), "protocol.q", q.q, "must be a positive pressure");
+      require(q.segments >= 2, "protocol.segments", q.segments, "must be >= 2");
+      require(q.first_ratio > 0 && std::isfinite(q.first_ratio), "protocol.first_ratio",
+              q.first_ratio, "must be positive");
+      require(q.delta > 0 && q.delta < 0.2 * R0 && q.delta < q.R_f && q.delta < R0 - q.R_f,
+              "protocol.delta", q.delta,
+              "must be positive and below 0.2 R0, R_f and R0 - R_f (the bands must be ordered)");
+      require(q.energy_tol > 0 && q.energy_tol < 1, "protocol.energy_tol", q.energy_tol,
+              "must be in (0, 1)");
+      require(q.cycles >= 1, "protocol.cycles", q.cycles, "must be >= 1");
+      const auto seg = segment_of_cells(p);
+      std::vector<int> count(q.segments, 0);
+      for (int s : seg) ++count[s];
+      for (int k = 0; k < q.segments; ++k)
+        if (count[k] == 0)
+          throw InputError("numerics.cells", std::to_string(p.numerics.cells),
+                           "every protocol segment needs at least one cell centre; segment " +
+                               std::to_string(k) + " has none (raise numerics.cells)");
+      break;
+    }
+  }
+}
+
+double relaxation_time(const Params& p) {
+  const double R0 = p.geometry.R0, L = p.geometry.L;
+  return 16.0 * p.fluid.mu * L * L / (p.wall.C1 * R0 * R0 * R0);
+}
+
+std::vector<int> segment_of_cells(const Params& p) {
+  const int N = p.numerics.cells, n = p.protocol.segments;
+  const double L = p.geometry.L, h = L / N;
+  const double ell = L / (n - 1 + p.protocol.first_ratio);  // length of segments 0..n-2
+  std::vector<int> seg(N);
+  for (int i = 0; i < N; ++i) {
+    const double z = (i + 0.5) * h;
+    int k = static_cast<int>(std::floor(z / ell));
+    if (k > n - 1) k = n - 1;
+    if (k < 0) k = 0;
+    seg[i] = k;
+  }
+  return seg;
+}
+
+}  // namespace detail
+
+double end_time(const Params& p) {
+  if (p.duration > 0) return p.duration;
+  switch (p.wave) {
+    case WaveKind::Step:
+      return p.geometry.L / p.step.speed;
+    case WaveKind::Sine:
+      return p.sine.wavelength / p.sine.speed;
+    case WaveKind::ForceDriven:
+    default: {
+      // Upper bound for a run of protocol.cycles cycles (see docs/reduced1d.md, "end time").
+      const double R0 = p.geometry.R0;
+      const double Rf = p.protocol.R_f;
+      const double tau = detail::relaxation_time(p) * std::pow(R0 / Rf, 3);
+      const double margin = std::max(1.0, p.wall.C1 * (R0 - Rf) / std::max(p.protocol.q - p.wall.C1 * (R0 - Rf), 1e-300));
+      return p.protocol.cycles * 20.0 * tau * std::min(margin, 1e3);
+    }
+  }
+}
+
+Result solve(const Params& params, const ProgressFn& progress) {
+  detail::validate(params);
+  if (params.wave == WaveKind::ForceDriven) return detail::solve_force_driven(params, progress);
+  return detail::solve_prescribed(params, progress);
+}
+
+}  // namespace swim::reduced1d

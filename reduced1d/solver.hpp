@@ -1,0 +1,65 @@
+// Reduced 1D tier: time integration of the lubrication fluid-structure model.
+//
+// solve() integrates the model described in params.hpp with SUNDIALS (CVODE BDF for
+// the prescribed waves and the inertia-free force-driven wave, IDA for the force-driven
+// wave with wall inertia, which is a DAE), locates protocol switches with SUNDIALS root
+// finding, and samples the state every numerics.output_interval.
+//
+// A numerical failure (radius collapse, integrator failure, step budget exhausted) does
+// not throw: the result carries the samples up to the failure and `failure` names the
+// cause and the parameter to change. The caller writes the partial results and exits 3.
+#pragma once
+
+#include <functional>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "reduced1d/params.hpp"
+
+namespace swim::reduced1d {
+
+/// One output row (all SI).
+struct Sample {
+  double t = 0;            ///< time [s]
+  double X = 0;            ///< swimmer displacement [m]
+  double W = 0;            ///< swimmer velocity [m/s]
+  double energy = 0;       ///< wall elastic + kinetic energy [J]
+  double R_min = 0;        ///< smallest radius along the tube [m]
+  double R_max = 0;        ///< largest radius along the tube [m]
+  double Q_rear = 0;       ///< volume flux through z = 0 in +z [m^3/s]
+  double Q_front = 0;      ///< volume flux through z = L in +z [m^3/s]
+  double V_rear = 0;       ///< int_0^t Q_rear [m^3]
+  double V_front = 0;      ///< int_0^t Q_front [m^3]
+  double tube_volume = 0;  ///< discrete tube volume sum(pi R_i^2 dz) [m^3]
+  int phase = 0;           ///< force-driven: 0 contraction, 1 recovery, 2 done; prescribed: 0
+};
+
+struct Result {
+  std::vector<Sample> series;
+  std::vector<double> z;             ///< cell centres [m]
+  std::vector<double> radius_times;  ///< times of the radius snapshots [s]
+  std::vector<double> radius;        ///< row-major snapshots: radius[k * z.size() + i] [m]
+  std::vector<double> cycle_start;   ///< start time of each cycle [s]
+  std::vector<double> cycle_end;     ///< end time of each completed cycle (energy back within tol) [s]
+  /// force-driven: time at which each segment (index 0 = leftmost) first reached R_f within delta,
+  /// for the last cycle started; -1 where not reached.
+  std::vector<double> segment_reached;
+  long switches = 0;                 ///< number of protocol force switches (all cycles)
+  std::map<std::string, long> stats; ///< integrator statistics (steps, rhs evals, ...)
+  std::optional<NumericalError> failure;  ///< set when the run stopped on a numerical failure
+};
+
+/// Called after every output sample with the current and final simulated times.
+using ProgressFn = std::function<void(double t, double t_end)>;
+
+Result solve(const Params& params, const ProgressFn& progress = {});
+
+/// End time of a run: params.duration when > 0, else the transit time of a prescribed wave
+/// (L / s for the step, lambda / s for the sine); for the force-driven wave with no duration
+/// an upper bound used for progress and the step budget.
+double end_time(const Params& params);
+
+}  // namespace swim::reduced1d
