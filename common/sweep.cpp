@@ -17,11 +17,10 @@ std::string num(double v) {
   return b;
 }
 
-/// SI value of a scene value for the CSV and plots: numbers as they are, strings as quantities.
+/// SI value of a numeric or quantity scene value, for the CSV and plots.
 std::pair<double, std::string> si_of(const std::string& key, const json& v) {
   if (v.is_number()) return {v.get<double>(), ""};
-  if (v.is_string()) return units::to_base(key, v.get<std::string>());
-  return {0.0, "?"};
+  return units::to_base(key, v.get<std::string>());
 }
 
 Axis read_axis(const std::string& key, const json& spec) {
@@ -78,10 +77,31 @@ Axis read_axis(const std::string& key, const json& spec) {
                      "must be a list of values, {\"values\": [...]} or {\"from\": .., \"to\": .., \"count\": n}");
   }
   if (a.values.empty()) throw InputError(where, scene::show(spec), "gives no values");
+  // Quantities and numbers map to SI; anything else (choices such as "step", null,
+  // booleans) is categorical and is represented by its position in the list.
+  bool categorical = false;
   for (const auto& v : a.values) {
-    auto [s, u] = si_of(where, v);
-    a.si.push_back(s);
-    a.si_unit = u;
+    if (v.is_number()) continue;
+    if (!v.is_string()) {
+      categorical = true;
+      break;
+    }
+    try {
+      units::split(where, v.get<std::string>());
+    } catch (const InputError&) {
+      categorical = true;
+      break;
+    }
+  }
+  for (size_t i = 0; i < a.values.size(); ++i) {
+    if (categorical) {
+      a.si.push_back(static_cast<double>(i));
+      a.si_unit = "index";
+    } else {
+      auto [s, u] = si_of(where, a.values[i]);
+      a.si.push_back(s);
+      a.si_unit = u;
+    }
   }
   return a;
 }

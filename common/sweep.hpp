@@ -21,7 +21,8 @@ struct Axis {
   std::string key;
   std::vector<json> values;  ///< scene values as they are written into the scene ("0.3 um", 0.55)
   std::vector<double> si;    ///< the same values in SI base units
-  std::string si_unit;       ///< base unit of si ("" for dimensionless, e.g. "m", "m-1.kg.s-1")
+  std::string si_unit;       ///< base unit of si ("" dimensionless, "m", "m-1.kg.s-1", ...; "index" for
+                             ///< categorical values such as "step", whose si is the list position)
 };
 
 struct Sweep {

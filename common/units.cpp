@@ -86,9 +86,9 @@ bool known_unit(const std::string& unit) {
   return static_cast<bool>(parse_unit(unit));
 }
 
-std::string format(double si_value, const std::string& si_unit) {
+std::string format(double value_si, const std::string& si_unit) {
   char b[64];
-  std::snprintf(b, sizeof b, "%.10g %s", si_value, si_unit.c_str());
+  std::snprintf(b, sizeof b, "%.10g %s", value_si, si_unit.c_str());
   return b;
 }
 

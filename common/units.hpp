@@ -24,7 +24,7 @@ Quantity parse(const std::string& key, const std::string& text, const std::strin
 bool known_unit(const std::string& unit);
 
 /// Format an SI value with its unit, e.g. format(1.25e-7, "m") -> "1.25e-07 m".
-std::string format(double si_value, const std::string& si_unit);
+std::string format(double value_si, const std::string& si_unit);
 
 }  // namespace swim::units
 

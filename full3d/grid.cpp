@@ -43,6 +43,13 @@ double VectorField::max_abs() const {
   return m;
 }
 
+bool VectorField::all_finite() const {
+  for (const auto& a : c)
+    for (double x : a)
+      if (!std::isfinite(x)) return false;
+  return true;
+}
+
 double ScalarField::max_abs() const {
   double m = 0.0;
   for (double x : v) m = std::max(m, std::abs(x));

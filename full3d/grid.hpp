@@ -91,6 +91,7 @@ struct VectorField {
   /// this += a * x
   void axpy(double a, const VectorField& x);
   double max_abs() const;
+  bool all_finite() const;
 };
 
 /// Cell-centred scalar (pressure, divergence).

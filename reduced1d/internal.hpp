@@ -28,7 +28,16 @@ Result solve_force_driven(const Params& p, const ProgressFn& progress);
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
                              const ProgressFn& progress = {});
 
-/// Protocol segment index of every cell (segment containing the cell centre).
-std::vector<int> segment_of_cells(const Params& p);
+/// Overlap of a cell with the protocol segments: the cell [i h, (i+1) h] lies in segment
+/// seg_a with length fraction w and in seg_b (= seg_a + 1) with fraction 1 - w. A cell never
+/// spans more than two segments because validate() requires h <= the shortest segment.
+struct CellOverlap {
+  int seg_a = 0, seg_b = 0;
+  double w = 1.0;
+};
+std::vector<CellOverlap> segment_overlaps(const Params& p);
+
+/// Segment boundaries z_0 = 0 < z_1 < ... < z_n = L.
+std::vector<double> segment_bounds(const Params& p);
 
 }  // namespace swim::reduced1d::detail

@@ -1,5 +1,6 @@
 #include "reduced1d/scene1d.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -145,7 +146,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
       p.protocol.q = r.quantity("total_force", "N", "0.1 pN", Range::positive()) / area;
     p.protocol.segments = static_cast<int>(r.integer("segments", 6, 2, 1000));
     p.protocol.first_ratio = r.number("first_segment_ratio", 1.0 / 3.0, Range::open(0.0, 1.0e3));
-    p.protocol.delta = R0 * r.number("tolerance_ratio", 0.02, Range::open(0.0, 0.5));
+    p.protocol.delta = R0 * r.number("tolerance_ratio", 0.02, Range::open(0.0, 0.2));
     p.protocol.energy_tol = r.number("energy_tolerance", 1e-3, Range::open(0.0, 1.0));
     p.protocol.cycles = static_cast<int>(r.integer("cycles", 1, 1, 100000));
     r.finish();
@@ -181,12 +182,14 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     p.numerics.atol_scale = n.number("atol_scale", 1e-6, Range::closed(1e-14, 1e-2));
     p.numerics.max_steps = n.integer("max_steps", 2000000, 100, 1000000000);
     n.finish();
-    if (forced) {
-      const double first = L * p.protocol.first_ratio / (p.protocol.first_ratio + p.protocol.segments - 1);
-      if (first < L / p.numerics.cells)
+    if (forced) {  // every protocol segment must span at least one cell
+      const double other = L / (p.protocol.first_ratio + p.protocol.segments - 1);
+      const double shortest = std::min(other, other * p.protocol.first_ratio);
+      const int needed = static_cast<int>(std::ceil(L / shortest - 1e-9));
+      if (p.numerics.cells < needed)
         throw InputError(n.path("cells"), std::to_string(p.numerics.cells),
-                         "too few cells to resolve the first protocol segment (length " + fmt(first, "m") +
-                             "); need at least " + std::to_string(static_cast<int>(std::ceil(L / first))));
+                         "too few cells to resolve the shortest protocol segment (length " + fmt(shortest, "m") +
+                             "); need at least " + std::to_string(needed));
     }
   }
   {

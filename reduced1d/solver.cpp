@@ -1,5 +1,6 @@
 #include "reduced1d/solver.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <sstream>
 #include <string>
@@ -66,14 +67,14 @@ void validate(const Params& p) {
       require(q.energy_tol > 0 && q.energy_tol < 1, "protocol.energy_tol", q.energy_tol,
               "must be in (0, 1)");
       require(q.cycles >= 1, "protocol.cycles", q.cycles, "must be >= 1");
-      const auto seg = segment_of_cells(p);
-      std::vector<int> count(q.segments, 0);
-      for (int s : seg) ++count[s];
-      for (int k = 0; k < q.segments; ++k)
-        if (count[k] == 0)
-          throw InputError("numerics.cells", std::to_string(p.numerics.cells),
-                           "every protocol segment needs at least one cell centre; segment " +
-                               std::to_string(k) + " has none (raise numerics.cells)");
+      const auto b = segment_bounds(p);
+      double shortest = b[1] - b[0];
+      for (int k = 0; k < q.segments; ++k) shortest = std::min(shortest, b[k + 1] - b[k]);
+      const int needed = static_cast<int>(std::ceil(p.geometry.L / shortest - 1e-9));
+      if (p.numerics.cells < needed)
+        throw InputError("numerics.cells", std::to_string(p.numerics.cells),
+                         "must be >= " + std::to_string(needed) +
+                             " so that the cell width does not exceed the shortest protocol segment");
       break;
     }
   }
@@ -84,19 +85,37 @@ double relaxation_time(const Params& p) {
   return 16.0 * p.fluid.mu * L * L / (p.wall.C1 * R0 * R0 * R0);
 }
 
-std::vector<int> segment_of_cells(const Params& p) {
-  const int N = p.numerics.cells, n = p.protocol.segments;
-  const double L = p.geometry.L, h = L / N;
+std::vector<double> segment_bounds(const Params& p) {
+  const int n = p.protocol.segments;
+  const double L = p.geometry.L;
   const double ell = L / (n - 1 + p.protocol.first_ratio);  // length of segments 0..n-2
-  std::vector<int> seg(N);
+  std::vector<double> b(n + 1);
+  for (int k = 0; k < n; ++k) b[k] = k * ell;
+  b[n] = L;
+  return b;
+}
+
+std::vector<CellOverlap> segment_overlaps(const Params& p) {
+  const int N = p.numerics.cells, n = p.protocol.segments;
+  const double h = p.geometry.L / N;
+  const auto b = segment_bounds(p);
+  std::vector<CellOverlap> out(N);
+  int k = 0;
   for (int i = 0; i < N; ++i) {
-    const double z = (i + 0.5) * h;
-    int k = static_cast<int>(std::floor(z / ell));
-    if (k > n - 1) k = n - 1;
-    if (k < 0) k = 0;
-    seg[i] = k;
+    const double z0 = i * h, z1 = (i + 1) * h;
+    while (k < n - 1 && b[k + 1] <= z0) ++k;
+    CellOverlap c;
+    c.seg_a = k;
+    if (k < n - 1 && b[k + 1] < z1) {
+      c.seg_b = k + 1;
+      c.w = std::clamp((b[k + 1] - z0) / h, 0.0, 1.0);
+    } else {
+      c.seg_b = k;
+      c.w = 1.0;
+    }
+    out[i] = c;
   }
-  return seg;
+  return out;
 }
 
 }  // namespace detail
@@ -110,12 +129,15 @@ double end_time(const Params& p) {
       return p.sine.wavelength / p.sine.speed;
     case WaveKind::ForceDriven:
     default: {
-      // Upper bound for a run of protocol.cycles cycles (see docs/reduced1d.md, "end time").
+      // Upper bound for a run of protocol.cycles cycles (docs/reduced1d.md, "End time"):
+      // tau (R0/R_f)^3 is the relaxation time of the tube narrowed to R_f, and the log term
+      // grows as q approaches the least pressure C1 (R0 - R_f) that can reach R_f.
       const double R0 = p.geometry.R0;
       const double Rf = p.protocol.R_f;
       const double tau = detail::relaxation_time(p) * std::pow(R0 / Rf, 3);
-      const double margin = std::max(1.0, p.wall.C1 * (R0 - Rf) / std::max(p.protocol.q - p.wall.C1 * (R0 - Rf), 1e-300));
-      return p.protocol.cycles * 20.0 * tau * std::min(margin, 1e3);
+      const double need = p.wall.C1 * (R0 - Rf);
+      const double margin = need / std::max(p.protocol.q - need, 1e-12 * need);
+      return p.protocol.cycles * 5.0 * tau * (1.0 + std::log1p(std::min(margin, 1e6)));
     }
   }
 }

@@ -164,7 +164,9 @@ void check_orders(ContainerKind kind, const Manufactured& m, double min_order_u,
                 ou, o2, op);
     EXPECT_GE(ou, min_order_u);
     EXPECT_GE(o2, min_order_u);
-    if (r == 2) EXPECT_GE(op, min_order_p);  // pressure: asymptotic pair only
+    if (r == 2) {
+      EXPECT_GE(op, min_order_p);  // pressure: asymptotic pair only
+    }
   }
 }
 

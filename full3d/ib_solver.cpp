@@ -1,0 +1,112 @@
+#include "full3d/ib_solver.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+#include "common/errors.hpp"
+#include "full3d/ib.hpp"
+
+namespace swim::full3d {
+
+namespace {
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+}  // namespace
+
+IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh mesh, MembraneParams membrane,
+                   Eigen::VectorXd node_mass, IbOptions opt)
+    : grid_(grid), mesh_(std::move(mesh)), membrane_(membrane), mass_(std::move(node_mass)), opt_(opt),
+      stokes_(grid, fluid, opt.stokes) {
+  if (mass_.size() != mesh_.nodes())
+    throw InputError("swimmer.node_mass", std::to_string(mass_.size()) + " values",
+                     "one mass per membrane node (" + std::to_string(mesh_.nodes()) + ")");
+  if (!(opt_.max_cfl > 0.0)) throw InputError("ib.max_cfl", num(opt_.max_cfl), "a positive number");
+}
+
+IbState IbSolver::initial_state() const {
+  IbState s;
+  s.X = mesh_.X0;
+  s.V = Eigen::Matrix3Xd::Zero(3, mesh_.nodes());
+  s.V_prev = s.V;
+  s.u = VectorField(grid_);
+  return s;
+}
+
+Eigen::Matrix3Xd IbSolver::fluid_force(const Eigen::Matrix3Xd& X, double t, const Eigen::Matrix3Xd& accel) const {
+  Eigen::Matrix3Xd F = elastic_forces(mesh_, X, membrane_);
+  if (external_) F += external_(t, X);
+  if (mass_.size() > 0 && mass_.maxCoeff() > 0.0)
+    for (Eigen::Index i = 0; i < F.cols(); ++i) F.col(i) -= mass_[i] * accel.col(i);
+  return F;
+}
+
+void IbSolver::guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const {
+  if (!A.allFinite())
+    throw NumericalError(std::string("non-finite ") + what + " (the explicit coupling became unstable)",
+                         "reduce the time step dt", t);
+}
+
+IbStepStats IbSolver::step(IbState& s, double dt) {
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError("dt", num(dt), "a positive time step in s");
+  IbStepStats st;
+  const Eigen::Matrix3Xd accel = (s.V - s.V_prev) / dt;
+  VectorField f(grid_);
+  VectorField u = s.u;
+  Eigen::Matrix3Xd U, Xnew;
+
+  Eigen::Matrix3Xd F = fluid_force(s.X, s.t, accel);
+  guard_finite(F, "membrane force", s.t);
+  if (opt_.scheme == IbScheme::ForwardEuler) {
+    spread(grid_, s.X, F, f);
+    const StokesStats ss = stokes_.step(u, f, dt);
+    st.stokes_iterations = ss.iterations;
+    st.max_divergence = ss.max_divergence;
+    interpolate(grid_, u, s.X, U);
+    Xnew = s.X + dt * U;
+  } else {
+    spread(grid_, s.X, F, f);
+    VectorField uh = s.u;
+    const StokesStats s1 = stokes_.step(uh, f, 0.5 * dt);
+    interpolate(grid_, uh, s.X, U);
+    guard_finite(U, "node velocity", s.t);
+    const Eigen::Matrix3Xd Xh = s.X + 0.5 * dt * U;
+    F = fluid_force(Xh, s.t + 0.5 * dt, accel);
+    guard_finite(F, "membrane force", s.t);
+    spread(grid_, Xh, F, f);
+    const StokesStats s2 = stokes_.step(u, f, dt);
+    st.stokes_iterations = s1.iterations + s2.iterations;
+    st.max_divergence = s2.max_divergence;
+    interpolate(grid_, u, Xh, U);
+    Xnew = s.X + dt * U;
+  }
+  guard_finite(U, "node velocity", s.t);
+  guard_finite(Xnew, "node position", s.t);
+  st.max_node_speed = U.colwise().norm().maxCoeff();
+  st.cfl = st.max_node_speed * dt / grid_.h();
+  if (st.cfl > opt_.max_cfl)
+    throw NumericalError("advective CFL number " + num(st.cfl) + " exceeds " + num(opt_.max_cfl) +
+                             " (nodes move " + num(st.cfl) + " cells per step)",
+                         "reduce the time step dt", s.t);
+  st.max_edge = max_edge_length(mesh_, Xnew);
+  if (opt_.check_no_leak && !(st.max_edge < 0.5 * grid_.h()))
+    throw NumericalError("membrane edge of " + num(st.max_edge) + " m exceeds h/2 = " + num(0.5 * grid_.h()) +
+                             " m after this step (was " + num(max_edge_length(mesh_, s.X)) +
+                             " m): the fluid would leak through the membrane",
+                         "reduce the time step dt if the edge jumped in one step, otherwise refine the membrane",
+                         s.t + dt);
+  if (!u.all_finite())
+    throw NumericalError("non-finite fluid velocity (the explicit coupling became unstable)",
+                         "reduce the time step dt", s.t);
+  s.X = std::move(Xnew);
+  s.V_prev = std::move(s.V);
+  s.V = std::move(U);
+  s.u = std::move(u);
+  s.t += dt;
+  return st;
+}
+
+}  // namespace swim::full3d

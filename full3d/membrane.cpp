@@ -1,0 +1,353 @@
+#include "full3d/membrane.hpp"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <numbers>
+#include <string>
+
+#include "common/errors.hpp"
+
+namespace swim::full3d {
+
+namespace {
+constexpr double kPi = std::numbers::pi;
+using V3 = Eigen::Vector3d;
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+}  // namespace
+
+CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector3d& axis_start) {
+  if (!(R0 > 0.0)) throw InputError("swimmer.R0", num(R0), "a positive radius in m");
+  if (!(L > 0.0)) throw InputError("swimmer.L", num(L), "a positive length in m");
+  if (n_theta < 3) throw InputError("swimmer.n_theta", std::to_string(n_theta), "an integer >= 3");
+  CylinderMesh m;
+  m.radius = R0;
+  m.length = L;
+  m.n_theta = n_theta;
+  m.axis_start = axis_start;
+  const double chord = 2.0 * R0 * std::sin(kPi / n_theta);
+  const double half = 2.0 * R0 * std::sin(kPi / (2.0 * n_theta));
+  const double dx_eq = std::sqrt(chord * chord - half * half);
+  m.n_rings = std::max(2, int(std::lround(L / dx_eq)) + 1);
+  m.ring_spacing = L / (m.n_rings - 1);
+  const int nn = m.n_rings * n_theta;
+  m.X0.resize(3, nn);
+  for (int r = 0; r < m.n_rings; ++r)
+    for (int i = 0; i < n_theta; ++i) {
+      const double phi = 2.0 * kPi * (i + 0.5 * (r % 2)) / n_theta;
+      m.X0.col(m.node(r, i)) = axis_start + V3(r * m.ring_spacing, R0 * std::cos(phi), R0 * std::sin(phi));
+    }
+  // triangles between ring r and r+1, oriented with outward normals
+  for (int r = 0; r + 1 < m.n_rings; ++r)
+    for (int i = 0; i < n_theta; ++i) {
+      const int ip = (i + 1) % n_theta;
+      std::array<int, 3> t1, t2;
+      if (r % 2 == 0) {  // ring r+1 shifted by +half step: (r+1, i) lies between (r, i) and (r, i+1)
+        t1 = {m.node(r, i), m.node(r, ip), m.node(r + 1, i)};
+        t2 = {m.node(r + 1, i), m.node(r, ip), m.node(r + 1, ip)};
+      } else {  // ring r shifted: (r, i) lies between (r+1, i) and (r+1, i+1)
+        t1 = {m.node(r, i), m.node(r + 1, ip), m.node(r + 1, i)};
+        t2 = {m.node(r, i), m.node(r, ip), m.node(r + 1, ip)};
+      }
+      for (auto t : {t1, t2}) {
+        const V3 a = m.X0.col(t[0]), b = m.X0.col(t[1]), c = m.X0.col(t[2]);
+        V3 centroid = (a + b + c) / 3.0 - axis_start;
+        centroid.x() = 0.0;
+        if ((b - a).cross(c - a).dot(centroid) < 0.0) std::swap(t[1], t[2]);
+        m.triangles.push_back(t);
+      }
+    }
+  // edges and hinges from directed triangle edges
+  std::map<std::pair<int, int>, int> edge_id;              // undirected
+  std::map<std::pair<int, int>, int> directed_opposite;    // (a,b) -> opposite vertex
+  for (const auto& t : m.triangles)
+    for (int e = 0; e < 3; ++e) {
+      const int a = t[e], b = t[(e + 1) % 3], c = t[(e + 2) % 3];
+      directed_opposite[{a, b}] = c;
+      const auto key = std::minmax(a, b);
+      if (!edge_id.count({key.first, key.second})) {
+        edge_id[{key.first, key.second}] = int(m.edges.size());
+        m.edges.push_back({key.first, key.second});
+      }
+    }
+  m.rest_length.resize(Eigen::Index(m.edges.size()));
+  for (std::size_t e = 0; e < m.edges.size(); ++e)
+    m.rest_length[Eigen::Index(e)] = (m.X0.col(m.edges[e][1]) - m.X0.col(m.edges[e][0])).norm();
+  for (const auto& [ab, c] : directed_opposite) {
+    const auto [a, b] = ab;
+    if (a > b) continue;  // visit each interior edge once
+    const auto it = directed_opposite.find({b, a});
+    if (it == directed_opposite.end()) continue;  // boundary edge: no bending hinge
+    m.hinges.push_back({a, b, c, it->second});
+    m.hinge_edge.push_back(edge_id.at({a, b}));
+  }
+  m.rest_angle.resize(Eigen::Index(m.hinges.size()));
+  for (std::size_t k = 0; k < m.hinges.size(); ++k) {
+    const auto& h = m.hinges[k];
+    m.rest_angle[Eigen::Index(k)] =
+        dihedral_angle(m.X0.col(h[0]), m.X0.col(h[1]), m.X0.col(h[2]), m.X0.col(h[3]));
+  }
+  m.node_area = Eigen::VectorXd::Zero(nn);
+  for (const auto& t : m.triangles) {
+    const double area =
+        0.5 * (m.X0.col(t[1]) - m.X0.col(t[0])).cross(m.X0.col(t[2]) - m.X0.col(t[0])).norm();
+    for (int v : t) m.node_area[v] += area / 3.0;
+  }
+  return m;
+}
+
+int n_theta_for_spacing(double R0, double spacing) {
+  if (!(spacing > 0.0)) throw InputError("swimmer.node_spacing", num(spacing), "a positive length in m");
+  int n = 3;
+  while (2.0 * R0 * std::sin(kPi / n) > spacing) ++n;
+  return n;
+}
+
+CylinderMesh make_cylinder_with_spacing(double R0, double L, double spacing, const Eigen::Vector3d& axis_start) {
+  return make_cylinder(R0, L, n_theta_for_spacing(R0, spacing), axis_start);
+}
+
+CylinderMesh make_cylinder_for_grid(double R0, double L, double h, const Eigen::Vector3d& axis_start,
+                                    double safety) {
+  if (!(h > 0.0)) throw InputError("grid.h", num(h), "a positive cell size in m");
+  const double limit = safety * 0.5 * h;
+  for (int n = n_theta_for_spacing(R0, limit);; ++n) {
+    CylinderMesh m = make_cylinder(R0, L, n, axis_start);
+    if (max_edge_length(m, m.X0) < limit) return m;
+  }
+}
+
+double max_edge_length(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
+  double mx = 0.0;
+  for (const auto& e : mesh.edges) mx = std::max(mx, (X.col(e[1]) - X.col(e[0])).norm());
+  return mx;
+}
+
+void check_no_leak(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double h, double t_s) {
+  const double mx = max_edge_length(mesh, X);
+  if (!(mx < 0.5 * h))
+    throw NumericalError("membrane edge of " + num(mx) + " m exceeds h/2 = " + num(0.5 * h) +
+                             " m (fluid leaks through the immersed boundary)",
+                         "refine the membrane (smaller swimmer.node_spacing) or reduce the deformation", t_s);
+}
+
+double dihedral_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                      const Eigen::Vector3d& d, Eigen::Matrix<double, 3, 4>* grad) {
+  const V3 e = b - a;
+  const V3 n1 = e.cross(c - a);  // normal of (a, b, c)
+  const V3 n2 = (d - a).cross(e);  // normal of (b, a, d)
+  const double le = e.norm();
+  const double theta = std::atan2(n1.cross(n2).dot(e) / le, n1.dot(n2));
+  if (grad) {
+    const double n1sq = n1.squaredNorm(), n2sq = n2.squaredNorm();
+    const V3 gc = -le / n1sq * n1;
+    const V3 gd = -le / n2sq * n2;
+    const double ac = (c - a).dot(e) / (le * le), ad = (d - a).dot(e) / (le * le);
+    grad->col(0) = -(1.0 - ac) * gc - (1.0 - ad) * gd;
+    grad->col(1) = -ac * gc - ad * gd;
+    grad->col(2) = gc;
+    grad->col(3) = gd;
+  }
+  return theta;
+}
+
+double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks) {
+  double s = 0.0;
+  for (std::size_t e = 0; e < mesh.edges.size(); ++e) {
+    const double dl = (X.col(mesh.edges[e][1]) - X.col(mesh.edges[e][0])).norm() - mesh.rest_length[Eigen::Index(e)];
+    s += dl * dl;
+  }
+  return 0.5 * ks * s;
+}
+
+void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F) {
+  for (std::size_t e = 0; e < mesh.edges.size(); ++e) {
+    const int a = mesh.edges[e][0], b = mesh.edges[e][1];
+    const V3 v = X.col(b) - X.col(a);
+    const double l = v.norm();
+    const V3 fb = -ks * (l - mesh.rest_length[Eigen::Index(e)]) / l * v;  // -dE/dX_b
+    F.col(b) += fb;
+    F.col(a) -= fb;
+  }
+}
+
+namespace {
+double ref_angle(const CylinderMesh& mesh, std::size_t k, BendingForm form) {
+  return form == BendingForm::ReferenceAngle ? mesh.rest_angle[Eigen::Index(k)] : 0.0;
+}
+}  // namespace
+
+double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form) {
+  double s = 0.0;
+  for (std::size_t k = 0; k < mesh.hinges.size(); ++k) {
+    const auto& h = mesh.hinges[k];
+    const double th = dihedral_angle(X.col(h[0]), X.col(h[1]), X.col(h[2]), X.col(h[3]));
+    const double t = std::tan(0.5 * (th - ref_angle(mesh, k, form)));
+    s += (X.col(h[1]) - X.col(h[0])).norm() * t * t;
+  }
+  return 0.5 * kb * s;
+}
+
+void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
+                        Eigen::Matrix3Xd& F) {
+  Eigen::Matrix<double, 3, 4> g;
+  for (std::size_t k = 0; k < mesh.hinges.size(); ++k) {
+    const auto& h = mesh.hinges[k];
+    const double th = dihedral_angle(X.col(h[0]), X.col(h[1]), X.col(h[2]), X.col(h[3]), &g);
+    const double t = std::tan(0.5 * (th - ref_angle(mesh, k, form)));
+    const V3 e = X.col(h[1]) - X.col(h[0]);
+    const double l = e.norm();
+    // dE = kb/2 t^2 dL + kb/2 L t (1 + t^2) dtheta
+    const double cl = 0.5 * kb * t * t;
+    const double ct = 0.5 * kb * l * t * (1.0 + t * t);
+    const V3 dl_db = e / l;
+    F.col(h[0]) -= ct * g.col(0) - cl * dl_db;
+    F.col(h[1]) -= ct * g.col(1) + cl * dl_db;
+    F.col(h[2]) -= ct * g.col(2);
+    F.col(h[3]) -= ct * g.col(3);
+  }
+}
+
+double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p) {
+  return stretching_energy(mesh, X, p.ks) + bending_energy(mesh, X, p.kb, p.bending);
+}
+
+Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p) {
+  Eigen::Matrix3Xd F = Eigen::Matrix3Xd::Zero(3, X.cols());
+  add_stretching_forces(mesh, X, p.ks, F);
+  add_bending_forces(mesh, X, p.kb, p.bending, F);
+  return F;
+}
+
+Eigen::VectorXd node_masses(const CylinderMesh& mesh, double areal_density) {
+  if (!(areal_density >= 0.0))
+    throw InputError("swimmer.areal_density", num(areal_density), "a non-negative mass per area in kg/m^2");
+  return areal_density * mesh.node_area;
+}
+
+Eigen::Matrix3Xd radial_directions(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
+  Eigen::Matrix3Xd R(3, X.cols());
+  for (Eigen::Index i = 0; i < X.cols(); ++i) {
+    V3 r = X.col(i) - mesh.axis_start;
+    r.x() = 0.0;
+    R.col(i) = r.normalized();
+  }
+  return R;
+}
+
+Eigen::VectorXd node_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
+  Eigen::VectorXd r(X.cols());
+  for (Eigen::Index i = 0; i < X.cols(); ++i) {
+    V3 v = X.col(i) - mesh.axis_start;
+    v.x() = 0.0;
+    r[i] = v.norm();
+  }
+  return r;
+}
+
+Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
+  const Eigen::VectorXd r = node_radii(mesh, X);
+  Eigen::VectorXd rr = Eigen::VectorXd::Zero(mesh.n_rings);
+  for (int i = 0; i < mesh.nodes(); ++i) rr[mesh.ring_of(i)] += r[i] / mesh.n_theta;
+  return rr;
+}
+
+PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
+                                      double tol_force, int max_iterations) {
+  const Eigen::Index n = 3 * mesh.X0.cols();
+  // objective Pi(X) = E(X) + P sum A_i r_i ; gradient = -F_el + P A_i e_r
+  auto eval = [&](const Eigen::VectorXd& x, Eigen::VectorXd& grad) {
+    const Eigen::Map<const Eigen::Matrix3Xd> X(x.data(), 3, mesh.X0.cols());
+    const Eigen::Matrix3Xd Xm = X;
+    Eigen::Matrix3Xd G = -elastic_forces(mesh, Xm, p);
+    const Eigen::Matrix3Xd er = radial_directions(mesh, Xm);
+    const Eigen::VectorXd r = node_radii(mesh, Xm);
+    double pi = elastic_energy(mesh, Xm, p);
+    for (Eigen::Index i = 0; i < Xm.cols(); ++i) {
+      G.col(i) += pressure * mesh.node_area[i] * er.col(i);
+      pi += pressure * mesh.node_area[i] * r[i];
+    }
+    grad = Eigen::Map<Eigen::VectorXd>(G.data(), n);
+    return pi;
+  };
+  if (tol_force <= 0.0) tol_force = 1e-7 * std::abs(pressure) * mesh.node_area.maxCoeff() + 1e-30;
+  auto max_node_force = [&](const Eigen::VectorXd& g) {
+    double m = 0.0;
+    for (Eigen::Index i = 0; i < n; i += 3) m = std::max(m, g.segment<3>(i).norm());
+    return m;
+  };
+
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(mesh.X0.data(), n), g(n), xn(n), gn(n);
+  double f = eval(x, g);
+  std::deque<Eigen::VectorXd> S, Y;
+  std::deque<double> rho;
+  const int mem = 12;
+  int it = 0;
+  double step_scale = 1.0;
+  for (; it < max_iterations && max_node_force(g) > tol_force; ++it) {
+    // two-loop recursion
+    Eigen::VectorXd q = g;
+    std::vector<double> al(S.size());
+    for (int k = int(S.size()) - 1; k >= 0; --k) {
+      al[k] = rho[k] * S[k].dot(q);
+      q -= al[k] * Y[k];
+    }
+    if (!S.empty()) q *= S.back().dot(Y.back()) / Y.back().squaredNorm();
+    else q *= 1e-3 * mesh.rest_length.minCoeff() / (g.norm() + 1e-300) * step_scale;
+    for (std::size_t k = 0; k < S.size(); ++k) {
+      const double b = rho[k] * Y[k].dot(q);
+      q += S[k] * (al[k] - b);
+    }
+    Eigen::VectorXd dir = -q;
+    if (dir.dot(g) >= 0.0) {  // not a descent direction: reset memory
+      S.clear(); Y.clear(); rho.clear();
+      dir = -g * (1e-3 * mesh.rest_length.minCoeff() / g.norm());
+    }
+    double t = 1.0;
+    const double slope = dir.dot(g);
+    bool accepted = false;
+    for (int ls = 0; ls < 40; ++ls) {
+      xn = x + t * dir;
+      const double fn = eval(xn, gn);
+      // Armijo, or (near round-off in the energy) a non-increase with a smaller gradient
+      if (std::isfinite(fn) && (fn <= f + 1e-4 * t * slope ||
+                                (fn - f <= 1e-13 * std::abs(f) && gn.norm() < g.norm()))) {
+        accepted = true;
+        f = fn;
+        break;
+      }
+      t *= 0.5;
+    }
+    if (!accepted) break;
+    const Eigen::VectorXd s = xn - x, y = gn - g;
+    const double sy = s.dot(y);
+    if (sy > 1e-300) {
+      S.push_back(s); Y.push_back(y); rho.push_back(1.0 / sy);
+      if (int(S.size()) > mem) { S.pop_front(); Y.pop_front(); rho.pop_front(); }
+    }
+    x = xn;
+    g = gn;
+  }
+  PressureResponse out;
+  out.X = Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, mesh.X0.cols());
+  out.iterations = it;
+  out.max_residual_force = max_node_force(g);
+  if (out.max_residual_force > tol_force)
+    throw NumericalError("membrane static relaxation stalled at residual force " + num(out.max_residual_force) +
+                             " N after " + std::to_string(it) + " iterations",
+                         "reduce the applied pressure or raise max_iterations");
+  out.ring_radius = ring_radii(mesh, out.X);
+  const int r0 = (mesh.n_rings - 1) / 2, r1 = mesh.n_rings / 2;
+  out.mid_radius = 0.5 * (out.ring_radius[r0] + out.ring_radius[r1]);
+  out.c1 = pressure / (mesh.radius - out.mid_radius);
+  return out;
+}
+
+}  // namespace swim::full3d

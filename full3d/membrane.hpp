@@ -1,0 +1,115 @@
+// Triangulated elastic cylinder: the swimmer's spring network (paper eqs. 6-11).
+//
+// Mesh: rings of n_theta nodes at x = x0 + r dx (r = 0..n_rings-1), axis along x;
+// node (r, i) sits at angle 2 pi (i + (r mod 2)/2) / n_theta, so alternate
+// rings are offset by half an angle step and every quad between rings splits
+// into two near-equilateral triangles. With the ring chord
+// c = 2 R0 sin(pi/n_theta) and the half-step chord s = 2 R0 sin(pi/(2 n_theta)),
+// the equilateral ring spacing is dx = sqrt(c^2 - s^2); n_rings = round(L/dx) + 1
+// and dx is then stretched to L/(n_rings - 1). Ends are open.
+//
+// Energies (X: 3 x N_n node positions, m):
+//   E_e = ks/2 sum_edges (L_l - L0_l)^2                                     (eq. 7)
+//   E_b = kb/2 sum_hinges L_l tan^2((theta_l - theta0_l)/2)                 (eq. 8)
+// theta_l is the signed angle between the outward normals of the two
+// triangles sharing interior edge l (positive for a convex fold), L_l the
+// current edge length. BendingForm::ReferenceAngle uses theta0_l of the
+// reference mesh (notes section 6: the undeformed tube is an equilibrium);
+// BendingForm::Printed uses theta0_l = 0 as eq. (8) is printed. Boundary
+// edges (open ends) carry no bending term. Forces F_i = -dE/dX_i (eq. 9) are the
+// exact analytic gradients.
+#pragma once
+
+#include <Eigen/Core>
+#include <array>
+#include <vector>
+
+namespace swim::full3d {
+
+struct CylinderMesh {
+  double radius = 0.0;   ///< R0, m
+  double length = 0.0;   ///< L, m
+  int n_theta = 0;       ///< nodes per ring
+  int n_rings = 0;
+  double ring_spacing = 0.0;  ///< dx, m
+  Eigen::Vector3d axis_start = Eigen::Vector3d::Zero();  ///< centre of ring 0; axis along +x
+
+  Eigen::Matrix3Xd X0;                     ///< reference node positions
+  std::vector<std::array<int, 3>> triangles;  ///< outward oriented
+  std::vector<std::array<int, 2>> edges;
+  Eigen::VectorXd rest_length;             ///< L0 per edge
+  /// (a, b, c, d): shared edge a->b; c opposite in triangle (a,b,c), d in (b,a,d).
+  std::vector<std::array<int, 4>> hinges;
+  std::vector<int> hinge_edge;             ///< edge index of each hinge
+  Eigen::VectorXd rest_angle;              ///< theta0 per hinge
+  Eigen::VectorXd node_area;               ///< reference area carried by each node (1/3 of its triangles), m^2
+
+  int nodes() const { return int(X0.cols()); }
+  int node(int ring, int i) const { return ring * n_theta + i; }
+  int ring_of(int node_id) const { return node_id / n_theta; }
+};
+
+/// Builds the cylinder mesh. Throws swim::InputError for R0 <= 0, L <= 0, n_theta < 3.
+CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector3d& axis_start);
+/// n_theta whose ring chord is closest to (not above) the target node spacing.
+int n_theta_for_spacing(double R0, double spacing);
+/// Cylinder with target node spacing (m).
+CylinderMesh make_cylinder_with_spacing(double R0, double L, double spacing, const Eigen::Vector3d& axis_start);
+/// Coarsest mesh whose longest reference edge is below safety * h/2 (paper's no-leak rule).
+CylinderMesh make_cylinder_for_grid(double R0, double L, double h, const Eigen::Vector3d& axis_start,
+                                    double safety = 0.9);
+
+double max_edge_length(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
+/// Throws swim::NumericalError if an edge is >= h/2 (fluid would leak through the membrane).
+void check_no_leak(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double h, double t_s = -1.0);
+
+enum class BendingForm { ReferenceAngle, Printed };
+
+struct MembraneParams {
+  double ks = 5.5e-8;  ///< spring constant, N/m
+  double kb = 1.0e-15; ///< bending constant, N (energy = kb * length)
+  BendingForm bending = BendingForm::ReferenceAngle;
+};
+
+/// Signed dihedral angle of hinge (a, b, c, d) and its gradient (3 x 4, columns a, b, c, d).
+double dihedral_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
+                      const Eigen::Vector3d& d, Eigen::Matrix<double, 3, 4>* grad = nullptr);
+
+double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks);
+double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form);
+void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F);
+void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
+                        Eigen::Matrix3Xd& F);
+double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p);
+/// F_i = -dE/dX_i (eq. 9), N.
+Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p);
+
+/// Node masses m_i = areal_density (kg/m^2) * node_area_i. The paper's equal
+/// masses are recovered by passing total/N_n per node directly instead.
+Eigen::VectorXd node_masses(const CylinderMesh& mesh, double areal_density);
+
+/// Distance of every node from the reference axis, m.
+Eigen::VectorXd node_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
+/// Mean radius of each ring, m.
+Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
+
+/// Outward radial unit vector of every node (from the reference axis).
+Eigen::Matrix3Xd radial_directions(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
+
+/// Static response of the membrane alone to a uniform inward pressure P (Pa):
+/// per-node load -P * node_area_i * e_r,i (conservative: potential P sum A_i r_i),
+/// equilibrium found by L-BFGS minimisation of E(X) + P sum A_i r_i.
+struct PressureResponse {
+  Eigen::Matrix3Xd X;
+  Eigen::VectorXd ring_radius;  ///< per ring, m
+  double mid_radius = 0.0;      ///< mean radius of the middle ring(s), m
+  double c1 = 0.0;              ///< effective C1 = P / (R0 - mid_radius), Pa/m
+  int iterations = 0;
+  double max_residual_force = 0.0;  ///< N
+};
+/// Throws swim::NumericalError when the minimiser does not reach tol_force
+/// (N, max nodal force imbalance; <= 0 selects 1e-7 of the largest nodal load).
+PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
+                                      double tol_force = 0.0, int max_iterations = 20000);
+
+}  // namespace swim::full3d

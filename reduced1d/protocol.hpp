@@ -1,0 +1,130 @@
+// Discrete state and actuation laws of the Section-3 protocol mapped to 1D (notes section 7).
+//
+// Contraction (phase 0): segments k = n-1 (rightmost, shortest) down to 0 are driven in turn
+// with q = +protocol.q until their MEAN cell radius reaches R_f (a located root: a discrete
+// event). Cells of segments that have reached R_f are "held" by the three-way rule on their
+// radius: +q above R_f + delta, -q below R_f - delta, 0 within delta. Cells left of the
+// active segment carry no actuation.
+// Recovery (phase 1, from the moment segment 0 reaches R_f): five bands per cell,
+//   R < 0.5 R0: -q;  [0.5, 0.8) R0: -0.5 q;  [0.8 R0, R0 - delta): -0.1 q;
+//   |R - R0| <= delta: 0;  R > R0 + delta: +0.1 q.
+// The cycle ends when the wall energy drops below energy_tol * E_ref (a located root).
+//
+// The held and recovery rules are relays on the local radius. Applied continuously in time
+// to the diffusive wall-flow system they have no classical solution: where the two laws on
+// either side of a threshold push the radius towards it, the relay chatters infinitely fast
+// (Filippov sliding mode); with a hysteresis band the chattering frequency is set by the cell
+// size and grows like N^2 (docs/reduced1d.md, "Why the relays are regularised"). The solver
+// therefore uses the Filippov regularisation of each relay: across every threshold the
+// actuation varies linearly over a width eps = kRampFraction * delta centred on the threshold.
+// The actuation is then a continuous, monotone function of the radius, the sliding motion is
+// resolved by the integrator, and only the n + 1 protocol events per cycle are discrete.
+#pragma once
+
+#include <vector>
+
+#include "reduced1d/params.hpp"
+
+namespace swim::reduced1d::detail {
+
+/// Ramp width of the regularised relays as a fraction of protocol.delta.
+inline constexpr double kRampFraction = 0.25;
+
+/// Actuation law q(R) [Pa]: levels y_k joined by C2 smooth steps (6 s^5 - 15 s^4 + 10 s^3)
+/// over [x_{k-1}, x_k], constant outside [x_0, x_{n-1}] (n = 0: q = c everywhere).
+struct ActuationLaw {
+  int n = 0;
+  double c = 0;
+  double x[8] = {}, y[8] = {};
+
+  static ActuationLaw constant(double q) {
+    ActuationLaw a;
+    a.c = q;
+    return a;
+  }
+  double operator()(double R) const {
+    if (n == 0) return c;
+    if (R <= x[0]) return y[0];
+    for (int k = 1; k < n; ++k)
+      if (R < x[k]) {
+        double s = (R - x[k - 1]) / (x[k] - x[k - 1]);
+        s = s * s * s * (10.0 + s * (-15.0 + 6.0 * s));  // C2 smooth step on the ramp
+        return y[k - 1] + (y[k] - y[k - 1]) * s;
+      }
+    return y[n - 1];
+  }
+  /// Radius where C1 (R - R0) + q(R) = 0 (the tube law at p = 0; unique since q is
+  /// non-decreasing).
+  double rest_radius(double R0, double C1) const;
+};
+
+class ProtocolMachine {
+ public:
+  /// Protocol from params. With `fixed_q` non-empty the machine is a constant actuation
+  /// q_i = fixed_q[i] (no protocol, only the collapse root).
+  ProtocolMachine(const Params& p, std::vector<double> fixed_q = {});
+
+  int phase() const { return phase_; }  ///< 0 contraction, 1 recovery, 2 done
+  bool fixed() const { return fixed_; }
+  int segments() const { return nseg_; }
+  int active() const { return active_; }
+  const std::vector<double>& reached() const { return reached_; }
+
+  /// Actuation of one cell: q = w a(R) + (1 - w) b(R) (a cell straddling a segment boundary
+  /// mixes the two segments' laws by length fraction).
+  struct CellLaw {
+    const ActuationLaw* a = nullptr;
+    const ActuationLaw* b = nullptr;
+    double w = 1.0;
+    double operator()(double R) const { return w >= 1.0 ? (*a)(R) : w * (*a)(R) + (1.0 - w) * (*b)(R); }
+  };
+  /// Actuation law of every cell for the current discrete state (pointers stay valid for the
+  /// lifetime of the machine).
+  void laws(std::vector<CellLaw>& law_of_cell) const;
+
+  /// Start a contraction at time t with cell radii R (cascades if the rightmost segment is
+  /// already at or below R_f).
+  void start_cycle(double t, const double* R);
+
+  /// Root functions of the current discrete state, in this order: collapse (always), then in
+  /// phase 0 the active segment's mean radius - R_f, in phase 1 E / (energy_tol E_ref) - 1.
+  int root_count() const;
+
+  /// Apply the located roots (flags from CVODE/IDA root info) at time t with cell radii R.
+  /// Returns the number of protocol switches (segment reached R_f, or cycle completed).
+  int apply(double t, const int* found, const double* R);
+
+  bool collapsed() const { return collapsed_; }
+  bool cycle_completed() const { return cycle_completed_; }
+  void finish() { phase_ = 2; }
+
+  /// Length-weighted mean radius of segment k for cell radii R.
+  double segment_mean(int k, const double* R) const;
+
+ private:
+  void reach_active(double t, const double* R, int& switches);
+  const ActuationLaw* segment_law(int k) const;
+
+  int N_, nseg_;
+  double Rf_;
+  bool fixed_ = false;
+  std::vector<int> seg_a_, seg_b_;
+  std::vector<double> w_;
+  std::vector<double> seg_weight_;
+  std::vector<int> seg_first_, seg_last_;
+  std::vector<ActuationLaw> fixed_laws_;
+  ActuationLaw active_law_, idle_law_, held_law_, recovery_law_;
+  int phase_ = 0;
+  int active_ = -1;
+  std::vector<double> reached_;
+  bool collapsed_ = false;
+  bool cycle_completed_ = false;
+};
+
+/// E_ref = (1/2) C1 (R0 - R_f)^2 2 pi R0 L: elastic energy of the tube uniformly at R_f.
+double reference_energy(const Params& p);
+
+/// Radius below which the tube counts as collapsed: 1e-3 R0.
+inline double collapse_radius(const Params& p) { return 1e-3 * p.geometry.R0; }
+
+}  // namespace swim::reduced1d::detail

@@ -1,0 +1,115 @@
+// Spreading (eq. 19) and interpolation (eq. 20) on the MAC grid.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "full3d/ib.hpp"
+#include "full3d/operators.hpp"
+
+using namespace swim::full3d;
+
+namespace {
+Eigen::Matrix3Xd random_points(const MacGrid& g, int n, double margin, std::mt19937& rng) {
+  Eigen::Matrix3Xd X(3, n);
+  for (int d = 0; d < 3; ++d) {
+    std::uniform_real_distribution<double> U(margin, g.length(d) - margin);
+    for (int k = 0; k < n; ++k) X(d, k) = U(rng);
+  }
+  return X;
+}
+Eigen::Matrix3Xd random_forces(int n, std::mt19937& rng) {
+  std::uniform_real_distribution<double> U(-1, 1);
+  Eigen::Matrix3Xd F(3, n);
+  for (int k = 0; k < n; ++k)
+    for (int d = 0; d < 3; ++d) F(d, k) = U(rng);
+  return F;
+}
+Eigen::Vector3d field_total(const MacGrid& g, const VectorField& f) {
+  Eigen::Vector3d s = Eigen::Vector3d::Zero();
+  for (int c = 0; c < 3; ++c)
+    for (double x : f.c[c]) s[c] += x;
+  return s * g.h() * g.h() * g.h();
+}
+}  // namespace
+
+TEST(ImmersedBoundary, SpreadConservesTotalForcePeriodicBox) {
+  std::mt19937 rng(1);
+  MacGrid g(12, 10, 9, 0.1, ContainerKind::PeriodicBox);
+  // points anywhere, including outside [0, L) (periodic images)
+  Eigen::Matrix3Xd X = random_points(g, 50, -0.3, rng);
+  const Eigen::Matrix3Xd F = random_forces(50, rng);
+  VectorField f(g);
+  spread(g, X, F, f);
+  const Eigen::Vector3d tot = field_total(g, f), ref = F.rowwise().sum();
+  EXPECT_LT((tot - ref).norm(), 1e-13 * F.cwiseAbs().sum());
+}
+
+TEST(ImmersedBoundary, SpreadConservesTotalForceAwayFromDuctWalls) {
+  std::mt19937 rng(2);
+  MacGrid g(12, 10, 9, 0.1, ContainerKind::SquareDuct);
+  const Eigen::Matrix3Xd X = random_points(g, 50, 2.01 * g.h(), rng);
+  const Eigen::Matrix3Xd F = random_forces(50, rng);
+  VectorField f(g);
+  spread(g, X, F, f);
+  EXPECT_LT((field_total(g, f) - F.rowwise().sum()).norm(), 1e-13 * F.cwiseAbs().sum());
+}
+
+TEST(ImmersedBoundary, SpreadAndInterpolateAreAdjoint) {
+  std::mt19937 rng(3);
+  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+    MacGrid g(10, 8, 12, 0.05, kind);
+    const Eigen::Matrix3Xd X = random_points(g, 40, 0.0, rng);  // includes nodes near walls
+    const Eigen::Matrix3Xd F = random_forces(40, rng);
+    VectorField u(g), f(g);
+    std::uniform_real_distribution<double> U(-1, 1);
+    for (auto& a : u.c)
+      for (double& x : a) x = U(rng);
+    zero_wall_faces(g, u);
+    spread(g, X, F, f);
+    Eigen::Matrix3Xd Ui;
+    interpolate(g, u, X, Ui);
+    double lhs = 0;
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t m = 0; m < u.c[c].size(); ++m) lhs += f.c[c][m] * u.c[c][m];
+    lhs *= g.h() * g.h() * g.h();
+    const double rhs = (F.array() * Ui.array()).sum();
+    EXPECT_NEAR(lhs, rhs, 1e-12 * std::abs(rhs)) << to_string(kind);
+  }
+}
+
+TEST(ImmersedBoundary, InterpolationReproducesConstantsAndLinearFields) {
+  std::mt19937 rng(4);
+  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+    MacGrid g(16, 14, 12, 0.1, kind);
+    const double a[3] = {0.3, -1.2, 2.0};
+    const double b[3][3] = {{1.0, -2.0, 0.5}, {0.7, 0.1, -0.4}, {-1.5, 0.9, 2.2}};
+    VectorField cst(g), lin(g);
+    for (int c = 0; c < 3; ++c) {
+      const auto d = g.dims(c);
+      for (int k = 0; k < d[2]; ++k)
+        for (int j = 0; j < d[1]; ++j)
+          for (int i = 0; i < d[0]; ++i) {
+            const auto x = g.position(c, i, j, k);
+            const std::size_t id = MacGrid::index(d, i, j, k);
+            cst.c[c][id] = a[c];
+            lin.c[c][id] = a[c] + b[c][0] * x[0] + b[c][1] * x[1] + b[c][2] * x[2];
+          }
+    }
+    // the linear field is not periodic: keep the stencils off the seams and walls
+    const Eigen::Matrix3Xd X = random_points(g, 30, 2.01 * g.h(), rng);
+    Eigen::Matrix3Xd Uc, Ul;
+    interpolate(g, cst, X, Uc);
+    interpolate(g, lin, X, Ul);
+    for (int k = 0; k < X.cols(); ++k)
+      for (int c = 0; c < 3; ++c) {
+        EXPECT_NEAR(Uc(c, k), a[c], 1e-14);
+        EXPECT_NEAR(Ul(c, k), a[c] + b[c][0] * X(0, k) + b[c][1] * X(1, k) + b[c][2] * X(2, k), 1e-13);
+      }
+    if (kind == ContainerKind::PeriodicBox) {  // constants everywhere, across the seams
+      const Eigen::Matrix3Xd Y = random_points(g, 30, -0.5, rng);
+      interpolate(g, cst, Y, Uc);
+      for (int k = 0; k < Y.cols(); ++k)
+        for (int c = 0; c < 3; ++c) EXPECT_NEAR(Uc(c, k), a[c], 1e-14);
+    }
+  }
+}

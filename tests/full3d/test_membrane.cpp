@@ -1,0 +1,196 @@
+// Spring-network membrane (eqs. 6-9): mesh, no-leak rule, analytic forces,
+// reference equilibrium, invariances, uniform-pressure response.
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <random>
+
+#include "common/errors.hpp"
+#include "full3d/membrane.hpp"
+
+using namespace swim::full3d;
+
+namespace {
+constexpr double kR0 = 0.125e-6, kL = 0.4e-6;
+
+CylinderMesh small_mesh() { return make_cylinder(kR0, kL, 10, Eigen::Vector3d(0.1e-6, 0.25e-6, 0.25e-6)); }
+
+Eigen::Matrix3Xd perturbed(const CylinderMesh& m, double rel, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> N(0.0, rel * m.rest_length.mean());
+  Eigen::Matrix3Xd X = m.X0;
+  for (Eigen::Index i = 0; i < X.size(); ++i) X.data()[i] += N(rng);
+  return X;
+}
+
+// max_i |F_i + dE/dX_i (central FD)| / max_i |F_i|
+template <class E>
+double fd_error(const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, E energy, double eps) {
+  Eigen::Matrix3Xd Y = X;
+  double err = 0.0;
+  for (Eigen::Index i = 0; i < X.size(); ++i) {
+    const double x0 = Y.data()[i];
+    Y.data()[i] = x0 + eps;
+    const double ep = energy(Y);
+    Y.data()[i] = x0 - eps;
+    const double em = energy(Y);
+    Y.data()[i] = x0;
+    err = std::max(err, std::abs(F.data()[i] + (ep - em) / (2 * eps)));
+  }
+  return err / F.cwiseAbs().maxCoeff();
+}
+}  // namespace
+
+TEST(MembraneMesh, NearEquilateralCylinder) {
+  const CylinderMesh m = small_mesh();
+  EXPECT_EQ(m.nodes(), m.n_theta * m.n_rings);
+  EXPECT_EQ(int(m.triangles.size()), 2 * m.n_theta * (m.n_rings - 1));
+  // Euler characteristic of an open tube: V - E + F = 0
+  EXPECT_EQ(m.nodes() - int(m.edges.size()) + int(m.triangles.size()), 0);
+  // every interior edge has a hinge; boundary edges are the two end rings
+  EXPECT_EQ(m.hinges.size() + 2 * std::size_t(m.n_theta), m.edges.size());
+  EXPECT_NEAR(m.ring_spacing * (m.n_rings - 1), kL, 1e-18);
+  const double ratio = m.rest_length.maxCoeff() / m.rest_length.minCoeff();
+  EXPECT_LT(ratio, 1.15) << "triangles should be near-equilateral";
+  // all nodes on the cylinder, total area close to 2 pi R0 L (inscribed polygon)
+  for (int i = 0; i < m.nodes(); ++i) {
+    Eigen::Vector3d r = m.X0.col(i) - m.axis_start;
+    r.x() = 0;
+    EXPECT_NEAR(r.norm(), kR0, 1e-18);
+  }
+  const double area = m.node_area.sum() / (2 * M_PI * kR0 * kL);
+  EXPECT_GT(area, 0.97);  // inscribed: slightly below the smooth cylinder's area
+  EXPECT_LT(area, 1.0);
+  // outward orientation
+  for (const auto& t : m.triangles) {
+    const Eigen::Vector3d n = (m.X0.col(t[1]) - m.X0.col(t[0])).cross(m.X0.col(t[2]) - m.X0.col(t[0]));
+    Eigen::Vector3d c = (m.X0.col(t[0]) + m.X0.col(t[1]) + m.X0.col(t[2])) / 3 - m.axis_start;
+    c.x() = 0;
+    EXPECT_GT(n.dot(c), 0.0);
+  }
+  // reference folds: convex (theta0 > 0) across the slanted edges, concave
+  // (theta0 < 0) across the ring chords, whose neighbouring apexes stick out
+  for (std::size_t k = 0; k < m.hinges.size(); ++k) {
+    const auto& h = m.hinges[k];
+    const bool ring_edge = m.ring_of(h[0]) == m.ring_of(h[1]);
+    EXPECT_GT(ring_edge ? -m.rest_angle[k] : m.rest_angle[k], 0.1);
+  }
+}
+
+TEST(MembraneMesh, NoLeakResolutionChoice) {
+  const double h = 0.5e-6 / 32;
+  const CylinderMesh m = make_cylinder_for_grid(kR0, kL, h, Eigen::Vector3d::Zero());
+  EXPECT_LT(max_edge_length(m, m.X0), 0.5 * h);
+  EXPECT_NO_THROW(check_no_leak(m, m.X0, h));
+  // the next coarser mesh would violate the safety margin
+  const CylinderMesh c = make_cylinder(kR0, kL, m.n_theta - 1, Eigen::Vector3d::Zero());
+  EXPECT_GE(max_edge_length(c, c.X0), 0.9 * 0.5 * h);
+  std::printf("h = %.4g m: n_theta = %d, n_rings = %d, nodes = %d, max edge = %.4g m (h/2 = %.4g m)\n", h,
+              m.n_theta, m.n_rings, m.nodes(), max_edge_length(m, m.X0), 0.5 * h);
+  Eigen::Matrix3Xd X = m.X0;
+  X.row(0) *= 1.6;  // stretch axially: edges beyond h/2
+  EXPECT_THROW(check_no_leak(m, X, h, 1e-6), swim::NumericalError);
+  EXPECT_THROW(make_cylinder(kR0, kL, 2, Eigen::Vector3d::Zero()), swim::InputError);
+}
+
+TEST(MembraneForces, DihedralGradientMatchesFiniteDifferences) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::Matrix<double, 3, 4> P;
+    P << 0, 1, 0.5, 0.5, 0, 0, 1, -1, 0, 0, 0.3, 0.2;
+    for (int i = 0; i < 12; ++i) P.data()[i] += 0.2 * U(rng);
+    Eigen::Matrix<double, 3, 4> g;
+    dihedral_angle(P.col(0), P.col(1), P.col(2), P.col(3), &g);
+    const double eps = 1e-6;
+    for (int i = 0; i < 12; ++i) {
+      Eigen::Matrix<double, 3, 4> Q = P;
+      Q.data()[i] += eps;
+      const double tp = dihedral_angle(Q.col(0), Q.col(1), Q.col(2), Q.col(3));
+      Q.data()[i] -= 2 * eps;
+      const double tm = dihedral_angle(Q.col(0), Q.col(1), Q.col(2), Q.col(3));
+      EXPECT_NEAR(g.data()[i], (tp - tm) / (2 * eps), 1e-8);
+    }
+  }
+}
+
+TEST(MembraneForces, ForcesAreMinusEnergyGradient) {
+  const CylinderMesh m = small_mesh();
+  const Eigen::Matrix3Xd X = perturbed(m, 0.05, 1);
+  const double eps = 1e-6 * m.rest_length.mean();
+  const double ks = 5.5e-8, kb = 1e-15;
+  {
+    Eigen::Matrix3Xd F = Eigen::Matrix3Xd::Zero(3, X.cols());
+    add_stretching_forces(m, X, ks, F);
+    const double e = fd_error(X, F, [&](const Eigen::Matrix3Xd& Y) { return stretching_energy(m, Y, ks); }, eps);
+    std::printf("stretching: relative FD gradient error %.2e\n", e);
+    EXPECT_LT(e, 1e-6);
+  }
+  for (auto form : {BendingForm::ReferenceAngle, BendingForm::Printed}) {
+    Eigen::Matrix3Xd F = Eigen::Matrix3Xd::Zero(3, X.cols());
+    add_bending_forces(m, X, kb, form, F);
+    const double e = fd_error(X, F, [&](const Eigen::Matrix3Xd& Y) { return bending_energy(m, Y, kb, form); }, eps);
+    std::printf("bending (%s): relative FD gradient error %.2e\n",
+                form == BendingForm::Printed ? "printed" : "reference angle", e);
+    EXPECT_LT(e, 1e-6);
+  }
+}
+
+TEST(MembraneForces, ReferenceMeshIsEquilibriumOnlyWithReferenceAngles) {
+  const CylinderMesh m = small_mesh();
+  MembraneParams p;
+  const Eigen::Matrix3Xd Fref = elastic_forces(m, m.X0, p);
+  p.bending = BendingForm::Printed;
+  const Eigen::Matrix3Xd Fprint = elastic_forces(m, m.X0, p);
+  // scale of a bending force: kb * theta0 / 2 (dE/dtheta ~ kb L theta/2, dtheta/dX ~ 1/L)
+  const double scale = p.kb * m.rest_angle.maxCoeff() / 2;
+  const double fr = Fref.colwise().norm().maxCoeff(), fp = Fprint.colwise().norm().maxCoeff();
+  std::printf("max |F| at the reference mesh: reference-angle form %.2e N, printed form %.2e N\n", fr, fp);
+  EXPECT_LT(fr, 1e-12 * scale);
+  EXPECT_GT(fp, 0.1 * scale);
+  EXPECT_DOUBLE_EQ(elastic_energy(m, m.X0, MembraneParams{}), 0.0);
+}
+
+TEST(MembraneForces, TotalForceAndTorqueVanish) {
+  const CylinderMesh m = small_mesh();
+  const Eigen::Matrix3Xd X = perturbed(m, 0.1, 2);
+  for (auto form : {BendingForm::ReferenceAngle, BendingForm::Printed}) {
+    const MembraneParams p{5.5e-8, 1e-15, form};
+    const Eigen::Matrix3Xd F = elastic_forces(m, X, p);
+    const double fsum = F.cwiseAbs().sum();
+    Eigen::Vector3d torque = Eigen::Vector3d::Zero();
+    for (Eigen::Index i = 0; i < X.cols(); ++i) torque += X.col(i).cross(F.col(i));
+    EXPECT_LT(F.rowwise().sum().norm(), 1e-13 * fsum);
+    EXPECT_LT(torque.norm(), 1e-13 * fsum * X.cwiseAbs().maxCoeff());
+  }
+}
+
+TEST(MembranePressure, UniformContractionAndEffectiveC1) {
+  const CylinderMesh m = make_cylinder(kR0, kL, 16, Eigen::Vector3d::Zero());
+  const MembraneParams p;
+  double c1[2];
+  const double P[2] = {2e-3, 4e-3};  // Pa
+  for (int s = 0; s < 2; ++s) {
+    const PressureResponse r = relax_under_pressure(m, p, P[s]);
+    c1[s] = r.c1;
+    const Eigen::VectorXd nr = node_radii(m, r.X);
+    // azimuthal uniformity: all nodes of a ring share its radius
+    for (int i = 0; i < m.nodes(); ++i)
+      EXPECT_NEAR(nr[i], r.ring_radius[m.ring_of(i)], 1e-6 * (kR0 - r.mid_radius));
+    // axial uniformity of the contraction over the interior rings
+    double lo = 1e300, hi = -1e300;
+    for (int k = 2; k < m.n_rings - 2; ++k) {
+      lo = std::min(lo, kR0 - r.ring_radius[k]);
+      hi = std::max(hi, kR0 - r.ring_radius[k]);
+    }
+    std::printf("P = %.3g Pa: n_theta=%d rings=%d it=%d, R0-R mid %.4e m, interior spread %.2f%%, "
+                "end ring %.4e m, C1 = %.4e Pa/m\n",
+                P[s], m.n_theta, m.n_rings, r.iterations, kR0 - r.mid_radius, 100 * (hi - lo) / hi,
+                kR0 - r.ring_radius[0], r.c1);
+    EXPECT_GT(kR0 - r.mid_radius, 0.0);
+    EXPECT_LT((hi - lo) / hi, 0.05);
+  }
+  EXPECT_NEAR(c1[1] / c1[0], 1.0, 0.02);  // linear regime
+}

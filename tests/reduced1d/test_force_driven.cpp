@@ -1,0 +1,153 @@
+// Force-driven wave: static uniform load, the Section-3 protocol over one cycle, volume
+// conservation with and without wall inertia, and robustness at extreme parameters.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+
+#include "reduced1d/internal.hpp"
+#include "reduced1d/protocol.hpp"
+#include "reduced1d/solver.hpp"
+
+using namespace swim::reduced1d;
+
+namespace {
+Params force_driven(int N = 50) {
+  Params p;
+  p.wave = WaveKind::ForceDriven;
+  p.numerics.cells = N;
+  p.numerics.output_interval = 2e-3;
+  return p;
+}
+bool all_finite(const Result& r) {
+  for (const auto& s : r.series)
+    for (double v : {s.t, s.X, s.W, s.energy, s.R_min, s.R_max, s.Q_rear, s.Q_front, s.V_rear,
+                     s.V_front, s.tube_volume})
+      if (!std::isfinite(v)) return false;
+  for (double v : r.radius)
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+}  // namespace
+
+TEST(Reduced1dForceDriven, UniformStaticLoadRelaxesToTubeLawRadius) {
+  for (bool inertia : {false, true}) {
+    Params p = force_driven(40);
+    p.wall.inertia = inertia;
+    const double q = 0.1;  // Pa: R -> R0 - q / C1 = 0.80 R0
+    const double t_end = 12 * detail::relaxation_time(p);
+    p.numerics.output_interval = t_end / 4;
+    const Result r = detail::solve_fixed_actuation(p, std::vector<double>(40, q), t_end);
+    ASSERT_FALSE(r.failure) << r.failure->what();
+    const double R_eq = p.geometry.R0 - q / p.wall.C1;
+    const int N = 40;
+    const std::size_t last = r.radius_times.size() - 1;
+    for (int i = 0; i < N; ++i) EXPECT_NEAR(r.radius[last * N + i], R_eq, 1e-4 * p.geometry.R0) << i;
+    // Calibration relation of notes section 1: C1 = pressure / (R0 - R).
+    const double R_mid = r.radius[last * N + N / 2];
+    EXPECT_NEAR(q / (p.geometry.R0 - R_mid), p.wall.C1, 1e-3 * p.wall.C1);
+    EXPECT_TRUE(all_finite(r));
+  }
+}
+
+TEST(Reduced1dForceDriven, ProtocolCompletesOneCycle) {
+  const Params p = force_driven(50);
+  const Result r = solve(p);
+  ASSERT_FALSE(r.failure) << r.failure->what();
+  ASSERT_TRUE(all_finite(r));
+  const int n = p.protocol.segments;
+  // Every segment reached R_f, right to left.
+  ASSERT_EQ(int(r.segment_reached.size()), n);
+  for (int k = 0; k < n; ++k) EXPECT_GE(r.segment_reached[k], 0.0) << k;
+  for (int k = 0; k + 1 < n; ++k) EXPECT_GT(r.segment_reached[k], r.segment_reached[k + 1]);
+  // Switch bound: the hold and recovery rules are continuous (regularised) actuation laws, so
+  // the only discrete switches are the n "segment reached R_f" events and the cycle end.
+  EXPECT_EQ(r.switches, n + 1);
+  // Cycle completed with the energy back within tolerance; simulated cycle time O(10-1000) ms.
+  ASSERT_EQ(r.cycle_start.size(), 1u);
+  ASSERT_EQ(r.cycle_end.size(), 1u);
+  EXPECT_GT(r.cycle_end[0], 0.01);
+  EXPECT_LT(r.cycle_end[0], 1.0);
+  EXPECT_LE(r.series.back().energy, 1.0001 * p.protocol.energy_tol * detail::reference_energy(p));
+  EXPECT_EQ(r.series.back().phase, 2);
+  EXPECT_DOUBLE_EQ(r.series.back().t, r.cycle_end[0]);
+  // The swimmer moves in +z by the end of the contraction (wave travels in -z).
+  double X_contraction = 0;
+  for (const auto& s : r.series)
+    if (s.t <= r.segment_reached[0]) X_contraction = s.X;
+  EXPECT_GT(X_contraction, 0.0);
+  EXPECT_GT(r.series.back().X, 0.0);
+  // Radii stay in a sane range.
+  for (const auto& s : r.series) {
+    EXPECT_GT(s.R_min, 0.3 * p.geometry.R0);
+    EXPECT_LT(s.R_max, 1.5 * p.geometry.R0);
+  }
+  EXPECT_GT(r.stats.at("steps"), 0);
+  EXPECT_EQ(r.stats.at("reinits"), n);  // one restart per switch except the final one
+}
+
+TEST(Reduced1dForceDriven, ConservesVolumeWithAndWithoutInertia) {
+  for (bool inertia : {false, true}) {
+    Params p = force_driven(40);
+    p.wall.inertia = inertia;
+    p.numerics.rtol = 1e-8;
+    p.numerics.atol_scale = 1e-8;
+    p.duration = inertia ? 0.03 : 0.0;  // the inertial run resolves wall oscillations: keep it short
+    const Result r = solve(p);
+    ASSERT_FALSE(r.failure) << r.failure->what();
+    const double V0 = r.series.front().tube_volume;
+    double worst = 0;
+    for (const auto& s : r.series)
+      worst = std::max(worst, std::abs((s.tube_volume - V0) - (s.V_rear - s.V_front)));
+    EXPECT_LT(worst, 1e-6 * V0) << "inertia=" << inertia;
+    double swing = 0;
+    for (const auto& s : r.series) swing = std::max(swing, std::abs(s.tube_volume - V0));
+    EXPECT_GT(swing, 0.05 * V0);  // the check is not vacuous
+  }
+}
+
+TEST(Reduced1dForceDriven, InertiaIsASmallCorrectionAtDefaultMass) {
+  Params a = force_driven(40);
+  a.duration = 0.03;
+  Params b = a;
+  b.wall.inertia = true;
+  const Result ra = solve(a), rb = solve(b);
+  ASSERT_FALSE(ra.failure);
+  ASSERT_FALSE(rb.failure) << rb.failure->what();
+  EXPECT_NEAR(rb.series.back().X, ra.series.back().X, 0.05 * std::abs(ra.series.back().X));
+}
+
+TEST(Reduced1dForceDriven, ExtremeParametersFailCleanlyOrSucceed) {
+  struct Case {
+    const char* name;
+    std::function<void(Params&)> set;
+  };
+  const std::vector<Case> cases = {
+      {"R_f/R0 = 0.1", [](Params& p) { p.protocol.R_f = 0.1 * p.geometry.R0; }},
+      {"R_f/R0 = 0.95", [](Params& p) { p.protocol.R_f = 0.95 * p.geometry.R0; }},
+      {"eps = R0/L = 0.02", [](Params& p) { p.geometry.L = p.geometry.R0 / 0.02; }},
+      {"eps = R0/L = 1", [](Params& p) { p.geometry.L = p.geometry.R0; }},
+      {"C1 x 1e-2", [](Params& p) { p.wall.C1 *= 1e-2; }},
+      {"C1 x 1e2", [](Params& p) { p.wall.C1 *= 1e2; }},
+      {"mu x 1e-2", [](Params& p) { p.fluid.mu *= 1e-2; }},
+      {"mu x 1e2", [](Params& p) { p.fluid.mu *= 1e2; }},
+  };
+  for (const auto& c : cases) {
+    Params p = force_driven(40);
+    c.set(p);
+    p.numerics.output_interval = 0.02 * detail::relaxation_time(p);
+    p.numerics.max_steps = 200000;
+    const Result r = solve(p);
+    EXPECT_TRUE(all_finite(r)) << c.name;
+    ASSERT_FALSE(r.series.empty()) << c.name;
+    if (r.failure) {
+      EXPECT_FALSE(r.failure->cause().empty()) << c.name;
+      EXPECT_FALSE(r.failure->remedy().empty()) << c.name;
+    } else {
+      EXPECT_EQ(r.cycle_end.size(), 1u) << c.name;
+    }
+    std::printf("[extreme] %-20s %s | t_end = %.4g s, switches = %ld, steps = %ld, X = %.4g m\n", c.name,
+                r.failure ? r.failure->what() : "completed", r.series.back().t, r.switches,
+                r.stats.at("steps"), r.series.back().X);
+  }
+}
