@@ -113,3 +113,23 @@ TEST(Cli, BadFlagsExitWithCodeTwo) {
     EXPECT_EQ(WEXITSTATUS(status), 2) << args;
   }
 }
+
+TEST(Scene, WallStiffnessFromACalibrationFileRelativeToTheScene) {
+  const fs::path dir = fs::temp_directory_path() / "swim_calib_test";
+  fs::create_directories(dir);
+  std::ofstream(dir / "calibration.json") << R"({"C1_Pa_per_m": 3.5e6, "C1_stderr_Pa_per_m": 1e4})";
+  json s = {{"wall", {{"calibration", "calibration.json"}}}};
+  json resolved;
+  const auto p = swim::reduced1d::read_scene(s, resolved, dir.string());
+  EXPECT_DOUBLE_EQ(p.wall.C1, 3.5e6);
+  EXPECT_EQ(resolved["wall"]["calibration"], "calibration.json");
+  std::ofstream(dir / "bad.json") << R"({"C1": 3.5e6})";
+  s["wall"]["calibration"] = "bad.json";
+  try {
+    swim::reduced1d::read_scene(s, resolved, dir.string());
+    FAIL() << "accepted a calibration file without C1_Pa_per_m";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "wall.calibration");
+  }
+  fs::remove_all(dir);
+}
