@@ -14,6 +14,7 @@ struct RunOptions {
   std::vector<std::string> sets;
   int progress = -1;  ///< -1 auto (terminal), 0 off, 1 on
   bool plot = false;
+  std::string resume;  ///< 3D: continue the run whose output folder (with checkpoint.bin) is given
 };
 
 int run(const RunOptions& o);

@@ -1,5 +1,5 @@
 // swim bench: performance figures, measured in one run so that ratios are meaningful on a
-// shared machine. 1D part: wall time of one force-driven cycle at N = 50, 200, 800 (best
+// shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 (best
 // of several repetitions) and screening throughput (designs per second) on all cores.
 #include <algorithm>
 #include <chrono>
@@ -13,6 +13,8 @@
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/screen.hpp"
 #include "reduced1d/solver.hpp"
+#include "full3d/protocol3d.hpp"
+#include "full3d/scene3d.hpp"
 
 namespace swim::app {
 
@@ -84,6 +86,83 @@ int bench(const std::string& out_opt, bool quick) {
     thr[kind] = {{"designs", n}, {"wall_time_s", wall}, {"designs_per_s", n / wall}, {"failed", failed}};
   }
   report["screening"] = thr;
+
+  // 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
+  // resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
+  // with 1 and 2 FFTW threads. Extrapolates the single-cycle wall time from steps/s.
+  std::printf("== 3D tier ==\n");
+  std::printf("  %-10s %7s %3s %9s %9s %9s %9s %9s %9s %7s\n", "grid", "nodes", "thr", "step[ms]", "fluid", "spread",
+              "interp", "forces", "bare[ms]", "ratio");
+  scene::json grids = scene::json::array();
+  const int steps = quick ? 3 : 10;
+  double default_steps_per_s[3] = {0, 0, 0};
+  for (int across : {12, 20, 32}) {
+    double per_step_thr[3] = {0, 0, 0};
+    for (int thr : {1, 2}) {
+      scene::json sc = scene::load_file(data_dir() + "/scenes/demo.json");
+      scene::apply_override(sc, "full3d.grid.cells_across=" + std::to_string(across));
+      scene::apply_override(sc, "full3d.threads=" + std::to_string(thr));
+      scene::json resolved;
+      const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+      const full3d::CylinderMesh mesh = full3d::make_mesh(p);
+      full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
+      full3d::IbOptions o;
+      o.stokes.fft.threads = thr;
+      if (thr > 1) full3d::fftw_threads_init_once();
+      full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), o);
+      full3d::Protocol3d proto(p.protocol, mesh, full3d::uniform_contraction_energy(mesh, p.membrane, p.protocol.R_f));
+      proto.start(0.0, mesh.X0);
+      ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) { return proto.force(X); });
+      full3d::IbState st = ib.initial_state();
+      ib.step(st, p.dt);  // warm-up (plans, first PCG)
+      full3d::IbStepStats sum;
+      const auto t0 = std::chrono::steady_clock::now();
+      for (int k = 0; k < steps; ++k) {
+        const auto s1 = ib.step(st, p.dt);
+        sum.time_fluid += s1.time_fluid;
+        sum.time_spread += s1.time_spread;
+        sum.time_interp += s1.time_interp;
+        sum.time_forces += s1.time_forces;
+      }
+      const double per = seconds_since(t0) / steps;
+      // bare FFT solve with the same forcing size
+      full3d::VectorField u(grid), f(grid);
+      for (auto& c : f.c)
+        for (size_t i = 0; i < c.size(); ++i) c[i] = std::sin(0.37 * double(i));
+      full3d::StokesSolver bare(grid, p.fluid, o.stokes);
+      bare.bare_fft_solve(u, f, p.dt);
+      const auto t1 = std::chrono::steady_clock::now();
+      for (int k = 0; k < steps; ++k) bare.bare_fft_solve(u, f, p.dt);
+      const double bare_per = seconds_since(t1) / steps;
+      per_step_thr[thr] = per;
+      char g[32];
+      std::snprintf(g, sizeof g, "%dx%dx%d", p.nx, p.ny, p.nz);
+      std::printf("  %-10s %7d %3d %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %7.1f\n", g, mesh.nodes(), thr, 1e3 * per,
+                  1e3 * sum.time_fluid / steps, 1e3 * sum.time_spread / steps, 1e3 * sum.time_interp / steps,
+                  1e3 * sum.time_forces / steps, 1e3 * bare_per, per / bare_per);
+      grids.push_back({{"grid", g}, {"nodes", mesh.nodes()}, {"threads", thr}, {"step_s", per},
+                       {"fluid_s", sum.time_fluid / steps}, {"spread_s", sum.time_spread / steps},
+                       {"interp_s", sum.time_interp / steps}, {"forces_s", sum.time_forces / steps},
+                       {"bare_fft_solve_s", bare_per}, {"step_over_bare", per / bare_per}});
+      if (across == 32) default_steps_per_s[thr] = 1.0 / per;
+    }
+    std::printf("  %-10s 2-thread speedup %.2f\n", "", per_step_thr[1] / per_step_thr[2]);
+  }
+  report["full3d_step"] = grids;
+  // Single cycle of the paper's scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution:
+  // extrapolated from steps/s, with the 1D cycle time of the same scene as the cycle length.
+  {
+    const auto p1 = demo_params({"protocol.cycles=1", "time.duration=\"auto\""});
+    const auto m1 = reduced1d::metrics(p1, reduced1d::solve(p1));
+    const double cycle = m1.mean_cycle_time_s, dt = 1e-5;
+    const double best = std::max(default_steps_per_s[1], default_steps_per_s[2]);
+    const double est = cycle / dt / best;
+    std::printf("paper single-cycle scene at the default resolution (128x32x32, dt = 1e-5 s): NOT run; extrapolated "
+                "%.0f steps x %.3g s/step = %.0f s (cycle length taken from the 1D tier: %.3g s)\n",
+                cycle / dt, 1.0 / best, est, cycle);
+    report["full3d_paper_cycle_extrapolated"] = {{"cycle_time_1d_s", cycle}, {"dt_s", dt}, {"steps", cycle / dt},
+                                                 {"steps_per_s", best}, {"wall_time_estimate_s", est}};
+  }
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());
   return 0;

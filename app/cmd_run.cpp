@@ -9,6 +9,8 @@
 #include "common/output.hpp"
 #include "common/progress.hpp"
 #include "common/scene.hpp"
+#include "full3d/run3d.hpp"
+#include "full3d/scene3d.hpp"
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
@@ -34,12 +36,44 @@ bool plot(const std::string& script, const std::vector<std::string>& args) {
   return true;
 }
 
+namespace {
+
+// The 3D tier: read and validate, run (full3d/run3d.hpp), report.
+int run3d(const RunOptions& o, const scene::json& sc) {
+  scene::json resolved;
+  const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+  if (!o.resume.empty() && !o.out.empty() && fs::path(o.out) != fs::path(o.resume))
+    throw InputError("--out", o.out, "with --resume the run continues in the resumed folder; omit --out");
+  const std::string out = !o.resume.empty() ? o.resume : o.out.empty() ? "out/" + p.name + "-3d" : o.out;
+  if (!o.resume.empty() && !fs::exists(full3d::checkpoint_path(out)))
+    throw InputError("--resume", o.resume, "no checkpoint.bin in this folder");
+  output::make_dir(out);
+  full3d::RunControl ctl;
+  ctl.progress = o.progress;
+  ctl.resume = !o.resume.empty();
+  const full3d::RunOutcome r = full3d::run3d(p, resolved, out, ctl);
+  const auto& s = r.summary;
+  std::printf("%s (3d): displacement %.6g m, mean velocity %.6g m/s (%.4g body lengths/s), %d cycle(s), "
+              "pumped volume %.6g m^3, %ld steps, wall time %.3g s\n  -> %s/summary.json\n",
+              p.name.c_str(), s["displacement_m"].get<double>(), s["mean_velocity_m_per_s"].get<double>(),
+              s["body_lengths_per_s"].get<double>(), s["cycles_completed"].get<int>(),
+              s["pumped_volume_m3"].get<double>(), r.steps, s["wall_time_s"].get<double>(), out.c_str());
+  if (r.failed) {
+    std::fprintf(stderr, "swim: %s\n  partial results and the last checkpoint kept in %s\n", r.message.c_str(),
+                 out.c_str());
+    return 3;
+  }
+  return 0;
+}
+
+}  // namespace
+
 int run(const RunOptions& o) {
   // 1. Everything is read and validated before anything is written.
   scene::json sc = scene::load_file(o.scene);
   for (const auto& s : o.sets) scene::apply_override(sc, s);
-  if (o.tier == "3d")
-    throw InputError("--tier", "3d", "the 3D tier is not available in this build yet; use --tier 1d");
+  if (o.tier == "3d") return run3d(o, sc);
+  if (!o.resume.empty()) throw InputError("--resume", o.resume, "only the 3D tier writes checkpoints; add --tier 3d");
   scene::json resolved;
   const std::string scene_dir = fs::path(o.scene).parent_path().string();
   const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir.empty() ? "." : scene_dir);

@@ -1,6 +1,6 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
-//   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...]
+//   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR]
 //   swim screen SWEEP.json [--out DIR] [--jobs N]
 //   swim bench [--out DIR]
 //   swim scenes
@@ -34,6 +34,7 @@ int main(int argc, char** argv) {
   run->add_option("--out", ro.out, "Output directory (default out/<scene name>-<tier>)");
   run->add_option("--set", ro.sets, "Override a scene value: key.path=value (same unit syntax as the file)");
   run->add_flag("--plot", ro.plot, "Also write plots (PNG) of the run");
+  run->add_option("--resume", ro.resume, "3D: continue an interrupted run from the checkpoint in this output folder");
   add_progress(run);
 
   std::string out;

@@ -1,5 +1,6 @@
 #include "full3d/ib_solver.hpp"
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -47,12 +48,19 @@ Eigen::Matrix3Xd IbSolver::fluid_force(const Eigen::Matrix3Xd& X, double t, cons
 void IbSolver::guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const {
   if (!A.allFinite())
     throw NumericalError(std::string("non-finite ") + what + " (the explicit coupling became unstable)",
-                         "reduce the time step dt", t);
+                         "reduce the time step " + opt_.dt_key, t);
 }
 
 IbStepStats IbSolver::step(IbState& s, double dt) {
-  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError("dt", num(dt), "a positive time step in s");
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(opt_.dt_key, num(dt), "a positive time step in s");
   IbStepStats st;
+  using clock = std::chrono::steady_clock;
+  auto tic = clock::now();
+  auto lap = [&](double& acc) {
+    const auto now = clock::now();
+    acc += std::chrono::duration<double>(now - tic).count();
+    tic = now;
+  };
   const Eigen::Matrix3Xd accel = (s.V - s.V_prev) / dt;
   VectorField f(grid_);
   VectorField u = s.u;
@@ -60,27 +68,38 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
 
   Eigen::Matrix3Xd F = fluid_force(s.X, s.t, accel);
   guard_finite(F, "membrane force", s.t);
+  lap(st.time_forces);
   if (opt_.scheme == IbScheme::ForwardEuler) {
     spread(grid_, s.X, F, f);
+    lap(st.time_spread);
     const StokesStats ss = stokes_.step(u, f, dt);
+    lap(st.time_fluid);
     st.stokes_iterations = ss.iterations;
     st.max_divergence = ss.max_divergence;
     interpolate(grid_, u, s.X, U);
+    lap(st.time_interp);
     Xnew = s.X + dt * U;
   } else {
     spread(grid_, s.X, F, f);
+    lap(st.time_spread);
     VectorField uh = s.u;
     const StokesStats s1 = stokes_.step(uh, f, 0.5 * dt);
+    lap(st.time_fluid);
     interpolate(grid_, uh, s.X, U);
+    lap(st.time_interp);
     guard_finite(U, "node velocity", s.t);
     const Eigen::Matrix3Xd Xh = s.X + 0.5 * dt * U;
     F = fluid_force(Xh, s.t + 0.5 * dt, accel);
     guard_finite(F, "membrane force", s.t);
+    lap(st.time_forces);
     spread(grid_, Xh, F, f);
+    lap(st.time_spread);
     const StokesStats s2 = stokes_.step(u, f, dt);
+    lap(st.time_fluid);
     st.stokes_iterations = s1.iterations + s2.iterations;
     st.max_divergence = s2.max_divergence;
     interpolate(grid_, u, Xh, U);
+    lap(st.time_interp);
     Xnew = s.X + dt * U;
   }
   guard_finite(U, "node velocity", s.t);
@@ -90,17 +109,17 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   if (st.cfl > opt_.max_cfl)
     throw NumericalError("advective CFL number " + num(st.cfl) + " exceeds " + num(opt_.max_cfl) +
                              " (nodes move " + num(st.cfl) + " cells per step)",
-                         "reduce the time step dt", s.t);
+                         "reduce the time step " + opt_.dt_key, s.t);
   st.max_edge = max_edge_length(mesh_, Xnew);
   if (opt_.check_no_leak && !(st.max_edge < 0.5 * grid_.h()))
     throw NumericalError("membrane edge of " + num(st.max_edge) + " m exceeds h/2 = " + num(0.5 * grid_.h()) +
                              " m after this step (was " + num(max_edge_length(mesh_, s.X)) +
                              " m): the fluid would leak through the membrane",
-                         "reduce the time step dt if the edge jumped in one step, otherwise refine the membrane",
+                         "reduce the time step " + opt_.dt_key + " if the edge jumped in one step, otherwise refine the membrane",
                          s.t + dt);
   if (!u.all_finite())
     throw NumericalError("non-finite fluid velocity (the explicit coupling became unstable)",
-                         "reduce the time step dt", s.t);
+                         "reduce the time step " + opt_.dt_key, s.t);
   s.X = std::move(Xnew);
   s.V_prev = std::move(s.V);
   s.V = std::move(U);

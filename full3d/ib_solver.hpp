@@ -21,6 +21,7 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <string>
 
 #include "full3d/grid.hpp"
 #include "full3d/membrane.hpp"
@@ -34,6 +35,7 @@ struct IbOptions {
   IbScheme scheme = IbScheme::ForwardEuler;
   double max_cfl = 0.5;       ///< max |U| dt / h allowed
   bool check_no_leak = true;  ///< enforce max edge < h/2 after every step
+  std::string dt_key = "dt";  ///< name of the time step in remedies (the run driver passes "full3d.dt")
   StokesOptions stokes{};
 };
 
@@ -51,6 +53,11 @@ struct IbStepStats {
   int stokes_iterations = 0;
   double max_divergence = 0.0;  ///< 1/s
   double max_edge = 0.0;        ///< m
+  // wall time of the parts of this step, s (for swim bench)
+  double time_forces = 0.0;     ///< membrane + actuation forces
+  double time_spread = 0.0;     ///< spreading (eq. 19)
+  double time_fluid = 0.0;      ///< Stokes solves
+  double time_interp = 0.0;     ///< interpolation (eq. 20)
 };
 
 /// External (actuation) force per node, N: f(t, X) -> 3 x N_n.
@@ -75,6 +82,7 @@ class IbSolver {
   const MacGrid& grid() const { return grid_; }
   const CylinderMesh& mesh() const { return mesh_; }
   StokesSolver& stokes() { return stokes_; }
+  const IbOptions& options() const { return opt_; }
 
  private:
   void guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const;

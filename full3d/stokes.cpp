@@ -1,7 +1,9 @@
 #include "full3d/stokes.hpp"
 
 #include <cmath>
+#include <algorithm>
 #include <complex>
+#include <limits>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -67,30 +69,54 @@ class DiagonalSolver {
 
   void solve(const std::vector<double>& r, std::vector<double>& x, double alpha, double beta) {
     const int n0 = dirs_[0].n, n1 = dirs_[1].n, n2 = dirs_[2].n;
-    const int f0 = dirs_[0].first, f1 = dirs_[1].first, f2 = dirs_[2].first;
+    const int f1 = dirs_[1].first, f2 = dirs_[2].first;  // x is periodic: no skipped face
+    const double* in = r.data();
+    double* b = buf_.data();
     for (int k = 0; k < n2; ++k)
       for (int j = 0; j < n1; ++j)
-        for (int i = 0; i < n0; ++i)
-          buf_[(std::size_t(k) * n1 + j) * n0 + i] = r[MacGrid::index(dims_, i + f0, j + f1, k + f2)];
+        std::copy_n(in + MacGrid::index(dims_, 0, j + f1, k + f2), n0, b + (std::size_t(k) * n1 + j) * n0);
     fwd_.execute();
+    const std::vector<double>& inv = inverse_denominators(alpha, beta);
+    const std::size_t nn = inv.size();
+    for (std::size_t m = 0; m < nn; ++m) b[m] *= inv[m];
+    bwd_.execute();
+    if (x.size() != r.size()) x.assign(r.size(), 0.0);
+    double* out = x.data();
+    if (f1 || f2) std::fill(x.begin(), x.end(), 0.0);  // wall faces
+    for (int k = 0; k < n2; ++k)
+      for (int j = 0; j < n1; ++j)
+        std::copy_n(b + (std::size_t(k) * n1 + j) * n0, n0, out + MacGrid::index(dims_, 0, j + f1, k + f2));
+  }
+
+ private:
+  // 1 / ((alpha + beta Lambda) N) per mode (0 for a zero denominator); two (alpha, beta)
+  // pairs are cached (the midpoint IB scheme alternates dt/2 and dt).
+  const std::vector<double>& inverse_denominators(double alpha, double beta) {
+    for (auto& c : cache_)
+      if (!c.inv.empty() && c.alpha == alpha && c.beta == beta) return c.inv;
+    Cached& c = cache_[next_];
+    next_ = 1 - next_;
+    const int n0 = dirs_[0].n, n1 = dirs_[1].n, n2 = dirs_[2].n;
+    c.alpha = alpha;
+    c.beta = beta;
+    c.inv.resize(std::size_t(n0) * n1 * n2);
     for (int k = 0; k < n2; ++k)
       for (int j = 0; j < n1; ++j) {
         const double lzy = dirs_[2].lambda[k] + dirs_[1].lambda[j];
         for (int i = 0; i < n0; ++i) {
           const double den = (alpha + beta * (lzy + dirs_[0].lambda[i])) * norm_;
-          double& b = buf_[(std::size_t(k) * n1 + j) * n0 + i];
-          b = den != 0.0 ? b / den : 0.0;
+          c.inv[(std::size_t(k) * n1 + j) * n0 + i] = den != 0.0 ? 1.0 / den : 0.0;
         }
       }
-    bwd_.execute();
-    x.assign(r.size(), 0.0);
-    for (int k = 0; k < n2; ++k)
-      for (int j = 0; j < n1; ++j)
-        for (int i = 0; i < n0; ++i)
-          x[MacGrid::index(dims_, i + f0, j + f1, k + f2)] = buf_[(std::size_t(k) * n1 + j) * n0 + i];
+    return c.inv;
   }
+  struct Cached {
+    double alpha = 0, beta = 0;
+    std::vector<double> inv;
+  };
+  std::array<Cached, 2> cache_;
+  int next_ = 0;
 
- private:
   std::array<int, 3> dims_;
   std::array<DirSpec, 3> dirs_;
   FftwBuffer buf_;
@@ -128,11 +154,21 @@ struct StokesSolver::Impl {
   // Square duct
   std::vector<DiagonalSolver> helmholtz;  // one per velocity component
   std::unique_ptr<DiagonalSolver> poisson;
+  double lambda_min = 0.0;  // smallest nonzero eigenvalue of -DG, 1/m^2
+  // Cylinder (fictitious domain): constraint rows and multiplier (warm-started)
+  std::unique_ptr<VelocityConstraints> con;
+  std::vector<double> lam;
+  // scratch
+  VectorField wb, w1, w2, uc;
+  ScalarField rp, zp, dp, sdp, div, phi;
+  std::vector<double> rl, zl, dl, sdl;
 
   Impl(const MacGrid& g, const FluidParams& f, const StokesOptions& o) : grid(g), fluid(f), opt(o), p(g) {
     if (!(f.rho > 0.0)) throw InputError("fluid.rho", std::to_string(f.rho), "a positive density in kg/m^3");
     if (!(f.mu > 0.0)) throw InputError("fluid.mu", std::to_string(f.mu), "a positive dynamic viscosity in Pa s");
     const int nx = g.nx(), ny = g.ny(), nz = g.nz();
+    if (g.kind() == ContainerKind::PeriodicBox && o.cylinder.enabled)
+      throw InputError("container", to_string(g.kind()), "the circular cylinder needs a square_duct grid");
     if (g.kind() == ContainerKind::PeriodicBox) {
       const std::size_t nc = std::size_t(nz) * ny * (nx / 2 + 1);
       for (int c = 0; c < 3; ++c) {
@@ -156,6 +192,15 @@ struct StokesSolver::Impl {
           std::array<DirSpec, 3>{make_dir(Bc::Periodic, nx, h), make_dir(Bc::NeumannCentred, ny, h),
                                  make_dir(Bc::NeumannCentred, nz, h)},
           o.fft);
+      const double c4 = 4.0 / (h * h);
+      lambda_min = std::min(c4 * std::pow(std::sin(kPi / (2.0 * ny)), 2), c4 * std::pow(std::sin(kPi / (2.0 * nz)), 2));
+      if (nx > 1) lambda_min = std::min(lambda_min, c4 * std::pow(std::sin(kPi / nx), 2));
+      for (auto* v : {&wb, &w1, &w2, &uc}) *v = VectorField(g);
+      for (auto* v : {&rp, &zp, &dp, &sdp, &div, &phi}) *v = ScalarField(g);
+      if (o.cylinder.enabled) {
+        con = std::make_unique<VelocityConstraints>(g, o.cylinder);
+        lam.assign(con->rows(), 0.0);
+      }
     }
   }
 
@@ -203,120 +248,141 @@ struct StokesSolver::Impl {
     c2r.execute_c2r(pspec.complex(), real[0].data());
     for (std::size_t m = 0; m < n; ++m) p.v[m] = real[0][m];
     StokesStats st;
-    ScalarField div(grid);
-    divergence(grid, u, div);
-    st.max_divergence = div.max_abs();
+    ScalarField dv(grid);
+    divergence(grid, u, dv);
+    st.max_divergence = dv.max_abs();
     return st;
   }
 
-  // ---- square duct -------------------------------------------------------------
+  // ---- square duct (and cylinder) ---------------------------------------------
   void apply_Ainv(const VectorField& r, VectorField& x, double alpha) {
     for (int c = 0; c < 3; ++c) helmholtz[c].solve(r.c[c], x.c[c], alpha, fluid.mu);
   }
-  // S q = -D A^{-1} G q
-  void apply_S(const ScalarField& q, ScalarField& out, double alpha, VectorField& w1, VectorField& w2) {
-    gradient(grid, q, w1);
-    apply_Ainv(w1, w2, alpha);
-    divergence(grid, w2, out);
-    for (double& x : out.v) x = -x;
+  // Preconditioner: M^{-1} = blockdiag(mu I + alpha (-DG)^{-1}  [Cahouet-Chabard],  E A E^T).
+  void apply_M(double alpha) {
+    if (alpha > opt.cc_poisson_drop_ratio * fluid.mu * lambda_min) {
+      poisson->solve(rp.v, zp.v, 0.0, 1.0);
+      for (std::size_t m = 0; m < zp.v.size(); ++m) zp.v[m] = alpha * zp.v[m] + fluid.mu * rp.v[m];
+    } else {  // quasi-steady: alpha (-DG)^{-1} is below the drop ratio times mu
+      for (std::size_t m = 0; m < zp.v.size(); ++m) zp.v[m] = fluid.mu * rp.v[m];
+    }
+    remove_mean(zp.v);
+    if (con) con->apply_local_helmholtz(rl, zl, alpha, fluid.mu);
   }
-  // M^{-1} r = mu r + alpha (-DG)^{-1} r
-  void apply_M(const ScalarField& r, ScalarField& z, double alpha) {
-    poisson->solve(r.v, z.v, 0.0, 1.0);
-    for (std::size_t m = 0; m < z.v.size(); ++m) z.v[m] = alpha * z.v[m] + fluid.mu * r.v[m];
-    remove_mean(z.v);
-  }
-  // Makes u exactly discrete-divergence-free: u -= G phi with D G phi = D u. Returns phi.
-  void project(VectorField& u, ScalarField& phi, VectorField& w) {
-    ScalarField div(grid);
+  // Makes u exactly discrete-divergence-free: u -= G phi with D G phi = D u.
+  void project(VectorField& u) {
     divergence(grid, u, div);
     poisson->solve(div.v, phi.v, 0.0, 1.0);  // phi = (-DG)^{-1} div
     for (double& x : phi.v) x = -x;
-    gradient(grid, phi, w);
-    u.axpy(-1.0, w);
+    gradient(grid, phi, w1);
+    u.axpy(-1.0, w1);
   }
 
-  VectorField rhs(const VectorField& u, const VectorField& f, double alpha) {
-    VectorField b(grid);
+  void rhs_into(VectorField& b, const VectorField& u, const VectorField& f, double alpha) {
     for (int c = 0; c < 3; ++c)
       for (std::size_t m = 0; m < b.c[c].size(); ++m) b.c[c][m] = alpha * u.c[c][m] + f.c[c][m];
     zero_wall_faces(grid, b);
-    return b;
+  }
+  static double norm2(const VectorField& v) {
+    double s = 0.0;
+    for (const auto& a : v.c) s += dot(a, a);
+    return std::sqrt(s);
+  }
+  // residual of the constraints on uc: r = (G^T uc, E uc) = (-D uc, E uc)
+  void constraint_residual(const VectorField& v, ScalarField& outp, std::vector<double>& outl) {
+    divergence(grid, v, outp);
+    for (double& x : outp.v) x = -x;
+    if (con) con->gather(v, outl);
+  }
+  double scaled_norm() const {
+    const double h = grid.h();
+    return std::sqrt(h * h * dot(rp.v, rp.v) + (con ? dot(rl, rl) : 0.0));
   }
 
+  // Solves A u + G p + E^T lam = b, D u = 0, E u = 0 (no E without the cylinder) by PCG
+  // on the multipliers y = (p, lam): K^T A^{-1} K y = K^T A^{-1} b with K = [G, E^T].
+  // The unprojected velocity uc = A^{-1}(b - K y) is updated alongside, so each
+  // iteration costs one K, one A^{-1} (three transforms pairs) and one K^T.
   StokesStats duct_step(VectorField& u, const VectorField& f, double dt) {
     const double alpha = fluid.rho / dt;
-    const VectorField b = rhs(u, f, alpha);
-    VectorField w1(grid), w2(grid);
+    rhs_into(wb, u, f, alpha);
     StokesStats st;
-    // rhs of the Schur system: -D A^{-1} b
-    ScalarField g(grid);
-    apply_Ainv(b, w1, alpha);
-    divergence(grid, w1, g);
-    for (double& x : g.v) x = -x;
-    const double gnorm = std::sqrt(dot(g.v, g.v));
-    ScalarField r(grid), z(grid), d(grid), Sd(grid);
     remove_mean(p.v);
-    apply_S(p, Sd, alpha, w1, w2);
-    for (std::size_t m = 0; m < r.v.size(); ++m) r.v[m] = g.v[m] - Sd.v[m];
-    double rnorm = std::sqrt(dot(r.v, r.v));
-    const double ref = gnorm > 0.0 ? gnorm : 1.0;
-    if (gnorm == 0.0 && rnorm == 0.0) {
-      std::fill(p.v.begin(), p.v.end(), 0.0);
-    } else {
-      apply_M(r, z, alpha);
-      d = z;
-      double rz = dot(r.v, z.v);
-      int it = 0;
-      while (rnorm > opt.cg_rtol * ref) {
-        if (it >= opt.cg_max_iterations)
-          throw NumericalError("Stokes pressure PCG did not converge in " + std::to_string(it) +
-                                   " iterations (relative residual " + std::to_string(rnorm / ref) + ")",
-                               "raise stokes.cg_max_iterations or loosen stokes.cg_rtol");
-        apply_S(d, Sd, alpha, w1, w2);
-        const double a = rz / dot(d.v, Sd.v);
-        for (std::size_t m = 0; m < r.v.size(); ++m) {
-          p.v[m] += a * d.v[m];
-          r.v[m] -= a * Sd.v[m];
-        }
-        rnorm = std::sqrt(dot(r.v, r.v));
-        apply_M(r, z, alpha);
-        const double rz_new = dot(r.v, z.v);
-        const double beta = rz_new / rz;
-        rz = rz_new;
-        for (std::size_t m = 0; m < d.v.size(); ++m) d.v[m] = z.v[m] + beta * d.v[m];
-        ++it;
-      }
-      st.iterations = it;
-    }
-    st.relative_residual = rnorm / ref;
-    // velocity from the converged pressure, then the exact final projection
     gradient(grid, p, w1);
     for (int c = 0; c < 3; ++c)
-      for (std::size_t m = 0; m < w1.c[c].size(); ++m) w1.c[c][m] = b.c[c][m] - w1.c[c][m];
-    apply_Ainv(w1, u, alpha);
-    ScalarField phi(grid);
-    project(u, phi, w1);
+      for (std::size_t m = 0; m < w1.c[c].size(); ++m) w1.c[c][m] = wb.c[c][m] - w1.c[c][m];
+    if (con) con->scatter_add(lam, -1.0, w1);
+    apply_Ainv(w1, uc, alpha);
+    constraint_residual(uc, rp, rl);
+    const double ref0 = norm2(uc);
+    double rnorm = scaled_norm();
+    double ref = std::max(ref0, std::numeric_limits<double>::min());
+    int it = 0;
+    if (rnorm > opt.cg_rtol * ref) {
+      apply_M(alpha);
+      dp = zp;
+      dl = zl;
+      double rz = dot(rp.v, zp.v) + (con ? dot(rl, zl) : 0.0);
+      while (true) {
+        if (it >= opt.cg_max_iterations)
+          throw NumericalError("Stokes multiplier PCG did not converge in " + std::to_string(it) +
+                                   " iterations (relative residual " + std::to_string(rnorm / ref) + ")",
+                               "raise stokes.cg_max_iterations or loosen stokes.cg_rtol");
+        gradient(grid, dp, w1);
+        if (con) con->scatter_add(dl, 1.0, w1);
+        apply_Ainv(w1, w2, alpha);
+        constraint_residual(w2, sdp, sdl);
+        const double dSd = dot(dp.v, sdp.v) + (con ? dot(dl, sdl) : 0.0);
+        if (!(dSd > 0.0)) break;  // exact solution reached (or breakdown at round-off)
+        const double a = rz / dSd;
+        for (std::size_t m = 0; m < p.v.size(); ++m) {
+          p.v[m] += a * dp.v[m];
+          rp.v[m] -= a * sdp.v[m];
+        }
+        if (con)
+          for (std::size_t m = 0; m < lam.size(); ++m) {
+            lam[m] += a * dl[m];
+            rl[m] -= a * sdl[m];
+          }
+        uc.axpy(-a, w2);
+        ++it;
+        rnorm = scaled_norm();
+        ref = std::max(ref0, norm2(uc));
+        if (rnorm <= opt.cg_rtol * ref) break;
+        apply_M(alpha);
+        const double rz_new = dot(rp.v, zp.v) + (con ? dot(rl, zl) : 0.0);
+        const double beta = rz_new / rz;
+        rz = rz_new;
+        for (std::size_t m = 0; m < dp.v.size(); ++m) dp.v[m] = zp.v[m] + beta * dp.v[m];
+        if (con)
+          for (std::size_t m = 0; m < dl.size(); ++m) dl[m] = zl[m] + beta * dl[m];
+      }
+    }
+    st.iterations = it;
+    st.relative_residual = rnorm / ref;
+    // velocity of the converged multipliers, then the exact final projection
+    for (int c = 0; c < 3; ++c) u.c[c] = uc.c[c];
+    project(u);
     zero_wall_faces(grid, u);
-    ScalarField div(grid);
     divergence(grid, u, div);
     st.max_divergence = div.max_abs();
+    if (con) {
+      con->gather(u, rl);
+      for (double x : rl) st.max_constraint = std::max(st.max_constraint, std::abs(x));
+    }
     return st;
   }
 
   StokesStats duct_bare(VectorField& u, const VectorField& f, double dt) {
     const double alpha = fluid.rho / dt;
-    VectorField b = rhs(u, f, alpha);
-    VectorField w(grid);
-    gradient(grid, p, w);
-    b.axpy(-1.0, w);
-    apply_Ainv(b, u, alpha);
-    ScalarField phi(grid);
-    project(u, phi, w);
+    rhs_into(wb, u, f, alpha);
+    gradient(grid, p, w1);
+    wb.axpy(-1.0, w1);
+    apply_Ainv(wb, u, alpha);
+    project(u);
     zero_wall_faces(grid, u);
     for (std::size_t m = 0; m < p.v.size(); ++m) p.v[m] += alpha * phi.v[m];
     StokesStats st;
-    ScalarField div(grid);
     divergence(grid, u, div);
     st.max_divergence = div.max_abs();
     return st;
@@ -337,7 +403,12 @@ void check_dt(double dt) {
 
 StokesStats StokesSolver::step(VectorField& u, const VectorField& f, double dt) {
   check_dt(dt);
-  return impl_->grid.kind() == ContainerKind::PeriodicBox ? impl_->box_step(u, f, dt) : impl_->duct_step(u, f, dt);
+  double cfl = 0.0;
+  if (impl_->opt.advection.enabled) cfl = advect(impl_->grid, u, dt, impl_->opt.advection);  // module (28)
+  StokesStats st =
+      impl_->grid.kind() == ContainerKind::PeriodicBox ? impl_->box_step(u, f, dt) : impl_->duct_step(u, f, dt);
+  st.advection_cfl = cfl;
+  return st;
 }
 
 StokesStats StokesSolver::bare_fft_solve(VectorField& u, const VectorField& f, double dt) {
@@ -346,6 +417,8 @@ StokesStats StokesSolver::bare_fft_solve(VectorField& u, const VectorField& f, d
 }
 
 const ScalarField& StokesSolver::pressure() const { return impl_->p; }
+const VelocityConstraints* StokesSolver::constraints() const { return impl_->con.get(); }
+const std::vector<double>& StokesSolver::multiplier() const { return impl_->lam; }
 const MacGrid& StokesSolver::grid() const { return impl_->grid; }
 const FluidParams& StokesSolver::fluid() const { return impl_->fluid; }
 

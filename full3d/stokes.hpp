@@ -24,11 +24,23 @@
 //   the coupled system is solved on the pressure Schur complement
 //     S p = -D A^{-1} b,  S = -D A^{-1} G  (SPD on zero-mean p)
 //   by preconditioned conjugate gradients with the Cahouet-Chabard
-//   preconditioner M^{-1} = mu I + (rho/dt) (-D G)^{-1} (exact for the box);
-//   every inner solve is one fast transform. The velocity u = A^{-1}(b - G p)
-//   is then made exactly discrete-divergence-free by one final Neumann
-//   projection u -= G phi, D G phi = D u; the momentum residual this leaves is
-//   O(CG tolerance). Pressure is warm-started from the previous step.
+//   preconditioner M^{-1} = mu I + (rho/dt) (-D G)^{-1} (exact for the box; the
+//   Poisson term is dropped in the quasi-steady regime, see cc_poisson_drop_ratio);
+//   every inner solve is one fast transform. The unprojected velocity
+//   u_k = A^{-1}(b - G p_k) is updated alongside the iterate, then made exactly
+//   discrete-divergence-free by one final Neumann projection u -= G phi,
+//   D G phi = D u; the momentum residual this leaves is O(CG tolerance).
+//   Pressure (and multiplier) are warm-started from the previous step.
+//
+// Cylinder (StokesOptions::cylinder, duct only; container.hpp): the paper's
+//   fictitious domain with a distributed Lagrange multiplier lam on linear
+//   velocity rows E u = 0 (the faces outside the cylinder):
+//     A u + G p + E^T lam = b,  D u = 0,  E u = 0,
+//   solved by the same PCG on y = (p, lam) with K = [G, E^T]:
+//     K^T A^{-1} K y = K^T A^{-1} b,  preconditioner blockdiag(Cahouet-Chabard, E A E^T).
+//
+// Advection (StokesOptions::advection; advection.hpp): when enabled, step()
+//   first runs the explicit Navier-Stokes sub-step (28) on u^n, then the Stokes step.
 //
 // bare_fft_solve(): the transform-only variant used for benchmarking. Box: the
 //   same exact solve. Duct: one incremental pressure-correction step
@@ -38,6 +50,8 @@
 
 #include <memory>
 
+#include "full3d/advection.hpp"
+#include "full3d/container.hpp"
 #include "full3d/fft.hpp"
 #include "full3d/grid.hpp"
 
@@ -50,14 +64,27 @@ struct FluidParams {
 
 struct StokesOptions {
   FftOptions fft{};
-  double cg_rtol = 1e-10;     ///< duct: relative residual ||D A^{-1}(b - G p)|| / ||D A^{-1} b||
+  /// duct: the PCG stops when the constraint residual of the unprojected velocity u_k,
+  /// sqrt(h^2 ||D u_k||^2 + ||E u_k||^2), is below cg_rtol * max(||u_k||, ||u_0||)
+  /// (u_0: the velocity of the warm-started multipliers), Euclidean norms over the grid.
+  double cg_rtol = 1e-10;
   int cg_max_iterations = 500;
+  /// Cahouet-Chabard M^{-1} = mu I + alpha (-DG)^{-1}: the Poisson term is dropped when
+  /// alpha / (mu lambda_min(-DG)) < this ratio (quasi-steady regime, where it changes M by
+  /// less than the ratio); 0 keeps it always.
+  double cc_poisson_drop_ratio = 1e-2;
+  /// The paper's rigid circular container inside the duct (container.hpp); duct only.
+  CylinderOptions cylinder{};
+  /// Navier-Stokes advection sub-step (28) before the Stokes step (advection.hpp).
+  AdvectionOptions advection{};
 };
 
 struct StokesStats {
   int iterations = 0;          ///< PCG iterations (0 for the box)
   double relative_residual = 0.0;
   double max_divergence = 0.0;  ///< max |D u^{n+1}| after the step, 1/s
+  double max_constraint = 0.0;  ///< cylinder: max |E u^{n+1}| (velocity outside / on the wall), m/s
+  double advection_cfl = 0.0;   ///< CFL number of the advection sub-step (0 when off)
 };
 
 class StokesSolver {
@@ -74,8 +101,11 @@ class StokesSolver {
   /// Transform-only solve (see header comment).
   StokesStats bare_fft_solve(VectorField& u, const VectorField& f, double dt);
 
-  /// Pressure of the last step, Pa (zero mean).
+  /// Pressure of the last step, Pa (zero mean; arbitrary in fully masked cylinder cells).
   const ScalarField& pressure() const;
+  /// Cylinder: the constraint rows and the multiplier of the last step (N/m^3 per row).
+  const VelocityConstraints* constraints() const;
+  const std::vector<double>& multiplier() const;
   const MacGrid& grid() const;
   const FluidParams& fluid() const;
 

@@ -17,6 +17,10 @@
 #include <sunmatrix/sunmatrix_band.h>
 
 #include <algorithm>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <cmath>
 #include <memory>
@@ -33,6 +37,13 @@ namespace swim::reduced1d::detail {
 namespace {
 
 using disc::pi;
+double g_rhs_ns = 0, g_root_ns = 0;
+struct Reporter { ~Reporter() { if (std::getenv("SWIM1D_TIMES")) std::fprintf(stderr, "rhs %.4f s root %.4f s\n", g_rhs_ns, g_root_ns); } } g_rep;
+
+/// Maximum BDF order of CVODE and IDA (docs/reduced1d.md, "Integrator settings").
+constexpr int kMaxOrder = 5;
+/// First step after a protocol switch as a fraction of the step in use before it.
+constexpr double kRestartStepFraction = 1e-1;
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -43,18 +54,38 @@ std::string fmt(double v) {
 
 // ---------------------------------------------------------------------------------------
 // Spatial model shared by both integrators.
+//
+// Actuation of cell i: q_i = law_i(R_i) + sum_k f_ik qs_k(Rbar_k), where law_i is the cell's
+// own law (active, idle, recovery), qs_k the law of a held segment k on its length-weighted
+// mean radius Rbar_k = sum_i f_ik R_i / W_k, and f_ik the length fraction of cell i in
+// segment k. An open end takes the actuation of its end cell at its own radius (quasi-static:
+// C1 (R_b - R0) + q = 0), so a held end segment moves the end radius with qs_k.
+//
+// Jacobian of the inertia-free right-hand side f(y): tridiagonal part (own laws, fluxes,
+// V_rear/V_front, D-X block) plus one rank-1 term U_k V_k^T per held segment (the segment
+// law couples every cell of the segment). jacobian() fills both exactly.
 struct ForceModel {
   int N;
   double L, h, R0, C1, m, mu;
   bool inertia, flow_closure;
   disc::BalanceCoefficients bal;
-  int stride;          // unknowns per cell: 1 (R) or 3 (R, V, p)
+  int stride;          // unknowns per cell: 1 (a) or 3 (a, V, p)
   int iD, iX, iVr, iVf, n;  // extras and total size
   double T_s, D_s, X_s, V_s, Vel_s, P_s;
-  // actuation law of every cell (fixed between protocol events) and the end radii
+  // actuation laws (fixed between protocol events)
   std::vector<ProtocolMachine::CellLaw> law;
-  std::vector<double> q;  // actuation at the last unpack
+  std::vector<const ActuationLaw*> seg_law;
+  std::vector<int> seg_a, seg_b;
+  std::vector<double> frac, seg_w;
+  std::vector<int> seg_first, seg_last;
+  int nseg = 0;
+  bool end0_seg = false, endL_seg = false;  // end radius follows a segment law
+  double Rb0_static, RbL_static;
+  // state-dependent quantities at the last unpack
+  std::vector<double> q, dq;          // total actuation and d(own law)/dR per cell
+  std::vector<double> Rbar, qs, dqs;  // per segment (only where seg_law != nullptr)
   double Rb0, RbL;
+  bool freeze_segments = false;  // reuse qs and the end radii (difference quotients)
   // workspace
   std::vector<double> R, V, p, r, Q;
 
@@ -70,7 +101,10 @@ struct ForceModel {
         flow_closure(P.swimmer.closure == Closure::Flow),
         bal(disc::BalanceCoefficients::from(P)),
         stride(P.wall.inertia ? 3 : 1),
+        Rb0_static(R0),
+        RbL_static(R0),
         q(N, 0.0),
+        dq(N, 0.0),
         Rb0(R0),
         RbL(R0),
         R(N),
@@ -95,13 +129,40 @@ struct ForceModel {
     P_s = C1 * R0;
   }
 
-  /// Install the cells' actuation laws; the end radii follow from the tube law at p = 0 with
-  /// the end cell's law (quasi-static open end).
-  void set_actuation(const std::vector<ProtocolMachine::CellLaw>& laws) {
+  /// Install the actuation laws of the current protocol state.
+  void set_actuation(const ProtocolMachine& mc, const std::vector<ProtocolMachine::CellLaw>& laws,
+                     const std::vector<const ActuationLaw*>& seg_laws) {
     law = laws;
+    seg_law = seg_laws;
+    nseg = int(seg_law.size());
+    seg_a = mc.seg_a();
+    seg_b = mc.seg_b();
+    frac = mc.frac();
+    seg_w = mc.seg_weight();
+    seg_first.resize(nseg);
+    seg_last.resize(nseg);
+    for (int k = 0; k < nseg; ++k) {
+      seg_first[k] = mc.seg_first(k);
+      seg_last[k] = mc.seg_last(k);
+    }
+    Rbar.assign(nseg, 0.0);
+    qs.assign(nseg, 0.0);
+    dqs.assign(nseg, 0.0);
     // The end cells lie inside the first/last segment (h <= shortest segment): pure laws.
-    Rb0 = law[0].a->rest_radius(R0, C1);
-    RbL = law[N - 1].a->rest_radius(R0, C1);
+    end0_seg = seg_law[seg_a[0]] != nullptr;
+    endL_seg = seg_law[seg_a[N - 1]] != nullptr;
+    Rb0_static = law[0].a->rest_radius(R0, C1);
+    RbL_static = law[N - 1].a->rest_radius(R0, C1);
+    Rb0 = Rb0_static;
+    RbL = RbL_static;
+  }
+
+  /// Extreme end radii the current laws can produce (for the collapse check at a switch).
+  void end_radius_range(double& lo0, double& loL) const {
+    lo0 = Rb0_static;
+    loL = RbL_static;
+    if (end0_seg) lo0 = law[0].a->rest_radius(R0, C1, seg_law[seg_a[0]]->operator()(1e300));
+    if (endL_seg) loL = law[N - 1].a->rest_radius(R0, C1, seg_law[seg_a[N - 1]]->operator()(1e300));
   }
 
   /// Unpack radii (and V, p) from the scaled state; p from the tube law without inertia.
@@ -111,14 +172,33 @@ struct ForceModel {
     for (int i = 0; i < N; ++i) {
       const double a = y[1 + stride * i];
       if (!(a > 0) || !std::isfinite(a)) ok = false;
-      const double Ri = R0 * std::sqrt(std::max(a, 1e-300));
-      R[i] = Ri;
-      q[i] = law[i](Ri);
+      R[i] = R0 * std::sqrt(std::max(a, 1e-300));
+    }
+    if (!freeze_segments) {
+      for (int k = 0; k < nseg; ++k) {
+        if (!seg_law[k]) continue;
+        double s = 0;
+        for (int i = seg_first[k]; i <= seg_last[k]; ++i) {
+          if (seg_a[i] == k) s += frac[i] * R[i];
+          if (seg_b[i] == k && seg_b[i] != seg_a[i]) s += (1.0 - frac[i]) * R[i];
+        }
+        Rbar[k] = s / seg_w[k];
+        qs[k] = seg_law[k]->eval(Rbar[k], dqs[k]);
+      }
+      if (end0_seg) Rb0 = law[0].a->rest_radius(R0, C1, qs[seg_a[0]]);
+      if (endL_seg) RbL = law[N - 1].a->rest_radius(R0, C1, qs[seg_a[N - 1]]);
+    }
+    for (int i = 0; i < N; ++i) {
+      const double Ri = R[i];
+      double qi = law[i].eval(Ri, dq[i]);
+      if (seg_law[seg_a[i]]) qi += frac[i] * qs[seg_a[i]];
+      if (seg_b[i] != seg_a[i] && seg_law[seg_b[i]]) qi += (1.0 - frac[i]) * qs[seg_b[i]];
+      q[i] = qi;
       if (inertia) {
         V[i] = Vel_s * y[3 * i + 2];
         p[i] = P_s * y[3 * i + 3];
       } else {
-        p[i] = C1 * (Ri - R0) + q[i];
+        p[i] = C1 * (Ri - R0) + qi;
       }
     }
     return ok;
@@ -134,6 +214,15 @@ struct ForceModel {
     }
     r[N] = disc::resistance(mu, 0.5 * h, R[N - 1], RbL);
     Q[N] = p[N - 1] / r[N];
+  }
+
+  /// d r / d a and d r / d b for the resistance r(d, a, b) of disc::resistance.
+  void dresistance(double d, double a, double b, double& ra, double& rb) const {
+    const double c = (8.0 * mu / pi) * d / 3.0;
+    const double a2 = a * a, b2 = b * b, ab = a * b;
+    const double a3b3 = a2 * a * b2 * b;
+    ra = -c * (a2 + 2.0 * ab + 3.0 * b2) / (a3b3 * a);
+    rb = -c * (b2 + 2.0 * ab + 3.0 * a2) / (a3b3 * b);
   }
 
   /// Swimmer integrals over the points {0, z_i, L} with radii {Rb0, R_i, RbL}.
@@ -184,6 +273,90 @@ struct ForceModel {
     return 0;
   }
 
+  /// Flux sensitivities at the current unpack/fluxes: dQ_j/dR_{j-1} (QL[j]) and dQ_j/dR_j (QR[j]),
+  /// through the pressures' own-law dependence and the resistances; QP*: dQ_j/dp_{j-1}, dQ_j/dp_j;
+  /// Qb0 = dQ_0/dRb0, QbL = dQ_N/dRbL.
+  struct FluxSens {
+    std::vector<double> QL, QR;
+    double Qb0 = 0, QbL = 0;
+  };
+  void flux_sensitivities(FluxSens& s, bool with_pressure) const {
+    s.QL.assign(N + 1, 0.0);
+    s.QR.assign(N + 1, 0.0);
+    double ra, rb;
+    // face 0: Q_0 = -p_0 / r_0, r_0 = r(h/2, Rb0, R_0)
+    dresistance(0.5 * h, Rb0, R[0], ra, rb);
+    s.QR[0] = (with_pressure ? -(C1 + dq[0]) / r[0] : 0.0) - Q[0] / r[0] * rb;
+    s.Qb0 = -Q[0] / r[0] * ra;
+    for (int j = 1; j < N; ++j) {
+      dresistance(h, R[j - 1], R[j], ra, rb);
+      s.QL[j] = (with_pressure ? (C1 + dq[j - 1]) / r[j] : 0.0) - Q[j] / r[j] * ra;
+      s.QR[j] = (with_pressure ? -(C1 + dq[j]) / r[j] : 0.0) - Q[j] / r[j] * rb;
+    }
+    // face N: Q_N = p_{N-1} / r_N, r_N = r(h/2, R_{N-1}, RbL)
+    dresistance(0.5 * h, R[N - 1], RbL, ra, rb);
+    s.QL[N] = (with_pressure ? (C1 + dq[N - 1]) / r[N] : 0.0) - Q[N] / r[N] * ra;
+    s.QbL = -Q[N] / r[N] * rb;
+  }
+
+  /// Exact Jacobian of rhs() at y (after rhs-equivalent unpack/fluxes): the band part into
+  /// `band(i, j, v)` (|i - j| <= 1) and the rank-1 segment terms into U/V (column-major n x
+  /// rank, returns the rank). Entries of D and X with respect to the radii are outside the band
+  /// and left out (they do not feed back into the areas).
+  template <class Band>
+  int jacobian(const double* y, Band band, std::vector<double>& U, std::vector<double>& Vt) {
+    unpack(y);
+    fluxes();
+    FluxSens s;
+    flux_sensitivities(s, true);
+    const double c = 1.0 / (h * pi * R0 * R0);
+    for (int i = 0; i < N; ++i) {
+      const double dRda = 0.5 * R0 * R0 / R[i];
+      // f_i = c (Q_i - Q_{i+1}): Q_i depends on R_{i-1}, R_i; Q_{i+1} on R_i, R_{i+1}
+      band(1 + i, 1 + i, c * (s.QR[i] - s.QL[i + 1]) * dRda);
+      if (i > 0) band(1 + i, i, c * s.QL[i] * 0.5 * R0 * R0 / R[i - 1]);
+      if (i + 1 < N) band(1 + i, 2 + i, -c * s.QR[i + 1] * 0.5 * R0 * R0 / R[i + 1]);
+    }
+    band(iVr, 1, s.QR[0] * 0.5 * R0 * R0 / R[0] / V_s);
+    band(iVf, iVf - 1, s.QL[N] * 0.5 * R0 * R0 / R[N - 1] / V_s);
+    // W = (thrust - D - c_ext X) / m_eff
+    band(iX, iD, -D_s / (bal.m_eff * X_s));
+    band(iX, iX, -bal.c_ext / bal.m_eff);
+    // rank-1 terms: d f / d qs_k (per unit segment actuation) times d qs_k / d a
+    int rank = 0;
+    U.clear();
+    Vt.clear();
+    std::vector<double> dQ(N + 1);
+    for (int k = 0; k < nseg; ++k) {
+      if (!seg_law[k] || dqs[k] == 0.0) continue;
+      std::fill(dQ.begin(), dQ.end(), 0.0);
+      const int lo = seg_first[k], hi = seg_last[k];
+      auto u = [&](int i) -> double {  // dp_i / dqs_k
+        if (i < lo || i > hi) return 0.0;
+        double v = 0;
+        if (seg_a[i] == k) v += frac[i];
+        if (seg_b[i] == k && seg_b[i] != seg_a[i]) v += 1.0 - frac[i];
+        return v;
+      };
+      for (int j = std::max(lo, 0); j <= std::min(hi + 1, N); ++j) {
+        if (j == 0) dQ[0] = -u(0) / r[0];
+        else if (j == N) dQ[N] = u(N - 1) / r[N];
+        else dQ[j] = -(u(j) - u(j - 1)) / r[j];
+      }
+      if (end0_seg && seg_a[0] == k) dQ[0] += s.Qb0 * (-1.0 / C1);
+      if (endL_seg && seg_a[N - 1] == k) dQ[N] += s.QbL * (-1.0 / C1);
+      const std::size_t off = U.size();
+      U.resize(off + n, 0.0);
+      Vt.resize(off + n, 0.0);
+      for (int i = std::max(lo - 1, 0); i <= std::min(hi + 1, N - 1); ++i) U[off + 1 + i] = c * (dQ[i] - dQ[i + 1]);
+      U[off + iVr] = dQ[0] / V_s;
+      U[off + iVf] = dQ[N] / V_s;
+      for (int i = lo; i <= hi; ++i) Vt[off + 1 + i] = dqs[k] * u(i) / seg_w[k] * 0.5 * R0 * R0 / R[i];
+      ++rank;
+    }
+    return rank;
+  }
+
   // Residual with inertia (IDA).
   int res(const double* y, const double* yp, double* F) {
     if (!unpack(y)) return 1;
@@ -207,6 +380,46 @@ struct ForceModel {
     for (int k = 0; k < n; ++k)
       if (!std::isfinite(F[k])) return 1;
     return 0;
+  }
+
+  /// Rank-1 segment terms of the IDA residual Jacobian dF/dy (the band part is obtained by
+  /// difference quotients with the segment actuation frozen). Same layout as jacobian().
+  int residual_low_rank(const double* y, std::vector<double>& U, std::vector<double>& Vt) {
+    unpack(y);
+    fluxes();
+    FluxSens s;
+    flux_sensitivities(s, false);
+    const double cv = 1.0 / (m * Vel_s);
+    const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
+    int rank = 0;
+    U.clear();
+    Vt.clear();
+    for (int k = 0; k < nseg; ++k) {
+      if (!seg_law[k] || dqs[k] == 0.0) continue;
+      const std::size_t off = U.size();
+      U.resize(off + n, 0.0);
+      Vt.resize(off + n, 0.0);
+      const int lo = seg_first[k], hi = seg_last[k];
+      for (int i = lo; i <= hi; ++i) {
+        double u = 0;
+        if (seg_a[i] == k) u += frac[i];
+        if (seg_b[i] == k && seg_b[i] != seg_a[i]) u += 1.0 - frac[i];
+        U[off + 1 + 3 * i + 1] = cv * u;  // F_V = V' - cv (p - C1 (R - R0) - q)
+        Vt[off + 1 + 3 * i] = dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
+      }
+      if (endL_seg && seg_a[N - 1] == k) {  // Q_N depends on RbL = R0 - qs/C1
+        const double dQN = s.QbL * (-1.0 / C1);
+        U[off + 1 + 3 * (N - 1) + 2] += cp * dQN / h;
+        U[off + iVf] += -dQN / V_s;
+      }
+      if (end0_seg && seg_a[0] == k) {
+        const double dQ0 = s.Qb0 * (-1.0 / C1);
+        U[off + 1 + 2] += -cp * dQ0 / h;
+        U[off + iVr] += -dQ0 / V_s;
+      }
+      ++rank;
+    }
+    return rank;
   }
 };
 
@@ -250,6 +463,8 @@ struct Problem {
   ForceModel M;
   ProtocolMachine machine;
   RootEval roots;
+  sun::LowRankTerm low_rank;  // segment couplings of the Newton matrix
+  std::vector<double> ftmp, ytmp, yptmp, rtmp;  // Jacobian workspace
   Problem(const Params& P, std::vector<double> fixed_q) : M(P), machine(P, std::move(fixed_q)) {
     roots.M = &M;
     roots.machine = &machine;
@@ -301,17 +516,31 @@ class CvodeBackend final : public Backend {
     // Tridiagonal in the areas (V_rear/V_front included). D and X depend on all radii; those
     // couplings lie outside the band and are left out of the Newton matrix (they do not feed
     // back into the areas).
+    // Newton matrix: exact tridiagonal Jacobian (areas, V_rear/V_front, D-X block) plus the
+    // rank-1 couplings of the held segments, solved by band LU + Sherman-Morrison-Woodbury.
+    // D and X depend on all radii; those couplings are left out (they do not feed back).
     A_ = sun::make_band_matrix(M.n, 1, 1, ctx_.get());
-    LS_ = sun::make_band_solver(y_.get(), A_.get(), ctx_.get());
+    pb.low_rank.scale = &CvodeBackend::minus_gamma;
+    pb.low_rank.scale_ctx = this;
+    LS_ = sun::make_low_rank_band_solver(y_.get(), A_.get(), &pb.low_rank, ctx_.get());
     sun::check(CVodeSetLinearSolver(mem, LS_.get(), A_.get()), "CVodeSetLinearSolver");
+    sun::check(CVodeSetJacFn(mem, &CvodeBackend::jac), "CVodeSetJacFn");
     sun::check(CVodeSetNoInactiveRootWarn(mem), "CVodeSetNoInactiveRootWarn");
-    // BDF orders 1-2 are A-stable; the steep (regularised) actuation laws and the advective
-    // part of the flux Jacobian give eigenvalues off the real axis, where orders 3-5 stall.
-    sun::check(CVodeSetMaxOrd(mem, 2), "CVodeSetMaxOrd");
+    sun::check(CVodeSetMaxOrd(mem, std::getenv("MAXORD") ? std::atoi(std::getenv("MAXORD")) : kMaxOrder), "CVodeSetMaxOrd");
+    if (std::getenv("MSBJ")) CVodeSetJacEvalFrequency(mem, std::atoi(std::getenv("MSBJ")));
+    if (std::getenv("MSBP")) CVodeSetLSetupFrequency(mem, std::atoi(std::getenv("MSBP")));
+    if (std::getenv("NLIT")) CVodeSetMaxNonlinIters(mem, std::atoi(std::getenv("NLIT")));
+    if (std::getenv("STALD")) CVodeSetStabLimDet(mem, 1);
   }
   double* y() override { return sun::data(y_.get()); }
   void restart(double t) override {
+    // The step size in use before a switch is a good scale for the first step after it: the
+    // switch changes the actuation of one segment, and CVODE's own estimate from the new
+    // derivative is orders of magnitude smaller (about 200 steps per restart to recover).
+    double h_last = 0;
+    CVodeGetCurrentStep(mem_.get(), &h_last);
     sun::check(CVodeReInit(mem_.get(), t, y_.get()), "CVodeReInit", last_msg);
+    if (h_last > 0) sun::check(CVodeSetInitStep(mem_.get(), kRestartStepFraction * h_last), "CVodeSetInitStep");
   }
   void set_roots(int n) override {
     sun::check(CVodeRootInit(mem_.get(), n, &CvodeBackend::g), "CVodeRootInit");
@@ -334,6 +563,26 @@ class CvodeBackend final : public Backend {
     CVodeGetNumSteps(mem_.get(), &v);
     return v;
   }
+  void trace(double t, int phase, int active) {
+    long ns, nf, ne, nc, nj, nni; double hl; int q;
+    void* mem = mem_.get();
+    CVodeGetNumSteps(mem, &ns); CVodeGetNumRhsEvals(mem, &nf); CVodeGetNumErrTestFails(mem, &ne);
+    CVodeGetNumNonlinSolvConvFails(mem, &nc); CVodeGetNumJacEvals(mem, &nj); CVodeGetNumNonlinSolvIters(mem,&nni);
+    CVodeGetLastStep(mem, &hl); CVodeGetLastOrder(mem, &q);
+    {
+      N_Vector ele = N_VClone(y_.get()), ew = N_VClone(y_.get());
+      CVodeGetEstLocalErrors(mem, ele); CVodeGetErrWeights(mem, ew);
+      double* e = sun::data(ele); double* w = sun::data(ew); const long nn = N_VGetLength(ele);
+      std::vector<std::pair<double,int>> v; double ss = 0;
+      for (long k = 0; k < nn; ++k) { v.push_back({std::abs(e[k]*w[k]), int(k)}); ss += e[k]*w[k]*e[k]*w[k]; }
+      std::sort(v.rbegin(), v.rend());
+      std::printf("ERR wrms=%.3e top:", std::sqrt(ss/nn));
+      for (int k = 0; k < 6; ++k) std::printf(" %d:%.2e(y=%.6f)", v[k].second, v[k].first, sun::data(y_.get())[v[k].second]);
+      std::printf("\n");
+      N_VDestroy(ele); N_VDestroy(ew);
+    }
+    std::printf("TRACE t=%.5e ph=%d act=%d steps=%ld rhs=%ld etf=%ld ncf=%ld jac=%ld nni=%ld h=%.3e q=%d\n", t, phase, active, ns, nf, ne, nc, nj, nni, hl, q);
+  }
   void harvest(std::map<std::string, long>& s) override {
     void* mem = mem_.get();
     add(s, "steps", CVodeGetNumSteps, mem);
@@ -349,10 +598,32 @@ class CvodeBackend final : public Backend {
 
  private:
   static int f(double, N_Vector y, N_Vector yd, void* user) {
-    return static_cast<Problem*>(user)->M.rhs(sun::data(y), sun::data(yd));
+    auto t0 = std::chrono::steady_clock::now();
+    int r = static_cast<Problem*>(user)->M.rhs(sun::data(y), sun::data(yd));
+    g_rhs_ns += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  }
+  static int jac(double, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector, N_Vector) {
+    auto* pb = static_cast<Problem*>(user);
+    std::fill(SM_DATA_B(J), SM_DATA_B(J) + SM_LDATA_B(J), 0.0);  // (SUNMatZero is unoptimised)
+    const long nn = pb->M.n;
+    auto band = [J, nn](int i, int j, double v) {
+      if (i >= 0 && j >= 0 && i < nn && j < nn) SM_ELEMENT_B(J, i, j) = v;
+    };
+    pb->low_rank.rank = pb->M.jacobian(sun::data(y), band, pb->low_rank.U, pb->low_rank.V);
+    for (double v : pb->low_rank.U)
+      if (!std::isfinite(v)) return 1;
+    return 0;
+  }
+  static double minus_gamma(void* self) {
+    double g = 0;
+    CVodeGetCurrentGamma(static_cast<CvodeBackend*>(self)->mem_.get(), &g);
+    return -g;
   }
   static int g(double, N_Vector y, double* gout, void* user) {
+    auto t0 = std::chrono::steady_clock::now();
     static_cast<Problem*>(user)->roots.eval(sun::data(y), gout);
+    g_root_ns += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return 0;
   }
   Problem& pb_;
@@ -392,10 +663,12 @@ class IdaBackend final : public Backend {
     // Interleaved (a, V, p) per cell: the continuity row of cell i reaches a_{i-1} (5 below)
     // and p_{i+1} (3 above); V_rear (first) and V_front (after the cells) stay inside.
     A_ = sun::make_band_matrix(M.n, 3, 5, ctx_.get());
-    LS_ = sun::make_band_solver(y_.get(), A_.get(), ctx_.get());
+    pb.low_rank.scale = nullptr;  // IDA: J = dF/dy + cj dF/dy', the segment terms are in dF/dy
+    LS_ = sun::make_low_rank_band_solver(y_.get(), A_.get(), &pb.low_rank, ctx_.get());
     sun::check(IDASetLinearSolver(mem, LS_.get(), A_.get()), "IDASetLinearSolver");
+    sun::check(IDASetJacFn(mem, &IdaBackend::jac), "IDASetJacFn");
     sun::check(IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn");
-    sun::check(IDASetMaxOrd(mem, 2), "IDASetMaxOrd");  // see CvodeBackend
+    sun::check(IDASetMaxOrd(mem, kMaxOrder), "IDASetMaxOrd");
   }
   double* y() override { return sun::data(y_.get()); }
   void restart(double t) override {
@@ -452,6 +725,60 @@ class IdaBackend final : public Backend {
   static int F(double, N_Vector y, N_Vector yp, N_Vector r, void* user) {
     return static_cast<Problem*>(user)->M.res(sun::data(y), sun::data(yp), sun::data(r));
   }
+  // Band part by grouped difference quotients with the segment actuation (and end radii)
+  // frozen at y, so that the non-local segment coupling does not alias into the band; the
+  // segment coupling itself is added exactly as rank-1 terms.
+  static int jac(double, double cj, N_Vector yv, N_Vector ypv, N_Vector rv, SUNMatrix J, void* user,
+                 N_Vector, N_Vector, N_Vector) {
+    auto* pb = static_cast<Problem*>(user);
+    pb->low_rank.rank = pb->M.residual_low_rank(sun::data(yv), pb->low_rank.U, pb->low_rank.V);
+    return band_dq(*pb, cj, yv, ypv, rv, J);
+  }
+
+ public:
+  static int band_dq(Problem& pbr, double cj, N_Vector yv, N_Vector ypv, N_Vector rv, SUNMatrix J) {
+    Problem* pb = &pbr;
+    ForceModel& M = pb->M;
+    M.unpack(sun::data(yv));  // segment actuation at y, frozen below
+    const int n = M.n, mu = 3, ml = 5, width = mu + ml + 1;
+    const double* y = sun::data(yv);
+    const double* yp = sun::data(ypv);
+    const double* r0 = sun::data(rv);
+    pb->ytmp.assign(y, y + n);
+    pb->yptmp.assign(yp, yp + n);
+    pb->rtmp.assign(n, 0.0);
+    SUNMatZero(J);
+    const double srur = 6e-6;  // ~ cube root of the unit roundoff (central differences)
+    M.freeze_segments = true;
+    int status = 0;
+    // Central differences: the ramps of the actuation laws have large curvature, and a
+    // one-sided quotient is then only accurate to a few 1e-6.
+    pb->ftmp.assign(n, 0.0);
+    for (int g = 0; g < width && status == 0; ++g) {
+      for (int sgn : {1, -1}) {
+        for (int j = g; j < n; j += width) {
+          const double inc = sgn * srur * std::max(std::abs(y[j]), 1e-2);
+          pb->ytmp[j] = y[j] + inc;
+          pb->yptmp[j] = yp[j] + cj * inc;
+        }
+        status = M.res(pb->ytmp.data(), pb->yptmp.data(), sgn > 0 ? pb->rtmp.data() : pb->ftmp.data());
+        if (status != 0) break;
+      }
+      for (int j = g; j < n; j += width) {
+        const double inc = srur * std::max(std::abs(y[j]), 1e-2);
+        pb->ytmp[j] = y[j];
+        pb->yptmp[j] = yp[j];
+        for (int i = std::max(0, j - mu); i <= std::min(n - 1, j + ml); ++i)
+          SM_ELEMENT_B(J, i, j) = (pb->rtmp[i] - pb->ftmp[i]) / (2.0 * inc);
+      }
+    }
+    (void)r0;
+    M.freeze_segments = false;
+    M.unpack(y);
+    return status;
+  }
+
+ private:
   static int g(double, N_Vector y, N_Vector, double* gout, void* user) {
     static_cast<Problem*>(user)->roots.eval(sun::data(y), gout);
     return 0;
@@ -497,6 +824,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
   int cycles_done = 0;
   double t = 0;
   std::vector<ProtocolMachine::CellLaw> lawbuf;
+  std::vector<const ActuationLaw*> seglawbuf;
   std::vector<double> Rcells(N, P.geometry.R0);
   std::unique_ptr<Backend> be;
   std::function<void(double)> check_ends;
@@ -536,13 +864,15 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     return Rcells.data();
   };
   auto apply_actuation = [&](double tt) {
-    machine.laws(lawbuf);
-    M.set_actuation(lawbuf);
+    machine.laws(lawbuf, seglawbuf);
+    M.set_actuation(machine, lawbuf, seglawbuf);
     check_ends(tt);
   };
   check_ends = [&](double tt) {
-    if (M.Rb0 < collapse || M.RbL < collapse) {
-      const bool left = M.Rb0 < collapse;
+    double lo0, loL;
+    M.end_radius_range(lo0, loL);
+    if (lo0 < collapse || loL < collapse) {
+      const bool left = lo0 < collapse;
       throw NumericalError(
           "tube radius collapsed to zero at z = " + fmt(left ? 0.0 : M.L) +
               " m: under its actuation the open end has no positive rest radius (R0 - q/C1 <= 0)",
@@ -557,8 +887,8 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
       machine.start_cycle(0.0, Rcells.data());
       res.cycle_start.push_back(0.0);
     }
-    machine.laws(lawbuf);
-    M.set_actuation(lawbuf);
+    machine.laws(lawbuf, seglawbuf);
+    M.set_actuation(machine, lawbuf, seglawbuf);
     if (M.inertia)
       be = std::make_unique<IdaBackend>(*pb, P);
     else
@@ -627,6 +957,10 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
         ++res.stats["reinits"];
         continue;
       }
+      if (std::getenv("SWIM1D_TRACE")) {
+        auto* cb = dynamic_cast<CvodeBackend*>(be.get());
+        if (cb) cb->trace(t, machine.phase(), machine.active());
+      }
       if (!record(t, be->y()))
         throw NumericalError("non-finite state", "tighten numerics.rtol or refine numerics.cells", t);
       if (tout >= t_stop) {
@@ -659,7 +993,119 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
 
 }  // namespace
 
-Result solve_force_driven(const Params& p, const ProgressFn& progress) { return run(p, {}, 0.0, progress); }
+JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned seed) {
+  validate(P);
+  Problem pb(P, {});
+  ForceModel& M = pb.M;
+  pb.machine.set_state(phase, active);
+  std::vector<ProtocolMachine::CellLaw> laws;
+  std::vector<const ActuationLaw*> seg;
+  pb.machine.laws(laws, seg);
+  M.set_actuation(pb.machine, laws, seg);
+  const int n = M.n, N = M.N;
+  std::uint64_t st = 0x9E3779B97F4A7C15ull * (seed + 1);
+  auto uni = [&]() {  // splitmix64 -> [0, 1)
+    st += 0x9E3779B97F4A7C15ull;
+    std::uint64_t z = st;
+    z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+    z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+    return double((z ^ (z >> 31)) >> 11) * 0x1.0p-53;
+  };
+  const double R0 = P.geometry.R0, Rf = P.protocol.R_f, d = P.protocol.delta;
+  std::vector<double> y(n, 0.0), yp(n, 0.0);
+  for (int i = 0; i < N; ++i) {
+    const bool held = seg[M.seg_a[i]] != nullptr;
+    const double Ri = held ? Rf + d * (4.0 * uni() - 2.0) : R0 * (0.45 + 0.6 * uni());
+    y[1 + M.stride * i] = (Ri / R0) * (Ri / R0);
+    if (M.inertia) {
+      y[3 * i + 2] = uni() - 0.5;
+      y[3 * i + 3] = uni() - 0.5;
+    }
+  }
+  // Shift each held segment so that its mean radius sits on a ramp of the held law (a few
+  // passes: cells straddling two segments couple neighbouring means).
+  std::vector<double> target(seg.size());
+  for (auto& v : target) v = (uni() < 0.5 ? Rf + d : Rf - d) + 0.1 * d * (uni() - 0.5);
+  for (int pass = 0; pass < 20; ++pass)
+  for (int k = 0; k < int(seg.size()); ++k) {
+    if (!seg[k]) continue;
+    M.unpack(y.data());
+    const double shift = target[k] - M.Rbar[k];
+    for (int i = M.seg_first[k]; i <= M.seg_last[k]; ++i) {
+      const double Ri = R0 * std::sqrt(y[1 + M.stride * i]) + shift;
+      y[1 + M.stride * i] = (Ri / R0) * (Ri / R0);
+    }
+  }
+  for (int k = 0; k < n; ++k) yp[k] = uni() - 0.5;
+  y[M.iD] = uni();
+  y[M.iX] = uni();
+
+  // analytic (band + low rank), dense
+  std::vector<double> J(std::size_t(n) * n, 0.0);  // row-major
+  std::vector<double> U, Vt;
+  int rank = 0;
+  const double cj = 1e3;
+  if (!M.inertia) {
+    rank = M.jacobian(y.data(), [&](int i, int j, double v) { J[std::size_t(i) * n + j] = v; }, U, Vt);
+  } else {
+    rank = M.residual_low_rank(y.data(), U, Vt);
+    // band part: the backend's difference-quotient routine on a band matrix
+    auto ctx = sun::make_context();
+    auto A = sun::make_band_matrix(n, 3, 5, ctx.get());
+    auto yv = sun::make_vector(n, ctx.get()), ypv = sun::make_vector(n, ctx.get()), rv = sun::make_vector(n, ctx.get());
+    std::copy(y.begin(), y.end(), sun::data(yv.get()));
+    std::copy(yp.begin(), yp.end(), sun::data(ypv.get()));
+    M.res(y.data(), yp.data(), sun::data(rv.get()));
+    pb.low_rank.rank = rank;
+    IdaBackend::band_dq(pb, cj, yv.get(), ypv.get(), rv.get(), A.get());
+    for (int i = 0; i < n; ++i)
+      for (int j = std::max(0, i - 5); j <= std::min(n - 1, i + 3); ++j) J[std::size_t(i) * n + j] = SM_ELEMENT_B(A.get(), i, j);
+    M.residual_low_rank(y.data(), U, Vt);
+  }
+  for (int k = 0; k < rank; ++k)
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) J[std::size_t(i) * n + j] += U[std::size_t(k) * n + i] * Vt[std::size_t(k) * n + j];
+
+  // central differences of the full model
+  std::vector<double> Jfd(std::size_t(n) * n, 0.0), fp(n), fm(n), yy = y, yyp = yp;
+  for (int j = 0; j < n; ++j) {
+    const double inc = 1e-6 * std::max(std::abs(y[j]), 1e-2);
+    yy[j] = y[j] + inc;
+    yyp[j] = yp[j] + cj * inc;
+    if (M.inertia) M.res(yy.data(), yyp.data(), fp.data()); else M.rhs(yy.data(), fp.data());
+    yy[j] = y[j] - inc;
+    yyp[j] = yp[j] - cj * inc;
+    if (M.inertia) M.res(yy.data(), yyp.data(), fm.data()); else M.rhs(yy.data(), fm.data());
+    yy[j] = y[j];
+    yyp[j] = yp[j];
+    for (int i = 0; i < n; ++i) Jfd[std::size_t(i) * n + j] = (fp[i] - fm[i]) / (2.0 * inc);
+  }
+  JacobianCheck out;
+  out.rank = rank;
+  for (int i = 0; i < n; ++i) {
+    if (i == M.iD || i == M.iX) continue;  // D and X rows: radii couplings left out by design
+    double rowmax = 0;
+    for (int j = 0; j < n; ++j) rowmax = std::max(rowmax, std::abs(Jfd[std::size_t(i) * n + j]));
+    if (rowmax == 0) continue;
+    for (int j = 0; j < n; ++j) {
+      const double a = J[std::size_t(i) * n + j], b = Jfd[std::size_t(i) * n + j];
+      if (a != 0 || b != 0) ++out.entries;
+      out.max_rel_error = std::max(out.max_rel_error, std::abs(a - b) / rowmax);
+    }
+  }
+  // D-X block (inside the band)
+  for (int i : {M.iD, M.iX})
+    for (int j : {M.iD, M.iX}) {
+      const double a = J[std::size_t(i) * n + j], b = Jfd[std::size_t(i) * n + j];
+      const double sc = std::max({std::abs(b), std::abs(Jfd[std::size_t(M.iX) * n + M.iD]), 1e-300});
+      if (a != 0 || b != 0) ++out.entries;
+      out.max_rel_error = std::max(out.max_rel_error, std::abs(a - b) / sc);
+    }
+  return out;
+}
+
+Result solve_force_driven(const Params& p, const ProgressFn& progress) {
+  if (std::getenv("RAMPKIND")) kRampKind = std::atoi(std::getenv("RAMPKIND")); return run(p, {}, 0.0, progress); }
 
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
                              const ProgressFn& progress) {

@@ -28,6 +28,18 @@ Result solve_force_driven(const Params& p, const ProgressFn& progress);
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
                              const ProgressFn& progress = {});
 
+/// Test of the analytic Newton-matrix Jacobians against central finite differences of the
+/// right-hand side (CVODE) or residual (IDA) at a random state: radii drawn in
+/// [R_f - 2 delta, R_f + 2 delta] (held segments, so that segment means fall on the ramps) or
+/// in [0.45, 1.05] R0, protocol in `phase` with `active` as the active segment. Returns the
+/// largest entry error relative to the largest entry of its row; rank = number of segment terms.
+struct JacobianCheck {
+  double max_rel_error = 0;
+  int rank = 0;
+  int entries = 0;  ///< non-zero entries compared
+};
+JacobianCheck check_jacobian(const Params& p, int phase, int active, unsigned seed);
+
 /// Overlap of a cell with the protocol segments: the cell [i h, (i+1) h] lies in segment
 /// seg_a with length fraction w and in seg_b (= seg_a + 1) with fraction 1 - w. A cell never
 /// spans more than two segments because validate() requires h <= the shortest segment.

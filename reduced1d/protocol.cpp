@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include "reduced1d/internal.hpp"
@@ -13,16 +14,16 @@ double reference_energy(const Params& p) {
   return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
 }
 
-double ActuationLaw::rest_radius(double R0, double C1) const {
-  // g(R) = C1 (R - R0) + q(R) is continuous and strictly increasing; q is piecewise linear,
-  // so solve g = 0 exactly on each piece.
-  if (n == 0) return R0 - c / C1;
+double ActuationLaw::rest_radius(double R0, double C1, double extra) const {
+  // g(R) = C1 (R - R0) + q(R) + extra is continuous and strictly increasing: constant pieces
+  // are solved exactly, ramps by bisection.
+  if (n == 0) return R0 - (c + extra) / C1;
   {  // left constant piece R <= x0
-    const double R = R0 - y[0] / C1;
+    const double R = R0 - (y[0] + extra) / C1;
     if (R <= x[0]) return R;
   }
   for (int k = 1; k < n; ++k) {
-    const auto g = [&](double R) { return C1 * (R - R0) + (*this)(R); };
+    const auto g = [&](double R) { return C1 * (R - R0) + (*this)(R) + extra; };
     if (g(x[k - 1]) <= 0 && g(x[k]) >= 0) {
       double a = x[k - 1], b = x[k];
       for (int it = 0; it < 200 && b - a > 1e-15 * (std::abs(a) + std::abs(b)); ++it) {
@@ -32,20 +33,20 @@ double ActuationLaw::rest_radius(double R0, double C1) const {
       return 0.5 * (a + b);
     }
   }
-  return R0 - y[n - 1] / C1;  // right constant piece
+  return R0 - (y[n - 1] + extra) / C1;  // right constant piece
 }
 
 namespace {
 // Relay with thresholds t_k and levels v_0 (below t_0), v_1, ..., v_m (above t_{m-1}), each
-// jump regularised by a linear ramp of width eps centred on its threshold.
+// jump regularised by a smooth step of width eps_k centred on its threshold.
 ActuationLaw regularised_relay(const std::vector<double>& thresholds, const std::vector<double>& levels,
-                               double eps) {
+                               const std::vector<double>& eps) {
   ActuationLaw a;
   a.n = 0;
   for (std::size_t k = 0; k < thresholds.size(); ++k) {
-    a.x[a.n] = thresholds[k] - 0.5 * eps;
+    a.x[a.n] = thresholds[k] - 0.5 * eps[k];
     a.y[a.n++] = levels[k];
-    a.x[a.n] = thresholds[k] + 0.5 * eps;
+    a.x[a.n] = thresholds[k] + 0.5 * eps[k];
     a.y[a.n++] = levels[k + 1];
   }
   return a;
@@ -56,6 +57,8 @@ ProtocolMachine::ProtocolMachine(const Params& p, std::vector<double> fixed_q)
     : N_(p.numerics.cells), nseg_(p.protocol.segments), Rf_(p.protocol.R_f), fixed_(!fixed_q.empty()) {
   const double R0 = p.geometry.R0, d = p.protocol.delta, q = p.protocol.q;
   const double eps = kRampFraction * d;
+  // Wide ramps at 0.5 R0 and 0.8 R0, limited so that neighbouring ramps never overlap.
+  const double wide = std::min({kWideRampFraction * R0, 0.3 * R0 - eps, 0.2 * R0 - d - eps});
   seg_a_.assign(N_, 0);
   seg_b_.assign(N_, 0);
   w_.assign(N_, 1.0);
@@ -84,9 +87,10 @@ ProtocolMachine::ProtocolMachine(const Params& p, std::vector<double> fixed_q)
   reached_.assign(nseg_, -1.0);
   active_law_ = ActuationLaw::constant(q);
   idle_law_ = ActuationLaw::constant(0.0);
-  held_law_ = regularised_relay({Rf_ - d, Rf_ + d}, {-q, 0.0, q}, eps);
+  held_law_ = regularised_relay({Rf_ - d, Rf_ + d}, {-q, 0.0, q}, {eps, eps});
   recovery_law_ = regularised_relay({0.5 * R0, 0.8 * R0, R0 - d, R0 + d},
-                                    {-q, -0.5 * q, -0.1 * q, 0.0, 0.1 * q}, eps);
+                                    {-q, -0.5 * q, -0.1 * q, 0.0, 0.1 * q},
+                                    {std::max(wide, eps), std::max(wide, eps), eps * (std::getenv("RRF") ? std::atof(std::getenv("RRF")) : 1.0), eps* (std::getenv("RRF") ? std::atof(std::getenv("RRF")) : 1.0)});
 }
 
 double ProtocolMachine::segment_mean(int k, const double* R) const {
@@ -99,19 +103,27 @@ double ProtocolMachine::segment_mean(int k, const double* R) const {
 }
 
 const ActuationLaw* ProtocolMachine::segment_law(int k) const {
-  if (phase_ == 0) return k == active_ ? &active_law_ : (k > active_ ? &held_law_ : &idle_law_);
+  // Cell law contributed by segment k (the held rule is a segment law, see laws()).
+  if (phase_ == 0) return k == active_ ? &active_law_ : &idle_law_;
   if (phase_ == 1) return &recovery_law_;
   return &idle_law_;
 }
 
-void ProtocolMachine::laws(std::vector<CellLaw>& law) const {
+void ProtocolMachine::laws(std::vector<CellLaw>& law, std::vector<const ActuationLaw*>& seg) const {
   law.assign(N_, CellLaw{&idle_law_, &idle_law_, 1.0});
+  seg.assign(nseg_, nullptr);
   for (int i = 0; i < N_; ++i) {
     if (fixed_) {
       law[i] = CellLaw{&fixed_laws_[i], &fixed_laws_[i], 1.0};
     } else {
       law[i] = CellLaw{segment_law(seg_a_[i]), segment_law(seg_b_[i]), w_[i]};
     }
+  }
+  if (!fixed_ && phase_ == 0)
+    for (int k = active_ + 1; k < nseg_; ++k) seg[k] = &held_law_;
+  if (!fixed_ && phase_ == 1 && std::getenv("SEGREC")) {
+    for (int i = 0; i < N_; ++i) law[i] = CellLaw{&idle_law_, &idle_law_, 1.0};
+    for (int k = 0; k < nseg_; ++k) seg[k] = &recovery_law_;
   }
 }
 

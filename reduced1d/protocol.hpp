@@ -27,8 +27,13 @@
 
 namespace swim::reduced1d::detail {
 
-/// Ramp width of the regularised relays as a fraction of protocol.delta.
+/// Ramp width of the regularised relays at the delta-tolerance thresholds (R_f +- delta for
+/// the hold, R0 +- delta for the recovery) as a fraction of protocol.delta.
 inline constexpr double kRampFraction = 0.25;
+inline int kRampKind = 2;
+/// Ramp width of the recovery thresholds at 0.5 R0 and 0.8 R0 as a fraction of R0. These
+/// thresholds are band boundaries, not tolerances, so their relays may be smoothed more widely.
+inline constexpr double kWideRampFraction = 0.05;
 
 /// Actuation law q(R) [Pa]: levels y_k joined by C2 smooth steps (6 s^5 - 15 s^4 + 10 s^3)
 /// over [x_{k-1}, x_k], constant outside [x_0, x_{n-1}] (n = 0: q = c everywhere).
@@ -42,20 +47,36 @@ struct ActuationLaw {
     a.c = q;
     return a;
   }
+  bool is_constant() const { return n == 0; }
   double operator()(double R) const {
+    double d;
+    return eval(R, d);
+  }
+  /// q(R) and dq/dR.
+  double eval(double R, double& dq) const {
+    dq = 0.0;
     if (n == 0) return c;
     if (R <= x[0]) return y[0];
     for (int k = 1; k < n; ++k)
       if (R < x[k]) {
-        double s = (R - x[k - 1]) / (x[k] - x[k - 1]);
-        s = s * s * s * (10.0 + s * (-15.0 + 6.0 * s));  // C2 smooth step on the ramp
-        return y[k - 1] + (y[k] - y[k - 1]) * s;
+        const double inv = 1.0 / (x[k] - x[k - 1]);
+        const double s = (R - x[k - 1]) * inv;
+        const double s2 = s * s;
+        double step = s2 * s * (10.0 + s * (-15.0 + 6.0 * s));  // C2 smooth step
+        double dstep = 30.0 * s2 * (1.0 - s) * (1.0 - s);
+        if (kRampKind == 4) {
+          const double s4 = s2 * s2, u = 1.0 - s;
+          step = s4 * s * (126.0 + s * (-420.0 + s * (540.0 + s * (-315.0 + 70.0 * s))));
+          dstep = 630.0 * s4 * u * u * u * u;
+        }
+        dq = (y[k] - y[k - 1]) * dstep * inv;
+        return y[k - 1] + (y[k] - y[k - 1]) * step;
       }
     return y[n - 1];
   }
-  /// Radius where C1 (R - R0) + q(R) = 0 (the tube law at p = 0; unique since q is
+  /// Radius where C1 (R - R0) + q(R) + extra = 0 (the tube law at p = 0; unique since q is
   /// non-decreasing).
-  double rest_radius(double R0, double C1) const;
+  double rest_radius(double R0, double C1, double extra = 0.0) const;
 };
 
 class ProtocolMachine {
@@ -77,10 +98,30 @@ class ProtocolMachine {
     const ActuationLaw* b = nullptr;
     double w = 1.0;
     double operator()(double R) const { return w >= 1.0 ? (*a)(R) : w * (*a)(R) + (1.0 - w) * (*b)(R); }
+    /// q(R) and dq/dR.
+    double eval(double R, double& dq) const {
+      if (w >= 1.0) return a->eval(R, dq);
+      double da, db;
+      const double v = w * a->eval(R, da) + (1.0 - w) * b->eval(R, db);
+      dq = w * da + (1.0 - w) * db;
+      return v;
+    }
   };
-  /// Actuation law of every cell for the current discrete state (pointers stay valid for the
-  /// lifetime of the machine).
-  void laws(std::vector<CellLaw>& law_of_cell) const;
+  /// Actuation laws for the current discrete state (pointers stay valid for the lifetime of
+  /// the machine): a law of every cell on its own radius, and a law of every segment on the
+  /// segment's length-weighted mean radius (nullptr where none), applied uniformly to the
+  /// segment (cell i receives its length fraction in the segment times the segment's q).
+  /// Held segments carry a segment law; the active, idle and recovery rules are cell laws.
+  void laws(std::vector<CellLaw>& law_of_cell, std::vector<const ActuationLaw*>& law_of_segment) const;
+
+  /// Cell-segment overlaps: cell i lies in segment seg_a(i) with length fraction w(i) and in
+  /// seg_b(i) with 1 - w(i); weight(k) = sum of the fractions of segment k.
+  const std::vector<int>& seg_a() const { return seg_a_; }
+  const std::vector<int>& seg_b() const { return seg_b_; }
+  const std::vector<double>& frac() const { return w_; }
+  const std::vector<double>& seg_weight() const { return seg_weight_; }
+  int seg_first(int k) const { return seg_first_[k]; }
+  int seg_last(int k) const { return seg_last_[k]; }
 
   /// Start a contraction at time t with cell radii R (cascades if the rightmost segment is
   /// already at or below R_f).
@@ -93,6 +134,12 @@ class ProtocolMachine {
   /// Apply the located roots (flags from CVODE/IDA root info) at time t with cell radii R.
   /// Returns the number of protocol switches (segment reached R_f, or cycle completed).
   int apply(double t, const int* found, const double* R);
+
+  /// Test hook: put the machine into phase `phase` with `active` as the active segment.
+  void set_state(int phase, int active) {
+    phase_ = phase;
+    active_ = active;
+  }
 
   bool collapsed() const { return collapsed_; }
   bool cycle_completed() const { return cycle_completed_; }

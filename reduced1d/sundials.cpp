@@ -8,7 +8,11 @@
 #include <sunmatrix/sunmatrix_dense.h>
 #include <sunnonlinsol/sunnonlinsol_fixedpoint.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <utility>
+#include <vector>
 
 namespace swim::reduced1d::sun {
 
@@ -76,8 +80,157 @@ Context make_context() {
   return Context(check_ptr(c, "SUNContext_Create"));
 }
 
+namespace fast {
+// Serial vector kernels compiled with the project's optimisation flags. The distribution's
+// SUNDIALS libraries are built without optimisation (measured: ~20 instructions per element
+// in N_VLinearSum_Serial), and CVODE/IDA spend most of a step in these kernels for the
+// small systems of the 1D tier. Same semantics as the serial implementations.
+inline double* d(N_Vector v) { return NV_DATA_S(v); }
+inline sunindextype len(N_Vector v) { return NV_LENGTH_S(v); }
+void linearsum(double a, N_Vector x, double b, N_Vector y, N_Vector z) {
+  const double *X = d(x), *Y = d(y);
+  double* Z = d(z);
+  const sunindextype n = len(x);
+  for (sunindextype i = 0; i < n; ++i) Z[i] = a * X[i] + b * Y[i];
+}
+void constant(double c, N_Vector z) {
+  double* Z = d(z);
+  const sunindextype n = len(z);
+  for (sunindextype i = 0; i < n; ++i) Z[i] = c;
+}
+void prod(N_Vector x, N_Vector y, N_Vector z) {
+  const double *X = d(x), *Y = d(y);
+  double* Z = d(z);
+  for (sunindextype i = 0, n = len(x); i < n; ++i) Z[i] = X[i] * Y[i];
+}
+void div(N_Vector x, N_Vector y, N_Vector z) {
+  const double *X = d(x), *Y = d(y);
+  double* Z = d(z);
+  for (sunindextype i = 0, n = len(x); i < n; ++i) Z[i] = X[i] / Y[i];
+}
+void scale(double c, N_Vector x, N_Vector z) {
+  const double* X = d(x);
+  double* Z = d(z);
+  for (sunindextype i = 0, n = len(x); i < n; ++i) Z[i] = c * X[i];
+}
+void abs(N_Vector x, N_Vector z) {
+  const double* X = d(x);
+  double* Z = d(z);
+  for (sunindextype i = 0, n = len(x); i < n; ++i) Z[i] = std::abs(X[i]);
+}
+void inv(N_Vector x, N_Vector z) {
+  const double* X = d(x);
+  double* Z = d(z);
+  for (sunindextype i = 0, n = len(x); i < n; ++i) Z[i] = 1.0 / X[i];
+}
+void addconst(N_Vector x, double b, N_Vector z) {
+  const double* X = d(x);
+  double* Z = d(z);
+  for (sunindextype i = 0, n = len(x); i < n; ++i) Z[i] = X[i] + b;
+}
+double dotprod(N_Vector x, N_Vector y) {
+  const double *X = d(x), *Y = d(y);
+  double s = 0;
+  for (sunindextype i = 0, n = len(x); i < n; ++i) s += X[i] * Y[i];
+  return s;
+}
+double maxnorm(N_Vector x) {
+  const double* X = d(x);
+  double m = 0;
+  for (sunindextype i = 0, n = len(x); i < n; ++i) m = std::max(m, std::abs(X[i]));
+  return m;
+}
+double wsqrsum(N_Vector x, N_Vector w) {
+  const double *X = d(x), *W = d(w);
+  double s = 0;
+  for (sunindextype i = 0, n = len(x); i < n; ++i) {
+    const double p = X[i] * W[i];
+    s += p * p;
+  }
+  return s;
+}
+double wrmsnorm(N_Vector x, N_Vector w) { return std::sqrt(wsqrsum(x, w) / double(len(x))); }
+double wsqrsummask(N_Vector x, N_Vector w, N_Vector id) {
+  const double *X = d(x), *W = d(w), *I = d(id);
+  double s = 0;
+  for (sunindextype i = 0, n = len(x); i < n; ++i)
+    if (I[i] > 0.0) {
+      const double p = X[i] * W[i];
+      s += p * p;
+    }
+  return s;
+}
+double wrmsnormmask(N_Vector x, N_Vector w, N_Vector id) {
+  return std::sqrt(wsqrsummask(x, w, id) / double(len(x)));
+}
+double minval(N_Vector x) {
+  const double* X = d(x);
+  double m = X[0];
+  for (sunindextype i = 1, n = len(x); i < n; ++i) m = std::min(m, X[i]);
+  return m;
+}
+int linearcombination(int nv, double* c, N_Vector* X, N_Vector z) {
+  double* Z = d(z);
+  const sunindextype n = len(z);
+  if (nv == 1) {
+    scale(c[0], X[0], z);
+    return 0;
+  }
+  const double* X0 = d(X[0]);
+  const double* X1 = d(X[1]);
+  if (X0 == Z) {
+    for (sunindextype i = 0; i < n; ++i) Z[i] = c[0] * Z[i] + c[1] * X1[i];
+  } else {
+    for (sunindextype i = 0; i < n; ++i) Z[i] = c[0] * X0[i] + c[1] * X1[i];
+  }
+  for (int k = 2; k < nv; ++k) {
+    const double* Xk = d(X[k]);
+    const double ck = c[k];
+    for (sunindextype i = 0; i < n; ++i) Z[i] += ck * Xk[i];
+  }
+  return 0;
+}
+int scaleaddmulti(int nv, double* a, N_Vector x, N_Vector* Y, N_Vector* Z) {
+  const double* X = d(x);
+  const sunindextype n = len(x);
+  for (int k = 0; k < nv; ++k) {
+    const double* Yk = d(Y[k]);
+    double* Zk = d(Z[k]);
+    const double ak = a[k];
+    for (sunindextype i = 0; i < n; ++i) Zk[i] = ak * X[i] + Yk[i];
+  }
+  return 0;
+}
+int dotprodmulti(int nv, N_Vector x, N_Vector* Y, double* out) {
+  for (int k = 0; k < nv; ++k) out[k] = dotprod(x, Y[k]);
+  return 0;
+}
+}  // namespace fast
+
 Vector make_vector(long n, SUNContext ctx) {
   Vector v(check_ptr(N_VNew_Serial(n, ctx), "N_VNew_Serial"));
+  N_Vector_Ops o = v->ops;  // clones copy this table
+  o->nvlinearsum = fast::linearsum;
+  o->nvconst = fast::constant;
+  o->nvprod = fast::prod;
+  o->nvdiv = fast::div;
+  o->nvscale = fast::scale;
+  o->nvabs = fast::abs;
+  o->nvinv = fast::inv;
+  o->nvaddconst = fast::addconst;
+  o->nvdotprod = fast::dotprod;
+  o->nvdotprodlocal = fast::dotprod;
+  o->nvmaxnorm = fast::maxnorm;
+  o->nvmaxnormlocal = fast::maxnorm;
+  o->nvwrmsnorm = fast::wrmsnorm;
+  o->nvwrmsnormmask = fast::wrmsnormmask;
+  o->nvwsqrsumlocal = fast::wsqrsum;
+  o->nvwsqrsummasklocal = fast::wsqrsummask;
+  o->nvmin = fast::minval;
+  o->nvminlocal = fast::minval;
+  o->nvlinearcombination = fast::linearcombination;
+  o->nvscaleaddmulti = fast::scaleaddmulti;
+  o->nvdotprodmulti = fast::dotprodmulti;
   N_VConst(0.0, v.get());
   return v;
 }
@@ -100,6 +253,198 @@ LinearSolver make_dense_solver(N_Vector y, SUNMatrix A, SUNContext ctx) {
 
 NonlinearSolver make_fixed_point_solver(N_Vector y, int m_accel, SUNContext ctx) {
   return NonlinearSolver(check_ptr(SUNNonlinSol_FixedPoint(y, m_accel, ctx), "SUNNonlinSol_FixedPoint"));
+}
+
+namespace {
+// Band LU with partial pivoting (LAPACK dgbtf2 layout: A(i, j) at ab[j * ldab + kv + i - j],
+// kv = ku + kl, ldab = 2 kl + ku + 1), compiled with the project's flags (the distribution's
+// SUNDIALS band kernels are unoptimised, see fast::).
+struct BandLU {
+  long n = 0;
+  int kl = 0, ku = 0, kv = 0, ldab = 0;
+  std::vector<double> ab;
+  std::vector<long> piv;
+  double& at(long i, long j) { return ab[std::size_t(j) * ldab + kv + i - j]; }
+  double at(long i, long j) const { return ab[std::size_t(j) * ldab + kv + i - j]; }
+  void resize(long n_, int kl_, int ku_) {
+    n = n_, kl = kl_, ku = ku_, kv = kl + ku, ldab = 2 * kl + ku + 1;
+    ab.assign(std::size_t(n) * ldab, 0.0);
+    piv.assign(n, 0);
+  }
+  void load(SUNMatrix M) {
+    std::fill(ab.begin(), ab.end(), 0.0);
+    const long mu = SM_UBAND_B(M), ml = SM_LBAND_B(M);
+    for (long j = 0; j < n; ++j) {
+      const long i0 = std::max(0L, j - mu), i1 = std::min(n - 1, j + ml);
+      for (long i = i0; i <= i1; ++i) at(i, j) = SM_ELEMENT_B(M, i, j);
+    }
+  }
+  bool factor() {
+    long ju = 0;
+    for (long j = 0; j < n; ++j) {
+      const long km = std::min<long>(kl, n - 1 - j);
+      long p = 0;
+      double best = std::abs(at(j, j));
+      for (long r = 1; r <= km; ++r)
+        if (std::abs(at(j + r, j)) > best) best = std::abs(at(j + r, j)), p = r;
+      piv[j] = j + p;
+      if (best == 0.0) return false;
+      ju = std::max(ju, std::min(j + ku + p, n - 1));
+      if (p != 0)
+        for (long c = j; c <= ju; ++c) std::swap(at(j, c), at(j + p, c));
+      const double inv = 1.0 / at(j, j);
+      for (long r = 1; r <= km; ++r) at(j + r, j) *= inv;
+      for (long c = j + 1; c <= ju; ++c) {
+        const double ajc = at(j, c);
+        if (ajc == 0.0) continue;
+        for (long r = 1; r <= km; ++r) at(j + r, c) -= at(j + r, j) * ajc;
+      }
+    }
+    return true;
+  }
+  void solve(double* b) const {
+    for (long j = 0; j < n; ++j) {
+      const long km = std::min<long>(kl, n - 1 - j);
+      if (piv[j] != j) std::swap(b[j], b[piv[j]]);
+      const double bj = b[j];
+      for (long r = 1; r <= km; ++r) b[j + r] -= at(j + r, j) * bj;
+    }
+    for (long j = n - 1; j >= 0; --j) {
+      b[j] /= at(j, j);
+      const double bj = b[j];
+      for (long i = std::max(0L, j - kv); i < j; ++i) b[i] -= at(i, j) * bj;
+    }
+  }
+};
+
+struct LowRankContent {
+  BandLU lu;
+  LowRankTerm* term = nullptr;
+  int rank = 0;     // rank used at the last setup
+  double s = 1.0;   // scale at the last setup
+  long n = 0;
+  std::vector<double> Z;   // M^{-1} U, column-major n x rank
+  std::vector<double> S;   // I + s V^T Z, LU-factored in place (rank x rank)
+  std::vector<int> piv;
+  std::vector<double> w;   // rank workspace
+  int last = 0;
+};
+LowRankContent* lr(SUNLinearSolver S) { return static_cast<LowRankContent*>(S->content); }
+
+SUNLinearSolver_Type lr_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
+SUNLinearSolver_ID lr_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+int lr_init(SUNLinearSolver) { return 0; }
+sunindextype lr_lastflag(SUNLinearSolver S) { return lr(S)->last; }
+
+// LU with partial pivoting of a small dense column-major matrix; returns false if singular.
+bool small_lu(std::vector<double>& a, std::vector<int>& piv, int r) {
+  for (int k = 0; k < r; ++k) {
+    int p = k;
+    for (int i = k + 1; i < r; ++i)
+      if (std::abs(a[k * r + i]) > std::abs(a[k * r + p])) p = i;
+    piv[k] = p;
+    if (a[k * r + p] == 0.0) return false;
+    if (p != k)
+      for (int j = 0; j < r; ++j) std::swap(a[j * r + k], a[j * r + p]);
+    for (int i = k + 1; i < r; ++i) {
+      a[k * r + i] /= a[k * r + k];
+      for (int j = k + 1; j < r; ++j) a[j * r + i] -= a[k * r + i] * a[j * r + k];
+    }
+  }
+  return true;
+}
+void small_solve(const std::vector<double>& a, const std::vector<int>& piv, int r, double* b) {
+  for (int k = 0; k < r; ++k) {
+    std::swap(b[k], b[piv[k]]);
+    for (int i = k + 1; i < r; ++i) b[i] -= a[k * r + i] * b[k];
+  }
+  for (int k = r - 1; k >= 0; --k) {
+    for (int j = k + 1; j < r; ++j) b[k] -= a[j * r + k] * b[j];
+    b[k] /= a[k * r + k];
+  }
+}
+
+int lr_setup(SUNLinearSolver S, SUNMatrix A) {
+  LowRankContent* c = lr(S);
+  c->lu.load(A);
+  if (!c->lu.factor()) return c->last = SUNLS_LUFACT_FAIL;
+  c->last = 0;
+  const LowRankTerm& t = *c->term;
+  c->rank = t.rank;
+  c->s = t.scale ? t.scale(t.scale_ctx) : 1.0;
+  const int r = c->rank;
+  const long n = c->n;
+  if (r == 0) return 0;
+  c->Z.assign(t.U.begin(), t.U.begin() + n * r);
+  for (int k = 0; k < r; ++k) c->lu.solve(c->Z.data() + n * k);
+  c->S.assign(std::size_t(r) * r, 0.0);
+  for (int i = 0; i < r; ++i)
+    for (int j = 0; j < r; ++j) {
+      double v = 0;
+      const double* Vi = t.V.data() + n * i;
+      const double* Zj = c->Z.data() + n * j;
+      for (long k = 0; k < n; ++k) v += Vi[k] * Zj[k];
+      c->S[j * r + i] = (i == j ? 1.0 : 0.0) + c->s * v;
+    }
+  c->piv.assign(r, 0);
+  c->w.assign(r, 0.0);
+  if (!small_lu(c->S, c->piv, r)) return c->last = SUNLS_LUFACT_FAIL;
+  return 0;
+}
+
+int lr_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, realtype) {
+  LowRankContent* c = lr(S);
+  const long n = c->n;
+  double* xd = N_VGetArrayPointer(x);
+  const double* bd = N_VGetArrayPointer(b);
+  if (xd != bd) std::copy(bd, bd + n, xd);
+  c->lu.solve(xd);
+  c->last = 0;
+  if (c->rank == 0) return 0;
+  const int r = c->rank;
+  const LowRankTerm& t = *c->term;
+  // x <- x - Z (I + s V^T Z)^{-1} s V^T x
+  for (int i = 0; i < r; ++i) {
+    double v = 0;
+    const double* Vi = t.V.data() + n * i;
+    for (long k = 0; k < n; ++k) v += Vi[k] * xd[k];
+    c->w[i] = c->s * v;
+  }
+  small_solve(c->S, c->piv, r, c->w.data());
+  for (int j = 0; j < r; ++j) {
+    const double* Zj = c->Z.data() + n * j;
+    const double wj = c->w[j];
+    for (long k = 0; k < n; ++k) xd[k] -= wj * Zj[k];
+  }
+  return 0;
+}
+
+int lr_free(SUNLinearSolver S) {
+  if (!S) return 0;
+  if (S->content) {
+    delete lr(S);
+    S->content = nullptr;
+  }
+  SUNLinSolFreeEmpty(S);
+  return 0;
+}
+}  // namespace
+
+LinearSolver make_low_rank_band_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, SUNContext ctx) {
+  SUNLinearSolver S = check_ptr(SUNLinSolNewEmpty(ctx), "SUNLinSolNewEmpty");
+  auto* c = new LowRankContent;
+  c->term = term;
+  c->n = N_VGetLength(y);
+  c->lu.resize(c->n, int(SM_LBAND_B(A)), int(SM_UBAND_B(A)));
+  S->content = c;
+  S->ops->gettype = lr_type;
+  S->ops->getid = lr_id;
+  S->ops->initialize = lr_init;
+  S->ops->setup = lr_setup;
+  S->ops->solve = lr_solve;
+  S->ops->lastflag = lr_lastflag;
+  S->ops->free = lr_free;
+  return LinearSolver(S);
 }
 
 CvodeMem make_cvode(int lmm, SUNContext ctx) {

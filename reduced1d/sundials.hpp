@@ -9,6 +9,7 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -89,6 +90,22 @@ LinearSolver make_dense_solver(N_Vector y, SUNMatrix A, SUNContext ctx);
 NonlinearSolver make_fixed_point_solver(N_Vector y, int m_accel, SUNContext ctx);
 CvodeMem make_cvode(int lmm, SUNContext ctx);
 IdaMem make_ida(SUNContext ctx);
+
+/// Low-rank correction of a banded Newton matrix: the matrix actually solved with is
+/// M + scale() U V^T, M the band matrix handed to the solver's setup, U and V column-major
+/// n x rank. The owner refreshes U, V, rank together with the band Jacobian.
+struct LowRankTerm {
+  int rank = 0;
+  std::vector<double> U, V;
+  double (*scale)(void* ctx) = nullptr;  ///< factor of U V^T at the time of setup (1 if null)
+  void* scale_ctx = nullptr;
+};
+
+/// Direct linear solver for (band M) + scale U V^T: band LU with partial pivoting (own
+/// optimised kernel, same algorithm as SUNLinSol_Band/LAPACK dgbtf2) and the
+/// Sherman-Morrison-Woodbury formula with a rank x rank dense solve. `term` must outlive the
+/// solver. A must be a SUNBandMatrix with the bandwidths used later.
+LinearSolver make_low_rank_band_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, SUNContext ctx);
 
 /// Raw data pointer of a serial vector.
 inline double* data(N_Vector v) { return N_VGetArrayPointer(v); }

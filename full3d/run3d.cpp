@@ -1,0 +1,564 @@
+#include "full3d/run3d.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+#include <optional>
+
+#include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/progress.hpp"
+#include "common/vtk.hpp"
+#include "full3d/checkpoint.hpp"
+#include "full3d/ib.hpp"
+
+namespace swim::full3d {
+
+using scene::json;
+
+namespace {
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+long steps_for(double interval, double dt) { return std::max(1L, std::lround(interval / dt)); }
+
+const std::vector<std::string> kSeriesColumns = {
+    "t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m", "flux_rear_m3_per_s",
+    "flux_front_m3_per_s", "volume_rear_m3", "volume_front_m3", "tube_volume_m3", "phase", "elastic_energy_J",
+    "bending_energy_J", "kinetic_energy_J", "active_segment", "cycles_completed", "cfl", "stokes_iterations",
+    "max_divergence_per_s"};
+
+/// The scene as it must match on resume: everything except the keys that only steer
+/// output cadence and parallelism.
+std::string resume_key(const json& resolved) {
+  json r = resolved;
+  if (r.contains("full3d") && r["full3d"].is_object()) {
+    r["full3d"].erase("checkpoint_interval");
+    r["full3d"].erase("threads");
+  }
+  return r.dump();
+}
+
+class Runner {
+ public:
+  Runner(const Params3d& p, const json& resolved, std::string out, const RunControl& ctl)
+      : p_(p), resolved_(resolved), out_(std::move(out)), ctl_(ctl), mesh_(make_mesh(p)),
+        mass_(node_masses(mesh_, p.mass_per_area)),
+        e_ref_(uniform_contraction_energy(mesh_, p.membrane, p.protocol.R_f)), protocol_(p.protocol, mesh_, e_ref_),
+        pvd_(out_ + "/membrane.pvd"), fluid_pvd_(out_ + "/fluid.pvd") {
+    const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
+    e_cap_ = p.energy_growth * e_ref_ * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
+    out_every_ = steps_for(p.output_interval, p.dt);
+    vtk_every_ = steps_for(p.vtk_interval, p.dt);
+    fluid_every_ = steps_for(p.fluid_interval, p.dt);
+    ckpt_every_ = steps_for(p.checkpoint_interval, p.dt);
+    n_end_ = p.duration > 0 ? std::max(1L, std::lround(p.duration / p.dt)) : -1;
+    n_limit_ = std::max(1L, std::lround(p.time_limit / p.dt));
+    vtk_on_ = p.vtk && !ctl.quiet_vtk;
+    fluid_on_ = p.fluid_fields && !p.dry && !ctl.quiet_vtk;
+    if (!p.dry) {
+      grid_.emplace(p.nx, p.ny, p.nz, p.h, p.container_kind());
+      IbOptions o;
+      o.scheme = p.scheme;
+      o.max_cfl = p.max_cfl;
+      o.dt_key = "full3d.dt";
+      o.stokes.fft.threads = p.threads;
+      if (p.threads > 1) fftw_threads_init_once();
+      const Eigen::VectorXd m = p.wall_inertia ? mass_ : Eigen::VectorXd::Zero(mesh_.nodes());
+      ib_ = std::make_unique<IbSolver>(*grid_, p.fluid, mesh_, p.membrane, m, o);
+      ib_->set_external_force([this](double, const Eigen::Matrix3Xd& X) { return protocol_.force(X); });
+      s_ = ib_->initial_state();
+    } else {
+      s_.X = mesh_.X0;
+      s_.V = Eigen::Matrix3Xd::Zero(3, mesh_.nodes());
+      s_.V_prev = s_.V;
+    }
+    build_discs();
+  }
+
+  RunOutcome run() {
+    RunOutcome res;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (ctl_.resume) {
+      load_checkpoint();
+    } else {
+      protocol_.start(0.0, s_.X);
+      x_center0_ = s_.X.row(0).mean();
+      record();
+      if (vtk_on_) write_vtk_frame();
+      if (fluid_on_) write_fluid_frame();
+      save_checkpoint(0.0);
+    }
+    const double t_end = n_end_ > 0 ? p_.duration : p_.time_limit;
+    Progress progress("3d " + p_.name + (n_end_ > 0 ? "" : " (auto: until " + std::to_string(p_.protocol.cycles) +
+                                                               " cycle(s), progress against full3d.time_limit)"),
+                      t_end, ctl_.progress);
+    long this_process = 0;
+    std::optional<NumericalError> failure;
+    try {
+      while (!finished()) {
+        if (n_end_ < 0 && n_ >= n_limit_)
+          throw NumericalError("the protocol did not complete " + std::to_string(p_.protocol.cycles) +
+                                   " cycle(s) within full3d.time_limit = " + num(p_.time_limit) + " s",
+                               "raise full3d.time_limit, or give a time.duration", s_.t);
+        advance();
+        ++n_;
+        ++this_process;
+        if (n_ % out_every_ == 0) record();
+        if (vtk_on_ && n_ % vtk_every_ == 0) write_vtk_frame();
+        if (fluid_on_ && n_ % fluid_every_ == 0) write_fluid_frame();
+        if (n_ % ckpt_every_ == 0) save_checkpoint(wall_before_ + seconds_since(t0));
+        progress.update(s_.t);
+        if (ctl_.stop_after_steps > 0 && this_process >= ctl_.stop_after_steps && !finished()) {
+          res.interrupted = true;
+          res.steps = n_;
+          return res;
+        }
+      }
+      if (last_recorded_ != n_) record();
+      if (vtk_on_ && n_ % vtk_every_ != 0) write_vtk_frame();
+    } catch (const NumericalError& e) {
+      failure = e;
+      // the state is the last step the solver accepted; record it when it is finite
+      if (last_recorded_ != n_ && s_.X.allFinite() && s_.V.allFinite() && std::isfinite(wall_energy())) record();
+    }
+    progress.done();
+    const double wall = wall_before_ + seconds_since(t0);
+    res.failed = failure.has_value();
+    res.message = failure ? failure->what() : "";
+    res.summary = write_outputs(failure ? "failed: " + std::string(failure->what()) : "ok", wall);
+    res.steps = n_;
+    return res;
+  }
+
+ private:
+  static double seconds_since(std::chrono::steady_clock::time_point t0) {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  }
+
+  bool finished() const { return n_end_ > 0 ? n_ >= n_end_ : protocol_.finished(); }
+
+  // --- one time step -------------------------------------------------------
+  void advance() {
+    if (p_.dry) {
+      dry_step();
+      last_cfl_ = 0;
+      last_iterations_ = 0;
+      last_divergence_ = 0;
+    } else {
+      const IbStepStats st = ib_->step(s_, p_.dt);
+      last_cfl_ = st.cfl;
+      last_iterations_ = st.stokes_iterations;
+      last_divergence_ = st.max_divergence;
+      max_cfl_ = std::max(max_cfl_, st.cfl);
+      iterations_total_ += st.stokes_iterations;
+      measure_fluxes();
+      vol_rear_ += 0.5 * p_.dt * (q_rear_prev_ + q_rear_);
+      vol_front_ += 0.5 * p_.dt * (q_front_prev_ + q_front_);
+      q_rear_prev_ = q_rear_;
+      q_front_prev_ = q_front_;
+    }
+    const double e = wall_energy();
+    guards(e);
+    protocol_.update(s_.t, s_.X, e);
+  }
+
+  void dry_step() {
+    full3d::dry_step(mesh_, p_.membrane, mass_, p_.dry_damping * mesh_.node_area,
+                     [this](double, const Eigen::Matrix3Xd& X) { return protocol_.force(X); }, p_.scheme, s_, p_.dt);
+  }
+
+  // --- measurements ----------------------------------------------------------
+  double kinetic_energy() const {
+    double k = 0;
+    for (Eigen::Index i = 0; i < s_.V.cols(); ++i) k += 0.5 * mass_[i] * s_.V.col(i).squaredNorm();
+    return k;
+  }
+  double wall_energy() const { return elastic_energy(mesh_, s_.X, p_.membrane) + kinetic_energy(); }
+
+  void guards(double e) {
+    if (!std::isfinite(e))
+      throw NumericalError("non-finite wall energy", "reduce the time step full3d.dt", s_.t);
+    if (e > e_cap_)
+      throw NumericalError("wall energy " + num(e) + " J grew beyond " + num(p_.energy_growth) +
+                               " times the reference energy (" + num(e_cap_) + " J): the explicit coupling is unstable",
+                           "reduce the time step full3d.dt (or raise full3d.energy_growth_limit if the growth is "
+                           "physical)",
+                           s_.t);
+    const double rmin = node_radii(mesh_, s_.X).minCoeff();
+    if (rmin < 0.02 * p_.R0)
+      throw NumericalError("the tube collapsed: a node came within " + num(rmin) + " m of the axis",
+                           "lower the actuation (protocol.total_force / pressure / load_factor) or reduce full3d.dt",
+                           s_.t);
+  }
+
+  void build_discs() {
+    // Mid-point rule on a polar grid of the unit disc: weights rho d rho d theta.
+    const int nr = 6, nth = 16;
+    for (int j = 0; j < nr; ++j)
+      for (int l = 0; l < nth; ++l) {
+        const double rho = (j + 0.5) / nr, th = 2.0 * M_PI * (l + 0.5 * (j % 2)) / nth;
+        disc_.push_back({rho * std::cos(th), rho * std::sin(th), rho * (1.0 / nr) * (2.0 * M_PI / nth)});
+      }
+  }
+
+  /// Volume flux through the disc spanned by ring r, relative to the ring's axial
+  /// motion, positive towards +x (m^3/s).
+  double disc_flux(int ring) const {
+    const int nt = mesh_.n_theta;
+    double xc = 0, vx = 0;
+    for (int i = 0; i < nt; ++i) {
+      xc += s_.X(0, mesh_.node(ring, i));
+      vx += s_.V(0, mesh_.node(ring, i));
+    }
+    xc /= nt;
+    vx /= nt;
+    const double R = ring_radii(mesh_, s_.X)[ring];
+    const Eigen::Vector3d a = mesh_.axis_start;
+    Eigen::Matrix3Xd P(3, disc_.size());
+    for (size_t k = 0; k < disc_.size(); ++k) P.col(k) = Eigen::Vector3d(xc, a[1] + R * disc_[k][0], a[2] + R * disc_[k][1]);
+    Eigen::Matrix3Xd U;
+    interpolate(*grid_, s_.u, P, U);
+    double q = 0;
+    for (size_t k = 0; k < disc_.size(); ++k) q += (U(0, k) - vx) * disc_[k][2] * R * R;
+    return q;
+  }
+
+  void measure_fluxes() {
+    q_rear_ = disc_flux(0);
+    q_front_ = disc_flux(mesh_.n_rings - 1);
+  }
+
+  void record() {
+    const Eigen::VectorXd rr = ring_radii(mesh_, s_.X);
+    const Eigen::VectorXd rn = node_radii(mesh_, s_.X);
+    const double es = stretching_energy(mesh_, s_.X, p_.membrane.ks);
+    const double eb = bending_energy(mesh_, s_.X, p_.membrane.kb, p_.membrane.bending);
+    const double ek = kinetic_energy();
+    double vol = 0;
+    const int nt = mesh_.n_theta;
+    std::vector<double> xr(mesh_.n_rings, 0.0);
+    for (int r = 0; r < mesh_.n_rings; ++r) {
+      for (int i = 0; i < nt; ++i) xr[r] += s_.X(0, mesh_.node(r, i));
+      xr[r] /= nt;
+    }
+    for (int r = 0; r + 1 < mesh_.n_rings; ++r)
+      vol += 0.5 * M_PI * (rr[r] * rr[r] + rr[r + 1] * rr[r + 1]) * (xr[r + 1] - xr[r]);
+    const auto& st = protocol_.state();
+    series_.push_back({s_.t, s_.X.row(0).mean() - x_center0_, s_.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
+                       rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
+                       double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
+                       last_divergence_});
+    radius_times_.push_back(s_.t);
+    radius_.insert(radius_.end(), rr.data(), rr.data() + rr.size());
+    last_recorded_ = n_;
+  }
+
+  // --- VTK -------------------------------------------------------------------
+  void write_vtk_frame() {
+    std::filesystem::create_directories(out_ + "/vtk");
+    char name[64];
+    std::snprintf(name, sizeof name, "vtk/membrane_%06d.vtp", int(pvd_.frames().size()));
+    const int nn = mesh_.nodes();
+    std::vector<double> xyz(s_.X.data(), s_.X.data() + 3 * nn);
+    vtk::PointArray vel{"velocity_m_per_s", 3, std::vector<double>(s_.V.data(), s_.V.data() + 3 * nn)};
+    const Eigen::Matrix3Xd Fe = protocol_.force(s_.X);
+    vtk::PointArray act{"actuation_force_N", 3, std::vector<double>(Fe.data(), Fe.data() + 3 * nn)};
+    const Eigen::VectorXd r = node_radii(mesh_, s_.X);
+    vtk::PointArray rad{"radius_m", 1, std::vector<double>(r.data(), r.data() + nn)};
+    vtk::PointArray seg{"segment", 1, std::vector<double>(nn)};
+    for (int i = 0; i < nn; ++i) seg.values[i] = protocol_.segment_of(i);
+    vtk::write_polydata(out_ + "/" + name, xyz, mesh_.triangles, {vel, act, rad, seg});
+    pvd_.add(s_.t, name);
+    pvd_.write();
+  }
+
+  void write_fluid_frame() {
+    std::filesystem::create_directories(out_ + "/vtk");
+    char name[64];
+    std::snprintf(name, sizeof name, "vtk/fluid_%06d.vti", int(fluid_pvd_.frames().size()));
+    const MacGrid& g = *grid_;
+    const int nx = g.nx(), ny = g.ny(), nz = g.nz();
+    std::ofstream o(out_ + "/" + name);
+    if (!o) throw std::runtime_error("cannot write " + out_ + "/" + name);
+    const double h = g.h();
+    o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\" Origin=\"0 0 0\" Spacing=\"" << h
+      << " " << h << " " << h << "\">\n<Piece Extent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\">\n<CellData>\n"
+      << "<DataArray type=\"Float64\" Name=\"velocity_m_per_s\" NumberOfComponents=\"3\" format=\"ascii\">\n";
+    char b[40];
+    const auto du = g.dims(0), dv = g.dims(1), dw = g.dims(2);
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {  // cell-centre averages of the face values
+          const int ip = (i + 1) % nx;
+          const int jp = g.periodic(1) ? (j + 1) % ny : j + 1;
+          const int kp = g.periodic(2) ? (k + 1) % nz : k + 1;
+          const double u = 0.5 * (s_.u.c[0][MacGrid::index(du, i, j, k)] + s_.u.c[0][MacGrid::index(du, ip, j, k)]);
+          const double v = 0.5 * (s_.u.c[1][MacGrid::index(dv, i, j, k)] + s_.u.c[1][MacGrid::index(dv, i, jp, k)]);
+          const double w = 0.5 * (s_.u.c[2][MacGrid::index(dw, i, j, k)] + s_.u.c[2][MacGrid::index(dw, i, j, kp)]);
+          std::snprintf(b, sizeof b, "%.7g %.7g %.7g\n", u, v, w);
+          o << b;
+        }
+    o << "</DataArray>\n<DataArray type=\"Float64\" Name=\"pressure_Pa\" format=\"ascii\">\n";
+    for (double v : ib_->stokes().pressure().v) {
+      std::snprintf(b, sizeof b, "%.7g\n", v);
+      o << b;
+    }
+    o << "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
+    fluid_pvd_.add(s_.t, name);
+    fluid_pvd_.write();
+  }
+
+  // --- checkpoints -------------------------------------------------------------
+  void save_checkpoint(double wall) {
+    CheckpointWriter w;
+    w.put("scene", resume_key(resolved_));
+    w.put("step", std::int64_t(n_));
+    w.put("t", s_.t);
+    w.put("X", s_.X.data(), s_.X.size());
+    w.put("V", s_.V.data(), s_.V.size());
+    w.put("V_prev", s_.V_prev.data(), s_.V_prev.size());
+    if (!p_.dry) {
+      for (int c = 0; c < 3; ++c) w.put("u" + std::to_string(c), s_.u.c[c]);
+      w.put("p", ib_->stokes().pressure().v);
+    }
+    const auto& st = protocol_.state();
+    w.put("phase", std::int64_t(st.phase));
+    w.put("active", std::int64_t(st.active));
+    w.put("cycles_completed", std::int64_t(st.cycles_completed));
+    w.put("switches", std::int64_t(st.switches));
+    w.put("cycle_start", st.cycle_start);
+    w.put("cycle_end", st.cycle_end);
+    w.put("segment_reached", st.segment_reached);
+    const std::vector<double> acc = {x_center0_, vol_rear_,  vol_front_,        q_rear_,   q_front_,
+                                     q_rear_prev_, q_front_prev_, max_cfl_, double(iterations_total_), wall,
+                                     last_cfl_, double(last_iterations_), last_divergence_};
+    w.put("accumulators", acc);
+    std::vector<double> flat;
+    for (const auto& row : series_) flat.insert(flat.end(), row.begin(), row.end());
+    w.put("series", flat);
+    w.put("radius_times", radius_times_);
+    w.put("radius", radius_);
+    w.put("last_recorded", std::int64_t(last_recorded_));
+    std::vector<double> ft;
+    for (const auto& f : pvd_.frames()) ft.push_back(f.first);
+    w.put("vtk_frames", ft);
+    ft.clear();
+    for (const auto& f : fluid_pvd_.frames()) ft.push_back(f.first);
+    w.put("fluid_frames", ft);
+    w.save(checkpoint_path(out_));
+    // partial results next to the checkpoint, so that a killed run still has them
+    write_outputs("running: last checkpoint at t = " + num(s_.t) + " s (resume with --resume " + out_ + ")", wall);
+  }
+
+  void load_checkpoint() {
+    CheckpointReader r(checkpoint_path(out_));
+    if (r.get_string("scene") != resume_key(resolved_))
+      throw InputError("--resume", out_, "the checkpoint was written for a different scene (only "
+                                         "full3d.checkpoint_interval and full3d.threads may change on resume)");
+    n_ = r.get_int("step");
+    s_.t = r.get_double("t");
+    r.get_into("X", s_.X.data(), s_.X.size());
+    r.get_into("V", s_.V.data(), s_.V.size());
+    r.get_into("V_prev", s_.V_prev.data(), s_.V_prev.size());
+    if (!p_.dry) {
+      for (int c = 0; c < 3; ++c) r.get_into("u" + std::to_string(c), s_.u.c[c].data(), s_.u.c[c].size());
+      // The duct's PCG is warm-started from the previous pressure: restore it so that the
+      // resumed run repeats the uninterrupted one to round-off. StokesSolver exposes the
+      // pressure read-only; the object itself is not const.
+      auto& pr = const_cast<ScalarField&>(ib_->stokes().pressure());
+      r.get_into("p", pr.v.data(), pr.v.size());
+    }
+    auto& st = protocol_.state();
+    st.phase = int(r.get_int("phase"));
+    st.active = int(r.get_int("active"));
+    st.cycles_completed = int(r.get_int("cycles_completed"));
+    st.switches = r.get_int("switches");
+    st.cycle_start = r.get_vector("cycle_start");
+    st.cycle_end = r.get_vector("cycle_end");
+    st.segment_reached = r.get_vector("segment_reached");
+    const auto acc = r.get_vector("accumulators");
+    if (acc.size() != 13) throw InputError("--resume", out_, "checkpoint accumulators of the wrong size");
+    x_center0_ = acc[0];
+    vol_rear_ = acc[1];
+    vol_front_ = acc[2];
+    q_rear_ = acc[3];
+    q_front_ = acc[4];
+    q_rear_prev_ = acc[5];
+    q_front_prev_ = acc[6];
+    max_cfl_ = acc[7];
+    iterations_total_ = long(acc[8]);
+    wall_before_ = acc[9];
+    last_cfl_ = acc[10];
+    last_iterations_ = long(acc[11]);
+    last_divergence_ = acc[12];
+    const auto flat = r.get_vector("series");
+    const size_t nc = kSeriesColumns.size();
+    series_.clear();
+    for (size_t k = 0; k + nc <= flat.size(); k += nc) series_.emplace_back(flat.begin() + k, flat.begin() + k + nc);
+    radius_times_ = r.get_vector("radius_times");
+    radius_ = r.get_vector("radius");
+    last_recorded_ = r.get_int("last_recorded");
+    for (double t : r.get_vector("vtk_frames")) {
+      char name[64];
+      std::snprintf(name, sizeof name, "vtk/membrane_%06d.vtp", int(pvd_.frames().size()));
+      pvd_.add(t, name);
+    }
+    for (double t : r.get_vector("fluid_frames")) {
+      char name[64];
+      std::snprintf(name, sizeof name, "vtk/fluid_%06d.vti", int(fluid_pvd_.frames().size()));
+      fluid_pvd_.add(t, name);
+    }
+    if (vtk_on_) pvd_.write();
+    if (fluid_on_) fluid_pvd_.write();
+  }
+
+  // --- outputs -----------------------------------------------------------------
+  json write_outputs(const std::string& status, double wall) {
+    const auto& st = protocol_.state();
+    json s = json::object();
+    s["tier"] = "3d";
+    s["scene"] = resolved_;
+    s["status"] = status;
+    const auto& last = series_.back();
+    const double t_end = last[0];
+    s["t_end_s"] = t_end;
+    s["displacement_m"] = last[1];
+    s["cycles_completed"] = st.cycles_completed;
+    std::vector<double> ct;
+    for (size_t k = 0; k < st.cycle_end.size() && k < st.cycle_start.size(); ++k)
+      ct.push_back(st.cycle_end[k] - st.cycle_start[k]);
+    s["cycle_times_s"] = ct;
+    s["cycle_start_times_s"] = st.cycle_start;
+    s["cycle_end_times_s"] = st.cycle_end;
+    const double vmean = t_end > 0 ? last[1] / t_end : 0.0;
+    s["mean_velocity_m_per_s"] = vmean;
+    s["body_lengths_per_s"] = vmean / p_.L;
+    s["final_velocity_m_per_s"] = last[2];
+    double vmax = -1e300, rmin = 1e300;
+    for (const auto& row : series_) {
+      vmax = std::max(vmax, row[2]);
+      rmin = std::min(rmin, row[4]);
+    }
+    s["max_velocity_m_per_s"] = vmax;
+    s["pumped_volume_m3"] = -vol_rear_;
+    s["min_radius_m"] = rmin;
+    s["protocol_switches"] = st.switches;
+    s["segment_reached_s"] = st.segment_reached;
+    s["steps"] = n_;
+    s["derived"] = {{"C1_estimate_Pa_per_m", p_.c1_estimate()},
+                    {"mass_per_area_kg_per_m2", p_.mass_per_area},
+                    {"mass_per_length_kg_per_m", p_.mass_per_area * 2.0 * M_PI * p_.R0},
+                    {"aspect_ratio_R0_over_L", p_.R0 / p_.L},
+                    {"contracted_ratio", p_.protocol.R_f / p_.R0},
+                    {"actuation_pressure_Pa", p_.protocol.q},
+                    {"force_per_node_N", p_.protocol.q * 2.0 * M_PI * p_.R0 * p_.L / mesh_.nodes()},
+                    {"reference_energy_J", e_ref_},
+                    {"cell_size_m", p_.h},
+                    {"grid", {p_.nx, p_.ny, p_.nz}},
+                    {"nodes", mesh_.nodes()},
+                    {"n_theta", mesh_.n_theta},
+                    {"rings", mesh_.n_rings},
+                    {"ring_spacing_m", mesh_.ring_spacing},
+                    {"max_edge_m", max_edge_length(mesh_, mesh_.X0)},
+                    {"segment_boundaries_m", protocol_.boundaries()}};
+    s["wall_time_s"] = wall;
+    {
+      output::CsvWriter csv(out_ + "/series.csv", kSeriesColumns);
+      for (const auto& row : series_) csv.row(row);
+    }
+    {
+      output::CsvWriter csv(out_ + "/radius.csv", {"t_s", "z_m", "radius_m"});
+      const int nr = mesh_.n_rings;
+      for (size_t k = 0; k < radius_times_.size(); ++k)
+        for (int r = 0; r < nr; ++r) csv.row({radius_times_[k], r * mesh_.ring_spacing, radius_[k * nr + r]});
+    }
+    json stats = {{"steps", n_},
+                  {"dt_s", p_.dt},
+                  {"mode", p_.dry ? "dry" : "fluid"},
+                  {"stokes_iterations_total", iterations_total_},
+                  {"max_cfl", max_cfl_},
+                  {"protocol_switches", st.switches},
+                  {"wall_time_s", wall},
+                  {"steps_per_s", wall > 0 ? n_ / wall : 0.0},
+                  {"output_every_steps", out_every_},
+                  {"checkpoint_every_steps", ckpt_every_}};
+    output::write_json(out_ + "/solver_stats.json", stats);
+    output::write_json(out_ + "/scene.resolved.json", resolved_);
+    output::write_json(out_ + "/summary.json", s);
+    return s;
+  }
+
+  const Params3d& p_;
+  const json& resolved_;
+  std::string out_;
+  RunControl ctl_;
+  CylinderMesh mesh_;
+  Eigen::VectorXd mass_;
+  double e_ref_;
+  Protocol3d protocol_;
+  std::optional<MacGrid> grid_;
+  std::unique_ptr<IbSolver> ib_;
+  IbState s_;
+  vtk::Collection pvd_, fluid_pvd_;
+  std::vector<std::array<double, 3>> disc_;
+
+  long n_ = 0, out_every_ = 1, vtk_every_ = 1, fluid_every_ = 1, ckpt_every_ = 1, n_end_ = -1, n_limit_ = 1;
+  long last_recorded_ = -1;
+  bool vtk_on_ = true, fluid_on_ = false;
+  double e_cap_ = 0;
+  double x_center0_ = 0, vol_rear_ = 0, vol_front_ = 0, q_rear_ = 0, q_front_ = 0, q_rear_prev_ = 0, q_front_prev_ = 0;
+  double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0, wall_before_ = 0;
+  long iterations_total_ = 0, last_iterations_ = 0;
+  std::vector<std::vector<double>> series_;
+  std::vector<double> radius_times_, radius_;
+};
+
+}  // namespace
+
+void dry_step(const CylinderMesh& mesh, const MembraneParams& membrane, const Eigen::VectorXd& mass,
+              const Eigen::VectorXd& nu, const ExternalForceFn& external, IbScheme scheme, IbState& s, double dt) {
+  auto force = [&](const Eigen::Matrix3Xd& X, double t) {
+    Eigen::Matrix3Xd F = elastic_forces(mesh, X, membrane);
+    if (external) F += external(t, X);
+    return F;
+  };
+  Eigen::Matrix3Xd V = s.V;
+  Eigen::Matrix3Xd X;
+  if (scheme == IbScheme::ForwardEuler) {  // symplectic Euler, damping implicit
+    const Eigen::Matrix3Xd F = force(s.X, s.t);
+    for (Eigen::Index i = 0; i < V.cols(); ++i) V.col(i) = (mass[i] * V.col(i) + dt * F.col(i)) / (mass[i] + dt * nu[i]);
+    X = s.X + dt * V;
+  } else {  // velocity Verlet, damping by the trapezoidal rule on each half kick
+    const Eigen::Matrix3Xd F0 = force(s.X, s.t);
+    for (Eigen::Index i = 0; i < V.cols(); ++i)
+      V.col(i) = (mass[i] * V.col(i) + 0.5 * dt * F0.col(i)) / (mass[i] + 0.5 * dt * nu[i]);
+    X = s.X + dt * V;
+    const Eigen::Matrix3Xd F1 = force(X, s.t + dt);
+    for (Eigen::Index i = 0; i < V.cols(); ++i)
+      V.col(i) = (mass[i] * V.col(i) + 0.5 * dt * F1.col(i)) / (mass[i] + 0.5 * dt * nu[i]);
+  }
+  if (!X.allFinite() || !V.allFinite())
+    throw NumericalError("non-finite node position or velocity in the dry swimmer (explicit integration unstable)",
+                         "reduce the time step full3d.dt (limit about 2 sqrt(m_i / k_node))", s.t);
+  s.V_prev = std::move(s.V);
+  s.V = std::move(V);
+  s.X = std::move(X);
+  s.t += dt;
+}
+
+RunOutcome run3d(const Params3d& p, const json& resolved, const std::string& out_dir, const RunControl& ctl) {
+  Runner r(p, resolved, out_dir, ctl);
+  return r.run();
+}
+
+}  // namespace swim::full3d

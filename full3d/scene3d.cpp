@@ -1,0 +1,256 @@
+#include "full3d/scene3d.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "common/errors.hpp"
+
+namespace swim::full3d {
+
+using scene::json;
+using scene::Range;
+using scene::Reader;
+
+namespace {
+
+std::string fmt(double v, const char* unit) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.6g %s", v, unit);
+  return b;
+}
+
+/// Exactly one of `keys` may be given; returns the one present, or `fallback` (as 1D).
+std::string one_of(const Reader& r, const std::vector<std::string>& keys, const std::string& fallback) {
+  std::string found;
+  for (const auto& k : keys) {
+    if (!r.has(k)) continue;
+    if (!found.empty()) {
+      std::string s;
+      for (size_t i = 0; i < keys.size(); ++i) s += (i ? ", " : "") + keys[i];
+      throw InputError(r.path(k), "(given together with " + found + ")", "give only one of: " + s);
+    }
+    found = k;
+  }
+  return found.empty() ? fallback : found;
+}
+
+bool multiple_of(double a, double h) {
+  const double n = std::round(a / h);
+  return n >= 1 && std::abs(a - n * h) <= 1e-9 * a;
+}
+
+}  // namespace
+
+double Params3d::c1_estimate() const { return 2.0 * membrane.ks / (std::sqrt(3.0) * R0 * R0); }
+
+ContainerKind Params3d::container_kind() const {
+  return container == "box" ? ContainerKind::PeriodicBox : ContainerKind::SquareDuct;
+}
+
+Eigen::Vector3d Params3d::axis_start() const {
+  return Eigen::Vector3d(0.5 * (nx * h - L), 0.5 * ny * h, 0.5 * nz * h);
+}
+
+CylinderMesh make_mesh(const Params3d& p) { return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor); }
+
+Params3d read_scene3d(const json& scene, json& resolved) {
+  Params3d p;
+  resolved = json::object();
+  Reader top(scene, "", resolved);
+  p.name = top.text("name", "unnamed");
+  top.text("description", "");
+
+  {
+    Reader s = top.child("swimmer");
+    p.R0 = s.quantity("radius", "m", "0.125 um", Range::positive());
+    p.L = s.quantity("length", "m", "0.4 um", Range::positive());
+    s.finish();
+  }
+  const double R0 = p.R0, L = p.L;
+  {
+    Reader f = top.child("fluid");
+    p.fluid.mu = f.quantity("viscosity", "Pa*s", "1.2e-3 Pa*s", Range::positive());
+    p.fluid.rho = f.quantity("density", "kg/m^3", "1000 kg/m^3", Range::positive());
+    f.finish();
+  }
+  {
+    Reader w = top.child("wall");
+    const std::string stiff = one_of(w, {"C1", "spring_constant", "calibration"}, "spring_constant");
+    if (stiff != "spring_constant")
+      throw InputError(w.path(stiff), scene::show(scene.at("wall").at(stiff)),
+                       "the 3D tier models the wall as a spring network and needs its spring constant: give "
+                       "wall.spring_constant (N/m) instead; C1 and calibration are 1D lumped stiffnesses");
+    p.membrane.ks = w.quantity("spring_constant", "N/m", "5.5e-8 N/m", Range::positive());
+    const std::string mass = one_of(w, {"mass_per_area", "mass_per_length"}, "mass_per_length");
+    if (mass == "mass_per_area")
+      p.mass_per_area = w.quantity("mass_per_area", "kg/m^2", "", Range::positive());
+    else  // notes section 1: mass per unit length m_l = 2 pi R0 m
+      p.mass_per_area = w.quantity("mass_per_length", "kg/m", "2.25e-3 ug/um", Range::positive()) / (2.0 * M_PI * R0);
+    w.finish();
+  }
+  double R_f = 0;
+  {
+    Reader w = top.child("wave");
+    const std::string kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven"});
+    if (kind != "force_driven")
+      throw InputError(w.path("kind"), "\"" + kind + "\"",
+                       "the 3D tier drives the wall by forces only (prescribed kinematics are not implemented): "
+                       "use \"force_driven\" or run --tier 1d");
+    if (one_of(w, {"contracted_ratio", "contracted_radius"}, "contracted_ratio") == "contracted_radius") {
+      R_f = w.quantity("contracted_radius", "m", "", Range::positive());
+      if (!(R_f < R0))
+        throw InputError(w.path("contracted_radius"), fmt(R_f, "m"),
+                         "must be below the reference radius swimmer.radius = " + fmt(R0, "m"));
+    } else {
+      R_f = R0 * w.number("contracted_ratio", 0.55, Range::open(0.0, 1.0));
+    }
+    w.finish();
+  }
+  {
+    Reader r = top.child("protocol");
+    p.protocol.R_f = R_f;
+    const double area = 2.0 * M_PI * R0 * L;
+    const double q_needed = p.c1_estimate() * (R0 - R_f);
+    const std::string act = one_of(r, {"pressure", "total_force", "load_factor"}, "total_force");
+    if (act == "pressure")
+      p.protocol.q = r.quantity("pressure", "Pa", "", Range::positive());
+    else if (act == "load_factor")
+      p.protocol.q = q_needed * r.number("load_factor", 1.5, Range::open(1.02, 1e6));
+    else
+      p.protocol.q = r.quantity("total_force", "N", "0.1 pN", Range::positive()) / area;
+    p.protocol.segments = static_cast<int>(r.integer("segments", 6, 2, 1000));
+    p.protocol.first_ratio = r.number("first_segment_ratio", 1.0 / 3.0, Range::open(0.0, 1.0e3));
+    p.protocol.delta = R0 * r.number("tolerance_ratio", 0.02, Range::open(0.0, 0.2));
+    p.protocol.energy_tol = r.number("energy_tolerance", 1e-3, Range::open(0.0, 1.0));
+    p.protocol.cycles = static_cast<int>(r.integer("cycles", 1, 1, 100000));
+    r.finish();
+    if (!(p.protocol.q > 1.02 * q_needed))
+      throw InputError(r.path(act), fmt(p.protocol.q, "Pa") + " (as pressure)",
+                       "cannot contract the wall to the contracted radius: the static load C1 (R0 - R_f) = " +
+                           fmt(q_needed, "Pa") + " must be exceeded by at least 2%; raise the actuation or "
+                           "wave.contracted_ratio");
+    if (!(p.protocol.delta < 0.5 * (R0 - R_f)) || !(p.protocol.delta < 0.5 * R_f))
+      throw InputError(r.path("tolerance_ratio"), fmt(p.protocol.delta / R0, ""),
+                       "the tolerance delta must be below half of both R0 - R_f and R_f");
+  }
+  top.pass_through("model1d");
+  top.pass_through("numerics1d");
+  {
+    Reader t = top.child("time");
+    const json& tn = scene.contains("time") ? scene["time"] : json::object();
+    if (tn.is_object() && tn.contains("duration") && tn["duration"] != "auto") {
+      p.duration = t.quantity("duration", "s", "", Range::positive());
+    } else {
+      t.text("duration", "auto");
+      p.duration = 0;
+    }
+    const std::string def = p.duration > 0 ? fmt(p.duration / 200.0, "s") : "0.5 ms";
+    p.output_interval = t.quantity("output_interval", "s", def, Range::positive());
+    if (p.duration > 0 && p.output_interval > p.duration)
+      throw InputError(t.path("output_interval"), fmt(p.output_interval, "s"),
+                       "must not exceed the run duration " + fmt(p.duration, "s"));
+    t.finish();
+  }
+  p.protocol.repeat_until_duration = p.duration > 0;
+
+  {
+    Reader f = top.child("full3d");
+    double width = 0;
+    {
+      Reader c = f.child("container");
+      p.container = c.choice("kind", "duct", {"box", "duct", "cylinder"});
+      if (p.container == "cylinder")
+        throw InputError(c.path("kind"), "\"cylinder\"",
+                         "the rigid circular container is not available in this build yet; use \"duct\" (no-slip "
+                         "square duct of half-width container.radius) or \"box\" (periodic)");
+      p.container_radius = c.quantity("radius", "m", "0.25 um", Range::positive());
+      p.period = c.quantity("period", "m", "2 um", Range::positive());
+      c.finish();
+      width = 2.0 * p.container_radius;
+    }
+    {
+      Reader g = f.child("grid");
+      if (one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
+        p.h = g.quantity("cell_size", "m", "", Range::positive());
+        if (!multiple_of(width, p.h))
+          throw InputError(g.path("cell_size"), fmt(p.h, "m"),
+                           "must divide the container width 2 * full3d.container.radius = " + fmt(width, "m"));
+      } else {
+        p.h = width / g.integer("cells_across", 32, 4, 4096);
+      }
+      if (!multiple_of(p.period, p.h))
+        throw InputError("full3d.container.period", fmt(p.period, "m"),
+                         "must be a multiple of the cell size " + fmt(p.h, "m"));
+      p.ny = p.nz = int(std::lround(width / p.h));
+      p.nx = int(std::lround(p.period / p.h));
+      g.finish();
+    }
+    p.dt = f.quantity("dt", "s", "10 us", Range::positive());
+    p.scheme = f.choice("scheme", "forward_euler", {"forward_euler", "midpoint"}) == "midpoint" ? IbScheme::Midpoint
+                                                                                               : IbScheme::ForwardEuler;
+    {
+      Reader m = f.child("membrane");
+      p.membrane.kb = m.quantity("bending_constant", "N", "1e-15 N", Range::non_negative());
+      p.membrane.bending = m.choice("bending_form", "reference_angle", {"reference_angle", "printed"}) == "printed"
+                               ? BendingForm::Printed
+                               : BendingForm::ReferenceAngle;
+      p.spacing_factor = m.number("spacing_factor", 0.9, Range::open(0.0, 1.0));
+      m.finish();
+    }
+    p.wall_inertia = f.boolean("wall_inertia", false);
+    p.navier_stokes = f.boolean("navier_stokes", false);
+    if (p.navier_stokes)
+      throw InputError(f.path("navier_stokes"), "true",
+                       "the Navier-Stokes advection module is not available in this build yet; use false (Stokes)");
+    p.dry = f.boolean("dry", false);
+    p.dry_damping = f.quantity("dry_damping", "kg/(m^2*s)", "1e4 kg/(m^2*s)", Range::non_negative());
+    p.max_cfl = f.number("max_cfl", 0.5, Range::open(0.0, 2.0));
+    p.energy_growth = f.number("energy_growth_limit", 50.0, Range::open(1.0, 1e12));
+    p.time_limit = f.quantity("time_limit", "s", "2 s", Range::positive());
+    {
+      Reader o = f.child("output");
+      p.vtk = o.boolean("vtk", true);
+      p.vtk_interval = o.quantity("vtk_interval", "s", fmt(p.output_interval, "s"), Range::positive());
+      p.fluid_fields = o.boolean("fluid_fields", false);
+      p.fluid_interval = o.quantity("fluid_interval", "s", fmt(10.0 * p.output_interval, "s"), Range::positive());
+      o.finish();
+    }
+    p.checkpoint_interval =
+        f.quantity("checkpoint_interval", "s", fmt(10.0 * p.output_interval, "s"), Range::positive());
+    p.threads = static_cast<int>(f.integer("threads", 1, 1, 256));
+    f.finish();
+  }
+  top.finish();
+
+  // Consistency (before anything is written).
+  if (p.dry && p.dry_damping == 0.0 && p.duration <= 0)
+    throw InputError("full3d.dry_damping", "0 kg/(m^2*s)",
+                     "an undamped dry swimmer never recovers (the energy criterion is never met): give a positive "
+                     "damping or a time.duration");
+  if (p.dry && !(p.mass_per_area > 0))
+    throw InputError("wall.mass_per_area", "", "the dry swimmer needs a positive wall mass");
+  if (!(R0 + 2.0 * p.h < p.container_radius))
+    throw InputError("full3d.container.radius", fmt(p.container_radius, "m"),
+                     "the swimmer must fit: swimmer.radius + 2 h (kernel support) = " + fmt(R0 + 2.0 * p.h, "m") +
+                         " must be below the container radius (h = " + fmt(p.h, "m") + ")");
+  if (!(L + 4.0 * p.h < p.nx * p.h))
+    throw InputError("full3d.container.period", fmt(p.period, "m"),
+                     "must exceed swimmer.length + 4 h = " + fmt(L + 4.0 * p.h, "m") +
+                         " so that the swimmer's ends do not interact through the periodic boundary");
+  if (p.nx * double(p.ny) * p.nz > 2.0e8)
+    throw InputError("full3d.grid", std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz),
+                     "more than 2e8 cells; use a coarser grid");
+  const double edge_bound = p.spacing_factor * 0.5 * p.h;
+  if (!(edge_bound > 1e-3 * R0))
+    throw InputError("full3d.membrane.spacing_factor", fmt(p.spacing_factor, ""), "gives a node spacing below 1e-3 R0");
+  const CylinderMesh mesh = make_mesh(p);
+  if (!(max_edge_length(mesh, mesh.X0) < 0.5 * p.h))
+    throw InputError("full3d.membrane.spacing_factor", fmt(p.spacing_factor, ""),
+                     "the mesh spacing must be below h/2 (no-leak rule)");
+  if (mesh.nodes() > 2000000)
+    throw InputError("full3d.grid", "", "the membrane would have more than 2e6 nodes; use a coarser grid");
+  Protocol3d check(p.protocol, mesh, 1.0);  // every segment must hold a ring
+  return p;
+}
+
+}  // namespace swim::full3d

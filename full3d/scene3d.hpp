@@ -1,0 +1,69 @@
+// Scene -> 3D parameters. Reads the physical sections shared with the 1D tier
+// (swimmer, fluid, wall, wave, protocol, time) with the same keys, defaults and
+// rules as reduced1d/scene1d.cpp, and the 3D section "full3d"; the 1D sections
+// (model1d, numerics1d) are passed through unchanged. Every value used is echoed
+// into `resolved`. Everything is validated here, before anything is written.
+//
+// 3D-specific rules (docs/scenes.md, "The full3d section"):
+//   - the spring network needs k_s: wall.C1 and wall.calibration (1D lumped
+//     stiffnesses) are rejected; wall.spring_constant (default 5.5e-8 N/m) is k_s.
+//   - node masses m_i = (mass per area) * A_i, A_i the node's reference area.
+//   - wave.kind must be force_driven (no prescribed kinematics in 3D).
+#pragma once
+
+#include <string>
+
+#include "common/scene.hpp"
+#include "full3d/grid.hpp"
+#include "full3d/ib_solver.hpp"
+#include "full3d/membrane.hpp"
+#include "full3d/protocol3d.hpp"
+
+namespace swim::full3d {
+
+struct Params3d {
+  std::string name = "unnamed";
+  // shared physics (SI)
+  double R0 = 0.125e-6, L = 0.4e-6;
+  FluidParams fluid{};
+  MembraneParams membrane{};      ///< ks from wall.spring_constant; kb, bending form from full3d.membrane
+  double mass_per_area = 0.0;     ///< kg/m^2
+  ProtocolParams protocol{};
+  double duration = 0.0;          ///< s; <= 0: until protocol.cycles cycles are complete
+  double output_interval = 5e-4;  ///< s
+  // full3d
+  std::string container = "duct";  ///< box | duct | cylinder
+  double container_radius = 0.25e-6;  ///< Rc (cylinder) or half-width (box, duct), m
+  double period = 2.0e-6;          ///< container length along x, m
+  int nx = 128, ny = 32, nz = 32;  ///< grid cells
+  double h = 0.5e-6 / 32;          ///< cell size, m
+  double spacing_factor = 0.9;     ///< longest reference edge < factor * h/2
+  double dt = 1e-5;                ///< s
+  IbScheme scheme = IbScheme::ForwardEuler;
+  bool wall_inertia = false;       ///< -m a term of eq. (16) in the fluid-coupled run
+  bool navier_stokes = false;
+  bool dry = false;                ///< paper's dry swimmer: m r'' + nu r' - F(r) = F_ext
+  double dry_damping = 1e4;        ///< nu per wall area, kg/(m^2 s) (node damping nu A_i)
+  double max_cfl = 0.5;
+  double energy_growth = 50.0;     ///< guard: wall energy above this many times max(E_ref, E_static)
+  double time_limit = 2.0;         ///< s; run cap when the duration is auto
+  bool vtk = true;
+  double vtk_interval = 5e-4;      ///< s
+  bool fluid_fields = false;
+  double fluid_interval = 5e-3;    ///< s
+  double checkpoint_interval = 5e-3;  ///< s of simulated time
+  int threads = 1;
+
+  double c1_estimate() const;      ///< 2 ks / (sqrt(3) R0^2), Pa/m
+  ContainerKind container_kind() const;
+  /// Axis start (centre of ring 0): the swimmer is centred in the container.
+  Eigen::Vector3d axis_start() const;
+};
+
+/// Throws swim::InputError naming the key, the value and what is allowed.
+Params3d read_scene3d(const scene::json& scene, scene::json& resolved);
+
+/// The reference mesh of the scene (no-leak rule with the scene's spacing factor).
+CylinderMesh make_mesh(const Params3d& p);
+
+}  // namespace swim::full3d

@@ -1,0 +1,247 @@
+// The 3D run driver (full3d/run3d.hpp) on the small scene data/scenes/tiny_3d.json
+// (32x12x12 duct, h = 40 nm): forward swimming, the stability guard with partial
+// results, checkpoint/resume to round-off, dry-swimmer inertia, the protocol in dry mode.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/errors.hpp"
+#include "common/scene.hpp"
+#include "full3d/run3d.hpp"
+
+using namespace swim;
+using namespace swim::full3d;
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Scene {
+  scene::json resolved;
+  Params3d p;
+};
+
+Scene tiny(const std::vector<std::string>& sets) {
+  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json");
+  for (const auto& s : sets) scene::apply_override(sc, s);
+  Scene s;
+  s.p = read_scene3d(sc, s.resolved);
+  return s;
+}
+
+std::string fresh_dir(const std::string& name) {
+  const std::string d = std::string(SWIM_BINARY_DIR) + "/tests/out_run3d/" + name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::vector<std::vector<double>> read_csv(const std::string& path) {
+  std::ifstream in(path);
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::vector<double>> rows;
+  while (std::getline(in, line)) {
+    std::vector<double> r;
+    std::stringstream ss(line);
+    std::string cell;
+    while (std::getline(ss, cell, ',')) r.push_back(std::stod(cell));
+    rows.push_back(r);
+  }
+  return rows;
+}
+
+// The strong, three-segment protocol that a 40 nm grid resolves (docs/full3d.md, "Run driver").
+const std::vector<std::string> kStrong = {"protocol.total_force=null", "protocol.load_factor=3",
+                                          "protocol.segments=3", "protocol.first_segment_ratio=1",
+                                          "full3d.membrane.spacing_factor=0.5"};
+
+}  // namespace
+
+TEST(Run3d, ForceDrivenRunMovesSwimmerForward) {
+  auto sets = kStrong;
+  sets.insert(sets.end(), {"full3d.dt=\"1 ms\"", "time.duration=\"0.3 s\"", "time.output_interval=\"10 ms\""});
+  const Scene s = tiny(sets);
+  const std::string dir = fresh_dir("forward");
+  RunControl ctl;
+  ctl.progress = 0;
+  ctl.quiet_vtk = true;
+  const RunOutcome r = run3d(s.p, s.resolved, dir, ctl);
+  ASSERT_FALSE(r.failed) << r.message;
+  const double disp = r.summary["displacement_m"].get<double>();
+  std::printf("displacement after 0.3 s: %.4g m = %.3g L; segments reached at", disp, disp / s.p.L);
+  for (double t : r.summary["segment_reached_s"]) std::printf(" %.3g", t);
+  std::printf(" s\n");
+  EXPECT_GT(disp, 0.01 * s.p.L);  // measured 0.040 L (contraction complete at 0.28 s)
+  EXPECT_EQ(r.summary["segment_reached_s"].size(), 3u);
+}
+
+TEST(Run3d, TimeStepBeyondStabilityFailsWithPartialResults) {
+  const Scene s = tiny({"full3d.dt=\"50 ms\"", "time.duration=\"2 s\""});
+  const std::string dir = fresh_dir("unstable");
+  RunControl ctl;
+  ctl.progress = 0;
+  const RunOutcome r = run3d(s.p, s.resolved, dir, ctl);
+  ASSERT_TRUE(r.failed);
+  std::printf("%s\n", r.message.c_str());
+  EXPECT_NE(r.message.find("full3d.dt"), std::string::npos);
+  EXPECT_EQ(r.summary["status"].get<std::string>().rfind("failed: ", 0), 0u);
+  for (const char* f : {"summary.json", "series.csv", "radius.csv", "checkpoint.bin", "membrane.pvd"})
+    EXPECT_TRUE(fs::exists(dir + "/" + f)) << f;
+  std::ifstream in(dir + "/series.csv");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str().find("nan"), std::string::npos);
+  EXPECT_EQ(ss.str().find("inf"), std::string::npos);
+  for (const auto& row : read_csv(dir + "/series.csv"))
+    for (double v : row) EXPECT_TRUE(std::isfinite(v));
+}
+
+TEST(Run3d, ResumeEqualsUninterruptedRun) {
+  const std::vector<std::string> sets = {"full3d.dt=\"1 ms\"", "time.duration=\"30 ms\"",
+                                         "time.output_interval=\"1 ms\"", "full3d.checkpoint_interval=\"10 ms\""};
+  const Scene s = tiny(sets);
+  RunControl ctl;
+  ctl.progress = 0;
+  ctl.quiet_vtk = true;
+  const std::string a = fresh_dir("resume_a"), b = fresh_dir("resume_b");
+  const RunOutcome ra = run3d(s.p, s.resolved, a, ctl);
+  ASSERT_FALSE(ra.failed) << ra.message;
+  RunControl stop = ctl;
+  stop.stop_after_steps = 17;  // "killed" at step 17; the last checkpoint is at step 10
+  const RunOutcome rb = run3d(s.p, s.resolved, b, stop);
+  ASSERT_TRUE(rb.interrupted);
+  RunControl res = ctl;
+  res.resume = true;
+  const RunOutcome rc = run3d(s.p, s.resolved, b, res);
+  ASSERT_FALSE(rc.failed) << rc.message;
+  EXPECT_EQ(rc.steps, ra.steps);
+  const auto A = read_csv(a + "/series.csv"), C = read_csv(b + "/series.csv");
+  ASSERT_EQ(A.size(), C.size());
+  double worst = 0;
+  for (size_t j = 0; j < A[0].size(); ++j) {
+    double scale = 0;
+    for (const auto& r : A) scale = std::max(scale, std::abs(r[j]));
+    if (scale == 0) continue;
+    for (size_t i = 0; i < A.size(); ++i) worst = std::max(worst, std::abs(A[i][j] - C[i][j]) / scale);
+  }
+  // series.csv carries 10 significant digits; compare the summary at full precision too
+  EXPECT_LE(worst, 1e-9);
+  const double da = ra.summary["displacement_m"].get<double>(), dc = rc.summary["displacement_m"].get<double>();
+  std::printf("displacement uninterrupted %.17g, resumed %.17g, relative difference %.3g\n", da, dc,
+              std::abs(da - dc) / std::abs(da));
+  EXPECT_LE(std::abs(da - dc), 1e-12 * std::abs(da));
+  EXPECT_EQ(ra.summary["pumped_volume_m3"].get<double>(), rc.summary["pumped_volume_m3"].get<double>());
+}
+
+TEST(Run3d, ResumeRejectsAnotherScene) {
+  const Scene s = tiny({"full3d.dt=\"1 ms\"", "time.duration=\"3 ms\""});
+  const std::string d = fresh_dir("resume_other");
+  RunControl ctl;
+  ctl.progress = 0;
+  ctl.quiet_vtk = true;
+  ASSERT_FALSE(run3d(s.p, s.resolved, d, ctl).failed);
+  const Scene o = tiny({"full3d.dt=\"0.5 ms\"", "time.duration=\"3 ms\""});
+  ctl.resume = true;
+  EXPECT_THROW(run3d(o.p, o.resolved, d, ctl), InputError);
+}
+
+// Node inertia: the free breathing oscillation of the undamped dry tube against the
+// analytic estimate omega^2 = C1 / m (C1 = 2 ks / (sqrt(3) R0^2), plane stress; axially
+// constrained (plane strain) the stiffness is 1/(1 - nu^2) = 9/8 larger for the lattice's
+// Poisson ratio 1/3), and energy conservation of the Verlet integrator.
+TEST(Run3d, DrySwimmerBreathingPeriodAndEnergy) {
+  const Scene s = tiny({});
+  const CylinderMesh mesh = make_mesh(s.p);
+  const Eigen::VectorXd m = node_masses(mesh, s.p.mass_per_area);
+  const Eigen::VectorXd nu = Eigen::VectorXd::Zero(mesh.nodes());
+  IbState st;
+  st.X = mesh.X0;
+  const double a = 0.01;
+  for (Eigen::Index i = 0; i < st.X.cols(); ++i)
+    for (int c = 1; c < 3; ++c) st.X(c, i) = mesh.axis_start[c] + (1 + a) * (st.X(c, i) - mesh.axis_start[c]);
+  st.V = Eigen::Matrix3Xd::Zero(3, mesh.nodes());
+  st.V_prev = st.V;
+  const double c1 = s.p.c1_estimate();
+  const double T_est = 2 * M_PI * std::sqrt(s.p.mass_per_area / c1);
+  const double dt = T_est / 400;
+  auto energy = [&](const IbState& x) {
+    double k = 0;
+    for (Eigen::Index i = 0; i < x.V.cols(); ++i) k += 0.5 * m[i] * x.V.col(i).squaredNorm();
+    return k + elastic_energy(mesh, x.X, s.p.membrane);
+  };
+  const double E0 = energy(st);
+  // middle ring radius deviation; period from its upward zero crossings
+  const int mid = mesh.n_rings / 2;
+  auto dev = [&](const IbState& x) { return ring_radii(mesh, x.X)[mid] - mesh.radius; };
+  (void)mid;
+  std::vector<double> ups;
+  double prev = dev(st), drift = 0;
+  for (int k = 0; k < 4000 && ups.size() < 6; ++k) {
+    dry_step(mesh, s.p.membrane, m, nu, nullptr, IbScheme::Midpoint, st, dt);
+    const double d = dev(st);
+    if (prev < 0 && d >= 0) ups.push_back(st.t - dt * d / (d - prev));
+    prev = d;
+    drift = std::max(drift, std::abs(energy(st) - E0) / E0);
+  }
+  ASSERT_GE(ups.size(), 2u);
+  const double T = (ups.back() - ups[0]) / (ups.size() - 1);
+  for (double u : ups) std::printf("  up-crossing at %.5g s\n", u);
+  std::printf("breathing period %.4g s, estimate %.4g s (plane stress) .. %.4g s (plane strain); energy drift %.2g\n",
+              T, T_est, T_est / std::sqrt(9.0 / 8.0), drift);
+  // The middle ring of this short open tube (L = 3.2 R0) also carries axial modes, so single
+  // periods scatter (3.2 .. 5.0 ms measured); the mean over five is 4.2 ms, 16 % below the
+  // plane-strain estimate. The bound is therefore loose: it checks the mass and stiffness
+  // scales of the inertia term, not the shell's mode shapes.
+  EXPECT_GT(T, 0.75 * T_est / std::sqrt(9.0 / 8.0));
+  EXPECT_LT(T, 1.15 * T_est);
+  EXPECT_LT(drift, 1e-3);
+}
+
+// The paper's protocol tested on the dry swimmer: every segment reaches R_f, the
+// contracted tube sits within delta of R_f, and the recovery ends the cycle.
+TEST(Run3d, DryProtocolReachesTargetOnEverySegment) {
+  const Scene s = tiny({"full3d.dry=true", "full3d.dt=\"2 us\"", "protocol.total_force=null", "protocol.load_factor=3",
+                        "wave.contracted_ratio=0.82", "protocol.segments=3", "protocol.first_segment_ratio=1",
+                        "time.output_interval=\"2 us\"", "full3d.checkpoint_interval=\"1 s\""});
+  const std::string dir = fresh_dir("dry_protocol");
+  RunControl ctl;
+  ctl.progress = 0;
+  ctl.quiet_vtk = true;
+  const RunOutcome r = run3d(s.p, s.resolved, dir, ctl);
+  ASSERT_FALSE(r.failed) << r.message;
+  EXPECT_EQ(r.summary["cycles_completed"].get<int>(), 1);
+  const auto reached = r.summary["segment_reached_s"].get<std::vector<double>>();
+  ASSERT_EQ(reached.size(), 3u);
+  const CylinderMesh mesh = make_mesh(s.p);
+  const Protocol3d proto(s.p.protocol, mesh, 1.0);
+  const auto rad = read_csv(dir + "/radius.csv");
+  const int nr = mesh.n_rings;
+  auto segment_mean = [&](double t, int k) {  // mean ring radius of segment k at output time t
+    double sum = 0;
+    int n = 0;
+    for (size_t i = 0; i + nr <= rad.size(); i += nr)
+      if (std::abs(rad[i][0] - t) < 0.5 * s.p.dt)
+        for (int q = 0; q < nr; ++q)
+          if (proto.segment_of(mesh.node(q, 0)) == k) {
+            sum += rad[i + q][2];
+            ++n;
+          }
+    return n ? sum / n : NAN;
+  };
+  const double Rf = s.p.protocol.R_f, delta = s.p.protocol.delta;
+  for (int e = 0; e < 3; ++e) {
+    const int k = 2 - e;
+    const double R = segment_mean(reached[e], k);
+    std::printf("segment %d reached R_f at t = %.4g s: mean radius %.5g m (R_f %.5g, delta %.3g)\n", k, reached[e], R,
+                Rf, delta);
+    EXPECT_LE(std::abs(R - Rf), delta);
+  }
+  for (int k = 1; k < 3; ++k) {  // held segments at the end of the contraction
+    const double R = segment_mean(reached[2], k);
+    std::printf("held segment %d at the end of the contraction: %.5g m\n", k, R);
+    EXPECT_LE(std::abs(R - Rf), 2 * delta);
+  }
+}

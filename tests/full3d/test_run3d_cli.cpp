@@ -1,0 +1,74 @@
+// `swim run --tier 3d` end to end on the small scene: the contract files, exit 2 for the
+// unavailable cylinder (nothing written), exit 3 with partial results for an unstable dt,
+// and --resume of a finished run folder.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace fs = std::filesystem;
+
+namespace {
+int swim(const std::string& args) {
+  const int s = std::system((std::string("\"") + SWIM_BINARY_DIR + "/bin/swim\" " + args + " > /dev/null 2>&1").c_str());
+  return WIFEXITED(s) ? WEXITSTATUS(s) : -1;
+}
+const std::string kScene = "\"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json\"";
+std::string dir(const std::string& n) {
+  const std::string d = std::string(SWIM_BINARY_DIR) + "/tests/out_run3d_cli/" + n;
+  fs::remove_all(d);
+  return d;
+}
+}  // namespace
+
+TEST(SwimRun3d, WritesContractFiles) {
+  const std::string d = dir("ok");
+  ASSERT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d +
+                 "\" --set full3d.dt='\"1 ms\"' --set time.duration='\"12 ms\"' --set full3d.output.vtk_interval='\"5 ms\"'"
+                 " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"10 ms\"'"),
+            0);
+  for (const char* f : {"summary.json", "series.csv", "radius.csv", "solver_stats.json", "scene.resolved.json",
+                        "membrane.pvd", "fluid.pvd", "checkpoint.bin", "vtk/membrane_000000.vtp",
+                        "vtk/membrane_000002.vtp", "vtk/fluid_000001.vti"})
+    EXPECT_TRUE(fs::exists(d + "/" + f)) << f;
+  std::ifstream in(d + "/summary.json");
+  const auto s = nlohmann::json::parse(in);
+  for (const char* k : {"tier", "scene", "displacement_m", "cycles_completed", "cycle_times_s", "mean_velocity_m_per_s",
+                        "body_lengths_per_s", "pumped_volume_m3", "wall_time_s", "status"})
+    EXPECT_TRUE(s.contains(k)) << k;
+  EXPECT_EQ(s["tier"], "3d");
+  EXPECT_EQ(s["status"], "ok");
+  EXPECT_EQ(s["scene"]["full3d"]["container"]["kind"], "duct");
+  std::ifstream csv(d + "/series.csv");
+  std::string header;
+  std::getline(csv, header);
+  EXPECT_EQ(header.rfind("t_s,x_center_m,velocity_m_per_s,energy_J,min_radius_m,max_radius_m", 0), 0u);
+  // a finished run resumes to the same end (nothing left to do)
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --resume \"" + d +
+                 "\" --set full3d.dt='\"1 ms\"' --set time.duration='\"12 ms\"' --set full3d.output.vtk_interval='\"5 ms\"'"
+                 " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"10 ms\"'"),
+            0);
+}
+
+TEST(SwimRun3d, BadInputExits2AndWritesNothing) {
+  const std::string d = dir("bad");
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.container.kind='\"cylinder\"'"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.bogus=1"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.container.radius='\"0.15 um\"'"), 2);
+  EXPECT_FALSE(fs::exists(d));
+}
+
+TEST(SwimRun3d, UnstableTimeStepExits3WithPartialResults) {
+  const std::string d = dir("unstable");
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d +
+                 "\" --set full3d.dt='\"50 ms\"' --set time.duration='\"2 s\"'"),
+            3);
+  std::ifstream in(d + "/summary.json");
+  const auto s = nlohmann::json::parse(in);
+  EXPECT_EQ(s["status"].get<std::string>().rfind("failed: ", 0), 0u);
+  EXPECT_TRUE(fs::exists(d + "/checkpoint.bin"));
+}
