@@ -15,6 +15,11 @@ using Triplet = Eigen::Triplet<double>;
 std::string num(double v) { return std::to_string(v); }
 }  // namespace
 
+bool cylinder_outside(const MacGrid& g, double radius, int c, int j, int k, double gap) {
+  const auto x = g.position(c, 0, j, k);
+  return std::hypot(x[1] - 0.5 * g.length(1), x[2] - 0.5 * g.length(2)) > radius + gap;
+}
+
 VelocityConstraints::VelocityConstraints(const MacGrid& g, const CylinderOptions& opt) : grid_(g), rc_(opt.radius) {
   if (g.kind() != ContainerKind::SquareDuct)
     throw InputError("container", to_string(g.kind()), "the circular cylinder is built inside a square_duct grid");
@@ -44,9 +49,9 @@ VelocityConstraints::VelocityConstraints(const MacGrid& g, const CylinderOptions
       for (int j = 0; j < d[1]; ++j)
         for (int i = 0; i < d[0]; ++i) {
           if (g.on_wall(c, 1, j) || g.on_wall(c, 2, k)) continue;
+          if (!cylinder_outside(g, opt.radius, c, j, k, gap)) continue;
           const auto x = g.position(c, i, j, k);
           const double r = std::hypot(x[1] - cy, x[2] - cz);
-          if (!(r > opt.radius + gap)) continue;
           const std::size_t gi = offset_[c] + MacGrid::index(d, i, j, k);
           if (opt.wall == CylinderWall::GhostLinear) {
             // fluid neighbour along y or z most aligned with the radial direction
@@ -211,9 +216,8 @@ void VelocityConstraints::apply_local_helmholtz(const std::vector<double>& r, st
   if (alpha != 0.0) zv += alpha * (EEt_ * rv);
 }
 
-bool VelocityConstraints::outside(int c, int i, int j, int k) const {
-  const auto x = grid_.position(c, i, j, k);
-  return std::hypot(x[1] - 0.5 * grid_.length(1), x[2] - 0.5 * grid_.length(2)) > rc_;
+bool VelocityConstraints::outside(int c, int /*i*/, int j, int k) const {
+  return cylinder_outside(grid_, rc_, c, j, k);
 }
 
 }  // namespace swim::full3d

@@ -46,6 +46,12 @@ struct CylinderOptions {
   double mask_gap = 1.0;       ///< SurfacePoints: mask only r > Rc + mask_gap h (cells)
 };
 
+/// The staircase mask, shared by the constraint rows below and the direct per-mode
+/// solver (direct_stokes.hpp): true when the face centre of component c (0..2) at
+/// cross-section position (j, k) lies outside r = radius + gap about the duct axis
+/// (Ly/2, Lz/2). Independent of the axial index (the geometry is x-invariant).
+bool cylinder_outside(const MacGrid& g, double radius, int c, int j, int k, double gap = 0.0);
+
 /// Sparse linear velocity constraints E u = 0 on the MAC faces.
 class VelocityConstraints {
  public:

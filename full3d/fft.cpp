@@ -88,4 +88,20 @@ FftwPlan plan_c2r_3d(std::array<int, 3> n, fftw_complex* in, double* out, const 
   return FftwPlan(fftw_plan_dft_c2r_3d(n[0], n[1], n[2], in, out, flags_of(opt)));
 }
 
+FftwPlan plan_many_r2c_1d(int n, int howmany, double* in, int istride, int idist, fftw_complex* out, int ostride,
+                          int odist, const FftOptions& opt) {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  set_threads_locked(opt);
+  return FftwPlan(
+      fftw_plan_many_dft_r2c(1, &n, howmany, in, nullptr, istride, idist, out, nullptr, ostride, odist, flags_of(opt)));
+}
+
+FftwPlan plan_many_c2r_1d(int n, int howmany, fftw_complex* in, int istride, int idist, double* out, int ostride,
+                          int odist, const FftOptions& opt) {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  set_threads_locked(opt);
+  return FftwPlan(
+      fftw_plan_many_dft_c2r(1, &n, howmany, in, nullptr, istride, idist, out, nullptr, ostride, odist, flags_of(opt)));
+}
+
 }  // namespace swim::full3d

@@ -79,5 +79,12 @@ FftwPlan plan_r2r_3d(std::array<int, 3> n, double* in, double* out, std::array<f
                      const FftOptions& opt);
 FftwPlan plan_r2c_3d(std::array<int, 3> n, double* in, fftw_complex* out, const FftOptions& opt);
 FftwPlan plan_c2r_3d(std::array<int, 3> n, fftw_complex* in, double* out, const FftOptions& opt);
+/// Batched 1D real transforms of length n (fftw_plan_many_dft_r2c / _c2r): `howmany`
+/// sequences, element stride and distance between sequences given separately for
+/// input and output (in units of the array element).
+FftwPlan plan_many_r2c_1d(int n, int howmany, double* in, int istride, int idist, fftw_complex* out, int ostride,
+                          int odist, const FftOptions& opt);
+FftwPlan plan_many_c2r_1d(int n, int howmany, fftw_complex* in, int istride, int idist, double* out, int ostride,
+                          int odist, const FftOptions& opt);
 
 }  // namespace swim::full3d

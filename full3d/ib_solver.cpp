@@ -45,10 +45,19 @@ Eigen::Matrix3Xd IbSolver::fluid_force(const Eigen::Matrix3Xd& X, double t, cons
   return F;
 }
 
+std::string IbSolver::dt_remedy() const {
+  std::string r = "reduce the time step " + opt_.dt_key;
+  if (mass_.size() > 0 && mass_.maxCoeff() > 0.0)
+    r += " -- but with the explicit node inertia -m a (lagged acceleration) a SMALLER step is less stable "
+         "(stable only while m M / dt < 1/2, M the membrane mobility): raise the time step or turn the inertia "
+         "term off (full3d.wall_inertia = false; docs/full3d.md)";
+  return r;
+}
+
 void IbSolver::guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const {
   if (!A.allFinite())
     throw NumericalError(std::string("non-finite ") + what + " (the explicit coupling became unstable)",
-                         "reduce the time step " + opt_.dt_key, t);
+                         dt_remedy(), t);
 }
 
 IbStepStats IbSolver::step(IbState& s, double dt) {
@@ -109,7 +118,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   if (st.cfl > opt_.max_cfl)
     throw NumericalError("advective CFL number " + num(st.cfl) + " exceeds " + num(opt_.max_cfl) +
                              " (nodes move " + num(st.cfl) + " cells per step)",
-                         "reduce the time step " + opt_.dt_key, s.t);
+                         dt_remedy(), s.t);
   st.max_edge = max_edge_length(mesh_, Xnew);
   if (opt_.check_no_leak && !(st.max_edge < 0.5 * grid_.h()))
     throw NumericalError("membrane edge of " + num(st.max_edge) + " m exceeds h/2 = " + num(0.5 * grid_.h()) +
@@ -118,8 +127,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
                          "reduce the time step " + opt_.dt_key + " if the edge jumped in one step, otherwise refine the membrane",
                          s.t + dt);
   if (!u.all_finite())
-    throw NumericalError("non-finite fluid velocity (the explicit coupling became unstable)",
-                         "reduce the time step " + opt_.dt_key, s.t);
+    throw NumericalError("non-finite fluid velocity (the explicit coupling became unstable)", dt_remedy(), s.t);
   s.X = std::move(Xnew);
   s.V_prev = std::move(s.V);
   s.V = std::move(U);

@@ -86,6 +86,7 @@ class IbSolver {
 
  private:
   void guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const;
+  std::string dt_remedy() const;
   MacGrid grid_;
   CylinderMesh mesh_;
   MembraneParams membrane_;

@@ -111,7 +111,7 @@ int Protocol3d::update(double t, const Eigen::Matrix3Xd& X, double wall_energy) 
         st_.active = 0;
       }
     }
-  } else if (st_.phase == 1 && wall_energy < p_.energy_tol * e_ref_) {
+  } else if (st_.phase == 1 && wall_energy < end_threshold()) {
     st_.cycle_end.push_back(t);
     ++st_.cycles_completed;
     ++switches;

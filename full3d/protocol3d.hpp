@@ -19,7 +19,9 @@
 //   [0.8 R0, R0 - delta): -0.1;  |r - R0| <= delta: 0;  r > R0 + delta: +0.1.
 // The cycle ends when the wall energy (elastic + bending + kinetic) drops
 // below energy_tol * E_ref, E_ref = elastic + bending energy of the tube
-// uniformly contracted to R_f; the next cycle then starts.
+// uniformly contracted to R_f (the paper's rule), or, with a positive end_energy,
+// below max(energy_tol * E_ref, end_energy) (docs/full3d.md, "Recovery end");
+// the next cycle then starts.
 //
 // Chattering. As in the 1D tier (reduced1d/protocol.hpp), the relays are
 // regularised: across every threshold the level varies by a C2 smooth step
@@ -31,6 +33,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <algorithm>
 #include <vector>
 
 #include "full3d/membrane.hpp"
@@ -49,6 +52,10 @@ struct ProtocolParams {
   double energy_tol = 1e-3;
   int cycles = 1;
   bool repeat_until_duration = false;  ///< true: cycles repeat (time.duration given)
+  /// J. > 0: the recovery ends when the wall energy drops below max(energy_tol E_ref,
+  /// end_energy) (full3d.recovery_end = dead_band: end_energy = energy of the tube uniformly
+  /// at R0 - delta, the edge of the five-band law's dead band). 0: the paper's energy_tol E_ref.
+  double end_energy = 0.0;
 };
 
 /// Discrete protocol state (checkpointed).
@@ -82,6 +89,8 @@ class Protocol3d {
   ProtocolState& state() { return st_; }
   const ProtocolParams& params() const { return p_; }
   double reference_energy() const { return e_ref_; }
+  /// Wall energy below which the recovery ends, J.
+  double end_threshold() const { return std::max(p_.energy_tol * e_ref_, p_.end_energy); }
   int segment_of(int node) const { return seg_[node]; }
   /// Mean node radius of each segment.
   Eigen::VectorXd segment_radii(const Eigen::Matrix3Xd& X) const;

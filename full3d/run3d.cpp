@@ -34,7 +34,7 @@ const std::vector<std::string> kSeriesColumns = {
     "t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m", "flux_rear_m3_per_s",
     "flux_front_m3_per_s", "volume_rear_m3", "volume_front_m3", "tube_volume_m3", "phase", "elastic_energy_J",
     "bending_energy_J", "kinetic_energy_J", "active_segment", "cycles_completed", "cfl", "stokes_iterations",
-    "max_divergence_per_s"};
+    "max_divergence_per_s", "max_edge_m"};
 
 /// The scene as it must match on resume: everything except the keys that only steer
 /// output cadence and parallelism.
@@ -52,7 +52,8 @@ class Runner {
   Runner(const Params3d& p, const json& resolved, std::string out, const RunControl& ctl)
       : p_(p), resolved_(resolved), out_(std::move(out)), ctl_(ctl), mesh_(make_mesh(p)),
         mass_(node_masses(mesh_, p.mass_per_area)),
-        e_ref_(uniform_contraction_energy(mesh_, p.membrane, p.protocol.R_f)), protocol_(p.protocol, mesh_, e_ref_),
+        e_ref_(uniform_contraction_energy(mesh_, p.membrane, p.protocol.R_f)),
+        protocol_(effective_protocol(p, mesh_), mesh_, e_ref_),
         pvd_(out_ + "/membrane.pvd"), fluid_pvd_(out_ + "/fluid.pvd") {
     const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
     e_cap_ = p.energy_growth * e_ref_ * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
@@ -71,6 +72,14 @@ class Runner {
       o.max_cfl = p.max_cfl;
       o.dt_key = "full3d.dt";
       o.stokes.fft.threads = p.threads;
+      if (p.container == "cylinder") {
+        o.stokes.cylinder.enabled = true;
+        o.stokes.cylinder.radius = p.container_radius;
+        o.stokes.cylinder.wall = p.cylinder_wall == "ghost_linear"     ? CylinderWall::GhostLinear
+                                 : p.cylinder_wall == "surface_points" ? CylinderWall::SurfacePoints
+                                                                       : CylinderWall::Staircase;
+      }
+      o.stokes.advection.enabled = p.navier_stokes;
       if (p.threads > 1) fftw_threads_init_once();
       const Eigen::VectorXd m = p.wall_inertia ? mass_ : Eigen::VectorXd::Zero(mesh_.nodes());
       ib_ = std::make_unique<IbSolver>(*grid_, p.fluid, mesh_, p.membrane, m, o);
@@ -187,13 +196,26 @@ class Runner {
   void guards(double e) {
     if (!std::isfinite(e))
       throw NumericalError("non-finite wall energy", "reduce the time step full3d.dt", s_.t);
-    if (e > e_cap_)
-      throw NumericalError("wall energy " + num(e) + " J grew beyond " + num(p_.energy_growth) +
-                               " times the reference energy (" + num(e_cap_) + " J): the explicit coupling is unstable",
-                           "reduce the time step full3d.dt (or raise full3d.energy_growth_limit if the growth is "
-                           "physical)",
-                           s_.t);
     const double rmin = node_radii(mesh_, s_.X).minCoeff();
+    if (e > e_cap_) {
+      // Below about 0.55 R0 of hoop contraction the linear spring lattice has a negative
+      // stiffness in the alternate-ring twist mode (docs/full3d.md, "Compressed-lattice
+      // instability"): no time step cures that, so say so when the run went that far.
+      const double r_lowest = std::min(rmin_seen_, rmin) / p_.R0;
+      const bool lattice = r_lowest < 0.56;
+      throw NumericalError(
+          "wall energy " + num(e) + " J grew beyond " + num(p_.energy_growth) + " times the reference energy (" +
+              num(e_cap_) + " J)" +
+              (lattice ? ": nodes had contracted to " + num(r_lowest) +
+                             " R0, where the compressed spring lattice loses its in-plane stability (alternate-ring "
+                             "twist mode, docs/full3d.md); a smaller time step does not help"
+                       : ": the explicit coupling is unstable"),
+          lattice ? "raise wave.contracted_ratio (>= 0.6), lower the actuation overshoot (protocol.load_factor), or run "
+                    "with fluid (full3d.dry = false)"
+                  : "reduce the time step full3d.dt (or raise full3d.energy_growth_limit if the growth is physical)",
+          s_.t);
+    }
+    rmin_seen_ = std::min(rmin_seen_, rmin);
     if (rmin < 0.02 * p_.R0)
       throw NumericalError("the tube collapsed: a node came within " + num(rmin) + " m of the axis",
                            "lower the actuation (protocol.total_force / pressure / load_factor) or reduce full3d.dt",
@@ -256,7 +278,7 @@ class Runner {
     series_.push_back({s_.t, s_.X.row(0).mean() - x_center0_, s_.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                        rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                        double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
-                       last_divergence_});
+                       last_divergence_, max_edge_length(mesh_, s_.X)});
     radius_times_.push_back(s_.t);
     radius_.insert(radius_.end(), rr.data(), rr.data() + rr.size());
     last_recorded_ = n_;
@@ -373,10 +395,10 @@ class Runner {
     if (!p_.dry) {
       for (int c = 0; c < 3; ++c) r.get_into("u" + std::to_string(c), s_.u.c[c].data(), s_.u.c[c].size());
       // The duct's PCG is warm-started from the previous pressure: restore it so that the
-      // resumed run repeats the uninterrupted one to round-off. StokesSolver exposes the
-      // pressure read-only; the object itself is not const.
-      auto& pr = const_cast<ScalarField&>(ib_->stokes().pressure());
+      // resumed run repeats the uninterrupted one to round-off.
+      ScalarField pr = ib_->stokes().pressure();
       r.get_into("p", pr.v.data(), pr.v.size());
+      ib_->stokes().set_pressure(pr);
     }
     auto& st = protocol_.state();
     st.phase = int(r.get_int("phase"));
@@ -444,11 +466,13 @@ class Runner {
     s["mean_velocity_m_per_s"] = vmean;
     s["body_lengths_per_s"] = vmean / p_.L;
     s["final_velocity_m_per_s"] = last[2];
-    double vmax = -1e300, rmin = 1e300;
+    double vmax = -1e300, rmin = 1e300, emax = 0;
     for (const auto& row : series_) {
       vmax = std::max(vmax, row[2]);
       rmin = std::min(rmin, row[4]);
+      emax = std::max(emax, row[20]);
     }
+    s["max_edge_over_h"] = emax / p_.h;  // at the output steps; the no-leak guard needs < 0.5
     s["max_velocity_m_per_s"] = vmax;
     s["pumped_volume_m3"] = -vol_rear_;
     s["min_radius_m"] = rmin;
@@ -463,6 +487,7 @@ class Runner {
                     {"actuation_pressure_Pa", p_.protocol.q},
                     {"force_per_node_N", p_.protocol.q * 2.0 * M_PI * p_.R0 * p_.L / mesh_.nodes()},
                     {"reference_energy_J", e_ref_},
+                    {"recovery_end_energy_J", protocol_.end_threshold()},
                     {"cell_size_m", p_.h},
                     {"grid", {p_.nx, p_.ny, p_.nz}},
                     {"nodes", mesh_.nodes()},
@@ -517,6 +542,7 @@ class Runner {
   bool vtk_on_ = true, fluid_on_ = false;
   double e_cap_ = 0;
   double x_center0_ = 0, vol_rear_ = 0, vol_front_ = 0, q_rear_ = 0, q_front_ = 0, q_rear_prev_ = 0, q_front_prev_ = 0;
+  double rmin_seen_ = 1e300;
   double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0, wall_before_ = 0;
   long iterations_total_ = 0, last_iterations_ = 0;
   std::vector<std::vector<double>> series_;

@@ -44,11 +44,19 @@ bool multiple_of(double a, double h) {
 double Params3d::c1_estimate() const { return 2.0 * membrane.ks / (std::sqrt(3.0) * R0 * R0); }
 
 ContainerKind Params3d::container_kind() const {
-  return container == "box" ? ContainerKind::PeriodicBox : ContainerKind::SquareDuct;
+  return container == "box" ? ContainerKind::PeriodicBox : ContainerKind::SquareDuct;  // cylinder: inside a duct
 }
 
 Eigen::Vector3d Params3d::axis_start() const {
   return Eigen::Vector3d(0.5 * (nx * h - L), 0.5 * ny * h, 0.5 * nz * h);
+}
+
+ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh) {
+  ProtocolParams q = p.protocol;
+  q.end_energy = p.recovery_end == "dead_band"
+                     ? uniform_contraction_energy(mesh, p.membrane, mesh.radius - p.protocol.delta)
+                     : 0.0;
+  return q;
 }
 
 CylinderMesh make_mesh(const Params3d& p) { return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor); }
@@ -160,9 +168,7 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       Reader c = f.child("container");
       p.container = c.choice("kind", "duct", {"box", "duct", "cylinder"});
       if (p.container == "cylinder")
-        throw InputError(c.path("kind"), "\"cylinder\"",
-                         "the rigid circular container is not available in this build yet; use \"duct\" (no-slip "
-                         "square duct of half-width container.radius) or \"box\" (periodic)");
+        p.cylinder_wall = c.choice("wall", "staircase", {"staircase", "ghost_linear", "surface_points"});
       p.container_radius = c.quantity("radius", "m", "0.25 um", Range::positive());
       p.period = c.quantity("period", "m", "2 um", Range::positive());
       c.finish();
@@ -181,11 +187,13 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       if (!multiple_of(p.period, p.h))
         throw InputError("full3d.container.period", fmt(p.period, "m"),
                          "must be a multiple of the cell size " + fmt(p.h, "m"));
-      p.ny = p.nz = int(std::lround(width / p.h));
+      // cylinder: the fictitious square domain is one cell wider than the cylinder on each side
+      // (paper, Remark 1: collocation points between the cylinder and the duct walls)
+      p.ny = p.nz = int(std::lround(width / p.h)) + (p.container == "cylinder" ? 2 : 0);
       p.nx = int(std::lround(p.period / p.h));
       g.finish();
     }
-    p.dt = f.quantity("dt", "s", "10 us", Range::positive());
+    p.dt = f.quantity("dt", "s", "1 ms", Range::positive());
     p.scheme = f.choice("scheme", "forward_euler", {"forward_euler", "midpoint"}) == "midpoint" ? IbScheme::Midpoint
                                                                                                : IbScheme::ForwardEuler;
     {
@@ -194,14 +202,12 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       p.membrane.bending = m.choice("bending_form", "reference_angle", {"reference_angle", "printed"}) == "printed"
                                ? BendingForm::Printed
                                : BendingForm::ReferenceAngle;
-      p.spacing_factor = m.number("spacing_factor", 0.9, Range::open(0.0, 1.0));
+      p.spacing_factor = m.number("spacing_factor", 0.6, Range::open(0.0, 1.0));
       m.finish();
     }
     p.wall_inertia = f.boolean("wall_inertia", false);
     p.navier_stokes = f.boolean("navier_stokes", false);
-    if (p.navier_stokes)
-      throw InputError(f.path("navier_stokes"), "true",
-                       "the Navier-Stokes advection module is not available in this build yet; use false (Stokes)");
+    p.recovery_end = f.choice("recovery_end", "dead_band", {"energy", "dead_band"});
     p.dry = f.boolean("dry", false);
     p.dry_damping = f.quantity("dry_damping", "kg/(m^2*s)", "1e4 kg/(m^2*s)", Range::non_negative());
     p.max_cfl = f.number("max_cfl", 0.5, Range::open(0.0, 2.0));

@@ -37,11 +37,15 @@ struct Params3d {
   double period = 2.0e-6;          ///< container length along x, m
   int nx = 128, ny = 32, nz = 32;  ///< grid cells
   double h = 0.5e-6 / 32;          ///< cell size, m
-  double spacing_factor = 0.9;     ///< longest reference edge < factor * h/2
-  double dt = 1e-5;                ///< s
+  double spacing_factor = 0.6;     ///< longest reference edge < factor * h/2 (docs/full3d.md)
+  double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md)
   IbScheme scheme = IbScheme::ForwardEuler;
   bool wall_inertia = false;       ///< -m a term of eq. (16) in the fluid-coupled run
-  bool navier_stokes = false;
+  bool navier_stokes = false;      ///< StokesOptions::advection (eq. 28 sub-step before each Stokes step)
+  std::string cylinder_wall = "staircase";  ///< cylinder: staircase | ghost_linear | surface_points
+  /// energy: the paper's end of recovery (E < energy_tolerance E_ref); dead_band: also ends
+  /// once E is below the energy of the tube uniformly at R0 - delta (docs/full3d.md).
+  std::string recovery_end = "dead_band";
   bool dry = false;                ///< paper's dry swimmer: m r'' + nu r' - F(r) = F_ext
   double dry_damping = 1e4;        ///< nu per wall area, kg/(m^2 s) (node damping nu A_i)
   double max_cfl = 0.5;
@@ -62,6 +66,9 @@ struct Params3d {
 
 /// Throws swim::InputError naming the key, the value and what is allowed.
 Params3d read_scene3d(const scene::json& scene, scene::json& resolved);
+
+/// The protocol parameters with the recovery-end energy of full3d.recovery_end filled in.
+ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh);
 
 /// The reference mesh of the scene (no-leak rule with the scene's spacing factor).
 CylinderMesh make_mesh(const Params3d& p);

@@ -6,9 +6,11 @@
 #include <limits>
 #include <numbers>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "common/errors.hpp"
+#include "full3d/direct_stokes.hpp"
 #include "full3d/operators.hpp"
 
 namespace swim::full3d {
@@ -158,6 +160,11 @@ struct StokesSolver::Impl {
   // Cylinder (fictitious domain): constraint rows and multiplier (warm-started)
   std::unique_ptr<VelocityConstraints> con;
   std::vector<double> lam;
+  // Direct per-mode solver; the multiplier is recovered lazily from (b, u, p, alpha) of the last step
+  std::unique_ptr<DirectStokes> direct;
+  bool lam_stale = false;
+  VectorField last_b, last_u;
+  double last_alpha = 0.0;
   // scratch
   VectorField wb, w1, w2, uc;
   ScalarField rp, zp, dp, sdp, div, phi;
@@ -200,6 +207,20 @@ struct StokesSolver::Impl {
       if (o.cylinder.enabled) {
         con = std::make_unique<VelocityConstraints>(g, o.cylinder);
         lam.assign(con->rows(), 0.0);
+      }
+      const bool direct_applies = !o.cylinder.enabled || o.cylinder.wall == CylinderWall::Staircase;
+      if (o.method == StokesMethod::Direct && !direct_applies)
+        throw InputError("stokes.method", "direct",
+                         "the direct solver supports the plain duct and the staircase cylinder wall only; use "
+                         "auto or iterative");
+      const double limit = o.direct_memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
+      const bool use_direct =
+          o.method == StokesMethod::Direct ||
+          (o.method == StokesMethod::Auto && direct_applies && 2.0 * double(DirectStokes::estimate_bytes(g)) <= limit);
+      if (use_direct) {
+        int thr = o.direct_threads;
+        if (thr <= 0) thr = std::max(1, int(std::thread::hardware_concurrency()));
+        direct = std::make_unique<DirectStokes>(g, f.mu, o.cylinder.enabled ? &o.cylinder : nullptr, thr, o.fft);
       }
     }
   }
@@ -373,8 +394,47 @@ struct StokesSolver::Impl {
     return st;
   }
 
+  // Direct per-mode solve (direct_stokes.hpp): no iteration, E u = 0 exactly.
+  StokesStats direct_step(VectorField& u, const VectorField& f, double dt) {
+    const double alpha = fluid.rho / dt;
+    rhs_into(wb, u, f, alpha);
+    direct->solve(wb, u, p, alpha);
+    StokesStats st;
+    st.direct = true;
+    if (direct->last_solve_factorized()) st.factorization_seconds = direct->last_factorization_seconds();
+    if (opt.direct_final_projection) project(u);
+    zero_wall_faces(grid, u);
+    divergence(grid, u, div);
+    st.max_divergence = div.max_abs();
+    if (con) {
+      // masked faces are eliminated unknowns, exactly zero unless the projection moved them
+      if (opt.direct_final_projection) {
+        con->gather(u, rl);
+        for (double x : rl) st.max_constraint = std::max(st.max_constraint, std::abs(x));
+      }
+      last_b = wb;
+      last_u = u;
+      last_alpha = alpha;
+      lam_stale = true;
+    }
+    return st;
+  }
+
+  // lambda = E (b - A u - G p), A = alpha - mu L: the force the masked rows need.
+  void refresh_multiplier() {
+    if (!lam_stale) return;
+    laplacian(grid, last_u, w1);
+    gradient(grid, p, w2);
+    for (int c = 0; c < 3; ++c)
+      for (std::size_t m = 0; m < w1.c[c].size(); ++m)
+        w1.c[c][m] = last_b.c[c][m] - last_alpha * last_u.c[c][m] + fluid.mu * w1.c[c][m] - w2.c[c][m];
+    con->gather(w1, lam);
+    lam_stale = false;
+  }
+
   StokesStats duct_bare(VectorField& u, const VectorField& f, double dt) {
     const double alpha = fluid.rho / dt;
+    lam_stale = false;
     rhs_into(wb, u, f, alpha);
     gradient(grid, p, w1);
     wb.axpy(-1.0, w1);
@@ -405,8 +465,9 @@ StokesStats StokesSolver::step(VectorField& u, const VectorField& f, double dt) 
   check_dt(dt);
   double cfl = 0.0;
   if (impl_->opt.advection.enabled) cfl = advect(impl_->grid, u, dt, impl_->opt.advection);  // module (28)
-  StokesStats st =
-      impl_->grid.kind() == ContainerKind::PeriodicBox ? impl_->box_step(u, f, dt) : impl_->duct_step(u, f, dt);
+  StokesStats st = impl_->grid.kind() == ContainerKind::PeriodicBox ? impl_->box_step(u, f, dt)
+                    : impl_->direct                                  ? impl_->direct_step(u, f, dt)
+                                                                     : impl_->duct_step(u, f, dt);
   st.advection_cfl = cfl;
   return st;
 }
@@ -417,8 +478,20 @@ StokesStats StokesSolver::bare_fft_solve(VectorField& u, const VectorField& f, d
 }
 
 const ScalarField& StokesSolver::pressure() const { return impl_->p; }
+void StokesSolver::set_pressure(const ScalarField& p) {
+  if (p.v.size() != impl_->grid.cells())
+    throw InputError("pressure", std::to_string(p.v.size()) + " values",
+                     "one value per cell (" + std::to_string(impl_->grid.cells()) + ")");
+  impl_->p = p;
+  impl_->lam_stale = false;  // the lazily recovered multiplier would mix old and new states
+}
+bool StokesSolver::uses_direct() const { return impl_->direct != nullptr; }
+std::size_t StokesSolver::direct_factor_bytes() const { return impl_->direct ? impl_->direct->factor_bytes() : 0; }
 const VelocityConstraints* StokesSolver::constraints() const { return impl_->con.get(); }
-const std::vector<double>& StokesSolver::multiplier() const { return impl_->lam; }
+const std::vector<double>& StokesSolver::multiplier() const {
+  if (impl_->direct && impl_->con) impl_->refresh_multiplier();
+  return impl_->lam;
+}
 const MacGrid& StokesSolver::grid() const { return impl_->grid; }
 const FluidParams& StokesSolver::fluid() const { return impl_->fluid; }
 

@@ -39,6 +39,12 @@
 //   solved by the same PCG on y = (p, lam) with K = [G, E^T]:
 //     K^T A^{-1} K y = K^T A^{-1} b,  preconditioner blockdiag(Cahouet-Chabard, E A E^T).
 //
+// Direct path (StokesOptions::method, default Auto; direct_stokes.hpp): duct and
+//   staircase cylinder solved exactly per axial Fourier mode by sparse LU factors
+//   computed once per dt (masked faces eliminated: E u = 0 holds exactly). The
+//   PCG above stays selectable with method = Iterative (and is used for the
+//   GhostLinear / SurfacePoints walls).
+//
 // Advection (StokesOptions::advection; advection.hpp): when enabled, step()
 //   first runs the explicit Navier-Stokes sub-step (28) on u^n, then the Stokes step.
 //
@@ -48,6 +54,7 @@
 //   divergence-free to round-off but with an O(dt) tangential slip at walls.
 #pragma once
 
+#include <cstddef>
 #include <memory>
 
 #include "full3d/advection.hpp"
@@ -62,8 +69,24 @@ struct FluidParams {
   double mu = 1.2e-3;    ///< dynamic viscosity, Pa s
 };
 
+/// Solver of the duct / cylinder step (the periodic box is always the exact Fourier projection).
+///   Direct:    per-axial-mode sparse LU (direct_stokes.hpp), factorised once per dt; plain duct
+///              and the Staircase cylinder wall only.
+///   Iterative: the multiplier PCG below (every wall kind).
+///   Auto:      Direct when it applies and the estimated factor memory for two dt values is
+///              below direct_memory_limit_gib, else Iterative.
+enum class StokesMethod { Auto, Direct, Iterative };
+
 struct StokesOptions {
   FftOptions fft{};
+  StokesMethod method = StokesMethod::Auto;
+  /// Direct: threads for the per-mode factorisations and solves; 0 = std::thread::hardware_concurrency().
+  int direct_threads = 0;
+  /// Auto: largest estimated factor memory (two cached dt values) for which Direct is chosen, GiB.
+  double direct_memory_limit_gib = 4.0;
+  /// Direct: follow the solve by the exact Neumann projection of the iterative path
+  /// (one more Poisson transform pair; not needed, the direct solve's divergence is at round-off).
+  bool direct_final_projection = false;
   /// duct: the PCG stops when the constraint residual of the unprojected velocity u_k,
   /// sqrt(h^2 ||D u_k||^2 + ||E u_k||^2), is below cg_rtol * max(||u_k||, ||u_0||)
   /// (u_0: the velocity of the warm-started multipliers), Euclidean norms over the grid.
@@ -85,6 +108,8 @@ struct StokesStats {
   double max_divergence = 0.0;  ///< max |D u^{n+1}| after the step, 1/s
   double max_constraint = 0.0;  ///< cylinder: max |E u^{n+1}| (velocity outside / on the wall), m/s
   double advection_cfl = 0.0;   ///< CFL number of the advection sub-step (0 when off)
+  bool direct = false;          ///< the step used the direct per-mode solver
+  double factorization_seconds = 0.0;  ///< direct: time spent (re)factorising in this step (new dt), s
 };
 
 class StokesSolver {
@@ -101,9 +126,18 @@ class StokesSolver {
   /// Transform-only solve (see header comment).
   StokesStats bare_fft_solve(VectorField& u, const VectorField& f, double dt);
 
-  /// Pressure of the last step, Pa (zero mean; arbitrary in fully masked cylinder cells).
+  /// Pressure of the last step, Pa. Iterative: zero mean, arbitrary in fully masked
+  /// cylinder cells. Direct: zero mean over the cells with a free face, 0 in the others.
   const ScalarField& pressure() const;
+  /// Replaces the pressure (checkpoint restore; the iterative path's warm start).
+  /// Throws swim::InputError if p does not have one value per cell.
+  void set_pressure(const ScalarField& p);
+  /// True when step() uses the direct per-mode solver (StokesOptions::method).
+  bool uses_direct() const;
+  /// Direct: measured memory of the cached LU factors (up to two dt values), bytes; 0 otherwise.
+  std::size_t direct_factor_bytes() const;
   /// Cylinder: the constraint rows and the multiplier of the last step (N/m^3 per row).
+  /// Direct: the multiplier is recovered on demand, lambda = E (b - A u - G p).
   const VelocityConstraints* constraints() const;
   const std::vector<double>& multiplier() const;
   const MacGrid& grid() const;

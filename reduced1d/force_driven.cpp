@@ -3,11 +3,14 @@
 // The conserved variable is the cross-section A_i = pi R_i^2 (state a_i = A_i / (pi R0^2)):
 // the tube volume h sum A_i is then a LINEAR function of the state, which BDF preserves
 // exactly, so d/dt(volume) = Q_rear - Q_front holds to solver tolerance at every step.
-// Without wall inertia (CVODE BDF, banded Jacobian):
-//   p_i = C1 (R_i - R0) + q_i(R_i),   Q_j = -(p_j - p_{j-1}) / r_j  (p = 0 beyond both ends),
-//   dA_i/dt = (Q_i - Q_{i+1}) / h.
+// Without wall inertia (CVODE BDF up to order 5, exact Jacobian = tridiagonal + one rank-1
+// term per held segment, band LU + Sherman-Morrison-Woodbury):
+//   p_i = C1 (R_i - R0) + q_i,   Q_j = -(p_j - p_{j-1}) / r_j  (p = 0 beyond both ends),
+//   dA_i/dt = (Q_i - Q_{i+1}) / h,   q_i = own law(R_i) + sum_k f_ik held law(Rbar_k).
 // With wall inertia (IDA, index-1 DAE in (a_i, V_i, p_i) interleaved per cell):
-//   A_i' = 2 pi R_i V_i,   m V_i' = p_i - C1 (R_i - R0) - q_i(R_i),   A_i' + (Q_{i+1} - Q_i)/h = 0.
+//   A_i' = 2 pi R_i V_i,   m V_i' = p_i - C1 (R_i - R0) - q_i,   A_i' + (Q_{i+1} - Q_i)/h = 0
+// (band Jacobian by central differences with the segment laws frozen, plus the same rank-1
+// segment terms, same solver).
 // Both carry the swimmer/flux integrals D, X, V_rear, V_front as extra differential states.
 // State scaling: A/(pi R0^2), V/(R0/T_s), p/(C1 R0), D/D_s, X/X_s, V/(pi R0^2 L).
 #include <cvode/cvode.h>
@@ -17,10 +20,7 @@
 #include <sunmatrix/sunmatrix_band.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <functional>
 #include <cmath>
 #include <memory>
@@ -37,13 +37,13 @@ namespace swim::reduced1d::detail {
 namespace {
 
 using disc::pi;
-double g_rhs_ns = 0, g_root_ns = 0;
-struct Reporter { ~Reporter() { if (std::getenv("SWIM1D_TIMES")) std::fprintf(stderr, "rhs %.4f s root %.4f s\n", g_rhs_ns, g_root_ns); } } g_rep;
 
 /// Maximum BDF order of CVODE and IDA (docs/reduced1d.md, "Integrator settings").
 constexpr int kMaxOrder = 5;
 /// First step after a protocol switch as a fraction of the step in use before it.
-constexpr double kRestartStepFraction = 1e-1;
+constexpr double kRestartStepFraction = 1e-2;
+/// Steps between refreshes of the Jacobian and of the Newton matrix (CVODE).
+constexpr int kJacobianAge = 5;
 
 std::string fmt(double v) {
   std::ostringstream s;
@@ -280,6 +280,8 @@ struct ForceModel {
     std::vector<double> QL, QR;
     double Qb0 = 0, QbL = 0;
   };
+  FluxSens sens_;           // Jacobian workspace (no allocation after the first call)
+  std::vector<double> dQ_;
   void flux_sensitivities(FluxSens& s, bool with_pressure) const {
     s.QL.assign(N + 1, 0.0);
     s.QR.assign(N + 1, 0.0);
@@ -307,7 +309,7 @@ struct ForceModel {
   int jacobian(const double* y, Band band, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
     fluxes();
-    FluxSens s;
+    FluxSens& s = sens_;
     flux_sensitivities(s, true);
     const double c = 1.0 / (h * pi * R0 * R0);
     for (int i = 0; i < N; ++i) {
@@ -326,7 +328,8 @@ struct ForceModel {
     int rank = 0;
     U.clear();
     Vt.clear();
-    std::vector<double> dQ(N + 1);
+    std::vector<double>& dQ = dQ_;
+    dQ.resize(N + 1);
     for (int k = 0; k < nseg; ++k) {
       if (!seg_law[k] || dqs[k] == 0.0) continue;
       std::fill(dQ.begin(), dQ.end(), 0.0);
@@ -387,7 +390,7 @@ struct ForceModel {
   int residual_low_rank(const double* y, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
     fluxes();
-    FluxSens s;
+    FluxSens& s = sens_;
     flux_sensitivities(s, false);
     const double cv = 1.0 / (m * Vel_s);
     const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
@@ -524,13 +527,17 @@ class CvodeBackend final : public Backend {
     pb.low_rank.scale_ctx = this;
     LS_ = sun::make_low_rank_band_solver(y_.get(), A_.get(), &pb.low_rank, ctx_.get());
     sun::check(CVodeSetLinearSolver(mem, LS_.get(), A_.get()), "CVodeSetLinearSolver");
-    sun::check(CVodeSetJacFn(mem, &CvodeBackend::jac), "CVodeSetJacFn");
+    // The Newton matrix I - gamma J is assembled here from the stored analytic Jacobian (no
+    // SUNMatrix copy/scale calls: the distribution's SUNDIALS kernels are unoptimised).
+    jband_.assign(3 * std::size_t(M.n), 0.0);
+    sun::check(CVodeSetLinSysFn(mem, &CvodeBackend::linsys), "CVodeSetLinSysFn");
     sun::check(CVodeSetNoInactiveRootWarn(mem), "CVodeSetNoInactiveRootWarn");
-    sun::check(CVodeSetMaxOrd(mem, std::getenv("MAXORD") ? std::atoi(std::getenv("MAXORD")) : kMaxOrder), "CVodeSetMaxOrd");
-    if (std::getenv("MSBJ")) CVodeSetJacEvalFrequency(mem, std::atoi(std::getenv("MSBJ")));
-    if (std::getenv("MSBP")) CVodeSetLSetupFrequency(mem, std::atoi(std::getenv("MSBP")));
-    if (std::getenv("NLIT")) CVodeSetMaxNonlinIters(mem, std::atoi(std::getenv("NLIT")));
-    if (std::getenv("STALD")) CVodeSetStabLimDet(mem, 1);
+    sun::check(CVodeSetMaxOrd(mem, kMaxOrder), "CVodeSetMaxOrd");
+    // The analytic Jacobian costs about one right-hand side: refresh it and the Newton matrix
+    // every kJacobianAge steps (CVODE default 51/20). Cells entering a ramp of an actuation law
+    // change their diagonal entry by up to 235 x C1, and a stale matrix then fails to converge.
+    sun::check(CVodeSetJacEvalFrequency(mem, kJacobianAge), "CVodeSetJacEvalFrequency");
+    sun::check(CVodeSetLSetupFrequency(mem, kJacobianAge), "CVodeSetLSetupFrequency");
   }
   double* y() override { return sun::data(y_.get()); }
   void restart(double t) override {
@@ -563,26 +570,6 @@ class CvodeBackend final : public Backend {
     CVodeGetNumSteps(mem_.get(), &v);
     return v;
   }
-  void trace(double t, int phase, int active) {
-    long ns, nf, ne, nc, nj, nni; double hl; int q;
-    void* mem = mem_.get();
-    CVodeGetNumSteps(mem, &ns); CVodeGetNumRhsEvals(mem, &nf); CVodeGetNumErrTestFails(mem, &ne);
-    CVodeGetNumNonlinSolvConvFails(mem, &nc); CVodeGetNumJacEvals(mem, &nj); CVodeGetNumNonlinSolvIters(mem,&nni);
-    CVodeGetLastStep(mem, &hl); CVodeGetLastOrder(mem, &q);
-    {
-      N_Vector ele = N_VClone(y_.get()), ew = N_VClone(y_.get());
-      CVodeGetEstLocalErrors(mem, ele); CVodeGetErrWeights(mem, ew);
-      double* e = sun::data(ele); double* w = sun::data(ew); const long nn = N_VGetLength(ele);
-      std::vector<std::pair<double,int>> v; double ss = 0;
-      for (long k = 0; k < nn; ++k) { v.push_back({std::abs(e[k]*w[k]), int(k)}); ss += e[k]*w[k]*e[k]*w[k]; }
-      std::sort(v.rbegin(), v.rend());
-      std::printf("ERR wrms=%.3e top:", std::sqrt(ss/nn));
-      for (int k = 0; k < 6; ++k) std::printf(" %d:%.2e(y=%.6f)", v[k].second, v[k].first, sun::data(y_.get())[v[k].second]);
-      std::printf("\n");
-      N_VDestroy(ele); N_VDestroy(ew);
-    }
-    std::printf("TRACE t=%.5e ph=%d act=%d steps=%ld rhs=%ld etf=%ld ncf=%ld jac=%ld nni=%ld h=%.3e q=%d\n", t, phase, active, ns, nf, ne, nc, nj, nni, hl, q);
-  }
   void harvest(std::map<std::string, long>& s) override {
     void* mem = mem_.get();
     add(s, "steps", CVodeGetNumSteps, mem);
@@ -598,32 +585,44 @@ class CvodeBackend final : public Backend {
 
  private:
   static int f(double, N_Vector y, N_Vector yd, void* user) {
-    auto t0 = std::chrono::steady_clock::now();
-    int r = static_cast<Problem*>(user)->M.rhs(sun::data(y), sun::data(yd));
-    g_rhs_ns += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
+    return static_cast<Problem*>(user)->M.rhs(sun::data(y), sun::data(yd));
   }
-  static int jac(double, N_Vector y, N_Vector, SUNMatrix J, void* user, N_Vector, N_Vector, N_Vector) {
+  // Newton matrix A = I - gamma J. The exact Jacobian (tridiagonal part in jband_, rank-1
+  // segment terms in pb.low_rank) is re-evaluated when CVODE asks for it (jok false).
+  static int linsys(double, N_Vector y, N_Vector, SUNMatrix A, booleantype jok, booleantype* jcur,
+                    double gamma, void* user, N_Vector, N_Vector, N_Vector) {
     auto* pb = static_cast<Problem*>(user);
-    std::fill(SM_DATA_B(J), SM_DATA_B(J) + SM_LDATA_B(J), 0.0);  // (SUNMatZero is unoptimised)
+    auto* self = static_cast<CvodeBackend*>(pb->low_rank.scale_ctx);
     const long nn = pb->M.n;
-    auto band = [J, nn](int i, int j, double v) {
-      if (i >= 0 && j >= 0 && i < nn && j < nn) SM_ELEMENT_B(J, i, j) = v;
-    };
-    pb->low_rank.rank = pb->M.jacobian(sun::data(y), band, pb->low_rank.U, pb->low_rank.V);
-    for (double v : pb->low_rank.U)
-      if (!std::isfinite(v)) return 1;
+    std::vector<double>& jb = self->jband_;
+    if (!jok) {
+      std::fill(jb.begin(), jb.end(), 0.0);
+      auto band = [&jb, nn](int i, int j, double v) {
+        if (i >= 0 && j >= 0 && i < nn && j < nn) jb[3 * std::size_t(i) + 1 + (j - i)] = v;
+      };
+      pb->low_rank.rank = pb->M.jacobian(sun::data(y), band, pb->low_rank.U, pb->low_rank.V);
+      for (double v : jb)
+        if (!std::isfinite(v)) return 1;
+      for (double v : pb->low_rank.U)
+        if (!std::isfinite(v)) return 1;
+      *jcur = SUNTRUE;
+    } else {
+      *jcur = SUNFALSE;
+    }
+    self->gamma_ = gamma;
+    std::fill(SM_DATA_B(A), SM_DATA_B(A) + SM_LDATA_B(A), 0.0);
+    for (long i = 0; i < nn; ++i) {
+      if (i > 0) SM_ELEMENT_B(A, i, i - 1) = -gamma * jb[3 * i];
+      SM_ELEMENT_B(A, i, i) = 1.0 - gamma * jb[3 * i + 1];
+      if (i + 1 < nn) SM_ELEMENT_B(A, i, i + 1) = -gamma * jb[3 * i + 2];
+    }
     return 0;
   }
-  static double minus_gamma(void* self) {
-    double g = 0;
-    CVodeGetCurrentGamma(static_cast<CvodeBackend*>(self)->mem_.get(), &g);
-    return -g;
-  }
+  static double minus_gamma(void* self) { return -static_cast<CvodeBackend*>(self)->gamma_; }
+  std::vector<double> jband_;  // row i: J(i, i-1), J(i, i), J(i, i+1)
+  double gamma_ = 0;
   static int g(double, N_Vector y, double* gout, void* user) {
-    auto t0 = std::chrono::steady_clock::now();
     static_cast<Problem*>(user)->roots.eval(sun::data(y), gout);
-    g_root_ns += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return 0;
   }
   Problem& pb_;
@@ -957,10 +956,6 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
         ++res.stats["reinits"];
         continue;
       }
-      if (std::getenv("SWIM1D_TRACE")) {
-        auto* cb = dynamic_cast<CvodeBackend*>(be.get());
-        if (cb) cb->trace(t, machine.phase(), machine.active());
-      }
       if (!record(t, be->y()))
         throw NumericalError("non-finite state", "tighten numerics.rtol or refine numerics.cells", t);
       if (tout >= t_stop) {
@@ -1105,7 +1100,7 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
 }
 
 Result solve_force_driven(const Params& p, const ProgressFn& progress) {
-  if (std::getenv("RAMPKIND")) kRampKind = std::atoi(std::getenv("RAMPKIND")); return run(p, {}, 0.0, progress); }
+ return run(p, {}, 0.0, progress); }
 
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
                              const ProgressFn& progress) {

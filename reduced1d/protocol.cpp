@@ -2,7 +2,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <numbers>
 
 #include "reduced1d/internal.hpp"
@@ -90,7 +89,7 @@ ProtocolMachine::ProtocolMachine(const Params& p, std::vector<double> fixed_q)
   held_law_ = regularised_relay({Rf_ - d, Rf_ + d}, {-q, 0.0, q}, {eps, eps});
   recovery_law_ = regularised_relay({0.5 * R0, 0.8 * R0, R0 - d, R0 + d},
                                     {-q, -0.5 * q, -0.1 * q, 0.0, 0.1 * q},
-                                    {std::max(wide, eps), std::max(wide, eps), eps * (std::getenv("RRF") ? std::atof(std::getenv("RRF")) : 1.0), eps* (std::getenv("RRF") ? std::atof(std::getenv("RRF")) : 1.0)});
+                                    {std::max(wide, eps), std::max(wide, eps), eps, eps});
 }
 
 double ProtocolMachine::segment_mean(int k, const double* R) const {
@@ -121,10 +120,6 @@ void ProtocolMachine::laws(std::vector<CellLaw>& law, std::vector<const Actuatio
   }
   if (!fixed_ && phase_ == 0)
     for (int k = active_ + 1; k < nseg_; ++k) seg[k] = &held_law_;
-  if (!fixed_ && phase_ == 1 && std::getenv("SEGREC")) {
-    for (int i = 0; i < N_; ++i) law[i] = CellLaw{&idle_law_, &idle_law_, 1.0};
-    for (int k = 0; k < nseg_; ++k) seg[k] = &recovery_law_;
-  }
 }
 
 int ProtocolMachine::root_count() const {

@@ -2,23 +2,27 @@
 //
 // Contraction (phase 0): segments k = n-1 (rightmost, shortest) down to 0 are driven in turn
 // with q = +protocol.q until their MEAN cell radius reaches R_f (a located root: a discrete
-// event). Cells of segments that have reached R_f are "held" by the three-way rule on their
-// radius: +q above R_f + delta, -q below R_f - delta, 0 within delta. Cells left of the
-// active segment carry no actuation.
-// Recovery (phase 1, from the moment segment 0 reaches R_f): five bands per cell,
-//   R < 0.5 R0: -q;  [0.5, 0.8) R0: -0.5 q;  [0.8 R0, R0 - delta): -0.1 q;
+// event). Segments that have reached R_f are "held" by the paper's three-way rule applied to
+// the SEGMENT ("the radius of the previous segment is checked, and the following force is
+// applied to the previous segment(s)"): on the segment's length-weighted mean radius Rbar,
+// +q above R_f + delta, -q below R_f - delta, 0 within delta, applied uniformly over the
+// segment. Segments left of the active one carry no actuation.
+// Recovery (phase 1, from the moment segment 0 reaches R_f): five bands per cell ("at that
+// node"), R < 0.5 R0: -q;  [0.5, 0.8) R0: -0.5 q;  [0.8 R0, R0 - delta): -0.1 q;
 //   |R - R0| <= delta: 0;  R > R0 + delta: +0.1 q.
 // The cycle ends when the wall energy drops below energy_tol * E_ref (a located root).
 //
-// The held and recovery rules are relays on the local radius. Applied continuously in time
-// to the diffusive wall-flow system they have no classical solution: where the two laws on
-// either side of a threshold push the radius towards it, the relay chatters infinitely fast
-// (Filippov sliding mode); with a hysteresis band the chattering frequency is set by the cell
-// size and grows like N^2 (docs/reduced1d.md, "Why the relays are regularised"). The solver
-// therefore uses the Filippov regularisation of each relay: across every threshold the
-// actuation varies linearly over a width eps = kRampFraction * delta centred on the threshold.
-// The actuation is then a continuous, monotone function of the radius, the sliding motion is
-// resolved by the integrator, and only the n + 1 protocol events per cycle are discrete.
+// The held and recovery rules are relays. Applied continuously in time to the diffusive
+// wall-flow system they have no classical solution: where the two laws on either side of a
+// threshold push the radius towards it, the relay chatters infinitely fast (Filippov sliding
+// mode); with a hysteresis band the chattering frequency is set by the cell size and grows like
+// N^2 (docs/reduced1d.md, "Why the relays are regularised"). The solver therefore uses the
+// Filippov regularisation of each relay: across every threshold the actuation follows a C2
+// smooth step of width kRampFraction * delta (the delta-tolerance thresholds R_f +- delta and
+// R0 +- delta) or kWideRampFraction * R0 (the band boundaries 0.5 R0 and 0.8 R0) centred on
+// the threshold. The actuation is then a continuous, non-decreasing function of the radius,
+// the sliding motion is resolved by the integrator, and only the n + 1 protocol events per
+// cycle are discrete.
 #pragma once
 
 #include <vector>
@@ -30,7 +34,6 @@ namespace swim::reduced1d::detail {
 /// Ramp width of the regularised relays at the delta-tolerance thresholds (R_f +- delta for
 /// the hold, R0 +- delta for the recovery) as a fraction of protocol.delta.
 inline constexpr double kRampFraction = 0.25;
-inline int kRampKind = 2;
 /// Ramp width of the recovery thresholds at 0.5 R0 and 0.8 R0 as a fraction of R0. These
 /// thresholds are band boundaries, not tolerances, so their relays may be smoothed more widely.
 inline constexpr double kWideRampFraction = 0.05;
@@ -62,13 +65,8 @@ struct ActuationLaw {
         const double inv = 1.0 / (x[k] - x[k - 1]);
         const double s = (R - x[k - 1]) * inv;
         const double s2 = s * s;
-        double step = s2 * s * (10.0 + s * (-15.0 + 6.0 * s));  // C2 smooth step
-        double dstep = 30.0 * s2 * (1.0 - s) * (1.0 - s);
-        if (kRampKind == 4) {
-          const double s4 = s2 * s2, u = 1.0 - s;
-          step = s4 * s * (126.0 + s * (-420.0 + s * (540.0 + s * (-315.0 + 70.0 * s))));
-          dstep = 630.0 * s4 * u * u * u * u;
-        }
+        const double step = s2 * s * (10.0 + s * (-15.0 + 6.0 * s));  // C2 smooth step
+        const double dstep = 30.0 * s2 * (1.0 - s) * (1.0 - s);
         dq = (y[k] - y[k - 1]) * dstep * inv;
         return y[k - 1] + (y[k] - y[k - 1]) * step;
       }

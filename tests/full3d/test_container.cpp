@@ -120,7 +120,7 @@ TEST(CylinderContainer, PoiseuilleStaircase) { poiseuille_orders(CylinderWall::S
 
 TEST(CylinderContainer, PoiseuilleSurfaceCollocation) { poiseuille_orders(CylinderWall::SurfacePoints, 0.8, 0.9, 0.05); }
 
-void swimmer_regime(CylinderWall wall) {
+void swimmer_regime(CylinderWall wall, StokesMethod method = StokesMethod::Auto) {
   // 64 x 32 x 32, Rc = 0.25 um, side 2.25 Rc, water, dt = 1e-5 s, random force
   // inside the cylinder: converges, divergence at round-off, constraint kept.
   const double Rc = 0.25e-6, side = 2.25 * Rc;
@@ -130,6 +130,7 @@ void swimmer_regime(CylinderWall wall) {
   opt.cylinder.enabled = true;
   opt.cylinder.radius = Rc;
   opt.cylinder.wall = wall;
+  opt.method = method;
   StokesSolver solver(grid, FluidParams{1.0e3, 1.2e-3}, opt);
   VectorField u(grid), f(grid);
   std::mt19937 rng(5);
@@ -162,7 +163,11 @@ void swimmer_regime(CylinderWall wall) {
 TEST(CylinderContainer, SwimmerRegimeStep) {
   // Only the default wall: GhostLinear's rows with a small crossing fraction make the
   // multiplier system hard for this preconditioner (no convergence in 500 iterations here).
-  swimmer_regime(CylinderWall::Staircase);
+  swimmer_regime(CylinderWall::Staircase);  // Auto: the direct per-mode solver
+}
+
+TEST(CylinderContainer, SwimmerRegimeStepIterative) {
+  swimmer_regime(CylinderWall::Staircase, StokesMethod::Iterative);  // the multiplier PCG
 }
 
 TEST(CylinderContainer, RejectsBadGeometry) {

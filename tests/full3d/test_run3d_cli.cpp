@@ -1,5 +1,5 @@
-// `swim run --tier 3d` end to end on the small scene: the contract files, exit 2 for the
-// unavailable cylinder (nothing written), exit 3 with partial results for an unstable dt,
+// `swim run --tier 3d` end to end on the small scene: the contract files, exit 2 for bad
+// input such as an unknown cylinder wall method (nothing written), exit 3 with partial results for an unstable dt,
 // and --resume of a finished run folder.
 #include <gtest/gtest.h>
 
@@ -54,7 +54,8 @@ TEST(SwimRun3d, WritesContractFiles) {
 
 TEST(SwimRun3d, BadInputExits2AndWritesNothing) {
   const std::string d = dir("bad");
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.container.kind='\"cylinder\"'"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.container.kind='\"cylinder\"'"
+                 " --set full3d.container.wall='\"bogus\"'"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.bogus=1"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);

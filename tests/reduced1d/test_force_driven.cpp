@@ -69,7 +69,9 @@ TEST(Reduced1dForceDriven, AnalyticJacobianMatchesFiniteDifferences) {
           EXPECT_LT(c.max_rel_error, 1e-6) << "inertia=" << inertia << " N=" << N << " phase=" << phase
                                             << " active=" << active << " seed=" << seed;
           EXPECT_GT(c.entries, 3 * N);
-          if (phase == 0) EXPECT_EQ(c.rank, n - 1 - active) << "every held segment sits on a ramp";
+          if (phase == 0) {
+            EXPECT_EQ(c.rank, n - 1 - active) << "every held segment sits on a ramp";
+          }
         }
       }
     }
