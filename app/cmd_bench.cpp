@@ -68,7 +68,7 @@ int bench(const std::string& out_opt, bool quick) {
   // design is reachable and runs a whole cycle (failing designs would cost nothing and
   // inflate the figure); N = 200 (the scene default) and N = 50 (a coarse screening grid).
   std::printf("screening throughput (%u threads, 10 x 10 grid over lambda and L):\n", cores);
-  scene::json thr = scene::json::object();
+  scene::json screening = scene::json::object();
   struct Case {
     std::string kind;
     int cells;
@@ -97,10 +97,10 @@ int bench(const std::string& out_opt, bool quick) {
     const std::string label = c.kind + " N=" + std::to_string(c.cells);
     std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed)\n", label.c_str(), n, wall, n / wall,
                 failed);
-    thr[label] = {{"designs", n}, {"cells", c.cells}, {"wall_time_s", wall}, {"designs_per_s", n / wall},
+    screening[label] = {{"designs", n}, {"cells", c.cells}, {"wall_time_s", wall}, {"designs_per_s", n / wall},
                   {"failed", failed}};
   }
-  report["screening"] = thr;
+  report["screening"] = screening;
 
   // 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
   // resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
