@@ -111,7 +111,7 @@ int Protocol3d::update(double t, const Eigen::Matrix3Xd& X, double wall_energy) 
         st_.active = 0;
       }
     }
-  } else if (st_.phase == 1 && wall_energy < end_threshold()) {
+  } else if (st_.phase == 1 && (p_.shape_end ? shape_recovered(X) : wall_energy < end_threshold())) {
     st_.cycle_end.push_back(t);
     ++st_.cycles_completed;
     ++switches;
@@ -125,6 +125,19 @@ int Protocol3d::update(double t, const Eigen::Matrix3Xd& X, double wall_energy) 
   }
   st_.switches += switches;
   return switches;
+}
+
+bool Protocol3d::shape_recovered(const Eigen::Matrix3Xd& X) const {
+  const CylinderMesh& m = *mesh_;
+  const Eigen::VectorXd rr = ring_radii(m, X);
+  if ((rr.array() - m.radius).abs().maxCoeff() > p_.delta) return false;
+  const double shift = X.row(0).mean() - m.X0.row(0).mean();
+  for (int r = 0; r < m.n_rings; ++r) {
+    double dx = 0;
+    for (int i = 0; i < m.n_theta; ++i) dx += X(0, m.node(r, i)) - m.X0(0, m.node(r, i));
+    if (std::abs(dx / m.n_theta - shift) > p_.delta) return false;
+  }
+  return true;
 }
 
 double uniform_contraction_energy(const CylinderMesh& mesh, const MembraneParams& m, double R_f) {

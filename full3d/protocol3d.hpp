@@ -20,7 +20,8 @@
 // The cycle ends when the wall energy (elastic + bending + kinetic) drops
 // below energy_tol * E_ref, E_ref = elastic + bending energy of the tube
 // uniformly contracted to R_f (the paper's rule), or, with a positive end_energy,
-// below max(energy_tol * E_ref, end_energy) (docs/full3d.md, "Recovery end");
+// below max(energy_tol * E_ref, end_energy), or, with shape_end, once the ring radii
+// and axial ring positions are back within delta (docs/full3d.md, "Recovery end");
 // the next cycle then starts.
 //
 // Chattering. As in the 1D tier (reduced1d/protocol.hpp), the relays are
@@ -56,6 +57,10 @@ struct ProtocolParams {
   /// end_energy) (full3d.recovery_end = dead_band: end_energy = energy of the tube uniformly
   /// at R0 - delta, the edge of the five-band law's dead band). 0: the paper's energy_tol E_ref.
   double end_energy = 0.0;
+  /// true (full3d.recovery_end = shape): the recovery ends when every ring's mean radius is
+  /// within delta of R0 and every ring's mean axial position is within delta of its reference
+  /// position (after removing the mean axial translation), whatever the energy.
+  bool shape_end = false;
 };
 
 /// Discrete protocol state (checkpointed).
@@ -89,6 +94,8 @@ class Protocol3d {
   ProtocolState& state() { return st_; }
   const ProtocolParams& params() const { return p_; }
   double reference_energy() const { return e_ref_; }
+  /// true when the tube is back at its reference shape within delta (see shape_end).
+  bool shape_recovered(const Eigen::Matrix3Xd& X) const;
   /// Wall energy below which the recovery ends, J.
   double end_threshold() const { return std::max(p_.energy_tol * e_ref_, p_.end_energy); }
   int segment_of(int node) const { return seg_[node]; }

@@ -43,6 +43,7 @@ std::string resume_key(const json& resolved) {
   if (r.contains("full3d") && r["full3d"].is_object()) {
     r["full3d"].erase("checkpoint_interval");
     r["full3d"].erase("threads");
+    r["full3d"].erase("time_limit");  // a run stopped by the cap can be continued with a larger one
   }
   return r.dump();
 }
@@ -316,7 +317,7 @@ class Runner {
       << "<ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\" Origin=\"0 0 0\" Spacing=\"" << h
       << " " << h << " " << h << "\">\n<Piece Extent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\">\n<CellData>\n"
       << "<DataArray type=\"Float64\" Name=\"velocity_m_per_s\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    char b[40];
+    char b[96];
     const auto du = g.dims(0), dv = g.dims(1), dw = g.dims(2);
     for (int k = 0; k < nz; ++k)
       for (int j = 0; j < ny; ++j)
@@ -384,9 +385,17 @@ class Runner {
 
   void load_checkpoint() {
     CheckpointReader r(checkpoint_path(out_));
-    if (r.get_string("scene") != resume_key(resolved_))
+    // the stored key is re-normalised, so that checkpoints written before a key was allowed
+    // to change still match
+    json stored;
+    try {
+      stored = json::parse(r.get_string("scene"));
+    } catch (const std::exception&) {
+      throw InputError("--resume", out_, "the checkpoint's scene record is not valid JSON");
+    }
+    if (resume_key(stored) != resume_key(resolved_))
       throw InputError("--resume", out_, "the checkpoint was written for a different scene (only "
-                                         "full3d.checkpoint_interval and full3d.threads may change on resume)");
+                                         "full3d.checkpoint_interval, full3d.threads and full3d.time_limit may change on resume)");
     n_ = r.get_int("step");
     s_.t = r.get_double("t");
     r.get_into("X", s_.X.data(), s_.X.size());

@@ -207,7 +207,8 @@ Params3d read_scene3d(const json& scene, json& resolved) {
     }
     p.wall_inertia = f.boolean("wall_inertia", false);
     p.navier_stokes = f.boolean("navier_stokes", false);
-    p.recovery_end = f.choice("recovery_end", "dead_band", {"energy", "dead_band"});
+    p.recovery_end = f.choice("recovery_end", "dead_band", {"energy", "dead_band", "shape"});
+    p.protocol.shape_end = p.recovery_end == "shape";
     p.dry = f.boolean("dry", false);
     p.dry_damping = f.quantity("dry_damping", "kg/(m^2*s)", "1e4 kg/(m^2*s)", Range::non_negative());
     p.max_cfl = f.number("max_cfl", 0.5, Range::open(0.0, 2.0));

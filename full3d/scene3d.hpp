@@ -44,7 +44,8 @@ struct Params3d {
   bool navier_stokes = false;      ///< StokesOptions::advection (eq. 28 sub-step before each Stokes step)
   std::string cylinder_wall = "staircase";  ///< cylinder: staircase | ghost_linear | surface_points
   /// energy: the paper's end of recovery (E < energy_tolerance E_ref); dead_band: also ends
-  /// once E is below the energy of the tube uniformly at R0 - delta (docs/full3d.md).
+  /// once E is below the energy of the tube uniformly at R0 - delta; shape: ring radii and
+  /// axial ring positions back within delta of the reference (docs/full3d.md).
   std::string recovery_end = "dead_band";
   bool dry = false;                ///< paper's dry swimmer: m r'' + nu r' - F(r) = F_ext
   double dry_damping = 1e4;        ///< nu per wall area, kg/(m^2 s) (node damping nu A_i)

@@ -321,3 +321,59 @@ TEST(Run3d, PaperRecoveryEndIsSelectable) {
   std::printf("E_delta / E_ref = %.4g (R_f = %.2f R0, delta = %.2f R0)\n", e_delta / e_ref,
               s.p.protocol.R_f / s.p.R0, s.p.protocol.delta / s.p.R0);
 }
+
+// A run stopped by full3d.time_limit can be continued with a larger cap (time_limit is,
+// with checkpoint_interval and threads, allowed to change on resume) and then ends exactly
+// as a run that had the larger cap from the start.
+TEST(Run3d, ResumeWithLargerTimeLimitFinishesTheCycle) {
+  auto cycle_scene = [](const std::string& limit) {
+    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json");
+    for (const std::string& s : {"full3d.time_limit=\"" + limit + "\"", std::string("full3d.checkpoint_interval=\"50 ms\""),
+                                std::string("full3d.output.vtk=false")})
+      scene::apply_override(sc, s);
+    Scene out;
+    out.p = read_scene3d(sc, out.resolved);
+    return out;
+  };
+  RunControl ctl;
+  ctl.progress = 0;
+  ctl.quiet_vtk = true;
+  const Scene full = cycle_scene("1.5 s");
+  const std::string a = fresh_dir("limit_a"), b = fresh_dir("limit_b");
+  const RunOutcome ra = run3d(full.p, full.resolved, a, ctl);
+  ASSERT_FALSE(ra.failed) << ra.message;
+  const Scene capped = cycle_scene("0.3 s");
+  const RunOutcome rb = run3d(capped.p, capped.resolved, b, ctl);
+  ASSERT_TRUE(rb.failed);
+  EXPECT_NE(rb.message.find("full3d.time_limit"), std::string::npos);
+  RunControl res = ctl;
+  res.resume = true;
+  const RunOutcome rc = run3d(full.p, full.resolved, b, res);
+  ASSERT_FALSE(rc.failed) << rc.message;
+  EXPECT_EQ(rc.summary["cycles_completed"].get<int>(), 1);
+  EXPECT_EQ(rc.steps, ra.steps);
+  EXPECT_EQ(rc.summary["displacement_m"].get<double>(), ra.summary["displacement_m"].get<double>());
+}
+
+// full3d.recovery_end = shape: the geometric end of the recovery (ring radii and axial ring
+// positions within delta of the reference, up to a rigid axial translation).
+TEST(Run3d, ShapeRecoveryCriterion) {
+  const Scene s = tiny({"full3d.recovery_end=\"shape\""});
+  EXPECT_TRUE(s.p.protocol.shape_end);
+  const CylinderMesh mesh = make_mesh(s.p);
+  const Protocol3d proto(effective_protocol(s.p, mesh), mesh, 1.0);
+  Eigen::Matrix3Xd X = mesh.X0;
+  EXPECT_TRUE(proto.shape_recovered(X));
+  X.row(0).array() += 3e-8;  // the swimmer has moved: still its reference shape
+  EXPECT_TRUE(proto.shape_recovered(X));
+  const double delta = s.p.protocol.delta;
+  Eigen::Matrix3Xd Y = X;  // radius off by 1.5 delta on the last ring
+  for (int i = 0; i < mesh.n_theta; ++i) {
+    const int k = mesh.node(mesh.n_rings - 1, i);
+    for (int c = 1; c < 3; ++c) Y(c, k) = mesh.axis_start[c] + (1 - 1.5 * delta / mesh.radius) * (Y(c, k) - mesh.axis_start[c]);
+  }
+  EXPECT_FALSE(proto.shape_recovered(Y));
+  Y = X;  // last ring pushed 1.5 delta into the tube (a folded end)
+  for (int i = 0; i < mesh.n_theta; ++i) Y(0, mesh.node(mesh.n_rings - 1, i)) -= 1.5 * delta;
+  EXPECT_FALSE(proto.shape_recovered(Y));
+}
