@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "common/errors.hpp"
+#include "common/scene_shared.hpp"
 
 namespace swim::full3d {
 
@@ -13,26 +14,7 @@ using scene::Reader;
 
 namespace {
 
-std::string fmt(double v, const char* unit) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.6g %s", v, unit);
-  return b;
-}
-
-/// Exactly one of `keys` may be given; returns the one present, or `fallback` (as 1D).
-std::string one_of(const Reader& r, const std::vector<std::string>& keys, const std::string& fallback) {
-  std::string found;
-  for (const auto& k : keys) {
-    if (!r.has(k)) continue;
-    if (!found.empty()) {
-      std::string s;
-      for (size_t i = 0; i < keys.size(); ++i) s += (i ? ", " : "") + keys[i];
-      throw InputError(r.path(k), "(given together with " + found + ")", "give only one of: " + s);
-    }
-    found = k;
-  }
-  return found.empty() ? fallback : found;
-}
+std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
 
 bool multiple_of(double a, double h) {
   const double n = std::round(a / h);
@@ -68,33 +50,20 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   p.name = top.text("name", "unnamed");
   top.text("description", "");
 
-  {
-    Reader s = top.child("swimmer");
-    p.R0 = s.quantity("radius", "m", "0.125 um", Range::positive());
-    p.L = s.quantity("length", "m", "0.4 um", Range::positive());
-    s.finish();
-  }
+  const scene::Body body = scene::read_body(top);
+  p.R0 = body.R0;
+  p.L = body.L;
+  p.fluid.mu = body.mu;
+  p.fluid.rho = body.rho;
   const double R0 = p.R0, L = p.L;
   {
-    Reader f = top.child("fluid");
-    p.fluid.mu = f.quantity("viscosity", "Pa*s", "1.2e-3 Pa*s", Range::positive());
-    p.fluid.rho = f.quantity("density", "kg/m^3", "1000 kg/m^3", Range::positive());
-    f.finish();
-  }
-  {
-    Reader w = top.child("wall");
-    const std::string stiff = one_of(w, {"C1", "spring_constant", "calibration"}, "spring_constant");
-    if (stiff != "spring_constant")
-      throw InputError(w.path(stiff), scene::show(scene.at("wall").at(stiff)),
+    const scene::WallSpec w = scene::read_wall(top, R0);
+    if (w.stiffness != "spring_constant")
+      throw InputError("wall." + w.stiffness, scene::show(scene.at("wall").at(w.stiffness)),
                        "the 3D tier models the wall as a spring network and needs its spring constant: give "
                        "wall.spring_constant (N/m) instead; C1 and calibration are 1D lumped stiffnesses");
-    p.membrane.ks = w.quantity("spring_constant", "N/m", "5.5e-8 N/m", Range::positive());
-    const std::string mass = one_of(w, {"mass_per_area", "mass_per_length"}, "mass_per_length");
-    if (mass == "mass_per_area")
-      p.mass_per_area = w.quantity("mass_per_area", "kg/m^2", "", Range::positive());
-    else  // notes section 1: mass per unit length m_l = 2 pi R0 m
-      p.mass_per_area = w.quantity("mass_per_length", "kg/m", "2.25e-3 ug/um", Range::positive()) / (2.0 * M_PI * R0);
-    w.finish();
+    p.membrane.ks = w.value;
+    p.mass_per_area = w.mass_per_area;
   }
   double R_f = 0;
   {
@@ -104,42 +73,18 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       throw InputError(w.path("kind"), "\"" + kind + "\"",
                        "the 3D tier drives the wall by forces only (prescribed kinematics are not implemented): "
                        "use \"force_driven\" or run --tier 1d");
-    if (one_of(w, {"contracted_ratio", "contracted_radius"}, "contracted_ratio") == "contracted_radius") {
-      R_f = w.quantity("contracted_radius", "m", "", Range::positive());
-      if (!(R_f < R0))
-        throw InputError(w.path("contracted_radius"), fmt(R_f, "m"),
-                         "must be below the reference radius swimmer.radius = " + fmt(R0, "m"));
-    } else {
-      R_f = R0 * w.number("contracted_ratio", 0.55, Range::open(0.0, 1.0));
-    }
+    R_f = scene::read_contracted_radius(w, R0);
     w.finish();
   }
   {
-    Reader r = top.child("protocol");
+    const scene::ProtocolSpec r = scene::read_protocol(top, R0, L, R_f, p.c1_estimate());
     p.protocol.R_f = R_f;
-    const double area = 2.0 * M_PI * R0 * L;
-    const double q_needed = p.c1_estimate() * (R0 - R_f);
-    const std::string act = one_of(r, {"pressure", "total_force", "load_factor"}, "total_force");
-    if (act == "pressure")
-      p.protocol.q = r.quantity("pressure", "Pa", "", Range::positive());
-    else if (act == "load_factor")
-      p.protocol.q = q_needed * r.number("load_factor", 1.5, Range::open(1.02, 1e6));
-    else
-      p.protocol.q = r.quantity("total_force", "N", "0.1 pN", Range::positive()) / area;
-    p.protocol.segments = static_cast<int>(r.integer("segments", 6, 2, 1000));
-    p.protocol.first_ratio = r.number("first_segment_ratio", 1.0 / 3.0, Range::open(0.0, 1.0e3));
-    p.protocol.delta = R0 * r.number("tolerance_ratio", 0.02, Range::open(0.0, 0.2));
-    p.protocol.energy_tol = r.number("energy_tolerance", 1e-3, Range::open(0.0, 1.0));
-    p.protocol.cycles = static_cast<int>(r.integer("cycles", 1, 1, 100000));
-    r.finish();
-    if (!(p.protocol.q > 1.02 * q_needed))
-      throw InputError(r.path(act), fmt(p.protocol.q, "Pa") + " (as pressure)",
-                       "cannot contract the wall to the contracted radius: the static load C1 (R0 - R_f) = " +
-                           fmt(q_needed, "Pa") + " must be exceeded by at least 2%; raise the actuation or "
-                           "wave.contracted_ratio");
-    if (!(p.protocol.delta < 0.5 * (R0 - R_f)) || !(p.protocol.delta < 0.5 * R_f))
-      throw InputError(r.path("tolerance_ratio"), fmt(p.protocol.delta / R0, ""),
-                       "the tolerance delta must be below half of both R0 - R_f and R_f");
+    p.protocol.q = r.q;
+    p.protocol.segments = r.segments;
+    p.protocol.first_ratio = r.first_ratio;
+    p.protocol.delta = r.delta;
+    p.protocol.energy_tol = r.energy_tol;
+    p.protocol.cycles = r.cycles;
   }
   top.pass_through("model1d");
   top.pass_through("numerics1d");
@@ -176,7 +121,7 @@ Params3d read_scene3d(const json& scene, json& resolved) {
     }
     {
       Reader g = f.child("grid");
-      if (one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
+      if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
         p.h = g.quantity("cell_size", "m", "", Range::positive());
         if (!multiple_of(width, p.h))
           throw InputError(g.path("cell_size"), fmt(p.h, "m"),

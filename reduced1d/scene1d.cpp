@@ -7,6 +7,7 @@
 #include <fstream>
 
 #include "common/errors.hpp"
+#include "common/scene_shared.hpp"
 #include "common/units.hpp"
 
 namespace swim::reduced1d {
@@ -16,29 +17,7 @@ using scene::Range;
 using scene::Reader;
 
 namespace {
-
-std::string fmt(double v, const char* unit) {
-  char b[48];
-  std::snprintf(b, sizeof b, "%.6g %s", v, unit);
-  return b;
-}
-
-/// Exactly one of `keys` may be given; returns the one present, or `fallback`.
-std::string one_of(const Reader& r, const std::vector<std::string>& keys, const std::string& fallback) {
-  std::string found;
-  for (const auto& k : keys) {
-    if (!r.has(k)) continue;
-    if (!found.empty())
-      throw InputError(r.path(k), "(given together with " + found + ")", "give only one of: " + [&] {
-        std::string s;
-        for (size_t i = 0; i < keys.size(); ++i) s += (i ? ", " : "") + keys[i];
-        return s;
-      }());
-    found = k;
-  }
-  return found.empty() ? fallback : found;
-}
-
+std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
 }  // namespace
 
 double c1_from_spring_constant(double k_s, double R0) { return 2.0 * k_s / (std::sqrt(3.0) * R0 * R0); }
@@ -70,36 +49,21 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   p.name = top.text("name", "unnamed");
   top.text("description", "");
 
-  {
-    Reader s = top.child("swimmer");
-    p.geometry.R0 = s.quantity("radius", "m", "0.125 um", Range::positive());
-    p.geometry.L = s.quantity("length", "m", "0.4 um", Range::positive());
-    s.finish();
-  }
+  const scene::Body body = scene::read_body(top);
+  p.geometry.R0 = body.R0;
+  p.geometry.L = body.L;
+  p.fluid.mu = body.mu;
+  p.fluid.rho = body.rho;
   const double R0 = p.geometry.R0, L = p.geometry.L;
   {
-    Reader f = top.child("fluid");
-    p.fluid.mu = f.quantity("viscosity", "Pa*s", "1.2e-3 Pa*s", Range::positive());
-    p.fluid.rho = f.quantity("density", "kg/m^3", "1000 kg/m^3", Range::positive());
-    f.finish();
-  }
-  {
-    Reader w = top.child("wall");
-    const std::string stiff = one_of(w, {"C1", "spring_constant", "calibration"}, "spring_constant");
-    if (stiff == "C1") {
-      p.wall.C1 = w.quantity("C1", "Pa/m", "", Range::positive());
-    } else if (stiff == "spring_constant") {
-      p.wall.C1 = c1_from_spring_constant(w.quantity("spring_constant", "N/m", "5.5e-8 N/m", Range::positive()), R0);
-    } else {
-      const std::string file = w.text("calibration", "");
-      p.wall.C1 = c1_from_calibration(w.path("calibration"), file, scene_dir);
-    }
-    const std::string mass = one_of(w, {"mass_per_area", "mass_per_length"}, "mass_per_length");
-    if (mass == "mass_per_area")
-      p.wall.m = w.quantity("mass_per_area", "kg/m^2", "", Range::positive());
-    else  // notes section 1: mass per unit length m_l = 2 pi R0 m
-      p.wall.m = w.quantity("mass_per_length", "kg/m", "2.25e-3 ug/um", Range::positive()) / (2.0 * M_PI * R0);
-    w.finish();
+    const scene::WallSpec w = scene::read_wall(top, R0);
+    if (w.stiffness == "C1")
+      p.wall.C1 = w.value;
+    else if (w.stiffness == "spring_constant")
+      p.wall.C1 = c1_from_spring_constant(w.value, R0);
+    else
+      p.wall.C1 = c1_from_calibration("wall.calibration", w.calibration, scene_dir);
+    p.wall.m = w.mass_per_area;
   }
 
   double R_f = 0;
@@ -107,14 +71,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     Reader w = top.child("wave");
     const std::string kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven"});
     p.wave = kind == "step" ? WaveKind::Step : kind == "sine" ? WaveKind::Sine : WaveKind::ForceDriven;
-    if (one_of(w, {"contracted_ratio", "contracted_radius"}, "contracted_ratio") == "contracted_radius") {
-      R_f = w.quantity("contracted_radius", "m", "", Range::positive());
-      if (!(R_f < R0))
-        throw InputError(w.path("contracted_radius"), fmt(R_f, "m"),
-                         "must be below the reference radius swimmer.radius = " + fmt(R0, "m"));
-    } else {
-      R_f = R0 * w.number("contracted_ratio", 0.55, Range::open(0.0, 1.0));
-    }
+    R_f = scene::read_contracted_radius(w, R0);
     if (p.wave == WaveKind::Step) {
       p.step.R_min = R_f;
       p.step.speed = w.quantity("speed", "m/s", "10 um/s", Range::positive());
@@ -133,31 +90,14 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   if (!forced && top.has("protocol"))
     throw InputError("protocol", scene::show(scene.at("protocol")), "is only used when wave.kind = \"force_driven\"");
   if (forced) {
-    Reader r = top.child("protocol");
+    const scene::ProtocolSpec r = scene::read_protocol(top, R0, L, R_f, p.wall.C1);
     p.protocol.R_f = R_f;
-    const double area = 2.0 * M_PI * R0 * L;
-    const double q_needed = p.wall.C1 * (R0 - R_f);  // static load that holds the wall at R_f
-    const std::string act = one_of(r, {"pressure", "total_force", "load_factor"}, "total_force");
-    if (act == "pressure")
-      p.protocol.q = r.quantity("pressure", "Pa", "", Range::positive());
-    else if (act == "load_factor")  // actuation as a multiple of the static load, for sweeps
-      p.protocol.q = q_needed * r.number("load_factor", 1.5, Range::open(1.02, 1e6));
-    else  // Section 3: F_ext spread evenly over the wall, F_ext / N_n per node of equal area
-      p.protocol.q = r.quantity("total_force", "N", "0.1 pN", Range::positive()) / area;
-    p.protocol.segments = static_cast<int>(r.integer("segments", 6, 2, 1000));
-    p.protocol.first_ratio = r.number("first_segment_ratio", 1.0 / 3.0, Range::open(0.0, 1.0e3));
-    p.protocol.delta = R0 * r.number("tolerance_ratio", 0.02, Range::open(0.0, 0.2));
-    p.protocol.energy_tol = r.number("energy_tolerance", 1e-3, Range::open(0.0, 1.0));
-    p.protocol.cycles = static_cast<int>(r.integer("cycles", 1, 1, 100000));
-    r.finish();
-    if (!(p.protocol.q > 1.02 * q_needed))
-      throw InputError(r.path(act), fmt(p.protocol.q, "Pa") + " (as pressure)",
-                       "cannot contract the wall to the contracted radius: the static load C1 (R0 - R_f) = " +
-                           fmt(q_needed, "Pa") + " must be exceeded by at least 2%; raise the actuation or "
-                           "wave.contracted_ratio");
-    if (!(p.protocol.delta < 0.5 * (R0 - R_f)) || !(p.protocol.delta < 0.5 * R_f))
-      throw InputError(r.path("tolerance_ratio"), fmt(p.protocol.delta / R0, ""),
-                       "the tolerance delta must be below half of both R0 - R_f and R_f");
+    p.protocol.q = r.q;
+    p.protocol.segments = r.segments;
+    p.protocol.first_ratio = r.first_ratio;
+    p.protocol.delta = r.delta;
+    p.protocol.energy_tol = r.energy_tol;
+    p.protocol.cycles = r.cycles;
   }
 
   {

@@ -1,0 +1,106 @@
+#include "common/scene_shared.hpp"
+
+#include <cmath>
+#include <cstdio>
+
+#include "common/errors.hpp"
+
+namespace swim::scene {
+
+std::string one_of(const Reader& r, const std::vector<std::string>& keys, const std::string& fallback) {
+  std::string found;
+  for (const auto& k : keys) {
+    if (!r.has(k)) continue;
+    if (!found.empty()) {
+      std::string s;
+      for (size_t i = 0; i < keys.size(); ++i) s += (i ? ", " : "") + keys[i];
+      throw InputError(r.path(k), "(given together with " + found + ")", "give only one of: " + s);
+    }
+    found = k;
+  }
+  return found.empty() ? fallback : found;
+}
+
+std::string format_quantity(double v, const char* unit) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.6g %s", v, unit);
+  return b;
+}
+
+Body read_body(Reader& top) {
+  Body b;
+  {
+    Reader s = top.child("swimmer");
+    b.R0 = s.quantity("radius", "m", "0.125 um", Range::positive());
+    b.L = s.quantity("length", "m", "0.4 um", Range::positive());
+    s.finish();
+  }
+  {
+    Reader f = top.child("fluid");
+    b.mu = f.quantity("viscosity", "Pa*s", "1.2e-3 Pa*s", Range::positive());
+    b.rho = f.quantity("density", "kg/m^3", "1000 kg/m^3", Range::positive());
+    f.finish();
+  }
+  return b;
+}
+
+WallSpec read_wall(Reader& top, double R0) {
+  WallSpec w;
+  Reader r = top.child("wall");
+  w.stiffness = one_of(r, {"C1", "spring_constant", "calibration"}, "spring_constant");
+  if (w.stiffness == "C1")
+    w.value = r.quantity("C1", "Pa/m", "", Range::positive());
+  else if (w.stiffness == "spring_constant")
+    w.value = r.quantity("spring_constant", "N/m", "5.5e-8 N/m", Range::positive());
+  else
+    w.calibration = r.text("calibration", "");
+  if (one_of(r, {"mass_per_area", "mass_per_length"}, "mass_per_length") == "mass_per_area")
+    w.mass_per_area = r.quantity("mass_per_area", "kg/m^2", "", Range::positive());
+  else  // notes section 1: mass per unit length m_l = 2 pi R0 m
+    w.mass_per_area = r.quantity("mass_per_length", "kg/m", "2.25e-3 ug/um", Range::positive()) / (2.0 * M_PI * R0);
+  r.finish();
+  return w;
+}
+
+double read_contracted_radius(Reader& w, double R0) {
+  if (one_of(w, {"contracted_ratio", "contracted_radius"}, "contracted_ratio") == "contracted_radius") {
+    const double R_f = w.quantity("contracted_radius", "m", "", Range::positive());
+    if (!(R_f < R0))
+      throw InputError(w.path("contracted_radius"), format_quantity(R_f, "m"),
+                       "must be below the reference radius swimmer.radius = " + format_quantity(R0, "m"));
+    return R_f;
+  }
+  return R0 * w.number("contracted_ratio", 0.55, Range::open(0.0, 1.0));
+}
+
+ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1) {
+  ProtocolSpec p;
+  Reader r = top.child("protocol");
+  const double area = 2.0 * M_PI * R0 * L;
+  const double q_needed = C1 * (R0 - R_f);  // static load that holds the wall at R_f
+  const std::string act = one_of(r, {"pressure", "total_force", "load_factor"}, "total_force");
+  if (act == "pressure")
+    p.q = r.quantity("pressure", "Pa", "", Range::positive());
+  else if (act == "load_factor")  // actuation as a multiple of the static load, for sweeps
+    p.q = q_needed * r.number("load_factor", 1.5, Range::open(1.02, 1e6));
+  else  // Section 3: F_ext spread evenly over the wall, F_ext / N_n per node of equal area
+    p.q = r.quantity("total_force", "N", "0.1 pN", Range::positive()) / area;
+  p.segments = static_cast<int>(r.integer("segments", 6, 2, 1000));
+  p.first_ratio = r.number("first_segment_ratio", 1.0 / 3.0, Range::open(0.0, 1.0e3));
+  p.delta = R0 * r.number("tolerance_ratio", 0.02, Range::open(0.0, 0.2));
+  p.energy_tol = r.number("energy_tolerance", 1e-3, Range::open(0.0, 1.0));
+  p.cycles = static_cast<int>(r.integer("cycles", 1, 1, 100000));
+  r.finish();
+  if (!(p.q > 1.02 * q_needed))
+    throw InputError(r.path(act), format_quantity(p.q, "Pa") + " (as pressure)",
+                     "cannot contract the wall to the contracted radius: the static load C1 (R0 - R_f) = " +
+                         format_quantity(q_needed, "Pa") +
+                         " must be exceeded by at least 2%; raise the actuation, use protocol.load_factor, or "
+                         "raise wave.contracted_ratio");
+  if (!(p.delta < 0.5 * (R0 - R_f)) || !(p.delta < 0.5 * R_f))
+    throw InputError(r.path("tolerance_ratio"), format_quantity(p.delta / R0, ""),
+                     "the tolerance delta must be below half of both R0 - R_f and R_f");
+  return p;
+}
+
+}  // namespace swim::scene

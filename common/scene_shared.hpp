@@ -1,0 +1,52 @@
+// The scene sections both tiers read the same way: swimmer, fluid, wall, the contracted
+// radius of the wave, and the force-driven protocol. Each tier reads its own sections
+// (model1d/numerics1d, full3d) and the tier-specific keys of `wave` around these.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/scene.hpp"
+
+namespace swim::scene {
+
+/// Exactly one of `keys` may be present in `r`; returns it, or `fallback` when none is.
+/// Two present keys are an InputError naming the second.
+std::string one_of(const Reader& r, const std::vector<std::string>& keys, const std::string& fallback);
+
+/// "1.25e-07 m": a value and its unit for messages and defaults.
+std::string format_quantity(double v, const char* unit);
+
+struct Body {
+  double R0 = 0, L = 0;     ///< swimmer.radius, swimmer.length [m]
+  double mu = 0, rho = 0;   ///< fluid.viscosity [Pa s], fluid.density [kg/m^3]
+};
+/// Reads (and finishes) the swimmer and fluid sections.
+Body read_body(Reader& top);
+
+struct WallSpec {
+  std::string stiffness;    ///< "C1", "spring_constant" or "calibration"
+  double value = 0;         ///< C1 [Pa/m] or k_s [N/m]; 0 for a calibration file
+  std::string calibration;  ///< path, for "calibration"
+  double mass_per_area = 0; ///< [kg/m^2] (mass_per_length converted with 2 pi R0, notes section 1)
+};
+/// Reads (and finishes) the wall section.
+WallSpec read_wall(Reader& top, double R0);
+
+/// wave.contracted_ratio | wave.contracted_radius -> R_f [m]; the caller reads the other
+/// wave keys and finishes `wave`.
+double read_contracted_radius(Reader& wave, double R0);
+
+struct ProtocolSpec {
+  double q = 0;             ///< actuation pressure [Pa], inward positive
+  int segments = 0;
+  double first_ratio = 0;   ///< first (rightmost) segment length / other segments
+  double delta = 0;         ///< radius tolerance [m]
+  double energy_tol = 0;
+  int cycles = 0;
+};
+/// Reads (and finishes) the protocol section of a force-driven wave. C1 [Pa/m] is the wall
+/// stiffness used to check that the actuation can reach R_f (static load C1 (R0 - R_f)).
+ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1);
+
+}  // namespace swim::scene
