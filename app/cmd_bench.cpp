@@ -14,6 +14,7 @@
 #include "reduced1d/screen.hpp"
 #include "reduced1d/solver.hpp"
 #include "full3d/protocol3d.hpp"
+#include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 
 namespace swim::app {
@@ -33,7 +34,8 @@ reduced1d::Params demo_params(const std::vector<std::string>& sets) {
 
 }  // namespace
 
-int bench(const std::string& out_opt, bool quick) {
+int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
+  const bool paper_cycle = paper_cycle_opt || !quick;
   const std::string out = out_opt.empty() ? "out/bench" : out_opt;
   output::make_dir(out);
   scene::json report = scene::json::object();
@@ -104,13 +106,12 @@ int bench(const std::string& out_opt, bool quick) {
 
   // 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
   // resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
-  // with 1 and 2 FFTW threads. Extrapolates the single-cycle wall time from steps/s.
+  // with 1 and 2 threads.
   std::printf("== 3D tier ==\n");
   std::printf("  %-10s %7s %3s %9s %9s %9s %9s %9s %9s %7s\n", "grid", "nodes", "thr", "step[ms]", "fluid", "spread",
               "interp", "forces", "bare[ms]", "ratio");
   scene::json grids = scene::json::array();
   const int steps = quick ? 3 : 10;
-  double default_steps_per_s[3] = {0, 0, 0};
   for (int across : {12, 20, 32}) {
     double per_step_thr[3] = {0, 0, 0};
     for (int thr : {1, 2}) {
@@ -122,7 +123,9 @@ int bench(const std::string& out_opt, bool quick) {
       const full3d::CylinderMesh mesh = full3d::make_mesh(p);
       full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
       full3d::IbOptions o;
+      o.threads = thr;
       o.stokes.fft.threads = thr;
+      o.stokes.direct_threads = thr;
       if (thr > 1) full3d::fftw_threads_init_once();
       full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), o);
       full3d::Protocol3d proto(p.protocol, mesh, full3d::uniform_contraction_energy(mesh, p.membrane, p.protocol.R_f));
@@ -159,29 +162,46 @@ int bench(const std::string& out_opt, bool quick) {
                        {"fluid_s", sum.time_fluid / steps}, {"spread_s", sum.time_spread / steps},
                        {"interp_s", sum.time_interp / steps}, {"forces_s", sum.time_forces / steps},
                        {"bare_fft_solve_s", bare_per}, {"step_over_bare", per / bare_per}});
-      if (across == 32) default_steps_per_s[thr] = 1.0 / per;
     }
     std::printf("  %-10s 2-thread speedup %.2f\n", "", per_step_thr[1] / per_step_thr[2]);
   }
   report["full3d_step"] = grids;
-  // Single cycle of the paper's scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution
-  // and time step: a full 3D cycle takes minutes, so the bench extrapolates from the measured
-  // steps/s with the cycle length of the 1D tier (a 3D cycle lasts longer: recovery; see
-  // docs/performance-3d.md for measured end-to-end runs).
-  {
+  // The paper's single-cycle scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution and
+  // time step, run end to end on all cores as shipped (recovery included; a 3D cycle lasts
+  // several times the 1D tier's because the recovery is slow). Minutes: full bench or
+  // --paper-cycle only.
+  if (paper_cycle) {
     scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.55.json");
+    scene::apply_override(sc, "full3d.threads=" + std::to_string(cores));
+    scene::apply_override(sc, "full3d.output.vtk=false");
     scene::json resolved;
-    const double dt = full3d::read_scene3d(sc, resolved).dt;
-    const auto p1 = demo_params({"protocol.cycles=1", "time.duration=\"auto\""});
-    const auto m1 = reduced1d::metrics(p1, reduced1d::solve(p1));
-    const double cycle = m1.mean_cycle_time_s;
-    const double best = std::max(default_steps_per_s[1], default_steps_per_s[2]);
-    const double est = cycle / dt / best;
-    std::printf("paper single-cycle scene at the default resolution (128x32x32, dt = %.3g s): extrapolated "
-                "%.0f steps x %.3g s/step = %.0f s (contraction+recovery length from the 1D tier: %.3g s)\n",
-                dt, cycle / dt, 1.0 / best, est, cycle);
-    report["full3d_paper_cycle_extrapolated"] = {{"cycle_time_1d_s", cycle}, {"dt_s", dt}, {"steps", cycle / dt},
-                                                 {"steps_per_s", best}, {"wall_time_estimate_s", est}};
+    const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+    const std::string dir = out + "/paper_cycle";
+    output::make_dir(dir);
+    full3d::RunControl ctl;
+    ctl.progress = 1;
+    ctl.quiet_vtk = true;
+    std::printf("paper single-cycle scene (paper_amplitude_0.55, %dx%dx%d, dt = %.3g s, %u threads) ...\n", p.nx,
+                p.ny, p.nz, p.dt, cores);
+    std::fflush(stdout);
+    const auto t0 = std::chrono::steady_clock::now();
+    const full3d::RunOutcome r = full3d::run3d(p, resolved, dir, ctl);
+    const double wall = seconds_since(t0);
+    const auto& sm = r.summary;
+    const auto& ends = sm.value("cycle_end_times_s", scene::json::array());
+    const bool done = !r.failed && !ends.empty();
+    const double t_cycle = done ? ends[0].get<double>() : sm.value("t_end_s", 0.0);
+    std::printf("  %s at t = %.3g s after %ld steps, displacement %.3g m, wall %.0f s (%.3g s/step; target: cycle "
+                "in <= 600 s)%s\n",
+                done ? "cycle ended" : "cycle NOT ended", t_cycle, r.steps, sm.value("displacement_m", 0.0), wall,
+                r.steps > 0 ? wall / double(r.steps) : 0.0, r.failed ? ("  FAILED: " + r.message).c_str() : "");
+    report["full3d_paper_cycle"] = {{"scene", "paper_amplitude_0.55"}, {"threads", cores},
+                                    {"grid", std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz)},
+                                    {"dt_s", p.dt}, {"cycle_completed", done}, {"cycle_end_s", t_cycle},
+                                    {"steps", r.steps}, {"wall_time_s", wall},
+                                    {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", r.failed}};
+  } else {
+    std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
   }
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());

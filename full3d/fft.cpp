@@ -104,4 +104,13 @@ FftwPlan plan_many_c2r_1d(int n, int howmany, fftw_complex* in, int istride, int
       fftw_plan_many_dft_c2r(1, &n, howmany, in, nullptr, istride, idist, out, nullptr, ostride, odist, flags_of(opt)));
 }
 
+FftwPlan plan_many_r2r(int rank, const int* n, int howmany, double* in, const int* inembed, int istride, int idist,
+                       double* out, const int* onembed, int ostride, int odist, const fftw_r2r_kind* kinds,
+                       const FftOptions& opt) {
+  std::lock_guard<std::mutex> lock(planner_mutex());
+  set_threads_locked(opt);
+  return FftwPlan(fftw_plan_many_r2r(rank, n, howmany, in, inembed, istride, idist, out, onembed, ostride, odist,
+                                     kinds, flags_of(opt)));
+}
+
 }  // namespace swim::full3d

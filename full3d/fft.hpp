@@ -86,5 +86,12 @@ FftwPlan plan_many_r2c_1d(int n, int howmany, double* in, int istride, int idist
                           int odist, const FftOptions& opt);
 FftwPlan plan_many_c2r_1d(int n, int howmany, fftw_complex* in, int istride, int idist, double* out, int ostride,
                           int odist, const FftOptions& opt);
+/// Advanced-interface real-to-real plan (fftw_plan_many_r2r): `howmany` rank-`rank`
+/// transforms of logical sizes n[0..rank-1] (the last contiguous), kinds[d] along
+/// dimension d, stored inside arrays of dimensions inembed / onembed (nullptr: n) with
+/// element strides istride / ostride and distances idist / odist between transforms.
+FftwPlan plan_many_r2r(int rank, const int* n, int howmany, double* in, const int* inembed, int istride, int idist,
+                       double* out, const int* onembed, int ostride, int odist, const fftw_r2r_kind* kinds,
+                       const FftOptions& opt);
 
 }  // namespace swim::full3d

@@ -36,6 +36,7 @@ struct IbOptions {
   double max_cfl = 0.5;       ///< max |U| dt / h allowed
   bool check_no_leak = true;  ///< enforce max edge < h/2 after every step
   std::string dt_key = "dt";  ///< name of the time step in remedies (the run driver passes "full3d.dt")
+  int threads = 1;            ///< threads for spreading, interpolation and membrane forces (parallel.hpp)
   StokesOptions stokes{};
 };
 
@@ -94,6 +95,7 @@ class IbSolver {
   IbOptions opt_;
   StokesSolver stokes_;
   ExternalForceFn external_;
+  VectorField work_f_, work_u_, work_uh_;  ///< step() work fields, reused between steps
 };
 
 }  // namespace swim::full3d

@@ -26,6 +26,23 @@ inline double peskin_4pt(double r) {
   return 0.0;
 }
 
+/// The four non-zero weights of one node along one direction, all from one square root.
+/// With r the node position in grid units (relative to the first grid point), i0 =
+/// floor(r) - 1 and t = r - floor(r) in [0, 1), the stencil points i0 .. i0+3 lie at
+/// distances 1+t, t, 1-t, 2-t from the node. On every branch of eq. (18) the radicand
+/// reduces to the same q^2 = 1 + 4t - 4t^2 (>= 1 on [0, 1), so no clamping is needed):
+///   w[0] = phi(1+t) = (3 - 2t - q)/8,   w[1] = phi(t)   = (3 - 2t + q)/8,
+///   w[2] = phi(1-t) = (1 + 2t + q)/8,   w[3] = phi(2-t) = (1 + 2t - q)/8.
+/// This is eq. (18) evaluated exactly (identical to peskin_4pt up to round-off).
+inline void peskin_4pt_weights(double t, double w[4]) {
+  const double q = std::sqrt(1.0 + 4.0 * t - 4.0 * t * t);
+  const double a = 3.0 - 2.0 * t, b = 1.0 + 2.0 * t;
+  w[0] = 0.125 * (a - q);
+  w[1] = 0.125 * (a + q);
+  w[2] = 0.125 * (b + q);
+  w[3] = 0.125 * (b - q);
+}
+
 /// Half-width of the support of peskin_4pt in grid cells.
 inline constexpr int kPeskin4ptHalfWidth = 2;
 

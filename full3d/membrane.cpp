@@ -9,6 +9,7 @@
 #include <string>
 
 #include "common/errors.hpp"
+#include "full3d/parallel.hpp"
 
 namespace swim::full3d {
 
@@ -94,6 +95,8 @@ CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector
     m.rest_angle[Eigen::Index(k)] =
         dihedral_angle(m.X0.col(h[0]), m.X0.col(h[1]), m.X0.col(h[2]), m.X0.col(h[3]));
   }
+  m.rest_cos = m.rest_angle.array().cos();
+  m.rest_sin = m.rest_angle.array().sin();
   m.node_area = Eigen::VectorXd::Zero(nn);
   for (const auto& t : m.triangles) {
     const double area =
@@ -167,8 +170,11 @@ double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, do
   return 0.5 * ks * s;
 }
 
-void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F) {
-  for (std::size_t e = 0; e < mesh.edges.size(); ++e) {
+namespace {
+// Spring forces (eq. 7 gradient) of edges [e0, e1) added to F.
+void add_stretching_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, std::size_t e0,
+                          std::size_t e1, Eigen::Matrix3Xd& F) {
+  for (std::size_t e = e0; e < e1; ++e) {
     const int a = mesh.edges[e][0], b = mesh.edges[e][1];
     const V3 v = X.col(b) - X.col(a);
     const double l = v.norm();
@@ -176,6 +182,11 @@ void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, 
     F.col(b) += fb;
     F.col(a) -= fb;
   }
+}
+}  // namespace
+
+void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F) {
+  add_stretching_range(mesh, X, ks, 0, mesh.edges.size(), F);
 }
 
 namespace {
@@ -195,34 +206,83 @@ double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, doubl
   return 0.5 * kb * s;
 }
 
-void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
-                        Eigen::Matrix3Xd& F) {
-  Eigen::Matrix<double, 3, 4> g;
-  for (std::size_t k = 0; k < mesh.hinges.size(); ++k) {
+namespace {
+// Bending forces (eq. 8 gradient) of hinges [k0, k1) added to F.
+//
+// Same quantities as dihedral_angle (with its gradient), without the trigonometric calls:
+// with the unnormalised normals n1 = e x (c - a), n2 = (d - a) x e of the two triangles,
+//   rho cos(theta) = n1.n2 =: C,   rho sin(theta) = (n1 x n2).e / |e| =: S,   rho = sqrt(C^2 + S^2),
+// and, with D = theta - theta0,
+//   t = tan(D/2) = sin D / (1 + cos D) = (S cos0 - C sin0) / (rho + C cos0 + S sin0),
+// which equals tan((atan2(S, C) - theta0)/2) exactly (the rest angle enters through
+// cos0 = cos(theta0), sin0 = sin(theta0), precomputed in the mesh).
+void add_bending_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
+                       std::size_t k0, std::size_t k1, Eigen::Matrix3Xd& F) {
+  const bool ref = form == BendingForm::ReferenceAngle;
+  const bool have_cs = mesh.rest_cos.size() == mesh.rest_angle.size() &&
+                       mesh.rest_sin.size() == mesh.rest_angle.size();
+  for (std::size_t k = k0; k < k1; ++k) {
     const auto& h = mesh.hinges[k];
-    const double th = dihedral_angle(X.col(h[0]), X.col(h[1]), X.col(h[2]), X.col(h[3]), &g);
-    const double t = std::tan(0.5 * (th - ref_angle(mesh, k, form)));
-    const V3 e = X.col(h[1]) - X.col(h[0]);
-    const double l = e.norm();
+    const V3 a = X.col(h[0]);
+    const V3 e = X.col(h[1]) - a;
+    const V3 ca = X.col(h[2]) - a, da = X.col(h[3]) - a;
+    const V3 n1 = e.cross(ca);  // normal of (a, b, c)
+    const V3 n2 = da.cross(e);  // normal of (b, a, d)
+    const double l2 = e.squaredNorm(), l = std::sqrt(l2);
+    const double C = n1.dot(n2), S = n1.cross(n2).dot(e) / l;
+    const double rho = std::sqrt(C * C + S * S);
+    double cos0 = 1.0, sin0 = 0.0;  // BendingForm::Printed: theta0 = 0
+    if (ref) {
+      const Eigen::Index i = Eigen::Index(k);
+      cos0 = have_cs ? mesh.rest_cos[i] : std::cos(mesh.rest_angle[i]);
+      sin0 = have_cs ? mesh.rest_sin[i] : std::sin(mesh.rest_angle[i]);
+    }
+    const double t = (S * cos0 - C * sin0) / (rho + C * cos0 + S * sin0);
+    // d theta / d(c, d) = -|e| n / |n|^2; d theta / d(a, b) from translation and rotation invariance
+    const V3 gc = -l / n1.squaredNorm() * n1;
+    const V3 gd = -l / n2.squaredNorm() * n2;
+    const double ac = ca.dot(e) / l2, ad = da.dot(e) / l2;
     // dE = kb/2 t^2 dL + kb/2 L t (1 + t^2) dtheta
     const double cl = 0.5 * kb * t * t;
     const double ct = 0.5 * kb * l * t * (1.0 + t * t);
     const V3 dl_db = e / l;
-    F.col(h[0]) -= ct * g.col(0) - cl * dl_db;
-    F.col(h[1]) -= ct * g.col(1) + cl * dl_db;
-    F.col(h[2]) -= ct * g.col(2);
-    F.col(h[3]) -= ct * g.col(3);
+    F.col(h[0]) -= ct * (-(1.0 - ac) * gc - (1.0 - ad) * gd) - cl * dl_db;
+    F.col(h[1]) -= ct * (-ac * gc - ad * gd) + cl * dl_db;
+    F.col(h[2]) -= ct * gc;
+    F.col(h[3]) -= ct * gd;
   }
+}
+}  // namespace
+
+void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
+                        Eigen::Matrix3Xd& F) {
+  add_bending_range(mesh, X, kb, form, 0, mesh.hinges.size(), F);
 }
 
 double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p) {
   return stretching_energy(mesh, X, p.ks) + bending_energy(mesh, X, p.kb, p.bending);
 }
 
-Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p) {
-  Eigen::Matrix3Xd F = Eigen::Matrix3Xd::Zero(3, X.cols());
-  add_stretching_forces(mesh, X, p.ks, F);
-  add_bending_forces(mesh, X, p.kb, p.bending, F);
+Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p,
+                                int threads) {
+  const std::size_t ne = mesh.edges.size(), nh = mesh.hinges.size();
+  const int T = block_count(long(std::max(ne, nh)), threads);
+  Eigen::Matrix3Xd F(3, X.cols());
+  // Thread t accumulates the springs of edge block t and the hinges of hinge block t
+  // (static blocks) into its own buffer (thread 0: F itself); the buffers are then summed
+  // in the fixed order 0, 1, .., T-1. T = 1 is the plain serial loop.
+  std::vector<Eigen::Matrix3Xd> part(std::size_t(T - 1));
+  parallel_blocks(T, T, [&](long tb, long, int) {
+    const std::size_t t = std::size_t(tb);
+    Eigen::Matrix3Xd& Ft = t == 0 ? F : part[t - 1];
+    Ft.setZero(3, X.cols());
+    add_stretching_range(mesh, X, p.ks, ne * t / T, ne * (t + 1) / T, Ft);
+    add_bending_range(mesh, X, p.kb, p.bending, nh * t / T, nh * (t + 1) / T, Ft);
+  });
+  if (T > 1)
+    parallel_blocks(long(X.cols()), T, [&](long b, long e, int) {
+      for (const auto& Ft : part) F.middleCols(b, e - b) += Ft.middleCols(b, e - b);
+    });
   return F;
 }
 

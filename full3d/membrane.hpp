@@ -42,6 +42,9 @@ struct CylinderMesh {
   std::vector<std::array<int, 4>> hinges;
   std::vector<int> hinge_edge;             ///< edge index of each hinge
   Eigen::VectorXd rest_angle;              ///< theta0 per hinge
+  /// cos(theta0), sin(theta0) per hinge (set with rest_angle by make_cylinder; the bending
+  /// forces fall back to computing them when their size does not match rest_angle)
+  Eigen::VectorXd rest_cos, rest_sin;
   Eigen::VectorXd node_area;               ///< reference area carried by each node (1/3 of its triangles), m^2
 
   int nodes() const { return int(X0.cols()); }
@@ -81,8 +84,11 @@ void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, 
 void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                         Eigen::Matrix3Xd& F);
 double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p);
-/// F_i = -dE/dX_i (eq. 9), N.
-Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p);
+/// F_i = -dE/dX_i (eq. 9), N. With threads > 1 the edges and hinges are split into static
+/// blocks, each accumulated into its own buffer and the buffers summed in a fixed order
+/// (parallel.hpp): reproducible for a given thread count, equal to threads = 1 up to round-off.
+Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p,
+                                int threads = 1);
 
 /// Node masses m_i = areal_density (kg/m^2) * node_area_i. The paper's equal
 /// masses are recovered by passing total/N_n per node directly instead.

@@ -72,7 +72,9 @@ class Runner {
       o.scheme = p.scheme;
       o.max_cfl = p.max_cfl;
       o.dt_key = "full3d.dt";
+      o.threads = p.threads;
       o.stokes.fft.threads = p.threads;
+      o.stokes.direct_threads = p.threads;
       if (p.container == "cylinder") {
         o.stokes.cylinder.enabled = true;
         o.stokes.cylinder.radius = p.container_radius;

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "common/errors.hpp"
+#include "full3d/capacitance_stokes.hpp"
 #include "full3d/direct_stokes.hpp"
 #include "full3d/operators.hpp"
 
@@ -162,6 +163,8 @@ struct StokesSolver::Impl {
   std::vector<double> lam;
   // Direct per-mode solver; the multiplier is recovered lazily from (b, u, p, alpha) of the last step
   std::unique_ptr<DirectStokes> direct;
+  // Exact capacitance (Woodbury) solver of the plain duct
+  std::unique_ptr<CapacitanceStokes> capacitance;
   bool lam_stale = false;
   VectorField last_b, last_u;
   double last_alpha = 0.0;
@@ -213,10 +216,22 @@ struct StokesSolver::Impl {
         throw InputError("stokes.method", "direct",
                          "the direct solver supports the plain duct and the staircase cylinder wall only; use "
                          "auto or iterative");
+      if (o.method == StokesMethod::Capacitance && o.cylinder.enabled)
+        throw InputError("stokes.method", "capacitance",
+                         "the capacitance solver supports the plain duct only; use auto, direct or iterative");
       const double limit = o.direct_memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
+      const bool use_capacitance =
+          o.method == StokesMethod::Capacitance ||
+          (o.method == StokesMethod::Auto && !o.cylinder.enabled &&
+           2.0 * double(CapacitanceStokes::estimate_bytes(g)) <= limit);
       const bool use_direct =
           o.method == StokesMethod::Direct ||
-          (o.method == StokesMethod::Auto && direct_applies && 2.0 * double(DirectStokes::estimate_bytes(g)) <= limit);
+          (o.method == StokesMethod::Auto && o.cylinder.enabled && direct_applies &&
+           2.0 * double(DirectStokes::estimate_bytes(g)) <= limit);
+      if (use_capacitance) {
+        const int thr = o.direct_threads > 0 ? o.direct_threads : std::max(1, o.fft.threads);
+        capacitance = std::make_unique<CapacitanceStokes>(g, f.mu, thr, o.fft);
+      }
       if (use_direct) {
         int thr = o.direct_threads;
         if (thr <= 0) thr = std::max(1, int(std::thread::hardware_concurrency()));
@@ -420,6 +435,23 @@ struct StokesSolver::Impl {
     return st;
   }
 
+  // Capacitance (Woodbury) solve of the plain duct (capacitance_stokes.hpp): exact, no iteration.
+  StokesStats capacitance_step(VectorField& u, const VectorField& f, double dt) {
+    const double alpha = fluid.rho / dt;
+    lam_stale = false;
+    capacitance->step(u, f, p, alpha);  // b = alpha u^n + f formed inside; wall faces come out exactly 0
+    StokesStats st;
+    st.direct = true;
+    if (capacitance->last_solve_factorized()) st.factorization_seconds = capacitance->last_factorization_seconds();
+    if (opt.direct_final_projection) {
+      project(u);
+      zero_wall_faces(grid, u);
+    }
+    divergence(grid, u, div);
+    st.max_divergence = div.max_abs();
+    return st;
+  }
+
   // lambda = E (b - A u - G p), A = alpha - mu L: the force the masked rows need.
   void refresh_multiplier() {
     if (!lam_stale) return;
@@ -466,6 +498,7 @@ StokesStats StokesSolver::step(VectorField& u, const VectorField& f, double dt) 
   double cfl = 0.0;
   if (impl_->opt.advection.enabled) cfl = advect(impl_->grid, u, dt, impl_->opt.advection);  // module (28)
   StokesStats st = impl_->grid.kind() == ContainerKind::PeriodicBox ? impl_->box_step(u, f, dt)
+                    : impl_->capacitance                             ? impl_->capacitance_step(u, f, dt)
                     : impl_->direct                                  ? impl_->direct_step(u, f, dt)
                                                                      : impl_->duct_step(u, f, dt);
   st.advection_cfl = cfl;
@@ -485,8 +518,16 @@ void StokesSolver::set_pressure(const ScalarField& p) {
   impl_->p = p;
   impl_->lam_stale = false;  // the lazily recovered multiplier would mix old and new states
 }
-bool StokesSolver::uses_direct() const { return impl_->direct != nullptr; }
-std::size_t StokesSolver::direct_factor_bytes() const { return impl_->direct ? impl_->direct->factor_bytes() : 0; }
+bool StokesSolver::uses_direct() const { return impl_->direct != nullptr || impl_->capacitance != nullptr; }
+StokesMethod StokesSolver::active_method() const {
+  if (impl_->grid.kind() == ContainerKind::PeriodicBox) return StokesMethod::Auto;
+  if (impl_->capacitance) return StokesMethod::Capacitance;
+  return impl_->direct ? StokesMethod::Direct : StokesMethod::Iterative;
+}
+std::size_t StokesSolver::direct_factor_bytes() const {
+  if (impl_->capacitance) return impl_->capacitance->factor_bytes();
+  return impl_->direct ? impl_->direct->factor_bytes() : 0;
+}
 const VelocityConstraints* StokesSolver::constraints() const { return impl_->con.get(); }
 const std::vector<double>& StokesSolver::multiplier() const {
   if (impl_->direct && impl_->con) impl_->refresh_multiplier();

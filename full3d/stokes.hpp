@@ -39,10 +39,20 @@
 //   solved by the same PCG on y = (p, lam) with K = [G, E^T]:
 //     K^T A^{-1} K y = K^T A^{-1} b,  preconditioner blockdiag(Cahouet-Chabard, E A E^T).
 //
-// Direct path (StokesOptions::method, default Auto; direct_stokes.hpp): duct and
-//   staircase cylinder solved exactly per axial Fourier mode by sparse LU factors
-//   computed once per dt (masked faces eliminated: E u = 0 holds exactly). The
-//   PCG above stays selectable with method = Iterative (and is used for the
+// Capacitance path (StokesOptions::method Capacitance, the Auto choice for the plain
+//   duct; capacitance_stokes.hpp): exact. The same system with FREE-SLIP walls (tangential
+//   ghost +u) is diagonal per wavevector in the bases R2HC (x) x {REDFT10, RODFT00} (y, z),
+//   so it is solved like the box. No-slip differs by a diagonal term on the m = 4(ny+nz)-8
+//   wall-adjacent tangential nodes, A_ns = A_fs + U Dg U^T, Dg = 2 mu W/h^2; per axial mode
+//   the Woodbury identity with the SPD capacitance matrix C = Dg^{-1} + U^T S_fs^{-1} U
+//   (Cholesky, once per dt, two dt cached) gives the no-slip solution from one free-slip
+//   solve and O(n^2) partial transforms on the wall lines: about one bare solve; the
+//   transforms and per-mode solves are split over direct_threads (parallel.hpp).
+//
+// Direct path (StokesOptions::method Direct, the Auto choice for the staircase cylinder;
+//   direct_stokes.hpp): duct and staircase cylinder solved exactly per axial Fourier mode
+//   by sparse LU factors computed once per dt (masked faces eliminated: E u = 0 holds
+//   exactly). The PCG above stays selectable with method = Iterative (and is used for the
 //   GhostLinear / SurfacePoints walls).
 //
 // Advection (StokesOptions::advection; advection.hpp): when enabled, step()
@@ -70,21 +80,25 @@ struct FluidParams {
 };
 
 /// Solver of the duct / cylinder step (the periodic box is always the exact Fourier projection).
+///   Capacitance: free-slip spectral solve plus the per-axial-mode Woodbury correction to no-slip
+///              (capacitance_stokes.hpp), exact, about one bare FFT solve; plain duct only.
 ///   Direct:    per-axial-mode sparse LU (direct_stokes.hpp), factorised once per dt; plain duct
 ///              and the Staircase cylinder wall only.
 ///   Iterative: the multiplier PCG below (every wall kind).
-///   Auto:      Direct when it applies and the estimated factor memory for two dt values is
-///              below direct_memory_limit_gib, else Iterative.
-enum class StokesMethod { Auto, Direct, Iterative };
+///   Auto:      plain duct: Capacitance; Staircase cylinder: Direct; each only when its estimated
+///              factor memory for two dt values is below direct_memory_limit_gib, else Iterative.
+enum class StokesMethod { Auto, Direct, Iterative, Capacitance };
 
 struct StokesOptions {
   FftOptions fft{};
   StokesMethod method = StokesMethod::Auto;
   /// Direct: threads for the per-mode factorisations and solves; 0 = std::thread::hardware_concurrency().
+  /// Capacitance: threads for the transforms and per-mode solves (parallel.hpp); 0 = fft.threads.
   int direct_threads = 0;
-  /// Auto: largest estimated factor memory (two cached dt values) for which Direct is chosen, GiB.
+  /// Auto: largest estimated factor memory (two cached dt values) for which Direct or
+  /// Capacitance is chosen, GiB.
   double direct_memory_limit_gib = 4.0;
-  /// Direct: follow the solve by the exact Neumann projection of the iterative path
+  /// Direct / Capacitance: follow the solve by the exact Neumann projection of the iterative path
   /// (one more Poisson transform pair; not needed, the direct solve's divergence is at round-off).
   bool direct_final_projection = false;
   /// duct: the PCG stops when the constraint residual of the unprojected velocity u_k,
@@ -108,8 +122,8 @@ struct StokesStats {
   double max_divergence = 0.0;  ///< max |D u^{n+1}| after the step, 1/s
   double max_constraint = 0.0;  ///< cylinder: max |E u^{n+1}| (velocity outside / on the wall), m/s
   double advection_cfl = 0.0;   ///< CFL number of the advection sub-step (0 when off)
-  bool direct = false;          ///< the step used the direct per-mode solver
-  double factorization_seconds = 0.0;  ///< direct: time spent (re)factorising in this step (new dt), s
+  bool direct = false;          ///< the step used an exact per-mode solver (Direct or Capacitance)
+  double factorization_seconds = 0.0;  ///< Direct / Capacitance: time spent (re)factorising in this step (new dt), s
 };
 
 class StokesSolver {
@@ -128,13 +142,18 @@ class StokesSolver {
 
   /// Pressure of the last step, Pa. Iterative: zero mean, arbitrary in fully masked
   /// cylinder cells. Direct: zero mean over the cells with a free face, 0 in the others.
+  /// Capacitance: zero mean.
   const ScalarField& pressure() const;
   /// Replaces the pressure (checkpoint restore; the iterative path's warm start).
   /// Throws swim::InputError if p does not have one value per cell.
   void set_pressure(const ScalarField& p);
-  /// True when step() uses the direct per-mode solver (StokesOptions::method).
+  /// True when step() uses an exact per-mode solver, Direct or Capacitance (StokesOptions::method).
   bool uses_direct() const;
-  /// Direct: measured memory of the cached LU factors (up to two dt values), bytes; 0 otherwise.
+  /// The duct method step() uses after resolving Auto: Direct, Capacitance or Iterative
+  /// (Auto for the periodic box, which is always the exact Fourier projection).
+  StokesMethod active_method() const;
+  /// Direct: measured memory of the cached LU factors; Capacitance: of the cached capacitance
+  /// Cholesky factors (up to two dt values each), bytes; 0 otherwise.
   std::size_t direct_factor_bytes() const;
   /// Cylinder: the constraint rows and the multiplier of the last step (N/m^3 per row).
   /// Direct: the multiplier is recovered on demand, lambda = E (b - A u - G p).

@@ -124,16 +124,18 @@ void compare_with_iterative(const MacGrid& g, bool cylinder, double dt) {
         for (int k = 0; k < d[2]; ++k)
           for (int j = 0; j < d[1]; ++j)
             if (cylinder_outside(g, kRc, c, j, k))
-              for (int i = 0; i < d[0]; ++i) ASSERT_EQ(ud.c[c][MacGrid::index(d, i, j, k)], 0.0);
+              for (int i = 0; i < d[0]; ++i) {
+                ASSERT_EQ(ud.c[c][MacGrid::index(d, i, j, k)], 0.0);
+              }
       }
       // multiplier recovered from the direct solution against the PCG's multiplier. Only
       // lambda + E G p is unique (the pressure of fully masked cells trades off with lambda).
-      auto total = [&](const StokesSolver& s) {
+      auto total = [&](const StokesSolver& solver) {
         VectorField gp(g);
-        gradient(g, s.pressure(), gp);
+        gradient(g, solver.pressure(), gp);
         std::vector<double> egp;
-        s.constraints()->gather(gp, egp);
-        std::vector<double> l = s.multiplier();
+        solver.constraints()->gather(gp, egp);
+        std::vector<double> l = solver.multiplier();
         for (std::size_t r = 0; r < l.size(); ++r) l[r] += egp[r];
         return l;
       };
@@ -192,7 +194,9 @@ TEST(DirectStokes, RefactorisesWhenDtChanges) {
   random_state(g, true, u2, f2, 7);
   for (int n = 0; n < 4; ++n) {
     fresh.step(u2, f2, dts[n]);
-    if (n == 2) EXPECT_LT(rel_diff(u2, last), 1e-15);
+    if (n == 2) {
+      EXPECT_LT(rel_diff(u2, last), 1e-15);
+    }
   }
   EXPECT_LT(rel_diff(u2, u), 1e-15);
   EXPECT_GT(s.direct_factor_bytes(), 0u);

@@ -1,0 +1,311 @@
+// Capacitance (Woodbury on a free-slip spectral base) duct Stokes solver
+// (capacitance_stokes.hpp) behind StokesSolver, method Capacitance:
+//  * equals the sparse-LU direct solver (method Direct) to 1e-10 relative in u and p on random
+//    forcing: nx != ny, odd and even sizes, ny = 2, quasi-steady and inertial rho/dt;
+//  * discrete divergence at round-off, wall faces zero, and the no-slip momentum residual
+//    b - (alpha - mu L) u - G p at round-off (L with the ghost rule of operators.hpp);
+//  * 1 and 2 threads agree to 1e-13, and repeated solves are bit-reproducible;
+//  * reuses the capacitance factors of the last two dt values;
+//  * second order on the manufactured duct solution of test_stokes.cpp;
+//  * Auto selects it for the plain duct (not for the cylinder).
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <random>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "full3d/capacitance_stokes.hpp"
+#include "full3d/operators.hpp"
+#include "full3d/stokes.hpp"
+
+using namespace swim::full3d;
+
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+const FluidParams kWater{1.0e3, 1.2e-3};
+
+StokesOptions options(StokesMethod method, int threads = 1) {
+  StokesOptions o;
+  o.method = method;
+  o.direct_threads = threads;
+  return o;
+}
+
+void random_state(const MacGrid& g, VectorField& u, VectorField& f, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> U(-1, 1);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < u.c[c].size(); ++i) {
+      u.c[c][i] = 1e-6 * U(rng);
+      f.c[c][i] = 1e3 * U(rng);
+    }
+  zero_wall_faces(g, u);
+}
+
+double max_abs_diff(const std::vector<double>& a, const std::vector<double>& b) {
+  double d = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) d = std::max(d, std::abs(a[i] - b[i]));
+  return d;
+}
+double rel_diff(const VectorField& a, const VectorField& b) {
+  double d = 0;
+  for (int c = 0; c < 3; ++c) d = std::max(d, max_abs_diff(a.c[c], b.c[c]));
+  return d / b.max_abs();
+}
+
+// max |b - (alpha - mu L) u - G p| over the largest of max |b|, max |alpha u|, max |mu L u|,
+// max |G p| (the size of the terms that cancel), b = alpha u^n + f with the wall faces zeroed
+double momentum_residual(const MacGrid& g, const VectorField& un, const VectorField& f, const VectorField& u,
+                         const ScalarField& p, double alpha, double mu) {
+  VectorField lap(g), gp(g);
+  laplacian(g, u, lap);
+  gradient(g, p, gp);
+  VectorField b(g);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < b.c[c].size(); ++i) b.c[c][i] = alpha * un.c[c][i] + f.c[c][i];
+  zero_wall_faces(g, b);
+  double r = 0;
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < b.c[c].size(); ++i)
+      r = std::max(r, std::abs(b.c[c][i] - alpha * u.c[c][i] + mu * lap.c[c][i] - gp.c[c][i]));
+  const double scale = std::max({b.max_abs(), alpha * u.max_abs(), mu * lap.max_abs(), gp.max_abs()});
+  return r / scale;
+}
+
+void compare_with_direct(const MacGrid& g, double dt) {
+  StokesSolver cap(g, kWater, options(StokesMethod::Capacitance));
+  StokesSolver dir(g, kWater, options(StokesMethod::Direct));
+  ASSERT_EQ(cap.active_method(), StokesMethod::Capacitance);
+  ASSERT_EQ(dir.active_method(), StokesMethod::Direct);
+  VectorField u(g), f(g);
+  random_state(g, u, f, 5);
+  VectorField uc = u, ud = u;
+  for (int s = 0; s < 2; ++s) {
+    const VectorField un = uc;
+    const StokesStats sc = cap.step(uc, f, dt);
+    dir.step(ud, f, dt);
+    EXPECT_TRUE(sc.direct);
+    EXPECT_EQ(sc.iterations, 0);
+    const double du = rel_diff(uc, ud);
+    const double dp = max_abs_diff(cap.pressure().v, dir.pressure().v) / dir.pressure().max_abs();
+    const double div = sc.max_divergence / (uc.max_abs() / g.h());
+    const double res = momentum_residual(g, un, f, uc, cap.pressure(), kWater.rho / dt, kWater.mu);
+    double mean = 0;
+    for (double x : cap.pressure().v) mean += x;
+    mean /= double(g.cells());
+    std::printf("[%dx%dx%d dt=%.0e step %d] |u_c - u_d|/|u| = %.2e  |p_c - p_d|/|p| = %.2e  div=%.1e  res=%.1e\n",
+                g.nx(), g.ny(), g.nz(), dt, s, du, dp, div, res);
+    EXPECT_LT(du, 1e-12);  // measured <= 2e-15
+    EXPECT_LT(dp, 1e-12);  // measured <= 2e-14
+    EXPECT_LT(div, 1e-13);
+    EXPECT_LT(res, 1e-13);
+    EXPECT_LT(std::abs(mean), 1e-12 * cap.pressure().max_abs());
+    for (int c = 1; c < 3; ++c) {  // wall faces exactly zero
+      const auto d = g.dims(c);
+      for (int k = 0; k < d[2]; ++k)
+        for (int j = 0; j < d[1]; ++j)
+          for (int i = 0; i < d[0]; ++i) {
+            if (g.on_wall(c, c, c == 1 ? j : k)) {
+              ASSERT_EQ(uc.c[c][MacGrid::index(d, i, j, k)], 0.0);
+            }
+          }
+    }
+  }
+}
+
+}  // namespace
+
+TEST(CapacitanceStokes, MatchesDirectQuasiSteadyEvenNx) {
+  // rho/dt = 1e8 << mu/h^2 = 4.8e11: viscous (quasi-steady) regime
+  compare_with_direct(MacGrid(12, 10, 8, 0.5e-6 / 10, ContainerKind::SquareDuct), 1e-5);
+}
+
+TEST(CapacitanceStokes, MatchesDirectInertialOddNx) {
+  // rho/dt = 1e12 > mu/h^2 = 3e11: inertia-dominated
+  compare_with_direct(MacGrid(9, 8, 11, 0.5e-6 / 8, ContainerKind::SquareDuct), 1e-9);
+}
+
+TEST(CapacitanceStokes, MatchesDirectSceneDt) {
+  // the scenes' default dt = 1 ms at the demo's h: rho/dt is 1e-5 of mu lambda_1, and 1e-8 of
+  // it at dt = 1 s (the free-slip base damps the axial plug flow by rho/dt only; the solver
+  // takes that mode from the no-slip sine basis, so no accuracy is lost)
+  compare_with_direct(MacGrid(16, 16, 16, 0.5e-6 / 16, ContainerKind::SquareDuct), 1e-3);
+  compare_with_direct(MacGrid(10, 12, 9, 0.5e-6 / 12, ContainerKind::SquareDuct), 1.0);
+}
+
+TEST(CapacitanceStokes, MatchesDirectThinDuct) {
+  // ny = 2 (a single interior y face), odd nz, nx = 1 (only the axial mean mode)
+  compare_with_direct(MacGrid(5, 2, 7, 1e-7, ContainerKind::SquareDuct), 1e-6);
+  compare_with_direct(MacGrid(1, 6, 5, 1e-7, ContainerKind::SquareDuct), 1e-6);
+}
+
+TEST(CapacitanceStokes, ThreadsAgreeAndRepeat) {
+  const MacGrid g(14, 12, 10, 0.5e-6 / 12, ContainerKind::SquareDuct);
+  StokesSolver s1(g, kWater, options(StokesMethod::Capacitance, 1));
+  StokesSolver s2(g, kWater, options(StokesMethod::Capacitance, 2));
+  StokesSolver s2b(g, kWater, options(StokesMethod::Capacitance, 2));
+  VectorField u(g), f(g);
+  random_state(g, u, f, 9);
+  VectorField u1 = u, u2 = u, u2b = u;
+  s1.step(u1, f, 1e-5);
+  s2.step(u2, f, 1e-5);
+  s2b.step(u2b, f, 1e-5);
+  const double d = rel_diff(u1, u2);
+  const double dp = max_abs_diff(s1.pressure().v, s2.pressure().v) / s1.pressure().max_abs();
+  std::printf("1 vs 2 threads: |du|/|u| = %.2e  |dp|/|p| = %.2e\n", d, dp);
+  EXPECT_LT(d, 1e-13);
+  EXPECT_LT(dp, 1e-13);
+  EXPECT_EQ(rel_diff(u2, u2b), 0.0);  // same thread count: bit-identical
+  EXPECT_EQ(s2.pressure().v, s2b.pressure().v);
+}
+
+TEST(CapacitanceStokes, CachesTwoDtValues) {
+  const MacGrid g(8, 8, 8, 1e-7, ContainerKind::SquareDuct);
+  StokesSolver s(g, kWater, options(StokesMethod::Capacitance));
+  VectorField u(g), f(g);
+  random_state(g, u, f, 7);
+  const double dts[4] = {1e-5, 0.5e-5, 1e-5, 0.5e-5};
+  for (int n = 0; n < 4; ++n) {
+    const StokesStats st = s.step(u, f, dts[n]);
+    if (n < 2)
+      EXPECT_GT(st.factorization_seconds, 0.0) << n;
+    else
+      EXPECT_EQ(st.factorization_seconds, 0.0) << n;
+  }
+  EXPECT_GT(s.direct_factor_bytes(), 0u);
+  EXPECT_LE(s.direct_factor_bytes(), 2 * CapacitanceStokes::estimate_bytes(g));
+  EXPECT_GT(double(s.direct_factor_bytes()), 0.8 * 2.0 * double(CapacitanceStokes::estimate_bytes(g)));
+}
+
+TEST(CapacitanceStokes, MethodSelection) {
+  const MacGrid duct(8, 12, 12, 1e-7, ContainerKind::SquareDuct);
+  StokesOptions o;
+  EXPECT_EQ(StokesSolver(duct, kWater, o).active_method(), StokesMethod::Capacitance);  // Auto, plain duct
+  EXPECT_TRUE(StokesSolver(duct, kWater, o).uses_direct());
+  o.direct_memory_limit_gib = 0.0;
+  EXPECT_EQ(StokesSolver(duct, kWater, o).active_method(), StokesMethod::Iterative);
+  o = StokesOptions{};
+  o.cylinder.enabled = true;
+  o.cylinder.radius = 0.5e-6;
+  EXPECT_EQ(StokesSolver(duct, kWater, o).active_method(), StokesMethod::Direct);  // Auto, staircase
+  o.method = StokesMethod::Capacitance;
+  EXPECT_THROW(StokesSolver(duct, kWater, o), swim::InputError);
+  EXPECT_THROW(CapacitanceStokes(MacGrid(4, 4, 4, 1.0, ContainerKind::PeriodicBox), 1.0, 1, FftOptions{}),
+               swim::InputError);
+}
+
+// Manufactured duct solution of test_stokes.cpp (no slip at y, z in {0, 1}, period 1 in x):
+// u = curl(0, psi_y, psi_z) + sin(pi y) sin(pi z) e_x, psi_z = sin(2 pi x) sin^2(pi y) sin(pi z),
+// psi_y = cos(2 pi x) sin(pi y) sin^2(pi z); p = sin(2 pi x + 0.2) cos(pi y) sin(pi z).
+namespace {
+struct Exact {
+  static double u(double x, double y, double z) {
+    return kPi * std::sin(2 * kPi * x) * std::sin(2 * kPi * y) * std::sin(kPi * z) -
+           kPi * std::cos(2 * kPi * x) * std::sin(kPi * y) * std::sin(2 * kPi * z) +
+           std::sin(kPi * y) * std::sin(kPi * z);
+  }
+  static double v(double x, double y, double z) {
+    return -kPi * std::cos(2 * kPi * x) * (1 - std::cos(2 * kPi * y)) * std::sin(kPi * z);
+  }
+  static double w(double x, double y, double z) {
+    return -kPi * std::sin(2 * kPi * x) * std::sin(kPi * y) * (1 - std::cos(2 * kPi * z));
+  }
+  static double p(double x, double y, double z) {
+    return std::sin(2 * kPi * x + 0.2) * std::cos(kPi * y) * std::sin(kPi * z);
+  }
+  static double comp(int c, const std::array<double, 3>& r) {
+    return c == 0 ? u(r[0], r[1], r[2]) : c == 1 ? v(r[0], r[1], r[2]) : w(r[0], r[1], r[2]);
+  }
+};
+
+// Max-norm velocity error of one step from 0.3 u_e to u_e, forcing from the exact fields
+// (the Laplacian of u_e by a fourth-order central difference with step 1e-3, and grad p_e
+// likewise: both far below the O(h^2) discretisation error of the grids used).
+double manufactured_error(int n) {
+  MacGrid g(n, n, n, 1.0 / n, ContainerKind::SquareDuct);
+  const FluidParams fl{1.0, 1.0};
+  const double dt = 0.05, alpha = fl.rho / dt;
+  StokesSolver solver(g, fl, options(StokesMethod::Capacitance));
+  VectorField u(g), f(g), ue(g);
+  const double e = 1e-3;
+  for (int c = 0; c < 3; ++c) {
+    const auto d = g.dims(c);
+    for (int k = 0; k < d[2]; ++k)
+      for (int j = 0; j < d[1]; ++j)
+        for (int i = 0; i < d[0]; ++i) {
+          const auto x = g.position(c, i, j, k);
+          const std::size_t id = MacGrid::index(d, i, j, k);
+          ue.c[c][id] = Exact::comp(c, x);
+          double lap = 0, dpc = 0;
+          for (int dir = 0; dir < 3; ++dir) {
+            auto at = [&](double s) {
+              auto y = x;
+              y[dir] += s;
+              return y;
+            };
+            const double f0 = Exact::comp(c, x);
+            lap += (-Exact::comp(c, at(2 * e)) + 16 * Exact::comp(c, at(e)) - 30 * f0 + 16 * Exact::comp(c, at(-e)) -
+                    Exact::comp(c, at(-2 * e))) /
+                   (12 * e * e);
+          }
+          {
+            auto at = [&](double s) {
+              auto y = x;
+              y[c] += s;
+              return Exact::p(y[0], y[1], y[2]);
+            };
+            dpc = (-at(2 * e) + 8 * at(e) - 8 * at(-e) + at(-2 * e)) / (12 * e);
+          }
+          u.c[c][id] = 0.3 * ue.c[c][id];
+          f.c[c][id] = alpha * 0.7 * ue.c[c][id] - fl.mu * lap + dpc;
+        }
+  }
+  zero_wall_faces(g, f);
+  zero_wall_faces(g, u);
+  zero_wall_faces(g, ue);
+  solver.step(u, f, dt);
+  double err = 0;
+  for (int c = 0; c < 3; ++c) err = std::max(err, max_abs_diff(u.c[c], ue.c[c]));
+  return err;
+}
+}  // namespace
+
+TEST(CapacitanceStokes, ManufacturedSecondOrder) {
+  const int ns[3] = {12, 24, 48};
+  double err[3];
+  for (int r = 0; r < 3; ++r) {
+    err[r] = manufactured_error(ns[r]);
+    std::printf("[n=%d] |e_u|_max = %.3e\n", ns[r], err[r]);
+  }
+  for (int r = 1; r < 3; ++r) {
+    const double order = std::log2(err[r - 1] / err[r]);
+    std::printf("[%d->%d] order %.3f\n", ns[r - 1], ns[r], order);
+    EXPECT_GE(order, 1.9);
+  }
+}
+
+TEST(CapacitanceStokes, SolveWithGivenRightHandSideEqualsStep) {
+  // CapacitanceStokes::solve(b) with b = alpha u^n + f is the step (the fused form) bit for bit
+  const MacGrid g(6, 7, 5, 1e-7, ContainerKind::SquareDuct);
+  const double alpha = 1e8;
+  CapacitanceStokes a(g, kWater.mu, 2, FftOptions{}), b(g, kWater.mu, 2, FftOptions{});
+  EXPECT_EQ(a.wall_nodes(), 4 * 7 + 4 * 5 - 8);
+  VectorField u(g), f(g);
+  random_state(g, u, f, 13);
+  VectorField rhs(g);
+  for (int c = 0; c < 3; ++c)
+    for (std::size_t i = 0; i < rhs.c[c].size(); ++i) rhs.c[c][i] = alpha * u.c[c][i] + f.c[c][i];
+  VectorField u1(g);
+  ScalarField p1(g), p2(g);
+  a.solve(rhs, u1, p1, alpha);
+  EXPECT_TRUE(a.last_solve_factorized());
+  b.step(u, f, p2, alpha);
+  EXPECT_EQ(rel_diff(u1, u), 0.0);
+  EXPECT_EQ(p1.v, p2.v);
+}
