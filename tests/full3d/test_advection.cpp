@@ -17,8 +17,10 @@
 #include "common/errors.hpp"
 #include "full3d/advection.hpp"
 #include "full3d/stokes.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 constexpr double kPi = std::numbers::pi;
@@ -47,20 +49,10 @@ double exact_term(int c, const std::array<double, 3>& x) {
 }
 
 void sample(const MacGrid& g, VectorField& u, double (*fn)(int, const std::array<double, 3>&)) {
-  for (int c = 0; c < 3; ++c) {
-    const auto d = g.dims(c);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) u.c[c][MacGrid::index(d, i, j, k)] = fn(c, g.position(c, i, j, k));
-  }
+  for_each_face(g, [&](const Face& q) { u.c[q.c][q.id] = fn(q.c, q.x); });
 }
 
-double max_diff(const VectorField& a, const VectorField& b) {
-  double m = 0;
-  for (int c = 0; c < 3; ++c)
-    for (std::size_t i = 0; i < a.c[c].size(); ++i) m = std::max(m, std::abs(a.c[c][i] - b.c[c][i]));
-  return m;
-}
+double max_diff(const VectorField& a, const VectorField& b) { return max_abs_diff(a, b); }
 }  // namespace
 
 TEST(Advection, SecondOrderInSpace) {

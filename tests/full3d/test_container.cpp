@@ -17,8 +17,10 @@
 #include "common/errors.hpp"
 #include "full3d/operators.hpp"
 #include "full3d/stokes.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 
@@ -135,18 +137,12 @@ void swimmer_regime(CylinderWall wall, StokesMethod method = StokesMethod::Auto)
   VectorField u(grid), f(grid);
   std::mt19937 rng(5);
   std::uniform_real_distribution<double> U(-1, 1);
-  for (int c = 0; c < 3; ++c) {
-    const auto d = grid.dims(c);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) {
-          const auto x = grid.position(c, i, j, k);
-          const double rr = std::hypot(x[1] - 0.5 * side, x[2] - 0.5 * side);
-          // a smooth force blob inside the cylinder (like a spread membrane force)
-          f.c[c][MacGrid::index(d, i, j, k)] =
-              rr < 0.6 * Rc ? 1e6 * std::cos(2 * M_PI * x[0] / grid.length(0) + c) * (1 - rr / (0.6 * Rc)) : 0.0;
-        }
-  }
+  for_each_face(grid, [&](const Face& q) {
+    const double rr = std::hypot(q.x[1] - 0.5 * side, q.x[2] - 0.5 * side);
+    // a smooth force blob inside the cylinder (like a spread membrane force)
+    f.c[q.c][q.id] =
+        rr < 0.6 * Rc ? 1e6 * std::cos(2 * M_PI * q.x[0] / grid.length(0) + q.c) * (1 - rr / (0.6 * Rc)) : 0.0;
+  });
   zero_wall_faces(grid, f);
   for (int s = 0; s < 3; ++s) {
     const auto t0 = std::chrono::steady_clock::now();

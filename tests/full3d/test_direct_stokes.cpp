@@ -16,8 +16,10 @@
 #include "full3d/direct_stokes.hpp"
 #include "full3d/operators.hpp"
 #include "full3d/stokes.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 
@@ -45,17 +47,11 @@ StokesOptions options(bool cylinder, StokesMethod method, int threads = 1) {
 void random_state(const MacGrid& g, bool cylinder, VectorField& u, VectorField& f, unsigned seed) {
   std::mt19937 rng(seed);
   std::uniform_real_distribution<double> U(-1, 1);
-  for (int c = 0; c < 3; ++c) {
-    const auto d = g.dims(c);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) {
-          const std::size_t id = MacGrid::index(d, i, j, k);
-          const bool out = cylinder && cylinder_outside(g, kRc, c, j, k);
-          u.c[c][id] = out ? 0.0 : 1e-6 * U(rng);
-          f.c[c][id] = 1e3 * U(rng);
-        }
-  }
+  for_each_face(g, [&](const Face& q) {
+    const bool out = cylinder && cylinder_outside(g, kRc, q.c, q.j, q.k);
+    u.c[q.c][q.id] = out ? 0.0 : 1e-6 * U(rng);
+    f.c[q.c][q.id] = 1e3 * U(rng);
+  });
   zero_wall_faces(g, u);
 }
 

@@ -5,8 +5,10 @@
 
 #include "full3d/ib.hpp"
 #include "full3d/operators.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 Eigen::Matrix3Xd random_points(const MacGrid& g, int n, double margin, std::mt19937& rng) {
@@ -16,13 +18,6 @@ Eigen::Matrix3Xd random_points(const MacGrid& g, int n, double margin, std::mt19
     for (int k = 0; k < n; ++k) X(d, k) = U(rng);
   }
   return X;
-}
-Eigen::Matrix3Xd random_forces(int n, std::mt19937& rng) {
-  std::uniform_real_distribution<double> U(-1, 1);
-  Eigen::Matrix3Xd F(3, n);
-  for (int k = 0; k < n; ++k)
-    for (int d = 0; d < 3; ++d) F(d, k) = U(rng);
-  return F;
 }
 Eigen::Vector3d field_total(const MacGrid& g, const VectorField& f) {
   Eigen::Vector3d s = Eigen::Vector3d::Zero();
@@ -84,17 +79,10 @@ TEST(ImmersedBoundary, InterpolationReproducesConstantsAndLinearFields) {
     const double a[3] = {0.3, -1.2, 2.0};
     const double b[3][3] = {{1.0, -2.0, 0.5}, {0.7, 0.1, -0.4}, {-1.5, 0.9, 2.2}};
     VectorField cst(g), lin(g);
-    for (int c = 0; c < 3; ++c) {
-      const auto d = g.dims(c);
-      for (int k = 0; k < d[2]; ++k)
-        for (int j = 0; j < d[1]; ++j)
-          for (int i = 0; i < d[0]; ++i) {
-            const auto x = g.position(c, i, j, k);
-            const std::size_t id = MacGrid::index(d, i, j, k);
-            cst.c[c][id] = a[c];
-            lin.c[c][id] = a[c] + b[c][0] * x[0] + b[c][1] * x[1] + b[c][2] * x[2];
-          }
-    }
+    for_each_face(g, [&](const Face& q) {
+      cst.c[q.c][q.id] = a[q.c];
+      lin.c[q.c][q.id] = a[q.c] + b[q.c][0] * q.x[0] + b[q.c][1] * q.x[1] + b[q.c][2] * q.x[2];
+    });
     // the linear field is not periodic: keep the stencils off the seams and walls
     const Eigen::Matrix3Xd X = random_points(g, 30, 2.01 * g.h(), rng);
     Eigen::Matrix3Xd Uc, Ul;

@@ -10,8 +10,10 @@
 #include "full3d/kernel.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/operators.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 
@@ -38,13 +40,6 @@ Eigen::Matrix3Xd random_cloud(const MacGrid& g, int n, std::mt19937& rng) {
   return X;
 }
 
-Eigen::Matrix3Xd random_forces(int n, std::mt19937& rng) {
-  std::uniform_real_distribution<double> U(-1, 1);
-  Eigen::Matrix3Xd F(3, n);
-  for (int k = 0; k < n; ++k)
-    for (int d = 0; d < 3; ++d) F(d, k) = U(rng);
-  return F;
-}
 
 double max_abs(const VectorField& f) {
   double m = 0.0;

@@ -12,8 +12,10 @@
 
 #include "full3d/operators.hpp"
 #include "full3d/stokes.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 constexpr double kPi = std::numbers::pi;
@@ -84,12 +86,7 @@ Manufactured duct_solution() {
 }
 
 void sample(const MacGrid& g, const std::array<Fn, 3>& fn, VectorField& out) {
-  for (int c = 0; c < 3; ++c) {
-    const auto d = g.dims(c);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) out.c[c][MacGrid::index(d, i, j, k)] = eval(fn[c], g.position(c, i, j, k));
-  }
+  for_each_face(g, [&](const Face& q) { out.c[q.c][q.id] = eval(fn[q.c], q.x); });
 }
 
 struct Errors {
@@ -108,17 +105,10 @@ Errors run_manufactured(ContainerKind kind, int n, const Manufactured& m, Stokes
   StokesSolver solver(g, fl, opt);
   VectorField u(g), f(g), ue(g);
   sample(g, m.u, ue);
-  for (int c = 0; c < 3; ++c) {
-    const auto d = g.dims(c);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) {
-          const auto x = g.position(c, i, j, k);
-          const std::size_t id = MacGrid::index(d, i, j, k);
-          u.c[c][id] = 0.3 * ue.c[c][id];
-          f.c[c][id] = alpha * 0.7 * ue.c[c][id] - fl.mu * eval_lap(m.u[c], x) + eval_d(m.p, c, x);
-        }
-  }
+  for_each_face(g, [&](const Face& q) {
+    u.c[q.c][q.id] = 0.3 * ue.c[q.c][q.id];
+    f.c[q.c][q.id] = alpha * 0.7 * ue.c[q.c][q.id] - fl.mu * eval_lap(m.u[q.c], q.x) + eval_d(m.p, q.c, q.x);
+  });
   zero_wall_faces(g, f);
   const StokesStats st = solver.step(u, f, dt);
   if (stats) *stats = st;
