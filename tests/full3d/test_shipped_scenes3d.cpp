@@ -1,0 +1,72 @@
+// Every shipped scene is a valid 3D scene: it resolves, its membrane satisfies the no-leak
+// rule at the shipped resolution, and its first steps run (on a coarser grid, to stay
+// quick) without tripping a guard and with finite outputs.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+
+#include "common/scene.hpp"
+#include "full3d/membrane.hpp"
+#include "full3d/run3d.hpp"
+
+using namespace swim;
+using namespace swim::full3d;
+namespace fs = std::filesystem;
+
+namespace {
+
+std::vector<std::string> shipped_scenes() {
+  std::vector<std::string> out;
+  for (const auto& e : fs::directory_iterator(SWIM_SOURCE_DIR "/data/scenes"))
+    if (e.path().extension() == ".json") out.push_back(e.path().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+}  // namespace
+
+TEST(ShippedScenes3d, ResolveWithTheMembraneInsideTheNoLeakBound) {
+  const auto files = shipped_scenes();
+  ASSERT_GE(files.size(), 9u);
+  for (const auto& f : files) {
+    SCOPED_TRACE(f);
+    scene::json sc = scene::load_file(f);
+    scene::json resolved;
+    const Params3d p = read_scene3d(sc, resolved);
+    const CylinderMesh mesh = make_mesh(p);
+    const double edge = max_edge_length(mesh, mesh.X0);
+    std::printf("%-40s %3dx%2dx%2d h = %.3g nm, %5d nodes, longest edge %.2f h\n",
+                fs::path(f).filename().c_str(), p.nx, p.ny, p.nz, 1e9 * p.h, mesh.nodes(), edge / p.h);
+    EXPECT_LT(edge, 0.5 * p.h);
+    EXPECT_GT(p.dt, 0.0);
+  }
+}
+
+TEST(ShippedScenes3d, FirstStepsRunOnACoarseGrid) {
+  for (const auto& f : shipped_scenes()) {
+    SCOPED_TRACE(f);
+    scene::json sc = scene::load_file(f);
+    // the paper-sized scenes on a 16-cells-across grid; the tiny scenes are coarse already
+    const bool own_grid = sc.contains("full3d") && sc["full3d"].contains("grid") &&
+                          sc["full3d"]["grid"].contains("cell_size");
+    if (!own_grid) scene::apply_override(sc, "full3d.grid.cells_across=16");
+    for (const char* s : {"time.duration=\"4 ms\"", "time.output_interval=\"1 ms\"",
+                          "full3d.checkpoint_interval=\"2 ms\"", "full3d.output.vtk=false"})
+      scene::apply_override(sc, s);
+    scene::json resolved;
+    const Params3d p = read_scene3d(sc, resolved);
+    const std::string dir = std::string(SWIM_BINARY_DIR) + "/tests/out_shipped3d/" + fs::path(f).stem().string();
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    RunControl ctl;
+    ctl.progress = 0;
+    ctl.quiet_vtk = true;
+    const RunOutcome r = run3d(p, resolved, dir, ctl);
+    EXPECT_FALSE(r.failed) << r.message;
+    EXPECT_GE(r.steps, 4);
+    EXPECT_TRUE(std::isfinite(r.summary["displacement_m"].get<double>()));
+    EXPECT_TRUE(fs::exists(dir + "/summary.json"));
+  }
+}
