@@ -2,6 +2,8 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/SparseCholesky>
+#include <Eigen/SparseCore>
 #include <algorithm>
 #include <array>
 #include <chrono>
@@ -39,6 +41,82 @@ struct Dir1d {
     for (int m = 0; m < n; ++m) g[m] = -2.0 * std::sin(kPi * m / (2.0 * n)) / h;
   }
 };
+
+// Staircase-cylinder layout of the cross-section. Face status per component c (0..2) at
+// (j, k) of the dims(c)[1] x dims(c)[2] cross-section: kWall (duct wall face, zero in both
+// the free-slip and the no-slip problem), kFree, kRing (outside r = Rc and in the stencil of
+// a free face's momentum row -- lateral neighbour of the same component, the MAC Laplacian
+// being componentwise and x-neighbours sharing (j, k) -- or of the continuity row of a fluid
+// cell), kOuter (outside, in no fluid equation).
+enum : char { kWall = 0, kFree = 1, kRing = 2, kOuter = 3 };
+struct CylinderLayout {
+  std::array<std::array<int, 3>, 3> d{};
+  std::array<std::vector<char>, 3> st;
+  std::vector<char> fluid;  // per cell k ny + j: has a free face (carries a pressure)
+  int ring = 0;
+  bool wall_nodes_masked = true;  // every wall-adjacent tangential node is outside
+  char at(int c, int j, int k) const {
+    if (j < 0 || k < 0 || j >= d[c][1] || k >= d[c][2]) return kWall;
+    return st[c][std::size_t(k) * d[c][1] + j];
+  }
+};
+CylinderLayout cylinder_layout(const MacGrid& g, double radius) {
+  CylinderLayout L;
+  const int ny = g.ny(), nz = g.nz();
+  for (int c = 0; c < 3; ++c) {
+    L.d[c] = g.dims(c);
+    L.st[c].assign(std::size_t(L.d[c][1]) * L.d[c][2], kWall);
+    for (int k = 0; k < L.d[c][2]; ++k)
+      for (int j = 0; j < L.d[c][1]; ++j)
+        if (!g.on_wall(c, 1, j) && !g.on_wall(c, 2, k))
+          L.st[c][std::size_t(k) * L.d[c][1] + j] = cylinder_outside(g, radius, c, j, k) ? kOuter : kFree;
+  }
+  L.fluid.assign(std::size_t(ny) * nz, 0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      L.fluid[std::size_t(k) * ny + j] = L.at(0, j, k) == kFree || L.at(1, j, k) == kFree ||
+                                         L.at(1, j + 1, k) == kFree || L.at(2, j, k) == kFree ||
+                                         L.at(2, j, k + 1) == kFree;
+  auto fluid = [&](int j, int k) { return j >= 0 && k >= 0 && j < ny && k < nz && L.fluid[std::size_t(k) * ny + j]; };
+  for (int c = 0; c < 3; ++c)
+    for (int k = 0; k < L.d[c][2]; ++k)
+      for (int j = 0; j < L.d[c][1]; ++j) {
+        char& s = L.st[c][std::size_t(k) * L.d[c][1] + j];
+        if (s != kOuter) continue;
+        bool r = L.at(c, j - 1, k) == kFree || L.at(c, j + 1, k) == kFree || L.at(c, j, k - 1) == kFree ||
+                 L.at(c, j, k + 1) == kFree;
+        if (c == 0) r = r || fluid(j, k);
+        if (c == 1) r = r || fluid(j - 1, k) || fluid(j, k);
+        if (c == 2) r = r || fluid(j, k - 1) || fluid(j, k);
+        if (r) {
+          s = kRing;
+          ++L.ring;
+        }
+      }
+  // wall-adjacent tangential nodes: u on j = 0, ny-1 or k = 0, nz-1; v on k = 0, nz-1; w on j = 0, ny-1
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j) {
+      const bool edge_y = j == 0 || j == ny - 1, edge_z = k == 0 || k == nz - 1;
+      if ((edge_y || edge_z) && L.at(0, j, k) == kFree) L.wall_nodes_masked = false;
+    }
+  for (int k : {0, nz - 1})
+    for (int j = 1; j < ny; ++j)
+      if (L.at(1, j, k) == kFree) L.wall_nodes_masked = false;
+  for (int j : {0, ny - 1})
+    for (int k = 1; k < nz; ++k)
+      if (L.at(2, j, k) == kFree) L.wall_nodes_masked = false;
+  return L;
+}
+
+bool cylinder_radius_valid(const MacGrid& g, double radius) {
+  return g.kind() == ContainerKind::SquareDuct && radius > 0.0 &&
+         2.0 * radius <= std::min(g.length(1), g.length(2)) * (1.0 + 1e-12);
+}
+
+int find_root(std::vector<int>& parent, int a) {
+  while (parent[a] != a) a = parent[a] = parent[parent[a]];
+  return a;
+}
 
 }  // namespace
 
@@ -100,6 +178,8 @@ struct CapacitanceStokes::Impl {
     // would cost the same but is not backward stable: C(0) is ill-conditioned through the
     // axial plug mode, and the inverse lost 4 digits before that mode was split off.)
     std::vector<std::vector<double>> chol;
+    // cylinder: sparse Cholesky factor of the axial-mean x problem (alpha - mu L) on the free u faces
+    std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> u0llt;
     std::size_t bytes = 0;
   };
   std::array<Factors, 2> cache;
@@ -112,10 +192,198 @@ struct CapacitanceStokes::Impl {
     std::vector<double> a0, a1, b0, b1, e;
     std::vector<double> inv_lam, inv_den;  // per (my, mz): 1/|g|^2 (0 at g = 0), 1/(alpha + mu |g|^2)
     Eigen::MatrixXd w;                      // m x 2: wall values U^T y, then z = C^{-1} U^T y
+    FftwBuffer fb;                          // cylinder: one plane, aligned like the planes (FFTW new-array execution)
+    Eigen::VectorXd u0b, u0x;               // cylinder: axial-mean x problem on the free u faces
   };
   std::vector<Scratch> scratch;
 
-  Impl(const MacGrid& g, double mu_, int thr, const FftOptions& fft_in)
+  // ---- staircase cylinder ----------------------------------------------------------------
+  // The ring nodes R (m of them) replace the wall nodes; node a is the face at plane index
+  // ring[a] (= the cross-section row) of component ring_c[a].
+  bool cyl = false;
+  std::vector<char> row_masked;  // per u/v/w row (< off[3]): wall face or outside the cylinder
+  std::vector<char> cell_fluid;  // per cell k ny + j: has a free face
+  std::vector<int> ring;
+  std::vector<char> ring_c;
+  // Null vectors of C(kx): lam = (G q)|_R for q the indicator of a group of cells connected
+  // through non-ring y/z faces (real-space G: (q_j - q_{j-1})/h on y faces, g_x q on x faces in
+  // the rotated frame). yz: the y/z-face entries; ux: the ring x faces of the group (coefficient g_x).
+  // null0: every group (kx = 0, g_x = 0); null1: the groups with no free or outer x face (kx > 0).
+  struct NullVec {
+    std::vector<std::pair<int, double>> yz;
+    std::vector<int> ux;
+  };
+  std::vector<NullVec> null0, null1;
+  std::vector<int> u0_id;  // per cell: index of its free x face in the axial-mean problem, -1 if masked
+  int u0_n = 0;
+  double mask_residual = 0.0;
+
+  void setup_cylinder(double radius) {
+    const CylinderLayout L = cylinder_layout(grid, radius);
+    if (!L.wall_nodes_masked)
+      throw InputError("container.radius", std::to_string(radius),
+                       "the capacitance cylinder solver needs every wall-adjacent tangential face outside the "
+                       "cylinder (radius <= duct half-width - h/2); use stokes.method = direct");
+    cyl = true;
+    const double h = grid.h();
+    row_masked.assign(std::size_t(off[3]), 0);
+    for (int c = 0; c < 3; ++c)
+      for (int k = 0; k < L.d[c][2]; ++k)
+        for (int j = 0; j < L.d[c][1]; ++j) {
+          const char st = L.at(c, j, k);
+          const int row = off[c] + k * L.d[c][1] + j;
+          row_masked[row] = st != kFree;
+          if (st == kRing) {
+            ring.push_back(row);
+            ring_c.push_back(char(c));
+          }
+        }
+    m = int(ring.size());
+    cell_fluid = L.fluid;
+    // groups of cells connected through free or outer y/z faces
+    std::vector<int> parent(std::size_t(ny) * nz);
+    for (std::size_t i = 0; i < parent.size(); ++i) parent[i] = int(i);
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j) {
+        const int cell = k * ny + j;
+        const char sv = L.at(1, j, k), sw = L.at(2, j, k);
+        if (j > 0 && (sv == kFree || sv == kOuter)) parent[find_root(parent, cell)] = find_root(parent, cell - 1);
+        if (k > 0 && (sw == kFree || sw == kOuter)) parent[find_root(parent, cell)] = find_root(parent, cell - ny);
+      }
+    std::vector<int> root(parent.size());
+    std::vector<char> has_x(parent.size(), 0);  // group has a free or outer x face
+    for (std::size_t i = 0; i < parent.size(); ++i) {
+      root[i] = find_root(parent, int(i));
+      const char su = L.st[0][i];
+      if (su == kFree || su == kOuter) has_x[root[i]] = 1;
+    }
+    std::vector<NullVec> grp(parent.size());
+    for (int a = 0; a < m; ++a) {
+      const int c = ring_c[a], r = ring[a] - off[c];
+      const int j = r % L.d[c][1], k = r / L.d[c][1];
+      if (c == 0) {
+        grp[root[std::size_t(k) * ny + j]].ux.push_back(a);
+      } else {
+        // y face j between cells j-1 and j: (q_j - q_{j-1})/h (likewise z)
+        const int c1 = k * ny + j, c0 = c == 1 ? c1 - 1 : c1 - ny;
+        if (root[c1] != root[c0]) {
+          grp[root[c1]].yz.emplace_back(a, 1.0 / h);
+          grp[root[c0]].yz.emplace_back(a, -1.0 / h);
+        }
+      }
+    }
+    for (std::size_t i = 0; i < grp.size(); ++i) {
+      if (root[i] != int(i)) continue;
+      if (!grp[i].yz.empty()) null0.push_back(NullVec{grp[i].yz, {}});
+      if (!has_x[i] && (!grp[i].yz.empty() || !grp[i].ux.empty())) null1.push_back(grp[i]);
+    }
+    u0_id.assign(std::size_t(ny) * nz, -1);
+    for (std::size_t i = 0; i < u0_id.size(); ++i)
+      if (L.st[0][i] == kFree) u0_id[i] = u0_n++;
+
+    // Reflection symmetry. When the face statuses are invariant under Ry and Rz (the centred
+    // staircase; the mask is computed in floating point, so it is checked, not assumed), the
+    // ring maps onto itself, C(kx) and the lift N N^T commute with both reflections (the
+    // groups map onto groups), and the capacitance splits into the four character blocks
+    // (as for the duct's wall nodes); C is then assembled from one column per orbit. Otherwise
+    // one block of order m.
+    auto refl = [&](int c, int& j, int& k, double& sg, int g) {
+      if (g & 1) {
+        j = c == 1 ? ny - j : ny - 1 - j;
+        if (c == 1) sg = -sg;
+      }
+      if (g & 2) {
+        k = c == 2 ? nz - k : nz - 1 - k;
+        if (c == 2) sg = -sg;
+      }
+    };
+    sym_ok = true;
+    for (int c = 0; c < 3 && sym_ok; ++c)
+      for (int k = 0; k < L.d[c][2] && sym_ok; ++k)
+        for (int j = 0; j < L.d[c][1] && sym_ok; ++j)
+          for (int g = 1; g < 4; ++g) {
+            int jj = j, kk = k;
+            double sg = 1.0;
+            refl(c, jj, kk, sg, g);
+            if (L.at(c, jj, kk) != L.at(c, j, k)) sym_ok = false;
+          }
+    std::vector<int> ring_of_row(std::size_t(off[3]), -1);
+    for (int a = 0; a < m; ++a) ring_of_row[ring[a]] = a;
+    for (int g = 0; g < 4; ++g) {
+      ring_img[g].assign(std::size_t(m), 0);
+      ring_sgn[g].assign(std::size_t(m), 1.0);
+    }
+    if (sym_ok) {
+      for (int a = 0; a < m; ++a) {
+        const int c = ring_c[a], r = ring[a] - off[c];
+        const int d1 = L.d[c][1];
+        for (int g = 0; g < 4; ++g) {
+          int j = r % d1, k = r / d1;
+          double sg = 1.0;
+          refl(c, j, k, sg, g);
+          ring_img[g][a] = ring_of_row[std::size_t(off[c] + k * d1 + j)];
+          ring_sgn[g][a] = sg;
+        }
+      }
+      build_symmetry_with([&](int a, int g, int& node, double& sg) {
+        node = ring_img[g][a];
+        sg = ring_sgn[g][a];
+      });
+      std::vector<char> done(std::size_t(m), 0);
+      for (int a = 0; a < m; ++a)
+        if (!done[a]) {
+          orbit_rep.push_back(a);
+          for (int g = 0; g < 4; ++g) done[ring_img[g][a]] = 1;
+        }
+    } else {
+      sym.assign(std::size_t(m), SymVec{});
+      for (int a = 0; a < m; ++a) {
+        sym[a].n = 1;
+        sym[a].node[0] = a;
+        sym[a].w[0] = 1.0;
+        ring_img[0][a] = a;
+        orbit_rep.push_back(a);
+      }
+      cls_off = {0, m, m, m, m};
+      chol_off = {0, packed_col(m, m), packed_col(m, m), packed_col(m, m), packed_col(m, m)};
+    }
+  }
+  bool sym_ok = false;
+  std::array<std::vector<int>, 4> ring_img;     // image of ring node a under g (g = gy + 2 gz)
+  std::array<std::vector<double>, 4> ring_sgn;  // sign of the reflected component
+  std::vector<int> orbit_rep;                   // one ring node per orbit (all nodes without symmetry)
+
+  // Sparse (alpha - mu L) of the axial mean x component on the free u faces of the cross-section
+  // (5-point, masked neighbours zero, duct-wall ghost -u), Cholesky-factorised.
+  std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> factor_mean_x(double alpha) const {
+    const double ih2 = 1.0 / (grid.h() * grid.h());
+    std::vector<Eigen::Triplet<double>> t;
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j) {
+        const int i = u0_id[std::size_t(k) * ny + j];
+        if (i < 0) continue;
+        double diag = alpha + 4.0 * mu * ih2;
+        const int nb[4][2] = {{j - 1, k}, {j + 1, k}, {j, k - 1}, {j, k + 1}};
+        for (const auto& q : nb) {
+          if (q[0] < 0 || q[0] >= ny || q[1] < 0 || q[1] >= nz) {
+            diag += mu * ih2;  // ghost u = -u_0 across the duct wall
+            continue;
+          }
+          const int n = u0_id[std::size_t(q[1]) * ny + q[0]];
+          if (n >= 0) t.emplace_back(i, n, -mu * ih2);
+        }
+        t.emplace_back(i, i, diag);
+      }
+    Eigen::SparseMatrix<double> A(u0_n, u0_n);
+    A.setFromTriplets(t.begin(), t.end());
+    auto llt = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>>(A);
+    if (llt->info() != Eigen::Success)
+      throw NumericalError("axial-mean factorisation of the cylinder capacitance solver failed",
+                           "use stokes.method = direct");
+    return llt;
+  }
+
+  Impl(const MacGrid& g, double mu_, const CylinderOptions* cylopt, int thr, const FftOptions& fft_in)
       : grid(g), mu(mu_), threads(std::max(1, thr)), nx(g.nx()), ny(g.ny()), nz(g.nz()), nxh(g.nx() / 2 + 1),
         dy(g.ny(), g.h()), dz(g.nz(), g.h()) {
     if (g.kind() != ContainerKind::SquareDuct)
@@ -186,18 +454,14 @@ struct CapacitanceStokes::Impl {
         u0_lam[std::size_t(mz) * ny + my] = 4.0 / (g.h() * g.h()) * (sy * sy + sz * sz);
       }
 
-    // wall nodes
-    bv = 2 * nz + 2 * (ny - 2);
-    bw = bv + 2 * (ny - 1);
-    m = bw + 2 * (nz - 1);
-    const double h = g.h();
-    dg_inv.assign(std::size_t(m), h * h / (2.0 * mu));
-    for (int js = 0; js < 2; ++js) {  // corners of u touch two walls
-      dg_inv[std::size_t(js) * nz] = h * h / (4.0 * mu);
-      dg_inv[std::size_t(js) * nz + nz - 1] = h * h / (4.0 * mu);
+    if (cylopt) {
+      if (!cylinder_radius_valid(g, cylopt->radius))
+        throw InputError("container.radius", std::to_string(cylopt->radius),
+                         "a positive radius Rc with 2 Rc <= the duct side");
+      setup_cylinder(cylopt->radius);
+    } else {
+      setup_wall_nodes();
     }
-
-    build_symmetry();
     scratch.resize(std::size_t(threads));
     const std::size_t nl = std::size_t(std::max(ny, nz)) + 1;
     for (auto& s : scratch) {
@@ -208,7 +472,28 @@ struct CapacitanceStokes::Impl {
       s.inv_lam.assign(std::size_t(ny) * nz, 0.0);
       s.inv_den.assign(std::size_t(ny) * nz, 0.0);
       s.w = Eigen::MatrixXd::Zero(m, 2);
+      if (cyl) {
+        s.fb = FftwBuffer(P);
+        std::fill(s.fb.data(), s.fb.data() + P, 0.0);
+        s.u0b.resize(u0_n);
+        s.u0x.resize(u0_n);
+      }
     }
+  }
+
+  void setup_wall_nodes() {
+    // wall nodes
+    bv = 2 * nz + 2 * (ny - 2);
+    bw = bv + 2 * (ny - 1);
+    m = bw + 2 * (nz - 1);
+    const double h = grid.h();
+    dg_inv.assign(std::size_t(m), h * h / (2.0 * mu));
+    for (int js = 0; js < 2; ++js) {  // corners of u touch two walls
+      dg_inv[std::size_t(js) * nz] = h * h / (4.0 * mu);
+      dg_inv[std::size_t(js) * nz + nz - 1] = h * h / (4.0 * mu);
+    }
+
+    build_symmetry();
   }
 
   double* plane(int r) { return planes.data() + std::size_t(r) * P; }
@@ -250,6 +535,18 @@ struct CapacitanceStokes::Impl {
     }
   }
   void build_symmetry() {
+    build_symmetry_with([&](int a, int g, int& node, double& sg) {
+      int c, j, k;
+      node_position(a, c, j, k);
+      sg = 1.0;
+      if (g & 1) reflect(c, j, k, sg, 1);
+      if (g & 2) reflect(c, j, k, sg, 2);
+      node = node_of(c, j, k);
+    });
+  }
+  // image(a, g, node, sign): the image of node a under g = gy + 2 gz (gy: Ry applied, gz: Rz)
+  template <class Image>
+  void build_symmetry_with(Image&& image) {
     std::array<std::vector<SymVec>, 4> cls;
     std::vector<char> done(std::size_t(m), 0);
     for (int a = 0; a < m; ++a) {
@@ -257,13 +554,7 @@ struct CapacitanceStokes::Impl {
       std::array<int, 4> img{};
       std::array<double, 4> sgn{};
       for (int g = 0; g < 4; ++g) {  // g = gy + 2 gz
-        int c, j, k;
-        node_position(a, c, j, k);
-        double sg = 1.0;
-        if (g & 1) reflect(c, j, k, sg, 1);
-        if (g & 2) reflect(c, j, k, sg, 2);
-        img[g] = node_of(c, j, k);
-        sgn[g] = sg;
+        image(a, g, img[g], sgn[g]);
         done[img[g]] = 1;
       }
       for (int cl = 0; cl < 4; ++cl) {  // character chi(g) = sy^gy sz^gz, sy = -1 if cl & 1
@@ -570,18 +861,200 @@ struct CapacitanceStokes::Impl {
     return 0.5 * (C + C.transpose());
   }
 
+  // ---- cylinder: capacitance, factorisation and mode solve --------------------------------
+  // Unnormalised forward yz transform of the unit field at ring node a, written into the
+  // coefficient slots of R (u, v, w parts; all other slots left untouched, zero): separable,
+  // the product of the 1D basis values across y and z.
+  void ring_unit_transform(int a, double* R) const {
+    const int c = ring_c[a], r = ring[a] - off[c];
+    const int d1 = c == 1 ? ny + 1 : ny;
+    const int j = r % d1, k = r / d1;
+    double* X = R + off[c];
+    if (c == 0) {
+      for (int mz = 0; mz < nz; ++mz) {
+        const double cz = dz.cf[std::size_t(mz) * nz + k];
+        for (int my = 0; my < ny; ++my) X[std::size_t(mz) * ny + my] = cz * dy.cf[std::size_t(my) * ny + j];
+      }
+    } else if (c == 1) {
+      for (int mz = 0; mz < nz; ++mz) {
+        const double cz = dz.cf[std::size_t(mz) * nz + k];
+        for (int my = 1; my < ny; ++my) X[std::size_t(mz) * (ny + 1) + my] = cz * dy.sn[std::size_t(my) * ny + j];
+      }
+    } else {
+      for (int mz = 1; mz < nz; ++mz) {
+        const double sz = dz.sn[std::size_t(mz) * nz + k];
+        for (int my = 0; my < ny; ++my) X[std::size_t(mz) * ny + my] = sz * dy.cf[std::size_t(my) * ny + j];
+      }
+    }
+  }
+  void clear_ring_unit(int a, double* R) const {
+    const int c = ring_c[a];
+    const std::size_t n = c == 1 ? std::size_t(nz) * (ny + 1) : c == 2 ? std::size_t(nz + 1) * ny : std::size_t(nz) * ny;
+    std::fill(R + off[c], R + off[c] + n, 0.0);
+  }
+
+  // Capacitance of mode kx for the cylinder: C = E_R S_fs(kx)^{-1} E_R^T + s N N^T (see the
+  // header): one unit solve per column (separable forward transform, spectral projection, three
+  // inverse 2D transforms, gather on the ring). kx = 0: the ring x faces are decoupled
+  // (g_x = 0, exact zeros) and solved separately; their block is replaced by I.
+  Eigen::MatrixXd capacitance_cyl(int kx, double alpha, Scratch& s) const {
+    const double gx = gx_of(kx);
+    const double syz = 1.0 / (4.0 * ny * nz);
+    Eigen::MatrixXd C(m, m);
+    std::fill(s.r.begin(), s.r.end(), 0.0);
+    mode_tables(gx, alpha, s);
+    double* fb = s.fb.data();
+    for (int a : orbit_rep) {
+      ring_unit_transform(a, s.r.data());
+      apply_M(s.r.data(), fb, gx, s, syz, false);
+      clear_ring_unit(a, s.r.data());
+      for (int c = 0; c < 3; ++c) yz_inv[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
+      double* col = C.col(a).data();
+      for (int b = 0; b < m; ++b) col[b] = fb[ring[b]];
+      if (sym_ok)  // C(g b, g a) = sign_g(b) sign_g(a) C(b, a)
+        for (int g = 1; g < 4; ++g) {
+          const int ga = ring_img[g][a];
+          if (ga == a) continue;
+          double* cg = C.col(ga).data();
+          const double sa = ring_sgn[g][a];
+          for (int b = 0; b < m; ++b) cg[ring_img[g][b]] = ring_sgn[g][b] * sa * col[b];
+        }
+    }
+    // s: the mean diagonal of the coupled part, the scale of the null-space lift (and of the
+    // decoupled kx = 0 x block); with s far from the spectrum of C the Cholesky factor of the
+    // lifted matrix would mix round-off of the lifted directions into the others
+    double sc = 0.0;
+    int ns = 0;
+    for (int a = 0; a < m; ++a)
+      if (kx != 0 || ring_c[a] != 0) {
+        sc += C(a, a);
+        ++ns;
+      }
+    sc = ns ? sc / ns : 1.0;
+    if (kx == 0)
+      for (int a = 0; a < m; ++a)
+        if (ring_c[a] == 0) {
+          C.row(a).setZero();
+          C.col(a).setZero();
+          C(a, a) = sc;
+        }
+    Eigen::MatrixXd Cs = 0.5 * (C + C.transpose());
+    // lift the null space: + s n n^T per (normalised) null vector
+    std::vector<std::pair<int, double>> v;
+    for (const NullVec& nv : kx == 0 ? null0 : null1) {
+      v = nv.yz;
+      if (kx != 0)
+        for (int a : nv.ux) v.emplace_back(a, gx);
+      double n2 = 0.0;
+      for (const auto& e : v) n2 += e.second * e.second;
+      if (!(n2 > 0.0)) continue;
+      for (const auto& e : v)
+        for (const auto& f : v) Cs(e.first, f.first) += sc * e.second * f.second / n2;
+    }
+    return Cs;
+  }
+
+  const Factors& factors_cyl(double alpha) {
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<std::vector<double>> chol(static_cast<std::size_t>(nxh));
+    parallel_blocks(nxh, threads, [&](long b, long e, int t) {
+      for (long kx = b; kx < e; ++kx) {
+        const Eigen::MatrixXd C = capacitance_cyl(int(kx), alpha, scratch[t]);
+        factor_blocks(C, chol[kx], kx, alpha, "cylinder");
+      }
+    });
+    auto u0llt = factor_mean_x(alpha);
+    Factors& f = cache[next_slot];
+    next_slot = 1 - next_slot;
+    f.alpha = alpha;
+    f.chol = std::move(chol);
+    f.u0llt = std::move(u0llt);
+    f.bytes = std::size_t(nxh) * chol_off[4] * sizeof(double) +
+              std::size_t(f.u0llt->matrixL().nestedExpression().nonZeros()) * (sizeof(double) + sizeof(int));
+    factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    factorized_last = true;
+    return f;
+  }
+
+  // Mode solve for the cylinder: free-slip Y = M T b, ring values y_R (3 inverse transforms of a
+  // copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam (3 forward transforms), then the inverses.
+  void solve_mode_cyl(int kx, const Factors& fac, double alpha, Scratch& s) {
+    const bool two = paired(kx);
+    const int np = two ? 2 : 1;
+    double* F[2] = {plane(kx), two ? plane(nx - kx) : nullptr};
+    double* fb = s.fb.data();
+    if (kx == 0) std::copy_n(F[0] + off[0], std::size_t(ny) * nz, s.y.data());  // b of the axial mean u
+    for (int q = 0; q < np; ++q)
+      for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(F[q] + yz_at[c], F[q] + yz_at[c]);
+    if (two) rotate(F[0], F[1], kx, +1);
+    const double gx = gx_of(kx);
+    const double syz = 1.0 / (4.0 * ny * nz), inv_n = syz / nx;
+    mode_tables(gx, alpha, s);
+    for (int q = 0; q < np; ++q) {
+      apply_M(F[q], F[q], gx, s, 1.0, false);
+      std::copy_n(F[q], std::size_t(off[3]), fb);
+      for (int c = 0; c < 3; ++c) yz_inv[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
+      double* w = s.w.col(q).data();
+      for (int a = 0; a < m; ++a) w[a] = syz * fb[ring[a]];
+      if (kx == 0)
+        for (int a = 0; a < m; ++a)
+          if (ring_c[a] == 0) w[a] = 0.0;
+    }
+    block_solve(fac.chol[kx].data(), np, s);
+    for (int q = 0; q < np; ++q) {
+      std::fill(fb, fb + off[3], 0.0);
+      const double* z = s.w.col(q).data();
+      for (int a = 0; a < m; ++a) fb[ring[a]] = z[a];
+      for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
+      apply_M(fb, F[q], gx, s, inv_n, true);
+    }
+    if (two) rotate(F[0], F[1], kx, -1);
+    for (int q = 0; q < np; ++q) {
+      double* f = F[q];
+      for (int k = 0; k < nz; ++k) {
+        f[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
+        f[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
+      }
+      std::fill(f + off[2], f + off[2] + ny, 0.0);
+      std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
+      for (int c = 0; c < 4; ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
+    }
+    if (kx == 0) {  // exact axial mean of u on the free faces (masked ones 0), scaled by 1/nx like the planes
+      double* u = F[0] + off[0];
+      for (std::size_t i = 0; i < u0_id.size(); ++i)
+        if (u0_id[i] >= 0) s.u0b[u0_id[i]] = s.y[i];
+      s.u0x = fac.u0llt->solve(s.u0b);
+      for (std::size_t i = 0; i < u0_id.size(); ++i) u[i] = u0_id[i] >= 0 ? s.u0x[u0_id[i]] / nx : 0.0;
+    }
+  }
+
   const Factors& factors(double alpha) {
     for (auto& f : cache)
       if (!f.chol.empty() && f.alpha == alpha) {
         factorized_last = false;
         return f;
       }
+    if (cyl) return factors_cyl(alpha);
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<std::vector<double>> chol(static_cast<std::size_t>(nxh));
     parallel_blocks(nxh, threads, [&](long b, long e, int t) {
       for (long kx = b; kx < e; ++kx) {
         const Eigen::MatrixXd C = capacitance(int(kx), alpha, scratch[t]);
-        std::vector<double>& l = chol[kx];
+        factor_blocks(C, chol[kx], kx, alpha, "duct");
+      }
+    });
+    Factors& f = cache[next_slot];
+    next_slot = 1 - next_slot;
+    f.alpha = alpha;
+    f.chol = std::move(chol);
+    f.bytes = std::size_t(nxh) * chol_off[4] * sizeof(double);
+    factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    factorized_last = true;
+    return f;
+  }
+
+  // Cholesky factors of the symmetry blocks Q_c^T C Q_c, packed into l at chol_off[c].
+  void factor_blocks(const Eigen::MatrixXd& C, std::vector<double>& l, long kx, double alpha, const char* what) const {
         l.resize(chol_off[4]);
         for (int cl = 0; cl < 4; ++cl) {
           const int o = cls_off[cl], n = cls_off[cl + 1] - o;
@@ -598,24 +1071,14 @@ struct CapacitanceStokes::Impl {
           const Eigen::LLT<Eigen::MatrixXd> llt(B);  // reads the lower triangle
           if (llt.info() != Eigen::Success)
             throw NumericalError(
-                "capacitance matrix of the duct Stokes solver is not positive definite for axial mode " +
-                    std::to_string(kx) + " (rho/dt = " + std::to_string(alpha) + ")",
+                std::string("capacitance matrix of the ") + what +
+                    " Stokes solver is not positive definite for axial mode " + std::to_string(kx) + " (rho/dt = " + std::to_string(alpha) + ")",
                 "use stokes.method = direct or iterative");
           const Eigen::MatrixXd& lm = llt.matrixLLT();  // lower triangle holds L
           double* dst = l.data() + chol_off[cl];
           for (int j = 0; j < n; ++j)
             for (int i = j; i < n; ++i) dst[packed_col(j, n) + std::size_t(i - j)] = lm(i, j);
         }
-      }
-    });
-    Factors& f = cache[next_slot];
-    next_slot = 1 - next_slot;
-    f.alpha = alpha;
-    f.chol = std::move(chol);
-    f.bytes = std::size_t(nxh) * chol_off[4] * sizeof(double);
-    factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    factorized_last = true;
-    return f;
   }
 
   // Rotation of the x component of a paired mode into the real frame, q = i e^{i theta/2} u^
@@ -636,6 +1099,36 @@ struct CapacitanceStokes::Impl {
         const double qr = ur[i], qi = ui[i];
         ur[i] = cs * qi - sn * qr;
         ui[i] = -(cs * qr + sn * qi);
+      }
+    }
+  }
+
+  // s.w(:, q) = C^{-1} s.w(:, q), q < np: to the symmetry-adapted basis (s.e: 2 columns of m),
+  // the four block solves with the packed factors l, and back.
+  void block_solve(const double* l, int np, Scratch& s) const {
+    for (int q = 0; q < np; ++q) {
+      const double* w = s.w.col(q).data();
+      double* e = s.e.data() + std::size_t(q) * m;
+      for (int i = 0; i < m; ++i) {
+        const SymVec& v = sym[i];
+        double acc = 0.0;
+        for (int t = 0; t < v.n; ++t) acc += v.w[t] * w[v.node[t]];
+        e[i] = acc;
+      }
+    }
+    for (int cl = 0; cl < 4; ++cl) {
+      const int o = cls_off[cl], n = cls_off[cl + 1] - o;
+      if (n == 0) continue;
+      double* const zc[2] = {s.e.data() + o, s.e.data() + m + o};
+      cholesky_solve(l + chol_off[cl], n, zc, np);
+    }
+    for (int q = 0; q < np; ++q) {
+      double* w = s.w.col(q).data();
+      const double* e = s.e.data() + std::size_t(q) * m;
+      std::fill(w, w + m, 0.0);
+      for (int i = 0; i < m; ++i) {
+        const SymVec& v = sym[i];
+        for (int t = 0; t < v.n; ++t) w[v.node[t]] += v.w[t] * e[i];
       }
     }
   }
@@ -672,31 +1165,7 @@ struct CapacitanceStokes::Impl {
     for (int q = 0; q < np; ++q)
       for (int i = 0; i < m; ++i) s.w(i, q) *= syz;
     // to the symmetry-adapted basis (s.e: 2 columns of m), the four block solves, and back
-    for (int q = 0; q < np; ++q) {
-      const double* w = s.w.col(q).data();
-      double* e = s.e.data() + std::size_t(q) * m;
-      for (int i = 0; i < m; ++i) {
-        const SymVec& v = sym[i];
-        double acc = 0.0;
-        for (int t = 0; t < v.n; ++t) acc += v.w[t] * w[v.node[t]];
-        e[i] = acc;
-      }
-    }
-    for (int cl = 0; cl < 4; ++cl) {
-      const int o = cls_off[cl], n = cls_off[cl + 1] - o;
-      if (n == 0) continue;
-      double* const zc[2] = {s.e.data() + o, s.e.data() + m + o};
-      cholesky_solve(fac.chol[kx].data() + chol_off[cl], n, zc, np);
-    }
-    for (int q = 0; q < np; ++q) {
-      double* w = s.w.col(q).data();
-      const double* e = s.e.data() + std::size_t(q) * m;
-      std::fill(w, w + m, 0.0);
-      for (int i = 0; i < m; ++i) {
-        const SymVec& v = sym[i];
-        for (int t = 0; t < v.n; ++t) w[v.node[t]] += v.w[t] * e[i];
-      }
-    }
+    block_solve(fac.chol[kx].data(), np, s);
     // X = Y - M T (U z), normalised
     for (int q = 0; q < np; ++q) {
       wall_transform(s.w.col(q).data(), s.r.data(), s);
@@ -745,10 +1214,18 @@ struct CapacitanceStokes::Impl {
           std::memcpy(dst, fc, sizeof(double) * len);
         }
       });
+      if (cyl)  // masked rows: b ignored (their momentum rows carry the multiplier)
+        for (long r = rb; r < re; ++r)
+          if (row_masked[r]) std::fill_n(real.data() + std::size_t(r) * nx, nx, 0.0);
       xfwd[t].execute();
     });
     parallel_blocks(nxh, threads, [&](long kb, long ke, int t) {
-      for (long kx = kb; kx < ke; ++kx) solve_mode(int(kx), fac, alpha, scratch[t]);
+      for (long kx = kb; kx < ke; ++kx) {
+        if (cyl)
+          solve_mode_cyl(int(kx), fac, alpha, scratch[t]);
+        else
+          solve_mode(int(kx), fac, alpha, scratch[t]);
+      }
     });
     parallel_blocks(off[4], threads, [&](long rb, long re, int t) {
       xbwd[t].execute();
@@ -758,6 +1235,38 @@ struct CapacitanceStokes::Impl {
                     sizeof(double) * std::size_t(hi - lo) * nx);
       });
     });
+    if (cyl) {
+      // masked faces: zero in exact arithmetic (ring: the constraint; outer: the homogeneous
+      // outside problem); record their round-off and set them to 0. Pressure: zero mean over
+      // the fluid cells, 0 in the others (serial sums: deterministic).
+      double res = 0.0;
+      for (int c = 0; c < 3; ++c) {
+        const auto d = grid.dims(c);
+        for (int r = 0; r < d[1] * d[2]; ++r)
+          if (row_masked[off[c] + r]) {
+            double* x = u.c[c].data() + std::size_t(r) * nx;
+            for (int i = 0; i < nx; ++i) res = std::max(res, std::abs(x[i]));
+            std::fill_n(x, nx, 0.0);
+          }
+      }
+      mask_residual = res;
+      double psum = 0.0;
+      std::size_t cnt = 0;
+      for (std::size_t cell = 0; cell < cell_fluid.size(); ++cell)
+        if (cell_fluid[cell]) {
+          for (int i = 0; i < nx; ++i) psum += p.v[cell * nx + i];
+          cnt += std::size_t(nx);
+        }
+      const double pm = cnt ? psum / double(cnt) : 0.0;
+      for (std::size_t cell = 0; cell < cell_fluid.size(); ++cell) {
+        double* pc = p.v.data() + cell * nx;
+        if (cell_fluid[cell])
+          for (int i = 0; i < nx; ++i) pc[i] -= pm;
+        else
+          std::fill_n(pc, nx, 0.0);
+      }
+      return;
+    }
     // the pressure's zero mode is the gauge (0); remove its round-off mean (serial sum: deterministic)
     double sum = 0.0;
     for (double x : p.v) sum += x;
@@ -767,7 +1276,25 @@ struct CapacitanceStokes::Impl {
 };
 
 CapacitanceStokes::CapacitanceStokes(const MacGrid& g, double mu, int threads, const FftOptions& fft)
-    : impl_(std::make_unique<Impl>(g, mu, threads, fft)) {}
+    : impl_(std::make_unique<Impl>(g, mu, nullptr, threads, fft)) {}
+CapacitanceStokes::CapacitanceStokes(const MacGrid& g, double mu, const CylinderOptions* cylinder, int threads,
+                                     const FftOptions& fft)
+    : impl_(std::make_unique<Impl>(g, mu, cylinder, threads, fft)) {}
+
+bool CapacitanceStokes::supports_cylinder(const MacGrid& g, const CylinderOptions& cylinder) {
+  if (!cylinder_radius_valid(g, cylinder.radius)) return false;
+  return cylinder_layout(g, cylinder.radius).wall_nodes_masked;
+}
+
+std::size_t CapacitanceStokes::estimate_bytes(const MacGrid& g, const CylinderOptions* cylinder) {
+  if (!cylinder) return estimate_bytes(g);
+  const std::size_t m = std::size_t(cylinder_layout(g, cylinder->radius).ring);
+  // packed dense factors per mode, plus the sparse axial-mean factor (bounded by a band of n)
+  const std::size_t cells = std::size_t(g.ny()) * g.nz();
+  return std::size_t(g.nx() / 2 + 1) * (m * (m + 1) / 2) * sizeof(double) +
+         cells * std::size_t(std::max(g.ny(), g.nz())) * (sizeof(double) + sizeof(int));
+}
+double CapacitanceStokes::last_mask_residual() const { return impl_->mask_residual; }
 CapacitanceStokes::~CapacitanceStokes() = default;
 CapacitanceStokes::CapacitanceStokes(CapacitanceStokes&&) noexcept = default;
 CapacitanceStokes& CapacitanceStokes::operator=(CapacitanceStokes&&) noexcept = default;
@@ -793,5 +1320,6 @@ double CapacitanceStokes::last_factorization_seconds() const { return impl_->fac
 bool CapacitanceStokes::last_solve_factorized() const { return impl_->factorized_last; }
 int CapacitanceStokes::wall_nodes() const { return impl_->m; }
 int CapacitanceStokes::threads() const { return impl_->threads; }
+int CapacitanceStokes::symmetry_blocks() const { return impl_->cyl && !impl_->sym_ok ? 1 : 4; }
 
 }  // namespace swim::full3d

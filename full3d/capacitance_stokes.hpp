@@ -54,11 +54,34 @@
 // same code whatever the thread count; only the x transforms' row blocking (and so the
 // FFTW algorithm chosen per block) depends on it, so results are deterministic for a
 // given thread count and agree to round-off across counts. FFTW's own threads are not used.
+//
+// Staircase cylinder (constructor with a CylinderOptions; container.hpp). The constrained
+// step A u + G p + E^T lam = b, D u = 0, E u = 0 (E: the faces outside r = Rc) is solved as
+// a constrained FREE-SLIP problem: when every wall-adjacent tangential node is outside the
+// cylinder (supports_cylinder()), the no-slip term U Dg U^T acts only on masked rows and
+// drops out. The constraint is imposed on the "ring" R only: the outside faces in the stencil
+// of a free face's momentum row or of a fluid cell's continuity row (the remaining outside
+// faces then solve a homogeneous Stokes problem with zero boundary values, so they vanish).
+// Per axial mode the capacitance C = E_R S_fs^{-1} E_R^T (|R| x |R|) is symmetric positive
+// SEMI-definite; its null space is known in closed form, lam = (G q)|_R for q the indicator
+// of a group of cells connected through non-ring y/z faces (for kx > 0 only groups with no
+// non-ring x face), and is lifted by adding s N N^T, which leaves the solution of the
+// consistent system C lam = E_R y unchanged (see docs/full3d-fluid.md). The axial mean of the
+// x component is again solved separately, here by a sparse Cholesky factorisation of the
+// masked 2D Helmholtz operator. When the floating-point staircase is exactly symmetric under
+// both reflections (checked), C is assembled from one unit solve per orbit and factorised in
+// the four character blocks, else as one block. A solve: 13 yz transforms per plane (forward b,
+// inverse of a copy of Y for the ring values, forward of E_R^T lam, inverse of X) plus the
+// block substitutions, about 1.5 bare solves at 128 x 34 x 34 (|R| = 280, 5.3 MB per dt).
+// Output: masked faces zero (their computed round-off is reported by last_mask_residual()),
+// p with zero mean over the cells with a free face, 0 in the others (the Direct path's
+// convention).
 #pragma once
 
 #include <cstddef>
 #include <memory>
 
+#include "full3d/container.hpp"
 #include "full3d/fft.hpp"
 #include "full3d/grid.hpp"
 
@@ -70,6 +93,14 @@ class CapacitanceStokes {
   /// plans are single-threaded and executed concurrently on disjoint data).
   /// Throws swim::InputError for a non-duct grid.
   CapacitanceStokes(const MacGrid& g, double mu, int threads, const FftOptions& fft);
+  /// cylinder: nullptr for the plain duct, else the staircase mask of radius cylinder->radius
+  /// (wall kind not consulted). Throws swim::InputError if !supports_cylinder(g, *cylinder).
+  CapacitanceStokes(const MacGrid& g, double mu, const CylinderOptions* cylinder, int threads,
+                    const FftOptions& fft);
+  /// True when the staircase cylinder of this radius can be solved: a duct grid, a valid
+  /// radius, and every wall-adjacent tangential node outside r = Rc (the cylinder at least
+  /// half a cell inside the duct walls; the scenes' duct is two cells wider than the cylinder).
+  static bool supports_cylinder(const MacGrid& g, const CylinderOptions& cylinder);
   ~CapacitanceStokes();
   CapacitanceStokes(CapacitanceStokes&&) noexcept;
   CapacitanceStokes& operator=(CapacitanceStokes&&) noexcept;
@@ -87,15 +118,25 @@ class CapacitanceStokes {
   /// Upper bound of the capacitance factor memory for one alpha, bytes: (nx/2+1) packed
   /// Cholesky factors of four symmetry blocks of about m/4 (about (nx/2+1) m^2/8 doubles).
   static std::size_t estimate_bytes(const MacGrid& g);
+  /// Cylinder: (nx/2+1) packed Cholesky factors of order |R| (about (nx/2+1) |R|^2/2 doubles)
+  /// plus the sparse factor of the axial-mean problem (small); cylinder == nullptr: the above.
+  static std::size_t estimate_bytes(const MacGrid& g, const CylinderOptions* cylinder);
+  /// Cylinder: max |u| on the masked faces as computed, before they are set to zero (round-off
+  /// of the exact constrained solve), m/s; 0 for the plain duct.
+  double last_mask_residual() const;
   /// Memory of the factors currently cached (all alpha values), bytes.
   std::size_t factor_bytes() const;
   /// Wall time of the last (re)factorisation, s; 0 before the first.
   double last_factorization_seconds() const;
   /// True when the last solve() had to factorise.
   bool last_solve_factorized() const;
-  /// Number m of wall-adjacent tangential nodes per cross-section (the capacitance size).
+  /// Number m of wall-adjacent tangential nodes per cross-section (the capacitance size);
+  /// cylinder: the number |R| of ring faces per cross-section.
   int wall_nodes() const;
   int threads() const;
+  /// Number of reflection-symmetry blocks the capacitance is split into: 4, or 1 for a
+  /// cylinder whose floating-point staircase mask is not exactly symmetric.
+  int symmetry_blocks() const;
 
  private:
   struct Impl;

@@ -216,21 +216,28 @@ struct StokesSolver::Impl {
         throw InputError("stokes.method", "direct",
                          "the direct solver supports the plain duct and the staircase cylinder wall only; use "
                          "auto or iterative");
-      if (o.method == StokesMethod::Capacitance && o.cylinder.enabled)
+      // the capacitance solver: plain duct, or the staircase cylinder at least half a cell
+      // inside the duct walls (CapacitanceStokes::supports_cylinder)
+      const bool capacitance_applies =
+          !o.cylinder.enabled ||
+          (o.cylinder.wall == CylinderWall::Staircase && CapacitanceStokes::supports_cylinder(g, o.cylinder));
+      if (o.method == StokesMethod::Capacitance && !capacitance_applies)
         throw InputError("stokes.method", "capacitance",
-                         "the capacitance solver supports the plain duct only; use auto, direct or iterative");
+                         "the capacitance solver supports the plain duct and the staircase cylinder (radius <= "
+                         "duct half-width - h/2) only; use auto, direct or iterative");
+      const CylinderOptions* cyl = o.cylinder.enabled ? &o.cylinder : nullptr;
       const double limit = o.direct_memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
       const bool use_capacitance =
           o.method == StokesMethod::Capacitance ||
-          (o.method == StokesMethod::Auto && !o.cylinder.enabled &&
-           2.0 * double(CapacitanceStokes::estimate_bytes(g)) <= limit);
+          (o.method == StokesMethod::Auto && capacitance_applies &&
+           2.0 * double(CapacitanceStokes::estimate_bytes(g, cyl)) <= limit);
       const bool use_direct =
           o.method == StokesMethod::Direct ||
-          (o.method == StokesMethod::Auto && o.cylinder.enabled && direct_applies &&
+          (o.method == StokesMethod::Auto && !use_capacitance && o.cylinder.enabled && direct_applies &&
            2.0 * double(DirectStokes::estimate_bytes(g)) <= limit);
       if (use_capacitance) {
         const int thr = o.direct_threads > 0 ? o.direct_threads : std::max(1, o.fft.threads);
-        capacitance = std::make_unique<CapacitanceStokes>(g, f.mu, thr, o.fft);
+        capacitance = std::make_unique<CapacitanceStokes>(g, f.mu, cyl, thr, o.fft);
       }
       if (use_direct) {
         int thr = o.direct_threads;
@@ -439,7 +446,15 @@ struct StokesSolver::Impl {
   StokesStats capacitance_step(VectorField& u, const VectorField& f, double dt) {
     const double alpha = fluid.rho / dt;
     lam_stale = false;
-    capacitance->step(u, f, p, alpha);  // b = alpha u^n + f formed inside; wall faces come out exactly 0
+    if (con) {
+      // cylinder: keep b for the lazily recovered multiplier, as the Direct path does
+      rhs_into(wb, u, f, alpha);
+      capacitance->solve(wb, u, p, alpha);  // wall and masked faces come out exactly 0
+      last_b = wb;
+      last_alpha = alpha;
+    } else {
+      capacitance->step(u, f, p, alpha);  // b = alpha u^n + f formed inside; wall faces come out exactly 0
+    }
     StokesStats st;
     st.direct = true;
     if (capacitance->last_solve_factorized()) st.factorization_seconds = capacitance->last_factorization_seconds();
@@ -449,6 +464,14 @@ struct StokesSolver::Impl {
     }
     divergence(grid, u, div);
     st.max_divergence = div.max_abs();
+    if (con) {
+      if (opt.direct_final_projection) {
+        con->gather(u, rl);
+        for (double x : rl) st.max_constraint = std::max(st.max_constraint, std::abs(x));
+      }
+      last_u = u;
+      lam_stale = true;
+    }
     return st;
   }
 
@@ -530,7 +553,7 @@ std::size_t StokesSolver::direct_factor_bytes() const {
 }
 const VelocityConstraints* StokesSolver::constraints() const { return impl_->con.get(); }
 const std::vector<double>& StokesSolver::multiplier() const {
-  if (impl_->direct && impl_->con) impl_->refresh_multiplier();
+  if ((impl_->direct || impl_->capacitance) && impl_->con) impl_->refresh_multiplier();
   return impl_->lam;
 }
 const MacGrid& StokesSolver::grid() const { return impl_->grid; }

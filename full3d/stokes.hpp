@@ -40,7 +40,7 @@
 //     K^T A^{-1} K y = K^T A^{-1} b,  preconditioner blockdiag(Cahouet-Chabard, E A E^T).
 //
 // Capacitance path (StokesOptions::method Capacitance, the Auto choice for the plain
-//   duct; capacitance_stokes.hpp): exact. The same system with FREE-SLIP walls (tangential
+//   duct and the staircase cylinder; capacitance_stokes.hpp): exact. The same system with FREE-SLIP walls (tangential
 //   ghost +u) is diagonal per wavevector in the bases R2HC (x) x {REDFT10, RODFT00} (y, z),
 //   so it is solved like the box. No-slip differs by a diagonal term on the m = 4(ny+nz)-8
 //   wall-adjacent tangential nodes, A_ns = A_fs + U Dg U^T, Dg = 2 mu W/h^2; per axial mode
@@ -48,9 +48,15 @@
 //   (Cholesky, once per dt, two dt cached) gives the no-slip solution from one free-slip
 //   solve and O(n^2) partial transforms on the wall lines: about one bare solve; the
 //   transforms and per-mode solves are split over direct_threads (parallel.hpp).
+//   Staircase cylinder (when every wall-adjacent tangential face is masked, i.e. the cylinder
+//   is at least half a cell inside the duct walls): the constrained free-slip system, the
+//   constraint E u = 0 imposed through the "ring" of masked faces next to the fluid, with the
+//   positive semidefinite capacitance E_R S_fs^{-1} E_R^T made definite by adding s N N^T on
+//   its known null space (outside pressure constants); exact, about 1.5 bare solves. The
+//   multiplier is recovered on demand as on the Direct path.
 //
-// Direct path (StokesOptions::method Direct, the Auto choice for the staircase cylinder;
-//   direct_stokes.hpp): duct and staircase cylinder solved exactly per axial Fourier mode
+// Direct path (StokesOptions::method Direct, the Auto choice for a staircase cylinder the
+//   capacitance path does not support; direct_stokes.hpp): duct and staircase cylinder solved exactly per axial Fourier mode
 //   by sparse LU factors computed once per dt (masked faces eliminated: E u = 0 holds
 //   exactly). The PCG above stays selectable with method = Iterative (and is used for the
 //   GhostLinear / SurfacePoints walls).
@@ -81,12 +87,16 @@ struct FluidParams {
 
 /// Solver of the duct / cylinder step (the periodic box is always the exact Fourier projection).
 ///   Capacitance: free-slip spectral solve plus the per-axial-mode Woodbury correction to no-slip
-///              (capacitance_stokes.hpp), exact, about one bare FFT solve; plain duct only.
+///              (capacitance_stokes.hpp), exact, about one bare FFT solve (1.5 for the cylinder);
+///              plain duct, and the Staircase cylinder when CapacitanceStokes::supports_cylinder
+///              (the cylinder at least half a cell inside the duct walls, as in the scenes).
 ///   Direct:    per-axial-mode sparse LU (direct_stokes.hpp), factorised once per dt; plain duct
 ///              and the Staircase cylinder wall only.
 ///   Iterative: the multiplier PCG below (every wall kind).
-///   Auto:      plain duct: Capacitance; Staircase cylinder: Direct; each only when its estimated
-///              factor memory for two dt values is below direct_memory_limit_gib, else Iterative.
+///   Auto:      plain duct and supported Staircase cylinder: Capacitance; other Staircase cylinders:
+///              Direct; each only when its estimated factor memory for two dt values is below
+///              direct_memory_limit_gib (a cylinder over the limit for Capacitance tries Direct),
+///              else Iterative.
 enum class StokesMethod { Auto, Direct, Iterative, Capacitance };
 
 struct StokesOptions {
@@ -141,8 +151,8 @@ class StokesSolver {
   StokesStats bare_fft_solve(VectorField& u, const VectorField& f, double dt);
 
   /// Pressure of the last step, Pa. Iterative: zero mean, arbitrary in fully masked
-  /// cylinder cells. Direct: zero mean over the cells with a free face, 0 in the others.
-  /// Capacitance: zero mean.
+  /// cylinder cells. Direct, and Capacitance with the cylinder: zero mean over the cells with a
+  /// free face, 0 in the others. Capacitance, plain duct: zero mean.
   const ScalarField& pressure() const;
   /// Replaces the pressure (checkpoint restore; the iterative path's warm start).
   /// Throws swim::InputError if p does not have one value per cell.
@@ -156,7 +166,7 @@ class StokesSolver {
   /// Cholesky factors (up to two dt values each), bytes; 0 otherwise.
   std::size_t direct_factor_bytes() const;
   /// Cylinder: the constraint rows and the multiplier of the last step (N/m^3 per row).
-  /// Direct: the multiplier is recovered on demand, lambda = E (b - A u - G p).
+  /// Direct and Capacitance: the multiplier is recovered on demand, lambda = E (b - A u - G p).
   const VelocityConstraints* constraints() const;
   const std::vector<double>& multiplier() const;
   const MacGrid& grid() const;
