@@ -20,6 +20,26 @@ namespace swim::full3d {
 
 using scene::json;
 
+IbOptions ib_options(const Params3d& p) {
+  IbOptions o;
+  o.scheme = p.scheme;
+  o.max_cfl = p.max_cfl;
+  o.dt_key = "full3d.dt";
+  o.threads = p.threads;
+  o.stokes.fft.threads = p.threads;
+  o.stokes.direct_threads = p.threads;
+  if (p.container == "cylinder") {
+    o.stokes.cylinder.enabled = true;
+    o.stokes.cylinder.radius = p.container_radius;
+    o.stokes.cylinder.wall = p.cylinder_wall == "ghost_linear"     ? CylinderWall::GhostLinear
+                             : p.cylinder_wall == "surface_points" ? CylinderWall::SurfacePoints
+                                                                   : CylinderWall::Staircase;
+  }
+  o.stokes.advection.enabled = p.navier_stokes;
+  if (p.threads > 1) fftw_threads_init_once();
+  return o;
+}
+
 namespace {
 
 std::string num(double v) {
@@ -68,22 +88,7 @@ class Runner {
     fluid_on_ = p.fluid_fields && !p.dry && !ctl.quiet_vtk;
     if (!p.dry) {
       grid_.emplace(p.nx, p.ny, p.nz, p.h, p.container_kind());
-      IbOptions o;
-      o.scheme = p.scheme;
-      o.max_cfl = p.max_cfl;
-      o.dt_key = "full3d.dt";
-      o.threads = p.threads;
-      o.stokes.fft.threads = p.threads;
-      o.stokes.direct_threads = p.threads;
-      if (p.container == "cylinder") {
-        o.stokes.cylinder.enabled = true;
-        o.stokes.cylinder.radius = p.container_radius;
-        o.stokes.cylinder.wall = p.cylinder_wall == "ghost_linear"     ? CylinderWall::GhostLinear
-                                 : p.cylinder_wall == "surface_points" ? CylinderWall::SurfacePoints
-                                                                       : CylinderWall::Staircase;
-      }
-      o.stokes.advection.enabled = p.navier_stokes;
-      if (p.threads > 1) fftw_threads_init_once();
+      const IbOptions o = ib_options(p);
       const Eigen::VectorXd m = p.wall_inertia ? mass_ : Eigen::VectorXd::Zero(mesh_.nodes());
       ib_ = std::make_unique<IbSolver>(*grid_, p.fluid, mesh_, p.membrane, m, o);
       ib_->set_external_force([this](double, const Eigen::Matrix3Xd& X) { return protocol_.force(X); });
