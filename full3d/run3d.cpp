@@ -482,14 +482,16 @@ class Runner {
     s["mean_velocity_m_per_s"] = vmean;
     s["body_lengths_per_s"] = vmean / p_.L;
     s["final_velocity_m_per_s"] = last[2];
-    double vmax = -1e300, rmin = 1e300, emax = 0;
+    double vmax = -1e300, rmin = 1e300, emax = 0, xmax = 0;
     for (const auto& row : series_) {
       vmax = std::max(vmax, row[2]);
+      xmax = std::max(xmax, row[1]);
       rmin = std::min(rmin, row[4]);
       emax = std::max(emax, row[20]);
     }
     s["max_edge_over_h"] = emax / p_.h;  // at the output steps; the no-leak guard needs < 0.5
     s["max_velocity_m_per_s"] = vmax;
+    s["max_displacement_m"] = xmax;  // largest centre displacement at the output steps
     s["pumped_volume_m3"] = -vol_rear_;
     s["min_radius_m"] = rmin;
     s["protocol_switches"] = st.switches;

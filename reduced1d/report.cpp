@@ -22,6 +22,7 @@ Metrics metrics(const Params& p, const Result& r) {
   m.min_radius_m = last.R_min;
   for (const auto& s : r.series) {
     m.max_velocity_m_per_s = std::max(m.max_velocity_m_per_s, s.W);
+    m.max_displacement_m = std::max(m.max_displacement_m, s.X);
     m.min_radius_m = std::min(m.min_radius_m, s.R_min);
   }
   m.cycles_completed = static_cast<int>(r.cycle_end.size());
@@ -44,6 +45,7 @@ json write_run(const std::string& dir, const Params& p, const json& resolved, co
   summary["status"] = r.failure ? "failed: " + std::string(r.failure->what()) : "ok";
   summary["t_end_s"] = m.t_end_s;
   summary["displacement_m"] = m.displacement_m;
+  summary["max_displacement_m"] = m.max_displacement_m;
   summary["cycles_completed"] = m.cycles_completed;
   summary["cycle_times_s"] = m.cycle_times_s;
   summary["cycle_start_times_s"] = r.cycle_start;

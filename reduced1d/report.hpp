@@ -14,6 +14,7 @@ namespace swim::reduced1d {
 struct Metrics {
   double t_end_s = 0;
   double displacement_m = 0;
+  double max_displacement_m = 0;  ///< largest centre displacement over the output samples
   double mean_velocity_m_per_s = 0;
   double body_lengths_per_s = 0;
   double final_velocity_m_per_s = 0;

@@ -65,11 +65,12 @@ TEST(Executable, RunWritesTheContractOutputs) {
             0);
   std::ifstream in(out / "summary.json");
   const json s = json::parse(in);
-  for (const char* k : {"tier", "scene", "displacement_m", "cycles_completed", "cycle_times_s", "mean_velocity_m_per_s",
+  for (const char* k : {"tier", "scene", "displacement_m", "max_displacement_m", "cycles_completed", "cycle_times_s", "mean_velocity_m_per_s",
                         "body_lengths_per_s", "pumped_volume_m3", "wall_time_s", "status"})
     EXPECT_TRUE(s.contains(k)) << k;
   EXPECT_EQ(s["status"], "ok");
   EXPECT_EQ(s["scene"]["numerics1d"]["cells"], 60);
+  EXPECT_GE(s["max_displacement_m"].get<double>(), s["displacement_m"].get<double>());
   EXPECT_TRUE(swim::output::all_finite(s));
   std::ifstream csv(out / "series.csv");
   std::string header;

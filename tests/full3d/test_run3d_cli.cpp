@@ -35,10 +35,11 @@ TEST(SwimRun3d, WritesContractFiles) {
     EXPECT_TRUE(fs::exists(d + "/" + f)) << f;
   std::ifstream in(d + "/summary.json");
   const auto s = nlohmann::json::parse(in);
-  for (const char* k : {"tier", "scene", "displacement_m", "cycles_completed", "cycle_times_s", "mean_velocity_m_per_s",
+  for (const char* k : {"tier", "scene", "displacement_m", "max_displacement_m", "cycles_completed", "cycle_times_s", "mean_velocity_m_per_s",
                         "body_lengths_per_s", "pumped_volume_m3", "wall_time_s", "status"})
     EXPECT_TRUE(s.contains(k)) << k;
   EXPECT_EQ(s["tier"], "3d");
+  EXPECT_GE(s["max_displacement_m"].get<double>(), s["displacement_m"].get<double>());
   EXPECT_EQ(s["status"], "ok");
   EXPECT_EQ(s["scene"]["full3d"]["container"]["kind"], "duct");
   std::ifstream csv(d + "/series.csv");
