@@ -424,22 +424,33 @@ struct StokesSolver::Impl {
     StokesStats st;
     st.direct = true;
     if (direct->last_solve_factorized()) st.factorization_seconds = direct->last_factorization_seconds();
-    if (opt.direct_final_projection) project(u);
     zero_wall_faces(grid, u);
+    if (con) {
+      last_b = wb;
+      last_alpha = alpha;
+    }
+    finish_exact_step(u, st);
+    return st;
+  }
+
+  // Shared tail of the exact paths (Direct, Capacitance): the optional final projection, the
+  // divergence statistic and, for the cylinder, the state of the lazily recovered multiplier.
+  // Masked faces are eliminated unknowns, exactly zero unless the projection moved them.
+  void finish_exact_step(VectorField& u, StokesStats& st) {
+    if (opt.direct_final_projection) {
+      project(u);
+      zero_wall_faces(grid, u);
+    }
     divergence(grid, u, div);
     st.max_divergence = div.max_abs();
     if (con) {
-      // masked faces are eliminated unknowns, exactly zero unless the projection moved them
       if (opt.direct_final_projection) {
         con->gather(u, rl);
         for (double x : rl) st.max_constraint = std::max(st.max_constraint, std::abs(x));
       }
-      last_b = wb;
       last_u = u;
-      last_alpha = alpha;
       lam_stale = true;
     }
-    return st;
   }
 
   // Capacitance (Woodbury) solve of the plain duct (capacitance_stokes.hpp): exact, no iteration.
@@ -458,20 +469,7 @@ struct StokesSolver::Impl {
     StokesStats st;
     st.direct = true;
     if (capacitance->last_solve_factorized()) st.factorization_seconds = capacitance->last_factorization_seconds();
-    if (opt.direct_final_projection) {
-      project(u);
-      zero_wall_faces(grid, u);
-    }
-    divergence(grid, u, div);
-    st.max_divergence = div.max_abs();
-    if (con) {
-      if (opt.direct_final_projection) {
-        con->gather(u, rl);
-        for (double x : rl) st.max_constraint = std::max(st.max_constraint, std::abs(x));
-      }
-      last_u = u;
-      lam_stale = true;
-    }
+    finish_exact_step(u, st);
     return st;
   }
 

@@ -22,8 +22,10 @@
 #include "full3d/capacitance_stokes.hpp"
 #include "full3d/operators.hpp"
 #include "full3d/stokes.hpp"
+#include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
+using namespace swim::full3d::testing;
 
 namespace {
 
@@ -247,38 +249,34 @@ double manufactured_error(int n) {
   StokesSolver solver(g, fl, options(StokesMethod::Capacitance));
   VectorField u(g), f(g), ue(g);
   const double e = 1e-3;
-  for (int c = 0; c < 3; ++c) {
-    const auto d = g.dims(c);
-    for (int k = 0; k < d[2]; ++k)
-      for (int j = 0; j < d[1]; ++j)
-        for (int i = 0; i < d[0]; ++i) {
-          const auto x = g.position(c, i, j, k);
-          const std::size_t id = MacGrid::index(d, i, j, k);
-          ue.c[c][id] = Exact::comp(c, x);
-          double lap = 0, dpc = 0;
-          for (int dir = 0; dir < 3; ++dir) {
-            auto at = [&](double s) {
-              auto y = x;
-              y[dir] += s;
-              return y;
-            };
-            const double f0 = Exact::comp(c, x);
-            lap += (-Exact::comp(c, at(2 * e)) + 16 * Exact::comp(c, at(e)) - 30 * f0 + 16 * Exact::comp(c, at(-e)) -
-                    Exact::comp(c, at(-2 * e))) /
-                   (12 * e * e);
-          }
-          {
-            auto at = [&](double s) {
-              auto y = x;
-              y[c] += s;
-              return Exact::p(y[0], y[1], y[2]);
-            };
-            dpc = (-at(2 * e) + 8 * at(e) - 8 * at(-e) + at(-2 * e)) / (12 * e);
-          }
-          u.c[c][id] = 0.3 * ue.c[c][id];
-          f.c[c][id] = alpha * 0.7 * ue.c[c][id] - fl.mu * lap + dpc;
-        }
-  }
+  for_each_face(g, [&](const Face& q) {
+    const int c = q.c;
+    const std::size_t id = q.id;
+    const auto& x = q.x;
+    ue.c[c][id] = Exact::comp(c, x);
+    double lap = 0, dpc = 0;
+    for (int dir = 0; dir < 3; ++dir) {
+      auto at = [&](double s) {
+        auto y = x;
+        y[dir] += s;
+        return y;
+      };
+      const double f0 = Exact::comp(c, x);
+      lap += (-Exact::comp(c, at(2 * e)) + 16 * Exact::comp(c, at(e)) - 30 * f0 + 16 * Exact::comp(c, at(-e)) -
+              Exact::comp(c, at(-2 * e))) /
+             (12 * e * e);
+    }
+    {
+      auto at = [&](double s) {
+        auto y = x;
+        y[c] += s;
+        return Exact::p(y[0], y[1], y[2]);
+      };
+      dpc = (-at(2 * e) + 8 * at(e) - 8 * at(-e) + at(-2 * e)) / (12 * e);
+    }
+    u.c[c][id] = 0.3 * ue.c[c][id];
+    f.c[c][id] = alpha * 0.7 * ue.c[c][id] - fl.mu * lap + dpc;
+  });
   zero_wall_faces(g, f);
   zero_wall_faces(g, u);
   zero_wall_faces(g, ue);
