@@ -124,7 +124,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
       scene::json sc = scene::load_file(data_dir() + "/scenes/demo.json");
       scene::apply_override(sc, "full3d.grid.cells_across=" + std::to_string(across));
       scene::apply_override(sc, "full3d.threads=" + std::to_string(thr));
-      scene::apply_override(sc, "full3d.container.kind=\"" + container + "\"");
+      scene::apply_override(sc, "container.kind=\"" + container + "\"");
       scene::json resolved;
       const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
       const full3d::CylinderMesh mesh = full3d::make_mesh(p);

@@ -39,9 +39,26 @@ Body read_body(Reader& top) {
     Reader f = top.child("fluid");
     b.mu = f.quantity("viscosity", "Pa*s", "1.2e-3 Pa*s", Range::positive());
     b.rho = f.quantity("density", "kg/m^3", "1000 kg/m^3", Range::positive());
+    b.temperature = f.quantity("temperature", "K", "310 K", Range::open(0.0, 1e4));
     f.finish();
   }
   return b;
+}
+
+ContainerSpec read_container(Reader& top, double R0, double L) {
+  ContainerSpec c;
+  Reader r = top.child("container");
+  c.kind = r.choice("kind", "duct", {"duct", "cylinder", "box"});
+  c.radius = r.quantity("radius", "m", "0.25 um", Range::positive());
+  c.period = r.quantity("period", "m", "2 um", Range::positive());
+  r.finish();
+  if (!(c.radius > R0))
+    throw InputError(r.path("radius"), format_quantity(c.radius, "m"),
+                     "must exceed swimmer.radius = " + format_quantity(R0, "m") + " (the swimmer must fit)");
+  if (!(c.period > L))
+    throw InputError(r.path("period"), format_quantity(c.period, "m"),
+                     "must exceed swimmer.length = " + format_quantity(L, "m") + " (one swimmer per period)");
+  return c;
 }
 
 WallSpec read_wall(Reader& top, double R0) {

@@ -20,9 +20,19 @@ std::string format_quantity(double v, const char* unit);
 struct Body {
   double R0 = 0, L = 0;     ///< swimmer.radius, swimmer.length [m]
   double mu = 0, rho = 0;   ///< fluid.viscosity [Pa s], fluid.density [kg/m^3]
+  double temperature = 0;   ///< fluid.temperature [K]
 };
 /// Reads (and finishes) the swimmer and fluid sections.
 Body read_body(Reader& top);
+
+/// The rigid periodic container both tiers run in (scene section `container`).
+struct ContainerSpec {
+  std::string kind;       ///< "duct" (square, default), "cylinder" (the paper's) or "box" (periodic, 3D only)
+  double radius = 0;      ///< cylinder radius or duct half-width [m]
+  double period = 0;      ///< axial period [m]
+};
+/// Reads (and finishes) the container section; the swimmer must fit (R0 < radius, L < period).
+ContainerSpec read_container(Reader& top, double R0, double L);
 
 struct WallSpec {
   std::string stiffness;    ///< "C1", "spring_constant" or "calibration"

@@ -57,6 +57,12 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   p.fluid.rho = body.rho;
   const double R0 = p.R0, L = p.L;
   {
+    const scene::ContainerSpec c = scene::read_container(top, R0, L);
+    p.container = c.kind;
+    p.container_radius = c.radius;
+    p.period = c.period;
+  }
+  {
     const scene::WallSpec w = scene::read_wall(top, R0);
     if (w.stiffness != "spring_constant")
       throw InputError("wall." + w.stiffness, scene::show(scene.at("wall").at(w.stiffness)),
@@ -108,29 +114,21 @@ Params3d read_scene3d(const json& scene, json& resolved) {
 
   {
     Reader f = top.child("full3d");
-    double width = 0;
-    {
-      Reader c = f.child("container");
-      p.container = c.choice("kind", "duct", {"box", "duct", "cylinder"});
-      if (p.container == "cylinder")
-        p.cylinder_wall = c.choice("wall", "staircase", {"staircase", "ghost_linear", "surface_points"});
-      p.container_radius = c.quantity("radius", "m", "0.25 um", Range::positive());
-      p.period = c.quantity("period", "m", "2 um", Range::positive());
-      c.finish();
-      width = 2.0 * p.container_radius;
-    }
+    const double width = 2.0 * p.container_radius;
+    if (p.container == "cylinder")
+      p.cylinder_wall = f.choice("cylinder_wall", "staircase", {"staircase", "ghost_linear", "surface_points"});
     {
       Reader g = f.child("grid");
       if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
         p.h = g.quantity("cell_size", "m", "", Range::positive());
         if (!multiple_of(width, p.h))
           throw InputError(g.path("cell_size"), fmt(p.h, "m"),
-                           "must divide the container width 2 * full3d.container.radius = " + fmt(width, "m"));
+                           "must divide the container width 2 * container.radius = " + fmt(width, "m"));
       } else {
         p.h = width / g.integer("cells_across", 32, 4, 4096);
       }
       if (!multiple_of(p.period, p.h))
-        throw InputError("full3d.container.period", fmt(p.period, "m"),
+        throw InputError("container.period", fmt(p.period, "m"),
                          "must be a multiple of the cell size " + fmt(p.h, "m"));
       // cylinder: the fictitious square domain is one cell wider than the cylinder on each side
       // (paper, Remark 1: collocation points between the cylinder and the duct walls)
@@ -182,11 +180,11 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   if (p.dry && !(p.mass_per_area > 0))
     throw InputError("wall.mass_per_area", "", "the dry swimmer needs a positive wall mass");
   if (!(R0 + 2.0 * p.h < p.container_radius))
-    throw InputError("full3d.container.radius", fmt(p.container_radius, "m"),
+    throw InputError("container.radius", fmt(p.container_radius, "m"),
                      "the swimmer must fit: swimmer.radius + 2 h (kernel support) = " + fmt(R0 + 2.0 * p.h, "m") +
                          " must be below the container radius (h = " + fmt(p.h, "m") + ")");
   if (!(L + 4.0 * p.h < p.nx * p.h))
-    throw InputError("full3d.container.period", fmt(p.period, "m"),
+    throw InputError("container.period", fmt(p.period, "m"),
                      "must exceed swimmer.length + 4 h = " + fmt(L + 4.0 * p.h, "m") +
                          " so that the swimmer's ends do not interact through the periodic boundary");
   if (p.nx * double(p.ny) * p.nz > 2.0e8)

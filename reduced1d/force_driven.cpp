@@ -11,7 +11,13 @@
 //   A_i' = 2 pi R_i V_i,   m V_i' = p_i - C1 (R_i - R0) - q_i,   A_i' + (Q_{i+1} - Q_i)/h = 0
 // (band Jacobian by central differences with the segment laws frozen, plus the same rank-1
 // segment terms, same solver).
-// Both carry the swimmer/flux integrals D, X, V_rear, V_front as extra differential states.
+// Both carry the swimmer/flux integrals D, X, V_rear, V_front (and the lab-frame end volumes)
+// as extra differential states.
+// Force-free model (default): p_i is the transmural pressure Pi_i = p_in - p_out. Confined:
+// the lumen fluxes come from the lumen/annulus/free-pipe system of outer_flow.hpp, which also
+// gives U and Q_tot (global couplings: two more rank-1 terms in the Newton matrix).
+// Unbounded: p_out = 0, the lumen fluxes are local as above and U is the slender-body
+// average of the induced axial flow (it does not feed back into the radii).
 // State scaling: A/(pi R0^2), V/(R0/T_s), p/(C1 R0), D/D_s, X/X_s, V/(pi R0^2 L).
 #include <cvode/cvode.h>
 #include <cvode/cvode_ls.h>
@@ -23,12 +29,14 @@
 #include <cstdint>
 #include <functional>
 #include <cmath>
+#include <complex>
 #include <memory>
 #include <sstream>
 #include <string>
 
 #include "reduced1d/discretisation.hpp"
 #include "reduced1d/internal.hpp"
+#include "reduced1d/outer_flow.hpp"
 #include "reduced1d/protocol.hpp"
 #include "reduced1d/sundials.hpp"
 
@@ -68,9 +76,11 @@ struct ForceModel {
   int N;
   double L, h, R0, C1, m, mu;
   bool inertia, flow_closure;
+  bool force_free, confined;  // force-free model; confined outer flow
+  double a_in, a_out;
   disc::BalanceCoefficients bal;
   int stride;          // unknowns per cell: 1 (a) or 3 (a, V, p)
-  int iD, iX, iVr, iVf, n;  // extras and total size
+  int iD, iX, iVr, iVf, iVrl, iVfl, n;  // extras and total size
   double T_s, D_s, X_s, V_s, Vel_s, P_s;
   // actuation laws (fixed between protocol events)
   std::vector<ProtocolMachine::CellLaw> law;
@@ -88,6 +98,13 @@ struct ForceModel {
   bool freeze_segments = false;  // reuse qs and the end radii (difference quotients)
   // workspace
   std::vector<double> R, V, p, r, Q;
+  std::vector<double> cond;  // dQ_j / d(-dPi_j): 1 / r_j, or 1 / (r_in + r_out) when confined
+  // force-free outer flow
+  std::unique_ptr<outer::ConfinedSystem> sys;
+  std::vector<double> Rpt, Pipt, zc, faces, sigma, rho, u_ind;
+  double U = 0;           // swimmer velocity at the last fluxes() [m/s]
+  bool geometry_ok = true;
+  double c_par = 0;       // unbounded: resistive-force coefficient per length
 
   explicit ForceModel(const Params& P)
       : N(P.numerics.cells),
@@ -99,6 +116,10 @@ struct ForceModel {
         mu(P.fluid.mu),
         inertia(P.wall.inertia),
         flow_closure(P.swimmer.closure == Closure::Flow),
+        force_free(P.swimmer.model == SwimmerModel::ForceFree),
+        confined(P.swimmer.model == SwimmerModel::ForceFree && P.swimmer.outer == OuterFlow::Confined),
+        a_in(P.swimmer.model == SwimmerModel::ForceFree ? P.swimmer.a_in : 0.0),
+        a_out(P.swimmer.model == SwimmerModel::ForceFree ? P.swimmer.a_out : 0.0),
         bal(disc::BalanceCoefficients::from(P)),
         stride(P.wall.inertia ? 3 : 1),
         Rb0_static(R0),
@@ -111,7 +132,8 @@ struct ForceModel {
         V(N, 0.0),
         p(N),
         r(N + 1),
-        Q(N + 1) {
+        Q(N + 1),
+        cond(N + 1, 0.0) {
     // Layout [V_rear, cell 0, ..., cell N-1, V_front, D, X]: V_rear/V_front sit next to the
     // end cells they depend on, so their couplings are inside the band of the Newton matrix
     // and BDF keeps the linear invariant h sum A_i - V_rear + V_front exactly.
@@ -119,11 +141,31 @@ struct ForceModel {
     iVf = 1 + stride * N;
     iD = iVf + 1;
     iX = iVf + 2;
-    n = iVf + 3;
+    iVrl = iVf + 3;
+    iVfl = iVf + 4;
+    n = iVf + 5;
+    if (force_free) {
+      std::vector<double> d(N + 1, h);
+      d[0] = d[N] = 0.5 * h;
+      Rpt.assign(N + 2, R0);
+      Pipt.assign(N + 2, 0.0);
+      if (confined) {
+        sys = std::make_unique<outer::ConfinedSystem>(N + 2, d, mu, a_in, a_out, P.container.radius_eff,
+                                                      P.container.period, L);
+      } else {
+        zc.resize(N);
+        faces.resize(N + 1);
+        for (int i = 0; i < N; ++i) zc[i] = (i + 0.5) * h;
+        for (int j = 0; j <= N; ++j) faces[j] = j * h;
+        sigma.assign(N, 0.0);
+        rho.assign(N, R0);
+        c_par = outer::slender_drag_per_length(L, R0, mu);
+      }
+    }
     T_s = 0.1 * relaxation_time(P);
     const double f_s = bal.per_length ? pi * C1 * R0 * R0 * R0 / L : C1 * R0 * R0 / (2.0 * L);
     D_s = f_s * T_s;
-    X_s = D_s * T_s / (bal.m_eff + bal.c_ext * T_s);
+    X_s = force_free ? R0 : D_s * T_s / (bal.m_eff + bal.c_ext * T_s);
     V_s = pi * R0 * R0 * L;
     Vel_s = R0 / T_s;
     P_s = C1 * R0;
@@ -204,16 +246,47 @@ struct ForceModel {
     return ok;
   }
 
-  /// Face resistances and fluxes (faces j = 0..N at z = j h; p = 0 at both ends).
+  /// Face resistances and fluxes (faces j = 0..N at z = j h; p = 0 at both ends), and the
+  /// swimmer velocity U of the force-free model.
   void fluxes() {
-    r[0] = disc::resistance(mu, 0.5 * h, Rb0, R[0]);
+    if (confined) {
+      Rpt[0] = Rb0;
+      Rpt[N + 1] = RbL;
+      for (int i = 0; i < N; ++i) Rpt[i + 1] = R[i], Pipt[i + 1] = p[i];
+      geometry_ok = sys->geometry(Rpt.data());
+      if (!geometry_ok) {
+        std::fill(Q.begin(), Q.end(), std::nan(""));
+        U = std::nan("");
+        return;
+      }
+      sys->transmural(Pipt.data());
+      for (int j = 0; j <= N; ++j) {
+        Q[j] = sys->Q_in[j];
+        r[j] = sys->k[j].rl;
+        cond[j] = 1.0 / (sys->k[j].rl + sys->k[j].ra);
+      }
+      U = sys->U;
+      return;
+    }
+    r[0] = disc::resistance(mu, 0.5 * h, Rb0 - a_in, R[0] - a_in);
     Q[0] = -p[0] / r[0];
     for (int j = 1; j < N; ++j) {
-      r[j] = disc::resistance(mu, h, R[j - 1], R[j]);
+      r[j] = disc::resistance(mu, h, R[j - 1] - a_in, R[j] - a_in);
       Q[j] = -(p[j] - p[j - 1]) / r[j];
     }
-    r[N] = disc::resistance(mu, 0.5 * h, R[N - 1], RbL);
+    r[N] = disc::resistance(mu, 0.5 * h, R[N - 1] - a_in, RbL - a_in);
     Q[N] = p[N - 1] / r[N];
+    for (int j = 0; j <= N; ++j) cond[j] = 1.0 / r[j];
+    if (force_free) {  // unbounded: slender-body average of the induced axial flow
+      for (int i = 0; i < N; ++i) {
+        sigma[i] = (Q[i] - Q[i + 1]) / h;  // d(pi R^2)/dt per unit length
+        rho[i] = R[i] + a_out;
+      }
+      outer::induced_axial_velocity(zc, faces, sigma, -Q[0], Q[N], rho, u_ind);
+      double s = 0;
+      for (int i = 0; i < N; ++i) s += u_ind[i];
+      U = s / N;
+    }
   }
 
   /// d r / d a and d r / d b for the resistance r(d, a, b) of disc::resistance.
@@ -249,16 +322,45 @@ struct ForceModel {
     return e;
   }
 
-  /// Extras' derivatives (scaled) from the current R, p, Q.
-  void extras(const double* y, double* dD, double* dX, double* dVr, double* dVf, double* W_out = nullptr) const {
-    const auto I = integrals();
-    const double f = bal.drag_integrand(I);
-    const double W = bal.velocity(bal.thrust_term(I), y[iD] * D_s, y[iX] * X_s);
-    *dD = f / D_s;
-    *dX = W / X_s;
-    *dVr = Q[0] / V_s;
-    *dVf = Q[N] / V_s;
+  /// Extras' derivatives (scaled) from the current R, p, Q: dd = (D, X, V_rear, V_front,
+  /// V_rear_lab, V_front_lab).
+  void extras(const double* y, double* dd, double* W_out = nullptr) const {
+    double W = U;
+    if (force_free) {
+      dd[0] = 0.0;
+    } else {
+      const auto I = integrals();
+      W = bal.velocity(bal.thrust_term(I), y[iD] * D_s, y[iX] * X_s);
+      dd[0] = bal.drag_integrand(I) / D_s;
+    }
+    dd[1] = W / X_s;
+    dd[2] = Q[0] / V_s;
+    dd[3] = Q[N] / V_s;
+    // lab frame: the lumen fluid crossing the moving end sections, Q + W pi R_end^2
+    dd[4] = (Q[0] + W * pi * Rb0 * Rb0) / V_s;
+    dd[5] = (Q[N] + W * pi * RbL * RbL) / V_s;
     if (W_out) *W_out = W;
+  }
+
+  /// End pressures, total flux and force split at the last fluxes() (force-free model).
+  void end_state(Sample& s) {
+    if (!force_free) return;
+    if (confined) {
+      sys->lumen_pressure(pl_);
+      s.p_rear = pl_[0];
+      s.p_front = pl_[N + 1];
+      s.Q_total = sys->Q_tot;
+    }
+    // control volume on the lumen: pi [R(0)^2 p(0) - R(L)^2 p(L)]; the outer flow balances it
+    s.F_lumen = pi * (Rb0 * Rb0 * s.p_rear - RbL * RbL * s.p_front);
+    s.F_outer = -s.F_lumen;
+  }
+  std::vector<double> pl_;
+
+  void extras_into(const double* y, double* yd) const {
+    double d[6];
+    extras(y, d);
+    yd[iD] = d[0], yd[iX] = d[1], yd[iVr] = d[2], yd[iVf] = d[3], yd[iVrl] = d[4], yd[iVfl] = d[5];
   }
 
   // Right-hand side without inertia (CVODE).
@@ -266,39 +368,75 @@ struct ForceModel {
     if (!unpack(y)) return 1;  // recoverable: the integrator retries with a smaller step
     fluxes();
     const double c = 1.0 / (h * pi * R0 * R0);
+    if (!geometry_ok) return 1;
     for (int i = 0; i < N; ++i) yd[1 + i] = (Q[i] - Q[i + 1]) * c;
-    extras(y, yd + iD, yd + iX, yd + iVr, yd + iVf);
+    extras_into(y, yd);
     for (int k = 0; k < n; ++k)
       if (!std::isfinite(yd[k])) return 1;
     return 0;
   }
 
   /// Flux sensitivities at the current unpack/fluxes: dQ_j/dR_{j-1} (QL[j]) and dQ_j/dR_j (QR[j]),
-  /// through the pressures' own-law dependence and the resistances; QP*: dQ_j/dp_{j-1}, dQ_j/dp_j;
-  /// Qb0 = dQ_0/dRb0, QbL = dQ_N/dRbL.
+  /// through the pressures' own-law dependence (with_pressure) and the geometry (resistances;
+  /// confined: lumen and annulus coefficients at fixed U and Q_tot); Qb0 = dQ_0/dRb0,
+  /// QbL = dQ_N/dRbL. Confined: also the geometric and pressure partials of the two closure
+  /// residuals g1 (periodicity) and g2 (force) per interval (ga, gb, gpi).
   struct FluxSens {
     std::vector<double> QL, QR;
     double Qb0 = 0, QbL = 0;
+    std::vector<double> g1a, g1b, g1pi, g2a, g2b, g2pi;  // confined only
   };
   FluxSens sens_;           // Jacobian workspace (no allocation after the first call)
   std::vector<double> dQ_;
   void flux_sensitivities(FluxSens& s, bool with_pressure) const {
     s.QL.assign(N + 1, 0.0);
     s.QR.assign(N + 1, 0.0);
-    double ra, rb;
-    // face 0: Q_0 = -p_0 / r_0, r_0 = r(h/2, Rb0, R_0)
-    dresistance(0.5 * h, Rb0, R[0], ra, rb);
-    s.QR[0] = (with_pressure ? -(C1 + dq[0]) / r[0] : 0.0) - Q[0] / r[0] * rb;
-    s.Qb0 = -Q[0] / r[0] * ra;
-    for (int j = 1; j < N; ++j) {
-      dresistance(h, R[j - 1], R[j], ra, rb);
-      s.QL[j] = (with_pressure ? (C1 + dq[j - 1]) / r[j] : 0.0) - Q[j] / r[j] * ra;
-      s.QR[j] = (with_pressure ? -(C1 + dq[j]) / r[j] : 0.0) - Q[j] / r[j] * rb;
+    // point radii and dPi/dR at the points (ends: Pi = 0 fixed)
+    auto Rp = [&](int k) { return k == 0 ? Rb0 : (k == N + 1 ? RbL : R[k - 1]); };
+    auto dPi = [&](int k) { return (k == 0 || k == N + 1 || !with_pressure) ? 0.0 : C1 + dq[k - 1]; };
+    if (confined) {
+      s.g1a.assign(N + 1, 0.0), s.g1b.assign(N + 1, 0.0), s.g1pi.assign(N + 1, 0.0);
+      s.g2a.assign(N + 1, 0.0), s.g2b.assign(N + 1, 0.0), s.g2pi.assign(N + 1, 0.0);
+      using C = std::complex<double>;
+      const double Qt = sys->Q_tot, Uv = sys->U, hcs = 1e-20 * R0;
+      for (int j = 0; j <= N; ++j) {
+        const double a = Rp(j), b = Rp(j + 1), d = (j == 0 || j == N) ? 0.5 * h : h;
+        const double dpi = sys->dPi[j];
+        // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
+        auto eval = [&](C aa, C bb, C& Qc, C& t1, C& t2) {
+          const auto k = outer::interval_coef<C>(aa, bb, d, mu, a_in, a_out, sys->Rc);
+          Qc = (k.ra * Qt + k.c * Uv - dpi) / (k.rl + k.ra);
+          t1 = k.rl * Qc;
+          t2 = -k.S * k.rl * Qc - k.S * dpi + k.e * Uv;
+        };
+        C Qc, t1, t2;
+        eval(C(a, hcs), C(b, 0.0), Qc, t1, t2);
+        const double Qa = Qc.imag() / hcs;
+        s.g1a[j] = t1.imag() / hcs, s.g2a[j] = t2.imag() / hcs;
+        eval(C(a, 0.0), C(b, hcs), Qc, t1, t2);
+        const double Qb = Qc.imag() / hcs;
+        s.g1b[j] = t1.imag() / hcs, s.g2b[j] = t2.imag() / hcs;
+        const auto& k = sys->k[j];
+        const double w = 1.0 / (k.rl + k.ra);
+        s.g1pi[j] = -k.rl * w;        // d t1 / d dPi
+        s.g2pi[j] = -k.S * k.ra * w;  // d t2 / d dPi
+        // dQ/d Pi_j = +w, dQ/d Pi_{j+1} = -w
+        s.QL[j] = Qa + w * dPi(j);
+        s.QR[j] = Qb - w * dPi(j + 1);
+      }
+      s.Qb0 = s.QL[0];
+      s.QbL = s.QR[N];
+      return;
     }
-    // face N: Q_N = p_{N-1} / r_N, r_N = r(h/2, R_{N-1}, RbL)
-    dresistance(0.5 * h, R[N - 1], RbL, ra, rb);
-    s.QL[N] = (with_pressure ? (C1 + dq[N - 1]) / r[N] : 0.0) - Q[N] / r[N] * ra;
-    s.QbL = -Q[N] / r[N] * rb;
+    for (int j = 0; j <= N; ++j) {
+      const double a = Rp(j), b = Rp(j + 1), d = (j == 0 || j == N) ? 0.5 * h : h;
+      double ra, rb;
+      dresistance(d, a - a_in, b - a_in, ra, rb);
+      s.QL[j] = dPi(j) / r[j] - Q[j] / r[j] * ra;
+      s.QR[j] = -dPi(j + 1) / r[j] - Q[j] / r[j] * rb;
+    }
+    s.Qb0 = s.QL[0];
+    s.QbL = s.QR[N];
   }
 
   /// Exact Jacobian of rhs() at y (after rhs-equivalent unpack/fluxes): the band part into
@@ -321,9 +459,37 @@ struct ForceModel {
     }
     band(iVr, 1, s.QR[0] * 0.5 * R0 * R0 / R[0] / V_s);
     band(iVf, iVf - 1, s.QL[N] * 0.5 * R0 * R0 / R[N - 1] / V_s);
-    // W = (thrust - D - c_ext X) / m_eff
-    band(iX, iD, -D_s / (bal.m_eff * X_s));
-    band(iX, iX, -bal.c_ext / bal.m_eff);
+    if (!force_free) {  // W = (thrust - D - c_ext X) / m_eff
+      band(iX, iD, -D_s / (bal.m_eff * X_s));
+      band(iX, iX, -bal.c_ext / bal.m_eff);
+    }
+    // Confined: Q_in,j = alpha_j W + beta_j U - gamma_j with (W, U) solving g(y, W, U) = 0
+    // (periodicity, force; W = Q_tot + U pi Rc^2), so d(W, U)/dy = -G^{-1} dg/dy with G the
+    // 2 x 2 of outer::ConfinedSystem. fq, fu: df/dW, df/dU; dgpi: dg/dPi at the cell points.
+    double Gi[2][2] = {{0, 0}, {0, 0}};
+    if (confined) {
+      const auto& G = sys->M;
+      const double det = G[0][0] * G[1][1] - G[0][1] * G[1][0];
+      Gi[0][0] = G[1][1] / det, Gi[0][1] = -G[0][1] / det, Gi[1][0] = -G[1][0] / det, Gi[1][1] = G[0][0] / det;
+      fq_.assign(n, 0.0), fu_.assign(n, 0.0);
+      std::vector<double> al(N + 1), be(N + 1);
+      for (int j = 0; j <= N; ++j) {
+        const auto& k = sys->k[j];
+        al[j] = k.ra / (k.rl + k.ra);
+        be[j] = (k.c - sys->A_c * k.ra) / (k.rl + k.ra);
+      }
+      for (int i = 0; i < N; ++i) {
+        fq_[1 + i] = c * (al[i] - al[i + 1]);
+        fu_[1 + i] = c * (be[i] - be[i + 1]);
+      }
+      fq_[iVr] = al[0] / V_s, fu_[iVr] = be[0] / V_s;
+      fq_[iVf] = al[N] / V_s, fu_[iVf] = be[N] / V_s;
+      dg1pi_.assign(N, 0.0), dg2pi_.assign(N, 0.0);
+      for (int i = 0; i < N; ++i) {  // point i + 1: right end of interval i, left end of i + 1
+        dg1pi_[i] = s.g1pi[i] - s.g1pi[i + 1];
+        dg2pi_[i] = s.g2pi[i] - s.g2pi[i + 1];
+      }
+    }
     // rank-1 terms: d f / d qs_k (per unit segment actuation) times d qs_k / d a
     int rank = 0;
     U.clear();
@@ -342,9 +508,9 @@ struct ForceModel {
         return v;
       };
       for (int j = std::max(lo, 0); j <= std::min(hi + 1, N); ++j) {
-        if (j == 0) dQ[0] = -u(0) / r[0];
-        else if (j == N) dQ[N] = u(N - 1) / r[N];
-        else dQ[j] = -(u(j) - u(j - 1)) / r[j];
+        if (j == 0) dQ[0] = -u(0) * cond[0];
+        else if (j == N) dQ[N] = u(N - 1) * cond[N];
+        else dQ[j] = -(u(j) - u(j - 1)) * cond[j];
       }
       if (end0_seg && seg_a[0] == k) dQ[0] += s.Qb0 * (-1.0 / C1);
       if (endL_seg && seg_a[N - 1] == k) dQ[N] += s.QbL * (-1.0 / C1);
@@ -355,10 +521,49 @@ struct ForceModel {
       U[off + iVr] = dQ[0] / V_s;
       U[off + iVf] = dQ[N] / V_s;
       for (int i = lo; i <= hi; ++i) Vt[off + 1 + i] = dqs[k] * u(i) / seg_w[k] * 0.5 * R0 * R0 / R[i];
+      if (confined) {  // the segment load also moves W and U: d(W, U)/dqs_k = -G^{-1} dg/dqs_k
+        double g1 = 0, g2 = 0;
+        for (int i = lo; i <= hi; ++i) {
+          g1 += dg1pi_[i] * u(i);
+          g2 += dg2pi_[i] * u(i);
+        }
+        if (end0_seg && seg_a[0] == k) g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
+        if (endL_seg && seg_a[N - 1] == k) g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
+        seg_x_.push_back({-(Gi[0][0] * g1 + Gi[0][1] * g2), -(Gi[1][0] * g1 + Gi[1][1] * g2), off});
+      }
       ++rank;
+    }
+    if (confined) {
+      // Two rank-1 terms df/dW (dW/dy)^T + df/dU (dU/dy)^T; dW/dy and dU/dy are the direct
+      // dependence on every radius plus the segment chains d(W, U)/dqs_k times the segment rows.
+      const std::size_t off = U.size();
+      U.resize(off + 2 * std::size_t(n), 0.0);
+      Vt.resize(off + 2 * std::size_t(n), 0.0);
+      std::copy(fq_.begin(), fq_.end(), U.begin() + off);
+      std::copy(fu_.begin(), fu_.end(), U.begin() + off + n);
+      for (int i = 0; i < N; ++i) {
+        const double dRda = 0.5 * R0 * R0 / R[i];
+        const double g1 = (s.g1b[i] + s.g1a[i + 1] + dg1pi_[i] * (C1 + dq[i])) * dRda;
+        const double g2 = (s.g2b[i] + s.g2a[i + 1] + dg2pi_[i] * (C1 + dq[i])) * dRda;
+        Vt[off + 1 + i] = -(Gi[0][0] * g1 + Gi[0][1] * g2);
+        Vt[off + n + 1 + i] = -(Gi[1][0] * g1 + Gi[1][1] * g2);
+      }
+      for (const auto& sx : seg_x_)
+        for (int row = 0; row < n; ++row) {
+          Vt[off + row] += sx.xw * Vt[sx.off + row];
+          Vt[off + n + row] += sx.xu * Vt[sx.off + row];
+        }
+      seg_x_.clear();
+      rank += 2;
     }
     return rank;
   }
+  struct SegChain {
+    double xw, xu;
+    std::size_t off;
+  };
+  std::vector<SegChain> seg_x_;
+  std::vector<double> fq_, fu_, dg1pi_, dg2pi_;  // confined Jacobian workspace
 
   // Residual with inertia (IDA).
   int res(const double* y, const double* yp, double* F) {
@@ -374,12 +579,11 @@ struct ForceModel {
       F[k + 1] = yp[k + 1] - cv * (p[i] - C1 * (R[i] - R0) - q[i]);
       F[k + 2] = cp * ((Q[i + 1] - Q[i]) / h + A0 * yp[k]);
     }
-    double d[4];
-    extras(y, d, d + 1, d + 2, d + 3);
-    F[iD] = yp[iD] - d[0];
-    F[iX] = yp[iX] - d[1];
-    F[iVr] = yp[iVr] - d[2];
-    F[iVf] = yp[iVf] - d[3];
+    if (!geometry_ok) return 1;
+    double d[6];
+    extras(y, d);
+    const int idx[6] = {iD, iX, iVr, iVf, iVrl, iVfl};
+    for (int k = 0; k < 6; ++k) F[idx[k]] = yp[idx[k]] - d[k];
     for (int k = 0; k < n; ++k)
       if (!std::isfinite(F[k])) return 1;
     return 0;
@@ -831,9 +1035,13 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
   auto record = [&](double tt, const double* y) -> bool {
     const bool ok = M.unpack(y);
     M.fluxes();
-    double d[4], W = 0;
-    M.extras(y, d, d + 1, d + 2, d + 3, &W);
+    if (!M.geometry_ok) return false;
+    double d[6], W = 0;
+    M.extras(y, d, &W);
     Sample s;
+    M.end_state(s);
+    s.V_rear_lab = y[M.iVrl] * M.V_s;
+    s.V_front_lab = y[M.iVfl] * M.V_s;
     s.t = tt;
     s.X = y[M.iX] * M.X_s;
     s.W = W;
@@ -849,9 +1057,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     s.tube_volume = pi * vol * M.h;
     s.phase = machine.phase();
     if (!ok) return false;
-    for (double v : {s.X, s.W, s.energy, s.R_min, s.R_max, s.Q_rear, s.Q_front, s.V_rear,
-                     s.V_front, s.tube_volume})
-      if (!std::isfinite(v)) return false;
+    if (!finite(s)) return false;
     res.series.push_back(s);
     res.radius_times.push_back(tt);
     res.radius.insert(res.radius.end(), M.R.begin(), M.R.end());
@@ -1078,7 +1284,8 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
   JacobianCheck out;
   out.rank = rank;
   for (int i = 0; i < n; ++i) {
-    if (i == M.iD || i == M.iX) continue;  // D and X rows: radii couplings left out by design
+    // D, X and lab-volume rows: radii couplings left out by design (no feedback)
+    if (i == M.iD || i == M.iX || i == M.iVrl || i == M.iVfl) continue;
     double rowmax = 0;
     for (int j = 0; j < n; ++j) rowmax = std::max(rowmax, std::abs(Jfd[std::size_t(i) * n + j]));
     if (rowmax == 0) continue;

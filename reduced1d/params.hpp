@@ -4,13 +4,25 @@
 // conversion and validation; the solver never sees unit strings. Every field has its
 // default here, and the scene layer echoes every value it used.
 //
-// Model (docs/reduced1d.md has the derivation and the choices):
-//   tube wall   m R_tt + C1 (R - R0) = (p - p_ext) - q(z,t)          (30)/(36) with actuation q
+// Models (docs/reduced1d.md has the derivations, docs/outer-flow-1d.md the outer flows):
+//
+// Force-free Stokes swimmer (the default, SwimmerModel::ForceFree). In the swimmer frame
+// (zeta = z - X(t) in [0, L]):
+//   tube wall   m R_tt + C1 (R - R0) = p_in - p_out - q(z,t)       (tube law with actuation q)
+//   lumen       Q_in = -(pi (R - a_in)^4 / 8 mu) dp_in/dz,  d(pi R^2)/dt + dQ_in/dz = 0
+//   outer flow  confined : Poiseuille-Couette annulus (R + a_out .. Rc) in parallel with the
+//                          lumen, a free pipe of radius Rc over the rest of the period P - L,
+//                          periodic pressure, container wall at rest in the lab frame;
+//               unbounded: slender body, resistive-force drag on U plus the axial flow that
+//                          the wall's line of sources and the two end jets induce;
+//   swimmer     total axial force on the tube = 0 at every instant -> U(t); X' = U.
+//
+// The paper's 1D model (SwimmerModel::Paper, a labelled reproduction mode):
 //   fluid       Q = -(pi R^4 / 8 mu) dp/dz,  d(pi R^2)/dt + dQ/dz = 0, p(0) = p(L) = p_ext
 //   swimmer     per area  : m   W = (pi rho / 8 mu L) int R^4 p_z dz - (1 / 2L) int_0^t int R   p_z dz dtau
 //               per length: m_l W = (pi rho / 8 mu L) int R^4 p_z dz - (pi / L) int_0^t int R^2 p_z dz dtau
 //               with m_l = 2 pi R0 m, and p_z either C1 R_z (tube-law closure, eq. 50) or the
-//               lubrication pressure gradient of the flow closure (notes section 3).
+//               lubrication pressure gradient of the flow closure.
 #pragma once
 
 #include <string>
@@ -25,7 +37,22 @@ enum class WaveKind {
   ForceDriven,  ///< radius evolves under the actuation protocol of Section 3 mapped to 1D
 };
 
-/// Pressure gradient used in the swimmer-velocity relation (45)/(51).
+/// Which swimmer model defines the velocity.
+enum class SwimmerModel {
+  ForceFree,  ///< Stokes: zero total axial force at every instant (default)
+  Paper,      ///< the paper's balance (45)/(52), reproduction mode
+};
+
+/// Outer flow of the force-free model.
+enum class OuterFlow {
+  Confined,   ///< lubrication lumen + annulus + free pipe in the scene's container (default)
+  Unbounded,  ///< slender-body outer flow in unbounded fluid
+};
+
+/// Rigid container shared with the 3D tier (scene section `container`).
+enum class ContainerKind { Cylinder, Duct, Box };
+
+/// Pressure gradient used in the swimmer-velocity relation (45)/(51) (paper mode).
 enum class Closure {
   TubeLaw,  ///< paper: dp/dz = C1 dR/dz (eq. 50)
   Flow,     ///< notes section 3: dp/dz from lubrication flow with open ends
@@ -34,7 +61,7 @@ enum class Closure {
 /// Which force balance defines W (notes section 4).
 enum class Balance { PerArea, PerLength };
 
-/// External drag on the swimmer body (notes section 5). Not in the paper.
+/// External drag on the swimmer body in paper mode. Not in the paper.
 enum class ExternalDrag { None, ResistiveForce };
 
 struct Geometry {
@@ -43,8 +70,19 @@ struct Geometry {
 };
 
 struct Fluid {
-  double mu = 1.2e-3;  ///< dynamic viscosity [Pa s]
-  double rho = 1.0e3;  ///< density [kg/m^3]
+  double mu = 1.2e-3;         ///< dynamic viscosity [Pa s]
+  double rho = 1.0e3;         ///< density [kg/m^3]
+  double temperature = 310.0; ///< absolute temperature [K] (Brownian scale of the design)
+};
+
+/// The rigid periodic container. The 1D tier sees a circular pipe of radius `radius_eff`:
+/// the cylinder's own radius, or for the square duct of half-width `radius` the radius of
+/// the circular pipe with the same Poiseuille conductance (1.0939 x half-width).
+struct Container {
+  ContainerKind kind = ContainerKind::Duct;
+  double radius = 0.25e-6;      ///< cylinder radius or duct half-width [m]
+  double period = 2.0e-6;       ///< axial period [m]
+  double radius_eff = 0.25e-6;  ///< circular radius the 1D tier uses [m]
 };
 
 struct Wall {
@@ -83,6 +121,11 @@ struct Protocol {
 };
 
 struct Swimmer {
+  SwimmerModel model = SwimmerModel::ForceFree;
+  OuterFlow outer = OuterFlow::Confined;
+  double a_in = 0.0;   ///< hydraulic offset of the lumen: the lumen conducts as radius R - a_in [m]
+  double a_out = 0.0;  ///< hydraulic offset of the outside: the outer flow sees radius R + a_out [m]
+  /// Paper mode only:
   Closure closure = Closure::TubeLaw;
   Balance balance = Balance::PerArea;
   bool thrust = true;  ///< keep the displaced-momentum (thrust) term of (45)
@@ -107,6 +150,7 @@ struct Params {
   SineWave sine;
   Protocol protocol;
   Swimmer swimmer;
+  Container container;
   Numerics numerics;
   /// End time [s]. For prescribed waves the default is the wave transit time; for the
   /// force-driven wave, <= 0 means "run until protocol.cycles cycles have completed".

@@ -1,8 +1,11 @@
 // Prescribed Step/Sine waves: the radius is analytic, so the only ODE states are the
-// time integrals of the swimmer balance and of the end fluxes:
-//   D' = drag integrand,  X' = W = (thrust - D - c X) / m_eff,  V_rear' = Q_rear,  V_front' = Q_front.
-// The end fluxes always come from the open-ended lubrication flow driven by the prescribed
-// wall motion (mass conserving); the closure only selects which dp/dz enters W.
+// time integrals of the swimmer velocity and of the end fluxes.
+// Force-free model: X' = U from the outer flow (confined: the 4 x 4 kinematic closure of
+// outer::ConfinedSystem; unbounded: the slender-body average), V' = lumen end fluxes.
+// Paper mode: D' = drag integrand, X' = W = (thrust - D - c X) / m_eff; the end fluxes come
+// from the open-ended lubrication flow driven by the prescribed wall motion (mass
+// conserving); the closure only selects which dp/dz enters W.
+// States: (D, X, V_rear, V_front, V_rear_lab, V_front_lab), scaled.
 #include <cvode/cvode.h>
 #include <cvode/cvode_ls.h>
 
@@ -12,6 +15,7 @@
 
 #include "reduced1d/discretisation.hpp"
 #include "reduced1d/internal.hpp"
+#include "reduced1d/outer_flow.hpp"
 #include "reduced1d/sundials.hpp"
 
 namespace swim::reduced1d::detail {
@@ -26,14 +30,18 @@ struct PrescribedModel {
   disc::BalanceCoefficients bal;
   int N;
   double L, h, R0, C1, mu;
-  bool flow_closure;
+  bool flow_closure, force_free, confined;
+  double a_in, a_out;
   // workspace (sized once)
-  std::vector<double> zpt, dpt, Rpt, At, r, Q, dp;
+  std::vector<double> zpt, dpt, Rpt, At, r, Q, dp, scum, zc, faces, rho, u_ind, pl;
+  std::unique_ptr<outer::ConfinedSystem> sys;
   // state scales: y = (D / D_s, X / X_s, V_rear / V_s, V_front / V_s)
   double D_s = 1, X_s = 1, V_s = 1;
 
   struct Eval {
     double f = 0, thrust = 0, Q0 = 0, QN = 0;
+    double U = 0, p0 = 0, pL = 0, Qt = 0;  // force-free
+    bool ok = true;
   };
 
   explicit PrescribedModel(const Params& p)
@@ -47,6 +55,10 @@ struct PrescribedModel {
         C1(p.wall.C1),
         mu(p.fluid.mu),
         flow_closure(p.swimmer.closure == Closure::Flow),
+        force_free(p.swimmer.model == SwimmerModel::ForceFree),
+        confined(force_free && p.swimmer.outer == OuterFlow::Confined),
+        a_in(force_free ? p.swimmer.a_in : 0.0),
+        a_out(force_free ? p.swimmer.a_out : 0.0),
         zpt(N + 2),
         dpt(N + 1),
         Rpt(N + 2),
@@ -61,8 +73,18 @@ struct PrescribedModel {
     const double T = end_time(p);
     const double f_s = bal.per_length ? pi * C1 * R0 * R0 * R0 / L : C1 * R0 * R0 / (2.0 * L);
     D_s = f_s * T;
-    X_s = D_s * T / (bal.m_eff + bal.c_ext * T);
+    X_s = force_free ? R0 : D_s * T / (bal.m_eff + bal.c_ext * T);
     V_s = pi * R0 * R0 * L;
+    scum.assign(N + 1, 0.0);
+    if (confined) {
+      sys = std::make_unique<outer::ConfinedSystem>(N + 2, dpt, mu, a_in, a_out, p.container.radius_eff,
+                                                    p.container.period, L);
+    } else if (force_free) {
+      zc.assign(zpt.begin() + 1, zpt.end() - 1);
+      faces.resize(N + 1);
+      for (int j = 0; j <= N; ++j) faces[j] = j * h;
+      rho.assign(N, R0);
+    }
   }
 
   /// Radius at the points, flux at the faces, pressure differences, swimmer integrands at t.
@@ -73,20 +95,44 @@ struct PrescribedModel {
       Rpt[k] = R;
       if (k >= 1 && k <= N) At[k - 1] = 2.0 * pi * R * Rt;
     }
+    Eval e;
+    if (confined) {
+      double S = 0;
+      for (int j = 0; j <= N; ++j) {
+        scum[j] = S;
+        if (j < N) S += h * At[j];
+      }
+      if (!sys->geometry(Rpt.data())) {
+        e.ok = false;
+        return e;
+      }
+      sys->kinematic(scum.data());
+      for (int j = 0; j <= N; ++j) Q[j] = sys->Q_in[j];
+      sys->lumen_pressure(pl);
+      e.Q0 = Q[0], e.QN = Q[N], e.U = sys->U, e.Qt = sys->Q_tot, e.p0 = pl[0], e.pL = pl[N + 1];
+      return e;
+    }
     // Open-ended flow: Q_j = Q_0 - S_j, S_j = h sum_{i<j} A_t,i, sum_j r_j Q_j = 0.
     double S = 0, sr = 0, srS = 0;
     for (int j = 0; j <= N; ++j) {
-      r[j] = disc::resistance(mu, dpt[j], Rpt[j], Rpt[j + 1]);
+      r[j] = disc::resistance(mu, dpt[j], Rpt[j] - a_in, Rpt[j + 1] - a_in);
       Q[j] = S;  // holds S_j for now
       sr += r[j];
       srS += r[j] * S;
       if (j < N) S += h * At[j];
     }
-    Eval e;
     const double Q0 = srS / sr;
     for (int j = 0; j <= N; ++j) Q[j] = Q0 - Q[j];
     e.Q0 = Q[0];
     e.QN = Q[N];
+    if (force_free) {  // unbounded: slender-body average of the induced axial flow
+      for (int i = 0; i < N; ++i) rho[i] = Rpt[i + 1] + a_out;
+      outer::induced_axial_velocity(zc, faces, At, -Q[0], Q[N], rho, u_ind);
+      double s = 0;
+      for (double v : u_ind) s += v;
+      e.U = s / N;
+      return e;
+    }
     if (flow_closure) {
       for (int j = 0; j <= N; ++j) dp[j] = -r[j] * Q[j];
     } else {
@@ -103,15 +149,23 @@ struct PrescribedModel {
     const double* Y = sun::data(y);
     double* F = sun::data(ydot);
     const Eval e = m->evaluate(t);
-    const double W = m->bal.velocity(e.thrust, Y[0] * m->D_s, Y[1] * m->X_s);
-    F[0] = e.f / m->D_s;
+    if (!e.ok) return -1;  // the wall reached the container: not recoverable
+    const double W = m->velocity(e, Y);
+    F[0] = m->force_free ? 0.0 : e.f / m->D_s;
     F[1] = W / m->X_s;
     F[2] = e.Q0 / m->V_s;
     F[3] = e.QN / m->V_s;
-    for (int k = 0; k < 4; ++k)
+    F[4] = (e.Q0 + W * pi * m->Rpt[0] * m->Rpt[0]) / m->V_s;
+    F[5] = (e.QN + W * pi * m->Rpt[N_end(m)] * m->Rpt[N_end(m)]) / m->V_s;
+    for (int k = 0; k < kStates; ++k)
       if (!std::isfinite(F[k])) return 1;
     return 0;
   }
+  static int N_end(const PrescribedModel* m) { return m->N + 1; }
+  double velocity(const Eval& e, const double* Y) const {
+    return force_free ? e.U : bal.velocity(e.thrust, Y[0] * D_s, Y[1] * X_s);
+  }
+  static constexpr int kStates = 6;
 };
 
 void add_stat(std::map<std::string, long>& s, const char* k, long v) { s[k] += v; }
@@ -129,15 +183,24 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress) {
 
   const double t_end = end_time(p);
   const double dt_out = p.numerics.output_interval;
-  const bool stiff = model.bal.c_ext > 0;  // external drag: X relaxes on m/c, stiff
+  const bool stiff = !model.force_free && model.bal.c_ext > 0;  // external drag: X relaxes on m/c, stiff
   std::string last_msg;
 
   auto record = [&](double t, const double* Y) -> bool {
     const auto e = model.evaluate(t);
+    if (!e.ok) return false;
     Sample s;
     s.t = t;
     s.X = Y[1] * model.X_s;
-    s.W = model.bal.velocity(e.thrust, Y[0] * model.D_s, s.X);
+    s.W = model.velocity(e, Y);
+    s.V_rear_lab = Y[4] * model.V_s;
+    s.V_front_lab = Y[5] * model.V_s;
+    if (model.force_free) {
+      s.p_rear = e.p0, s.p_front = e.pL, s.Q_total = e.Qt;
+      const double Rb0 = model.Rpt[0], RbL = model.Rpt[N + 1];
+      s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
+      s.F_outer = -s.F_lumen;
+    }
     const double* R = model.Rpt.data() + 1;
     s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
     s.R_min = *std::min_element(R, R + N);
@@ -150,9 +213,7 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress) {
     for (int i = 0; i < N; ++i) vol += R[i] * R[i];
     s.tube_volume = pi * vol * model.h;
     s.phase = 0;
-    for (double v : {s.X, s.W, s.energy, s.R_min, s.R_max, s.Q_rear, s.Q_front, s.V_rear,
-                     s.V_front, s.tube_volume})
-      if (!std::isfinite(v)) return false;
+    if (!finite(s)) return false;
     res.series.push_back(s);
     res.radius_times.push_back(t);
     res.radius.insert(res.radius.end(), R, R + N);
@@ -163,7 +224,7 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress) {
   double t = 0;
   try {
     auto ctx = sun::make_context();
-    auto y = sun::make_vector(4, ctx.get());
+    auto y = sun::make_vector(PrescribedModel::kStates, ctx.get());
     auto cv = sun::make_cvode(stiff ? CV_BDF : CV_ADAMS, ctx.get());
     void* mem = cv.get();
     sun::check(CVodeSetErrHandlerFn(mem, sun::capture_error, &last_msg), "CVodeSetErrHandlerFn");
@@ -176,7 +237,7 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress) {
     sun::LinearSolver LS;
     sun::NonlinearSolver NLS;
     if (stiff) {
-      A = sun::make_dense_matrix(4, ctx.get());
+      A = sun::make_dense_matrix(PrescribedModel::kStates, ctx.get());
       LS = sun::make_dense_solver(y.get(), A.get(), ctx.get());
       sun::check(CVodeSetLinearSolver(mem, LS.get(), A.get()), "CVodeSetLinearSolver");
     } else {

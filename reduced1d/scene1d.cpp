@@ -9,6 +9,7 @@
 #include "common/errors.hpp"
 #include "common/scene_shared.hpp"
 #include "common/units.hpp"
+#include "reduced1d/outer_flow.hpp"
 
 namespace swim::reduced1d {
 
@@ -21,6 +22,37 @@ std::string fmt(double v, const char* unit) { return scene::format_quantity(v, u
 }  // namespace
 
 double c1_from_spring_constant(double k_s, double R0) { return 2.0 * k_s / (std::sqrt(3.0) * R0 * R0); }
+
+namespace {
+json load_calibration(const std::string& key, const std::string& path, const std::string& scene_dir) {
+  namespace fs = std::filesystem;
+  fs::path p(path);
+  if (p.is_relative() && !fs::exists(p)) p = fs::path(scene_dir) / path;
+  std::ifstream in(p);
+  if (!in) throw InputError(key, "\"" + path + "\"", "calibration file not found (relative paths are tried from the "
+                                                     "working directory, then from the scene's directory)");
+  try {
+    return json::parse(in);
+  } catch (const json::parse_error& e) {
+    throw InputError(key, "\"" + path + "\"", std::string("calibration file is not valid JSON: ") + e.what());
+  }
+}
+}  // namespace
+
+std::pair<double, double> hydraulic_offsets_from_calibration(const std::string& key, const std::string& path,
+                                                             const std::string& scene_dir) {
+  const json j = load_calibration(key, path, scene_dir);
+  double v[2];
+  const char* names[2] = {"hydraulic_offset_inner_m", "hydraulic_offset_outer_m"};
+  for (int k = 0; k < 2; ++k) {
+    if (!j.is_object() || !j.contains(names[k]) || !j[names[k]].is_number())
+      throw InputError(key, "\"" + path + "\"", std::string("calibration file must hold a number \"") + names[k] + "\"");
+    v[k] = j[names[k]].get<double>();
+    if (!(v[k] >= 0) || !std::isfinite(v[k]))
+      throw InputError(key, "\"" + path + "\"", std::string(names[k]) + " must be >= 0");
+  }
+  return {v[0], v[1]};
+}
 
 double c1_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir) {
   namespace fs = std::filesystem;
@@ -54,9 +86,21 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   p.geometry.L = body.L;
   p.fluid.mu = body.mu;
   p.fluid.rho = body.rho;
+  p.fluid.temperature = body.temperature;
   const double R0 = p.geometry.R0, L = p.geometry.L;
   {
+    const scene::ContainerSpec c = scene::read_container(top, R0, L);
+    p.container.kind = c.kind == "cylinder" ? ContainerKind::Cylinder
+                       : c.kind == "box"    ? ContainerKind::Box
+                                            : ContainerKind::Duct;
+    p.container.radius = c.radius;
+    p.container.period = c.period;
+    p.container.radius_eff = c.kind == "duct" ? outer::duct_equivalent_radius(c.radius) : c.radius;
+  }
+  std::string calibration;
+  {
     const scene::WallSpec w = scene::read_wall(top, R0);
+    calibration = w.calibration;
     if (w.stiffness == "C1")
       p.wall.C1 = w.value;
     else if (w.stiffness == "spring_constant")
@@ -102,13 +146,50 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
 
   {
     Reader m = top.child("model1d");
-    p.swimmer.closure = m.choice("closure", "tube_law", {"tube_law", "flow"}) == "flow" ? Closure::Flow : Closure::TubeLaw;
-    p.swimmer.balance =
-        m.choice("balance", "per_area", {"per_area", "per_length"}) == "per_length" ? Balance::PerLength : Balance::PerArea;
-    p.swimmer.thrust = m.boolean("thrust", true);
-    p.swimmer.drag = m.choice("external_drag", "none", {"none", "resistive_force"}) == "resistive_force"
-                         ? ExternalDrag::ResistiveForce
-                         : ExternalDrag::None;
+    p.swimmer.model = m.choice("model", "force_free", {"force_free", "paper"}) == "paper" ? SwimmerModel::Paper
+                                                                                       : SwimmerModel::ForceFree;
+    if (p.swimmer.model == SwimmerModel::ForceFree) {
+      p.swimmer.outer = m.choice("outer_flow", "confined", {"confined", "unbounded"}) == "unbounded"
+                            ? OuterFlow::Unbounded
+                            : OuterFlow::Confined;
+      Reader ho = m.child("hydraulic_offsets");
+      if (ho.choice("source", "scene", {"scene", "calibration"}) == "calibration") {
+        if (calibration.empty())
+          throw InputError(ho.path("source"), "\"calibration\"",
+                           "needs wall.calibration (the calibration file that holds the measured offsets)");
+        const auto off = hydraulic_offsets_from_calibration("wall.calibration", calibration, scene_dir);
+        p.swimmer.a_in = off.first;
+        p.swimmer.a_out = off.second;
+      } else {
+        p.swimmer.a_in = ho.quantity("inner", "m", "0 m", Range::non_negative());
+        p.swimmer.a_out = ho.quantity("outer", "m", "0 m", Range::non_negative());
+      }
+      ho.finish();
+      if (!(p.swimmer.a_in < 0.5 * R_f))
+        throw InputError("model1d.hydraulic_offsets.inner", fmt(p.swimmer.a_in, "m"),
+                         "must be below half the contracted radius (" + fmt(0.5 * R_f, "m") +
+                             ") so that the lumen stays open");
+      if (p.swimmer.outer == OuterFlow::Confined && p.container.kind == ContainerKind::Box)
+        throw InputError(m.path("outer_flow"), "\"confined\"",
+                         "container.kind = \"box\" (a periodic box, 3D only) has no wall: use container.kind = "
+                         "\"cylinder\" or \"duct\", or model1d.outer_flow = \"unbounded\"");
+      if (p.swimmer.outer == OuterFlow::Confined && !(R0 + p.swimmer.a_out < 0.99 * p.container.radius_eff))
+        throw InputError("container.radius", fmt(p.container.radius, "m"),
+                         "the tube's outer hydraulic radius swimmer.radius + model1d.hydraulic_offsets.outer = " +
+                             fmt(R0 + p.swimmer.a_out, "m") + " must stay below the container radius seen by the 1D "
+                             "tier (" + fmt(p.container.radius_eff, "m") + ")");
+    } else {
+      Reader q = m.child("paper");
+      p.swimmer.closure = q.choice("closure", "tube_law", {"tube_law", "flow"}) == "flow" ? Closure::Flow : Closure::TubeLaw;
+      p.swimmer.balance = q.choice("balance", "per_area", {"per_area", "per_length"}) == "per_length"
+                              ? Balance::PerLength
+                              : Balance::PerArea;
+      p.swimmer.thrust = q.boolean("thrust", true);
+      p.swimmer.drag = q.choice("external_drag", "none", {"none", "resistive_force"}) == "resistive_force"
+                           ? ExternalDrag::ResistiveForce
+                           : ExternalDrag::None;
+      q.finish();
+    }
     p.wall.inertia = m.boolean("wall_inertia", false);
     if (p.wall.inertia && !forced)
       throw InputError(m.path("wall_inertia"), "true", "wall inertia only applies to wave.kind = \"force_driven\" "

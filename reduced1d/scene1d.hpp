@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 
 #include "common/scene.hpp"
 #include "reduced1d/params.hpp"
@@ -19,6 +20,10 @@ Params read_scene(const scene::json& scene, scene::json& resolved, const std::st
 double c1_from_spring_constant(double k_s, double R0);
 
 /// Read C1 [Pa/m] from a calibration.json (key "C1_Pa_per_m"). Throws InputError for `key`.
+/// Read the hydraulic offsets (a_in, a_out) [m] from a calibration.json (keys
+/// "hydraulic_offset_inner_m", "hydraulic_offset_outer_m"). Throws InputError for `key`.
+std::pair<double, double> hydraulic_offsets_from_calibration(const std::string& key, const std::string& path,
+                                                             const std::string& scene_dir);
 double c1_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir);
 
 }  // namespace swim::reduced1d

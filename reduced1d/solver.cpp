@@ -6,6 +6,7 @@
 #include <string>
 
 #include "reduced1d/internal.hpp"
+#include "reduced1d/outer_flow.hpp"
 
 namespace swim::reduced1d {
 
@@ -42,6 +43,15 @@ void validate(const Params& p) {
   require(p.numerics.max_steps > 0, "numerics.max_steps", double(p.numerics.max_steps),
           "must be positive");
   require(p.duration >= 0 && std::isfinite(p.duration), "duration", p.duration, "must be >= 0");
+  if (p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.outer == OuterFlow::Confined) {
+    require(p.container.radius_eff > R0 + p.swimmer.a_out, "container.radius", p.container.radius,
+            "must exceed swimmer.radius + model1d.hydraulic_offsets.outer");
+    require(p.container.period > p.geometry.L, "container.period", p.container.period,
+            "must exceed swimmer.length");
+  }
+  require(p.swimmer.a_in >= 0 && p.swimmer.a_in < 0.5 * R0, "model1d.hydraulic_offsets.inner", p.swimmer.a_in,
+          "must be in [0, R0/2)");
+  require(p.swimmer.a_out >= 0, "model1d.hydraulic_offsets.outer", p.swimmer.a_out, "must be >= 0");
   switch (p.wave) {
     case WaveKind::Step:
       require(p.step.R_min > 0, "step.R_min", p.step.R_min, "must be positive");
@@ -142,10 +152,27 @@ double end_time(const Params& p) {
   }
 }
 
+bool finite(const Sample& s) {
+  for (double v : {s.t, s.X, s.W, s.energy, s.R_min, s.R_max, s.Q_rear, s.Q_front, s.V_rear, s.V_front,
+                   s.tube_volume, s.p_rear, s.p_front, s.Q_total, s.F_lumen, s.F_outer, s.V_rear_lab, s.V_front_lab})
+    if (!std::isfinite(v)) return false;
+  return true;
+}
+
+double straight_tube_drag(const Params& p) {
+  if (p.swimmer.model != SwimmerModel::ForceFree) return 0.0;
+  const double R0 = p.geometry.R0, L = p.geometry.L, mu = p.fluid.mu;
+  if (p.swimmer.outer == OuterFlow::Unbounded) return outer::slender_drag_per_length(L, R0, mu) * L;
+  return outer::confined_drag_coefficient(R0, L, p.swimmer.a_in, p.swimmer.a_out, p.container.radius_eff,
+                                          p.container.period, mu);
+}
+
 Result solve(const Params& params, const ProgressFn& progress) {
   detail::validate(params);
-  if (params.wave == WaveKind::ForceDriven) return detail::solve_force_driven(params, progress);
-  return detail::solve_prescribed(params, progress);
+  Result r = params.wave == WaveKind::ForceDriven ? detail::solve_force_driven(params, progress)
+                                                  : detail::solve_prescribed(params, progress);
+  r.drag_coefficient = straight_tube_drag(params);
+  return r;
 }
 
 }  // namespace swim::reduced1d

@@ -34,8 +34,19 @@ struct Sample {
   double V_rear = 0;       ///< int_0^t Q_rear [m^3]
   double V_front = 0;      ///< int_0^t Q_front [m^3]
   double tube_volume = 0;  ///< discrete tube volume sum(pi R_i^2 dz) [m^3]
+  // Force-free model (0 in the paper's mode):
+  double p_rear = 0;       ///< lumen pressure at z = 0 (confined; gauge p_rear + p_front = 0) [Pa]
+  double p_front = 0;      ///< lumen pressure at z = L [Pa]
+  double Q_total = 0;      ///< confined: total swimmer-frame flux through a container section [m^3/s]
+  double F_lumen = 0;      ///< axial force of the lumen fluid on the tube, pi [R^2 p]_L^0 [N]
+  double F_outer = 0;      ///< axial force of the outer fluid on the tube (= -F_lumen) [N]
+  double V_rear_lab = 0;   ///< int (Q_rear + U pi R(0)^2) dt: lumen volume through z = 0, lab frame [m^3]
+  double V_front_lab = 0;  ///< same through z = L [m^3]
   int phase = 0;           ///< force-driven: 0 contraction, 1 recovery, 2 done; prescribed: 0
 };
+
+/// True when every value of the sample is finite.
+bool finite(const Sample& s);
 
 struct Result {
   std::vector<Sample> series;
@@ -48,6 +59,9 @@ struct Result {
   /// for the last cycle started; -1 where not reached.
   std::vector<double> segment_reached;
   long switches = 0;                 ///< number of protocol force switches (all cycles)
+  /// Drag coefficient of the straight tube (R = R0) in the model's outer flow, F = -zeta U
+  /// [N s/m]; 0 in the paper's mode (no outer flow).
+  double drag_coefficient = 0;
   std::map<std::string, long> stats; ///< integrator statistics (steps, rhs evals, ...)
   std::optional<NumericalError> failure;  ///< set when the run stopped on a numerical failure
 };
@@ -56,6 +70,10 @@ struct Result {
 using ProgressFn = std::function<void(double t, double t_end)>;
 
 Result solve(const Params& params, const ProgressFn& progress = {});
+
+/// Drag coefficient zeta [N s/m] of the straight tube (R = R0) towed through the model's outer
+/// flow (confined: lumen, annulus and free pipe; unbounded: resistive force); 0 in paper mode.
+double straight_tube_drag(const Params& params);
 
 /// End time of a run: params.duration when > 0, else the transit time of a prescribed wave
 /// (L / s for the step, lambda / s for the sine); for the force-driven wave with no duration

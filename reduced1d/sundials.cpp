@@ -323,8 +323,10 @@ struct LowRankContent {
   int rank = 0;     // rank used at the last setup
   double s = 1.0;   // scale at the last setup
   long n = 0;
-  std::vector<double> Z;   // M^{-1} U, column-major n x rank
-  std::vector<double> S;   // I + s V^T Z, LU-factored in place (rank x rank)
+  std::vector<double> Z;   // M^{-1} Q, column-major n x rank (U = Q R, Q orthonormal)
+  std::vector<double> W;   // V R^T, column-major n x rank: U V^T = Q W^T
+  std::vector<double> R;   // rank x rank, column-major
+  std::vector<double> S;   // I + s W^T Z, LU-factored in place (rank x rank)
   std::vector<int> piv;
   std::vector<double> w;   // rank workspace
   int last = 0;
@@ -375,13 +377,43 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   const int r = c->rank;
   const long n = c->n;
   if (r == 0) return 0;
+  // Orthonormalise the columns of U (modified Gram-Schmidt, twice): U V^T = Q (V R^T)^T.
+  // The terms may differ in scale by many decades and be nearly parallel; without this the
+  // capacitance matrix I + s V^T M^{-1} U is numerically singular even when M + s U V^T is not.
   c->Z.assign(t.U.begin(), t.U.begin() + n * r);
+  c->R.assign(std::size_t(r) * r, 0.0);
+  for (int k = 0; k < r; ++k) {
+    double* qk = c->Z.data() + n * k;
+    for (int pass = 0; pass < 2; ++pass)
+      for (int j = 0; j < k; ++j) {
+        const double* qj = c->Z.data() + n * j;
+        double d = 0;
+        for (long i = 0; i < n; ++i) d += qj[i] * qk[i];
+        c->R[std::size_t(k) * r + j] += d;
+        for (long i = 0; i < n; ++i) qk[i] -= d * qj[i];
+      }
+    double nrm = 0;
+    for (long i = 0; i < n; ++i) nrm += qk[i] * qk[i];
+    nrm = std::sqrt(nrm);
+    c->R[std::size_t(k) * r + k] = nrm;
+    if (nrm > 0)
+      for (long i = 0; i < n; ++i) qk[i] /= nrm;
+  }
+  c->W.assign(std::size_t(n) * r, 0.0);
+  for (int i = 0; i < r; ++i)      // W(:, i) = sum_k V(:, k) R(i, k)
+    for (int k = i; k < r; ++k) {
+      const double rik = c->R[std::size_t(k) * r + i];
+      if (rik == 0.0) continue;
+      const double* Vk = t.V.data() + n * k;
+      double* Wi = c->W.data() + n * i;
+      for (long m = 0; m < n; ++m) Wi[m] += rik * Vk[m];
+    }
   for (int k = 0; k < r; ++k) c->lu.solve(c->Z.data() + n * k);
   c->S.assign(std::size_t(r) * r, 0.0);
   for (int i = 0; i < r; ++i)
     for (int j = 0; j < r; ++j) {
       double v = 0;
-      const double* Vi = t.V.data() + n * i;
+      const double* Vi = c->W.data() + n * i;
       const double* Zj = c->Z.data() + n * j;
       for (long k = 0; k < n; ++k) v += Vi[k] * Zj[k];
       c->S[j * r + i] = (i == j ? 1.0 : 0.0) + c->s * v;
@@ -402,11 +434,10 @@ int lr_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   c->last = 0;
   if (c->rank == 0) return 0;
   const int r = c->rank;
-  const LowRankTerm& t = *c->term;
-  // x <- x - Z (I + s V^T Z)^{-1} s V^T x
+  // x <- x - Z (I + s W^T Z)^{-1} s W^T x
   for (int i = 0; i < r; ++i) {
     double v = 0;
-    const double* Vi = t.V.data() + n * i;
+    const double* Vi = c->W.data() + n * i;
     for (long k = 0; k < n; ++k) v += Vi[k] * xd[k];
     c->w[i] = c->s * v;
   }

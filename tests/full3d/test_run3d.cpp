@@ -247,17 +247,17 @@ TEST(Run3d, DryProtocolReachesTargetOnEverySegment) {
 }
 
 // Scene keys wired to StokesOptions: the paper's rigid circular container
-// (full3d.container.kind = cylinder, fictitious domain inside a duct one cell wider on each
+// (container.kind = cylinder, fictitious domain inside a duct one cell wider on each
 // side) and the Navier-Stokes advection sub-step (full3d.navier_stokes = true). Both are
 // accepted, echoed, and a short force-driven run completes with finite results.
 TEST(Run3d, CylinderAndNavierStokesScenesRun) {
   for (const bool ns : {false, true}) {
-    const Scene s = tiny({"full3d.container.kind=\"cylinder\"", std::string("full3d.navier_stokes=") + (ns ? "true" : "false"),
+    const Scene s = tiny({"container.kind=\"cylinder\"", std::string("full3d.navier_stokes=") + (ns ? "true" : "false"),
                           "full3d.dt=\"1 ms\"", "time.duration=\"10 ms\"", "time.output_interval=\"1 ms\""});
     EXPECT_EQ(s.p.container, "cylinder");
     EXPECT_EQ(s.p.navier_stokes, ns);
     EXPECT_EQ(s.p.ny, int(std::lround(2 * s.p.container_radius / s.p.h)) + 2);
-    EXPECT_EQ(s.resolved["full3d"]["container"]["wall"], "staircase");
+    EXPECT_EQ(s.resolved["full3d"]["cylinder_wall"], "staircase");
     const std::string dir = fresh_dir(ns ? "cylinder_ns" : "cylinder");
     RunControl ctl;
     ctl.progress = 0;

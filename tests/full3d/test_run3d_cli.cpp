@@ -41,7 +41,7 @@ TEST(SwimRun3d, WritesContractFiles) {
   EXPECT_EQ(s["tier"], "3d");
   EXPECT_GE(s["max_displacement_m"].get<double>(), s["displacement_m"].get<double>());
   EXPECT_EQ(s["status"], "ok");
-  EXPECT_EQ(s["scene"]["full3d"]["container"]["kind"], "duct");
+  EXPECT_EQ(s["scene"]["container"]["kind"], "duct");
   std::ifstream csv(d + "/series.csv");
   std::string header;
   std::getline(csv, header);
@@ -55,12 +55,12 @@ TEST(SwimRun3d, WritesContractFiles) {
 
 TEST(SwimRun3d, BadInputExits2AndWritesNothing) {
   const std::string d = dir("bad");
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.container.kind='\"cylinder\"'"
-                 " --set full3d.container.wall='\"bogus\"'"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.kind='\"cylinder\"'"
+                 " --set full3d.cylinder_wall='\"bogus\"'"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.bogus=1"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.container.radius='\"0.15 um\"'"), 2);
+  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.radius='\"0.15 um\"'"), 2);
   EXPECT_FALSE(fs::exists(d));
 }
 

@@ -1,0 +1,169 @@
+#include "reduced1d/outer_flow.hpp"
+
+#include <algorithm>
+#include <Eigen/Dense>
+
+namespace swim::reduced1d::outer {
+
+double duct_equivalent_radius(double half_width) {
+  double sum = 0;
+  for (int n = 1; n < 400; n += 2) sum += std::tanh(n * pi / 2.0) / std::pow(double(n), 5);
+  const double k = (4.0 / 3.0) * (1.0 - 192.0 / std::pow(pi, 5) * sum);
+  return std::pow(8.0 * k / pi, 0.25) * half_width;
+}
+
+double confined_drag_coefficient(double R, double L, double a_in, double a_out, double Rc, double P, double mu) {
+  ConfinedSystem sys(2, {L}, mu, a_in, a_out, Rc, P, L);
+  const double Rp[2] = {R, R};
+  if (!sys.geometry(Rp)) return 0.0;
+  const double Pi[2] = {0.0, 0.0};
+  sys.transmural(Pi);
+  return sys.drag_coefficient();
+}
+
+LumenForce lumen_wall_force(const double* R, const double* p, int npoints) {
+  LumenForce f;
+  for (int k = 0; k + 1 < npoints; ++k) {
+    const double a = R[k], b = R[k + 1], dp = p[k + 1] - p[k];
+    f.shear -= pi * dp * (a * a + a * b + b * b) / 3.0;
+    // int p d(R^2) for linear p and R on the interval, exactly
+    f.taper -= pi * (b - a) * (p[k] * (a + b) + dp * (a + 2.0 * b) / 3.0);
+  }
+  return f;
+}
+
+void induced_axial_velocity(const std::vector<double>& zc, const std::vector<double>& faces,
+                            const std::vector<double>& sigma, double m_rear, double m_front,
+                            const std::vector<double>& rho, std::vector<double>& u) {
+  const int N = int(zc.size());
+  u.assign(N, 0.0);
+  const double c = 1.0 / (4.0 * pi);
+  const double zL = faces.back(), z0 = faces.front();
+  for (int i = 0; i < N; ++i) {
+    const double r2 = rho[i] * rho[i], z = zc[i];
+    // sum_j sigma_j (g_{j+1} - g_j), g_f = 1 / sqrt((z - f)^2 + rho^2), by parts over faces
+    double gprev = 1.0 / std::sqrt((z - faces[0]) * (z - faces[0]) + r2);
+    double s = 0;
+    for (int j = 0; j < N; ++j) {
+      const double dz = z - faces[j + 1];
+      const double g = 1.0 / std::sqrt(dz * dz + r2);
+      s += sigma[j] * (g - gprev);
+      gprev = g;
+    }
+    const double d0 = z - z0, dL = z - zL;
+    const double k0 = d0 / std::pow(d0 * d0 + r2, 1.5), kL = dL / std::pow(dL * dL + r2, 1.5);
+    u[i] = c * (s + m_rear * k0 + m_front * kL);
+  }
+}
+
+ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, double mu_, double a_in_, double a_out_,
+                               double Rc_, double period, double L_)
+    : np(npoints),
+      ni(npoints - 1),
+      mu(mu_),
+      a_in(a_in_),
+      a_out(a_out_),
+      Rc(Rc_),
+      Pd(period),
+      L(L_),
+      r_free((period - L_) * 8.0 * mu_ / (pi * Rc_ * Rc_ * Rc_ * Rc_)),
+      A_c(pi * Rc_ * Rc_),
+      d(dd),
+      k(npoints - 1),
+      Q_in(npoints - 1, 0.0),
+      dPi(npoints - 1, 0.0),
+      pts_(npoints) {}
+
+bool ConfinedSystem::geometry(const double* Rpt) {
+  for (int p = 0; p < np; ++p) {
+    const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
+    if (!(Ro < Rc * (1.0 - 1e-3)) || !(Ri > 0)) return false;
+    pts_[p] = annulus_point<double>(Ro, Rc, mu);
+  }
+  for (int j = 0; j < ni; ++j) {
+    const double ai = Rpt[j] - a_in, bi = Rpt[j + 1] - a_in, ab = ai * bi;
+    IntervalCoef<double>& c = k[j];
+    c.rl = (8.0 * mu / pi) * d[j] * (ai * ai + ab + bi * bi) / (3.0 * ab * ab * ab);
+    const auto &pa = pts_[j], &pb = pts_[j + 1];
+    c.ra = 0.5 * d[j] * (pa.rho + pb.rho);
+    c.c = 0.5 * d[j] * (pa.kappa + pb.kappa);
+    c.S = 0.5 * (pa.S + pb.S);
+    c.e = 0.5 * d[j] * (pa.e + pb.e);
+  }
+  return true;
+}
+
+void ConfinedSystem::transmural(const double* Pi, double F_ext) {
+  // Unknowns W = Q_tot + U A_c (the lab-frame flux through the free pipe) and U; in these the
+  // 2 x 2 is well conditioned (Q_tot itself is close to -U A_c).
+  //   Q_in,j = alpha_j W + beta_j U - gamma_j,  alpha = ra / (rl + ra),
+  //   beta = (c - A_c ra) / (rl + ra),  gamma = dPi / (rl + ra).
+  // Periodicity: sum rl Q_in + r_free W = 0.  Force: sum S dp_out + U sum e = F_ext with
+  // dp_out = -rl Q_in - dPi.
+  double m11 = r_free, m12 = 0, b1 = 0, m21 = 0, m22 = 0, b2 = F_ext;
+  for (int j = 0; j < ni; ++j) {
+    const auto& c = k[j];
+    const double w = 1.0 / (c.rl + c.ra);
+    const double alpha = c.ra * w, beta = (c.c - A_c * c.ra) * w, dpi = Pi[j + 1] - Pi[j];
+    dPi[j] = dpi;
+    m11 += c.rl * alpha;
+    m12 += c.rl * beta;
+    b1 += c.rl * dpi * w;
+    m21 -= c.S * c.rl * alpha;
+    m22 += c.e - c.S * c.rl * beta;
+    b2 += c.S * alpha * dpi;
+  }
+  M[0][0] = m11, M[0][1] = m12, M[1][0] = m21, M[1][1] = m22;
+  const double det = m11 * m22 - m12 * m21;
+  W = (b1 * m22 - m12 * b2) / det;
+  U = (m11 * b2 - m21 * b1) / det;
+  Q_tot = W - A_c * U;
+  dp_tube = 0;
+  for (int j = 0; j < ni; ++j) {
+    const auto& c = k[j];
+    Q_in[j] = (c.ra * W + (c.c - A_c * c.ra) * U - dPi[j]) / (c.rl + c.ra);
+    dp_tube -= c.rl * Q_in[j];
+  }
+}
+
+void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {
+  // Unknowns x = (Q_in0, Q_tot, U, dp) with Q_in,j = Q_in0 - s_j, Q_out,j = Q_tot - Q_in,j:
+  //   lumen   dp = -sum rl (Q_in0 - s)
+  //   annulus dp = -sum ra (Q_tot - Q_in0 + s) - U sum c
+  //   free    dp = r_free (Q_tot + U A_c)
+  //   force   sum S (-ra (Q_tot - Q_in0 + s) - c U) + U sum e = F_ext
+  double RL = 0, RLs = 0, RA = 0, RAs = 0, C = 0, SRA = 0, SRAs = 0, SC = 0, E = 0;
+  for (int j = 0; j < ni; ++j) {
+    const auto& c = k[j];
+    RL += c.rl, RLs += c.rl * s_cum[j];
+    RA += c.ra, RAs += c.ra * s_cum[j];
+    C += c.c;
+    SRA += c.S * c.ra, SRAs += c.S * c.ra * s_cum[j];
+    SC += c.S * c.c;
+    E += c.e;
+  }
+  Eigen::Matrix4d A;
+  Eigen::Vector4d b;
+  A << RL, 0, 0, 1, /**/ -RA, RA, C, 1, /**/ 0, -r_free, -r_free * A_c, 1, /**/ SRA, -SRA, E - SC, 0;
+  b << RLs, -RAs, 0, F_ext + SRAs;
+  const Eigen::Vector4d x = A.partialPivLu().solve(b);
+  Q_tot = x(1);
+  U = x(2);
+  W = Q_tot + A_c * U;
+  dp_tube = x(3);
+  for (int j = 0; j < ni; ++j) Q_in[j] = x(0) - s_cum[j];
+}
+
+void ConfinedSystem::lumen_pressure(std::vector<double>& p) const {
+  p.resize(np);
+  p[0] = -0.5 * dp_tube;
+  for (int j = 0; j < ni; ++j) p[j + 1] = p[j] - k[j].rl * Q_in[j];
+}
+
+double ConfinedSystem::drag_coefficient() const {
+  // Rigid tow (dPi = 0) by an external force F_ext: W = -M12 U / M11 from the periodicity
+  // row, so F_ext = (M22 - M21 M12 / M11) U; the fluid's drag on the tube is -zeta U.
+  return M[1][1] - M[1][0] * M[0][1] / M[0][0];
+}
+
+}  // namespace swim::reduced1d::outer

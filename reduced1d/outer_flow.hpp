@@ -1,0 +1,149 @@
+// Outer flows of the force-free 1D swimmer (docs/outer-flow-1d.md derives every formula).
+//
+// Swimmer frame zeta = z - X(t) in [0, L]; the tube moves at U(t) in the lab frame and the
+// wall's material points move radially in the swimmer frame. Fluxes are swimmer-frame
+// fluxes (relative to the tube's cross-sections).
+//
+// Confined (lubrication in a rigid periodic pipe of radius Rc and period P):
+//   lumen    0 < r < R_i = R - a_in :  Q_in = -G_in p_in'                 G_in = pi R_i^4 / 8 mu
+//   annulus  R_o = R + a_out < r < Rc:  Q_out = -G_a p_out' - U K_a
+//            (container wall moves at -U in the swimmer frame)
+//            G_a = (pi / 8 mu) [Rc^4 - R_o^4 - (Rc^2 - R_o^2)^2 / lambda],  lambda = ln(Rc / R_o)
+//            K_a = pi Rc^2 - S,   S = pi (Rc^2 - R_o^2) / (2 lambda)
+//   free pipe (L < zeta < P): Q_free = -G_c p' - U pi Rc^2,  G_c = pi Rc^4 / 8 mu
+//   tube law p_in - p_out = Pi(zeta) (= C1 (R - R0) + q for a force-driven wave; Pi = 0 at the
+//            open ends, where lumen, annulus and free pipe meet at one pressure)
+//   Q_in + Q_out = Q_tot uniform along the tube (= Q_free), pressure periodic over P,
+//   force on the tube = 0  <=>  int_0^L (S p_out' + 2 pi mu U / lambda) dzeta = F_ext.
+//
+// Unbounded (slender body): the lumen ends are at the ambient pressure (p_in = Pi), and
+//   U = <u_ind>, the body-average of the axial velocity that the line of sources
+//   sigma = d(pi R^2)/dt and the end point sources (-Q_in(0) at the rear, +Q_in(L) at the front)
+//   induce on the outer surface r = R + a_out; resistive-force drag c_par (U - u_ind) per length
+//   with uniform c_par = 2 pi mu / (ln(2 L / R0) - 1/2).
+#pragma once
+
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <vector>
+
+namespace swim::reduced1d::outer {
+
+inline constexpr double pi = std::numbers::pi;
+
+/// Point functions of the annulus between R_o and Rc (templated for complex-step derivatives).
+template <class T>
+struct AnnulusPoint {
+  T rho;    ///< 1 / G_a [Pa s / m^4]
+  T kappa;  ///< K_a / G_a [Pa s / m^2]
+  T S;      ///< pi (Rc^2 - R_o^2) / (2 lambda) [m^2]
+  T e;      ///< 2 pi mu / lambda [Pa s]
+};
+
+template <class T>
+AnnulusPoint<T> annulus_point(T Ro, double Rc, double mu) {
+  using std::log;
+  const T lambda = log(Rc / Ro);
+  const T D2 = Rc * Rc - Ro * Ro;
+  const T Ga = (pi / (8.0 * mu)) * (Rc * Rc * Rc * Rc - Ro * Ro * Ro * Ro - D2 * D2 / lambda);
+  const T S = pi * D2 / (2.0 * lambda);
+  AnnulusPoint<T> a;
+  a.rho = 1.0 / Ga;
+  a.kappa = (pi * Rc * Rc - S) / Ga;
+  a.S = S;
+  a.e = 2.0 * pi * mu / lambda;
+  return a;
+}
+
+/// Coefficients of one interval [zeta_j, zeta_{j+1}] of length d with the membrane radius
+/// linear from a to b: lumen resistance (exact mean of R_i^-4), annulus resistance, Couette
+/// coefficient c = int K_a / G_a, force weight S (mean) and Couette drag e = int 2 pi mu / lambda
+/// (trapezoid on the point functions).
+template <class T>
+struct IntervalCoef {
+  T rl, ra, c, S, e;
+};
+
+template <class T>
+IntervalCoef<T> interval_coef(T a, T b, double d, double mu, double a_in, double a_out, double Rc) {
+  const T ai = a - a_in, bi = b - a_in;
+  const T ab = ai * bi;
+  IntervalCoef<T> k;
+  k.rl = (8.0 * mu / pi) * d * (ai * ai + ab + bi * bi) / (3.0 * ab * ab * ab);
+  const AnnulusPoint<T> pa = annulus_point<T>(a + a_out, Rc, mu), pb = annulus_point<T>(b + a_out, Rc, mu);
+  k.ra = 0.5 * d * (pa.rho + pb.rho);
+  k.c = 0.5 * d * (pa.kappa + pb.kappa);
+  k.S = 0.5 * (pa.S + pb.S);
+  k.e = 0.5 * d * (pa.e + pb.e);
+  return k;
+}
+
+/// The confined lubrication system on the point set {0, z_0, ..., z_{N-1}, L} (N + 2 points,
+/// N + 1 intervals; interval j contains face j). Two ways to close it:
+///  - transmural(): force-driven wave, Pi = p_in - p_out known at the points (0 at both ends);
+///    unknowns Q_tot and U (2 x 2);
+///  - kinematic(): prescribed wave, lumen flux known up to its value at the rear,
+///    Q_in,j = Q_in,0 - s_j; unknowns Q_in,0, Q_tot, U and the pressure rise pL - p0 (4 x 4).
+/// After either, Q_in (per face), the pressures and the force split are available.
+class ConfinedSystem {
+ public:
+  ConfinedSystem(int npoints, const std::vector<double>& d, double mu, double a_in, double a_out, double Rc,
+                 double period, double L);
+
+  /// Interval coefficients for the point radii (returns false if the wall reaches the
+  /// container or the lumen closes: then nothing else is valid).
+  bool geometry(const double* Rpt);
+  void transmural(const double* Pi, double F_ext = 0.0);
+  void kinematic(const double* s_cum, double F_ext = 0.0);
+
+  /// Lumen pressures at the points, gauge: mean free-pipe pressure = 0 (p0 + pL = 0).
+  void lumen_pressure(std::vector<double>& p) const;
+  /// Drag coefficient of the current shape towed rigidly (no wall pressure): F = -zeta U.
+  double drag_coefficient() const;
+
+  int np, ni;  ///< points, intervals
+  double mu, a_in, a_out, Rc, Pd, L, r_free, A_c;
+  std::vector<double> d;
+  std::vector<IntervalCoef<double>> k;  ///< per interval
+  std::vector<double> Q_in;             ///< lumen flux per face (swimmer frame) [m^3/s]
+  std::vector<double> dPi;              ///< Pi_{j+1} - Pi_j used (transmural) [Pa]
+  double U = 0, Q_tot = 0, dp_tube = 0;  ///< velocity, total swimmer-frame flux, pL - p0
+  double W = 0;                          ///< Q_tot + U pi Rc^2: lab-frame flux through the free pipe
+  double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
+
+ private:
+  std::vector<AnnulusPoint<double>> pts_;
+};
+
+/// Equivalent circular radius of a square duct of half-width a: the pipe with the same
+/// Poiseuille conductance, R = (8 k / pi)^(1/4) a with the duct's k = Q mu / (a^4 G)
+/// = (4/3) [1 - (192 / pi^5) sum_{n odd} tanh(n pi / 2) / n^5] = 0.5623.
+double duct_equivalent_radius(double half_width);
+
+/// Drag coefficient of a straight tube of radius R (uniform) towed through the confined
+/// container: F = -zeta U with lumen carried along and the annulus/free-pipe return flow.
+double confined_drag_coefficient(double R, double L, double a_in, double a_out, double Rc, double P, double mu);
+
+/// Resistive-force coefficient per length for the unbounded slender body.
+inline double slender_drag_per_length(double L, double R0, double mu) {
+  return 2.0 * pi * mu / (std::log(2.0 * L / R0) - 0.5);
+}
+
+/// Lumen force on the tube wall from a linear-in-interval pressure and radius, split into
+/// the wall shear -pi int R^2 p' and the pressure on the tapered wall -pi int p (R^2)'. Both
+/// are integrated exactly, so shear + taper = pi [R(0)^2 p(0) - R(L)^2 p(L)] to round-off.
+struct LumenForce {
+  double shear = 0, taper = 0;
+};
+LumenForce lumen_wall_force(const double* R, const double* p, int npoints);
+
+/// Axial velocity induced on the outer surface of a slender tube at the cell centres by a
+/// line of sources sigma_j (per unit length, uniform in cell j = [f_j, f_{j+1}]) and two point
+/// sources m_rear at zeta = 0 and m_front at zeta = L; rho_i = regularisation radius at cell i.
+/// Exact integration of the regularised source kernel over each cell. O(N^2).
+void induced_axial_velocity(const std::vector<double>& zc, const std::vector<double>& faces,
+                            const std::vector<double>& sigma, double m_rear, double m_front,
+                            const std::vector<double>& rho, std::vector<double>& u);
+
+}  // namespace swim::reduced1d::outer
