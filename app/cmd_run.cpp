@@ -9,6 +9,7 @@
 #include "common/output.hpp"
 #include "common/progress.hpp"
 #include "common/scene.hpp"
+#include "common/si_format.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/report.hpp"
@@ -37,6 +38,29 @@ bool plot(const std::string& script, const std::vector<std::string>& args) {
 }
 
 namespace {
+
+// One human-readable line per 1D run, SI prefixes; per-cycle figures only when a cycle completed.
+void print_summary_1d(const std::string& name, const scene::json& s, double wall, const std::string& out) {
+  std::string per_cycle;
+  if (s["mean_velocity_per_cycle_m_per_s"].is_number()) {
+    char b[160];
+    std::snprintf(b, sizeof b, "%s per cycle, %s (%.3g body lengths/s)",
+                  si(s["displacement_per_cycle_m"].get<double>(), "m").c_str(),
+                  si(s["mean_velocity_per_cycle_m_per_s"].get<double>(), "m/s").c_str(),
+                  s["body_lengths_per_cycle_per_s"].get<double>());
+    per_cycle = b;
+  } else {
+    per_cycle = "no per-cycle figures (" + s["per_cycle_absent_because"].get<std::string>() + ")";
+  }
+  std::printf("%s (1d, %s): displacement %s; %s; %d cycle(s); pumped %s; thermal rms %s per cycle "
+              "(directed/diffusive %.3g); wall time %s\n  -> %s/summary.json\n",
+              name.c_str(), s["model1d"].get<std::string>().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(),
+              per_cycle.c_str(), s["cycles_completed"].get<int>(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(),
+              si(s["brownian"]["thermal_rms_displacement_per_cycle_m"].get<double>(), "m").c_str(),
+              s["brownian"]["directed_to_diffusive_ratio"].get<double>(), si(wall, "s").c_str(), out.c_str());
+  for (const auto& w : s["implausible_because"])
+    std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
+}
 
 // The 3D tier: read and validate, run (full3d/run3d.hpp), report.
 int run3d(const RunOptions& o, const scene::json& sc) {
@@ -90,11 +114,7 @@ int run(const RunOptions& o) {
   // 3. Write (partial results too), report.
   const scene::json summary = reduced1d::write_run(out, p, resolved, r, wall);
   if (o.plot) plot("plot_run.py", {out});
-  std::printf("%s (1d): displacement %.6g m, mean velocity %.6g m/s (%.4g body lengths/s), %d cycle(s), "
-              "pumped volume %.6g m^3, wall time %.3g s\n  -> %s/summary.json\n",
-              p.name.c_str(), summary["displacement_m"].get<double>(), summary["mean_velocity_m_per_s"].get<double>(),
-              summary["body_lengths_per_s"].get<double>(), summary["cycles_completed"].get<int>(),
-              summary["pumped_volume_m3"].get<double>(), wall, out.c_str());
+  print_summary_1d(p.name, summary, wall, out);
   if (r.failure) {
     std::fprintf(stderr, "swim: %s\n  partial results kept in %s\n", r.failure->what(), out.c_str());
     return 3;

@@ -29,7 +29,6 @@
 #include <cstdint>
 #include <functional>
 #include <cmath>
-#include <complex>
 #include <memory>
 #include <sstream>
 #include <string>
@@ -397,27 +396,25 @@ struct ForceModel {
     if (confined) {
       s.g1a.assign(N + 1, 0.0), s.g1b.assign(N + 1, 0.0), s.g1pi.assign(N + 1, 0.0);
       s.g2a.assign(N + 1, 0.0), s.g2b.assign(N + 1, 0.0), s.g2pi.assign(N + 1, 0.0);
-      using C = std::complex<double>;
-      const double Qt = sys->Q_tot, Uv = sys->U, hcs = 1e-20 * R0;
+      const double Qt = sys->Q_tot, Uv = sys->U;
       for (int j = 0; j <= N; ++j) {
         const double a = Rp(j), b = Rp(j + 1), d = (j == 0 || j == N) ? 0.5 * h : h;
         const double dpi = sys->dPi[j];
-        // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
-        auto eval = [&](C aa, C bb, C& Qc, C& t1, C& t2) {
-          const auto k = outer::interval_coef<C>(aa, bb, d, mu, a_in, a_out, sys->Rc);
-          Qc = (k.ra * Qt + k.c * Uv - dpi) / (k.rl + k.ra);
-          t1 = k.rl * Qc;
-          t2 = -k.S * k.rl * Qc - k.S * dpi + k.e * Uv;
-        };
-        C Qc, t1, t2;
-        eval(C(a, hcs), C(b, 0.0), Qc, t1, t2);
-        const double Qa = Qc.imag() / hcs;
-        s.g1a[j] = t1.imag() / hcs, s.g2a[j] = t2.imag() / hcs;
-        eval(C(a, 0.0), C(b, hcs), Qc, t1, t2);
-        const double Qb = Qc.imag() / hcs;
-        s.g1b[j] = t1.imag() / hcs, s.g2b[j] = t2.imag() / hcs;
         const auto& k = sys->k[j];
-        const double w = 1.0 / (k.rl + k.ra);
+        const auto &da = sys->point_derivative(j), &db = sys->point_derivative(j + 1);
+        double rla, rlb;
+        dresistance(d, a - a_in, b - a_in, rla, rlb);
+        // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
+        const double w = 1.0 / (k.rl + k.ra), Qj = sys->Q_in[j];
+        auto partial = [&](const outer::AnnulusPoint<double>& dp, double drl, double& dQ, double& d1, double& d2) {
+          const double dra = 0.5 * d * dp.rho, dc = 0.5 * d * dp.kappa, dS = 0.5 * dp.S, de = 0.5 * d * dp.e;
+          dQ = (dra * Qt + dc * Uv - Qj * (drl + dra)) * w;
+          d1 = drl * Qj + k.rl * dQ;
+          d2 = -dS * k.rl * Qj - k.S * drl * Qj - k.S * k.rl * dQ - dS * dpi + de * Uv;
+        };
+        double Qa, Qb;
+        partial(da, rla, Qa, s.g1a[j], s.g2a[j]);
+        partial(db, rlb, Qb, s.g1b[j], s.g2b[j]);
         s.g1pi[j] = -k.rl * w;        // d t1 / d dPi
         s.g2pi[j] = -k.S * k.ra * w;  // d t2 / d dPi
         // dQ/d Pi_j = +w, dQ/d Pi_{j+1} = -w
@@ -1100,9 +1097,9 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
       be = std::make_unique<CvodeBackend>(*pb, P);
     be->set_roots(machine.root_count());
     be->set_stop_time(t_stop);
+    check_ends(0.0);
     if (!record(0.0, be->y()))
       throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
-    check_ends(0.0);
     if (!fixed && P.protocol.q <= M.C1 * (M.R0 - P.protocol.R_f)) {
       throw NumericalError(
           "the actuation cannot contract the tube to R_f: under protocol.q = " + fmt(P.protocol.q) +
@@ -1178,7 +1175,11 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
   } catch (const NumericalError& e) {
     res.failure = e;
   } catch (const sun::SundialsError& e) {
-    res.failure = NumericalError(
+    if (M.confined && !M.geometry_ok)
+      res.failure = NumericalError(
+          "the tube wall reached the container wall (outer hydraulic radius R + a_out >= container radius)",
+          "raise container.radius or lower protocol.q (the recovery overshoots R0)", t);
+    else res.failure = NumericalError(
         std::string(M.inertia ? "IDA" : "CVODE") + " failed: " + e.what(),
         "tighten numerics.rtol/atol_scale or raise numerics.cells; if the radius nearly closes, "
         "lower protocol.q or raise protocol.R_f",

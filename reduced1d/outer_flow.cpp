@@ -72,13 +72,16 @@ ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, doubl
       k(npoints - 1),
       Q_in(npoints - 1, 0.0),
       dPi(npoints - 1, 0.0),
-      pts_(npoints) {}
+      pts_(npoints),
+      dpts_(npoints) {}
 
 bool ConfinedSystem::geometry(const double* Rpt) {
   for (int p = 0; p < np; ++p) {
     const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
     if (!(Ro < Rc * (1.0 - 1e-3)) || !(Ri > 0)) return false;
-    pts_[p] = annulus_point<double>(Ro, Rc, mu);
+    const AnnulusPointD a = annulus_point_d(Ro, Rc, mu);
+    pts_[p] = a.f;
+    dpts_[p] = a.df;
   }
   for (int j = 0; j < ni; ++j) {
     const double ai = Rpt[j] - a_in, bi = Rpt[j + 1] - a_in, ab = ai * bi;

@@ -95,6 +95,8 @@ class ConfinedSystem {
   /// container or the lumen closes: then nothing else is valid).
   bool geometry(const double* Rpt);
   void transmural(const double* Pi, double F_ext = 0.0);
+  /// d/dR_o of the point functions at point p (valid after geometry()).
+  const AnnulusPoint<double>& point_derivative(int p) const { return dpts_[p]; }
   void kinematic(const double* s_cum, double F_ext = 0.0);
 
   /// Lumen pressures at the points, gauge: mean free-pipe pressure = 0 (p0 + pL = 0).
@@ -113,8 +115,31 @@ class ConfinedSystem {
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
 
  private:
-  std::vector<AnnulusPoint<double>> pts_;
+  std::vector<AnnulusPoint<double>> pts_, dpts_;
 };
+
+/// The point functions and their derivatives d/dR_o (analytic), for the Newton matrix.
+struct AnnulusPointD {
+  AnnulusPoint<double> f, df;
+};
+inline AnnulusPointD annulus_point_d(double Ro, double Rc, double mu) {
+  const double lambda = std::log(Rc / Ro), dl = -1.0 / Ro;
+  const double D2 = Rc * Rc - Ro * Ro, dD2 = -2.0 * Ro;
+  const double c8 = pi / (8.0 * mu);
+  const double G = c8 * (Rc * Rc * Rc * Rc - Ro * Ro * Ro * Ro - D2 * D2 / lambda);
+  const double dG = c8 * (-4.0 * Ro * Ro * Ro - 2.0 * D2 * dD2 / lambda + D2 * D2 * dl / (lambda * lambda));
+  const double S = pi * D2 / (2.0 * lambda), dS = 0.5 * pi * (dD2 / lambda - D2 * dl / (lambda * lambda));
+  AnnulusPointD a;
+  a.f.rho = 1.0 / G;
+  a.df.rho = -dG / (G * G);
+  a.f.S = S;
+  a.df.S = dS;
+  a.f.kappa = (pi * Rc * Rc - S) * a.f.rho;
+  a.df.kappa = -dS * a.f.rho + (pi * Rc * Rc - S) * a.df.rho;
+  a.f.e = 2.0 * pi * mu / lambda;
+  a.df.e = -2.0 * pi * mu * dl / (lambda * lambda);
+  return a;
+}
 
 /// Equivalent circular radius of a square duct of half-width a: the pipe with the same
 /// Poiseuille conductance, R = (8 k / pi)^(1/4) a with the duct's k = Q mu / (a^4 G)

@@ -170,6 +170,11 @@ class ProtocolMachine {
 double reference_energy(const Params& p);
 
 /// Radius below which the tube counts as collapsed: 1e-3 R0.
-inline double collapse_radius(const Params& p) { return 1e-3 * p.geometry.R0; }
+/// Radius at which the tube counts as collapsed: the lumen (R - a_in in the force-free model)
+/// is within 1e-3 R0 of closing.
+inline double collapse_radius(const Params& p) {
+  const double a_in = p.swimmer.model == SwimmerModel::ForceFree ? p.swimmer.a_in : 0.0;
+  return a_in + 1e-3 * p.geometry.R0;
+}
 
 }  // namespace swim::reduced1d::detail

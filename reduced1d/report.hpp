@@ -25,6 +25,18 @@ struct Metrics {
   double mean_cycle_time_s = 0;
   double min_radius_m = 0;
   long switches = 0;
+  /// Per completed cycle (force-driven): displacement over the cycle [m] and its mean velocity.
+  std::vector<double> cycle_displacements_m;
+  double displacement_per_cycle_m = 0;        ///< mean over completed cycles (prescribed: the transit)
+  double mean_velocity_per_cycle_m_per_s = 0;
+  bool has_cycle = false;                     ///< false: the per-cycle figures are absent
+  std::string no_cycle_reason;
+  double pumped_volume_lab_m3 = 0;            ///< -V_rear_lab at the end
+  /// Brownian scale over one cycle: sqrt(2 k_B T t_cycle / zeta), and |directed| / that.
+  double drag_coefficient_N_s_per_m = 0;
+  double thermal_rms_displacement_m = 0;
+  double directed_to_diffusive = 0;
+  std::vector<std::string> implausible;       ///< physically impossible results, if any
 };
 
 Metrics metrics(const Params& p, const Result& r);

@@ -22,7 +22,11 @@ TEST(Scene, EmptySceneGetsEveryDefaultAndTheEchoIsItselfAValidScene) {
   EXPECT_NEAR(p.geometry.L, 0.4e-6, 1e-20);
   EXPECT_EQ(resolved["swimmer"]["radius"], "0.125 um");
   EXPECT_EQ(resolved["wave"]["kind"], "force_driven");
-  EXPECT_TRUE(resolved["model1d"].contains("closure"));
+  EXPECT_EQ(resolved["model1d"]["model"], "force_free");
+  EXPECT_EQ(resolved["model1d"]["outer_flow"], "confined");
+  EXPECT_EQ(resolved["container"]["kind"], "duct");
+  EXPECT_EQ(resolved["fluid"]["temperature"], "310 K");
+  EXPECT_FALSE(resolved["model1d"].contains("paper"));
   json again;
   const auto q = swim::reduced1d::read_scene(resolved, again);
   EXPECT_EQ(resolved, again);
@@ -44,7 +48,8 @@ TEST(Scene, OverridesUseTheFileSyntaxAndNullRemovesAKey) {
   json s = json::object();
   swim::scene::apply_override(s, "swimmer.length=0.2 um");
   swim::scene::apply_override(s, "numerics1d.cells=64");
-  swim::scene::apply_override(s, "model1d.thrust=false");
+  swim::scene::apply_override(s, "model1d.model=paper");
+  swim::scene::apply_override(s, "model1d.paper.thrust=false");
   json resolved;
   const auto p = swim::reduced1d::read_scene(s, resolved);
   EXPECT_NEAR(p.geometry.L, 0.2e-6, 1e-20);

@@ -13,8 +13,10 @@
 using namespace swim::reduced1d;
 
 namespace {
-Params force_driven(int N = 50) {
+// The paper's balance (reproduction mode) unless a test asks for the force-free model.
+Params force_driven(int N = 50, SwimmerModel model = SwimmerModel::Paper) {
   Params p;
+  p.swimmer.model = model;
   p.wave = WaveKind::ForceDriven;
   p.numerics.cells = N;
   p.numerics.output_interval = 2e-3;

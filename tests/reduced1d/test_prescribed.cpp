@@ -25,6 +25,13 @@ double integrate(const std::function<double(double)>& f, double a, double b) {
   return r;
 }
 
+// The paper's own 1D model (reproduction mode): every test in this file checks its formulas.
+Params paper() {
+  Params p;
+  p.swimmer.model = SwimmerModel::Paper;
+  return p;
+}
+
 Params tight(Params p) {
   p.numerics.rtol = 1e-10;
   p.numerics.atol_scale = 1e-12;
@@ -33,7 +40,7 @@ Params tight(Params p) {
 
 // Closed form (52) for the prescribed radius: per area, tube-law closure.
 struct ClosedForm52 {
-  Params p;
+  Params p = paper();
   disc::PrescribedShape sh;
   explicit ClosedForm52(const Params& q) : p(q), sh(disc::PrescribedShape::from(q)) {}
   double R(double z, double t) const {
@@ -59,7 +66,7 @@ struct ClosedForm52 {
 
 TEST(Reduced1dPrescribed, StepTubeLawReproducesClosedForm52AtAnyN) {
   for (int N : {20, 400}) {
-    Params p = tight(Params{});
+    Params p = tight(paper());
     p.numerics.cells = N;
     p.numerics.output_interval = end_time(p) / 8;
     const Result r = solve(p);
@@ -84,7 +91,7 @@ TEST(Reduced1dPrescribed, SharpFrontLimitIsTheNote2FormNotPrinted54) {
   // X(T) -> C1 (Rmax^2 - Rmin^2) T^2 / (8 m L) as the width -> 0; (54) as printed is twice that.
   double prev_dev = 1;
   for (double frac : {1e-2, 1e-3, 1e-4}) {
-    Params p = tight(Params{});
+    Params p = tight(paper());
     p.swimmer.thrust = false;
     p.numerics.cells = 50;
     p.step.width = frac * p.geometry.L;
@@ -103,7 +110,7 @@ TEST(Reduced1dPrescribed, SharpFrontLimitIsTheNote2FormNotPrinted54) {
 
 TEST(Reduced1dPrescribed, PerLengthVersusPerAreaBalance) {
   for (double Rmin_frac : {0.99, 0.3}) {
-    Params a = tight(Params{});
+    Params a = tight(paper());
     a.swimmer.thrust = false;
     a.step.width = 1e-4 * a.geometry.L;
     a.step.R_min = Rmin_frac * a.geometry.R0;
@@ -124,7 +131,7 @@ TEST(Reduced1dPrescribed, PerLengthVersusPerAreaBalance) {
 
 TEST(Reduced1dPrescribed, FlowClosureConservesVolume) {
   for (WaveKind w : {WaveKind::Step, WaveKind::Sine}) {
-    Params p = tight(Params{});
+    Params p = tight(paper());
     p.wave = w;
     p.swimmer.closure = Closure::Flow;
     p.numerics.cells = 100;
@@ -139,7 +146,7 @@ TEST(Reduced1dPrescribed, FlowClosureConservesVolume) {
 TEST(Reduced1dPrescribed, FlowClosureIsSecondOrderInSpace) {
   // Smoothed step with width L/4; reference N = 1600. Observed order from N = 25..200.
   auto run = [](int N) {
-    Params p;
+    Params p = paper();
     p.swimmer.closure = Closure::Flow;
     p.step.width = 0.25 * p.geometry.L;
     p.numerics.cells = N;
@@ -167,10 +174,10 @@ TEST(Reduced1dPrescribed, FlowClosureIsSecondOrderInSpace) {
 }
 
 TEST(Reduced1dPrescribed, ResistiveDragBoundsTheVelocity) {
-  Params p;
+  Params p = paper();
   p.swimmer.drag = ExternalDrag::ResistiveForce;
   const Result r = solve(p);
-  Params q;
+  Params q = paper();
   const Result r0 = solve(q);
   ASSERT_FALSE(r.failure);
   ASSERT_FALSE(r0.failure);

@@ -1,0 +1,15 @@
+// Human-facing numbers with SI prefixes: "43.2 nm", "131 nm/s", "3.2 fN". Files stay in SI;
+// only printouts and figure labels use these.
+#pragma once
+
+#include <string>
+
+namespace swim {
+
+/// `value` in the SI `unit` ("m", "m/s", "N", "s", "m^3"), rescaled by the SI prefix
+/// (f, p, n, µ, m, -, k, M, G) that puts the mantissa in [1, 1000), with `digits`
+/// significant digits. Volumes ("m^3") keep the cubic unit of the prefixed length (µm^3).
+/// Zero prints as "0 <unit>"; non-finite values print as "n/a".
+std::string si(double value, const std::string& unit, int digits = 3);
+
+}  // namespace swim
