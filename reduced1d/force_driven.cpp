@@ -103,7 +103,6 @@ struct ForceModel {
   std::vector<double> Rpt, Pipt, zc, faces, sigma, rho, u_ind;
   double U = 0;           // swimmer velocity at the last fluxes() [m/s]
   bool geometry_ok = true;
-  double c_par = 0;       // unbounded: resistive-force coefficient per length
 
   explicit ForceModel(const Params& P)
       : N(P.numerics.cells),
@@ -158,7 +157,6 @@ struct ForceModel {
         for (int j = 0; j <= N; ++j) faces[j] = j * h;
         sigma.assign(N, 0.0);
         rho.assign(N, R0);
-        c_par = outer::slender_drag_per_length(L, R0, mu);
       }
     }
     T_s = 0.1 * relaxation_time(P);
@@ -281,10 +279,7 @@ struct ForceModel {
         sigma[i] = (Q[i] - Q[i + 1]) / h;  // d(pi R^2)/dt per unit length
         rho[i] = R[i] + a_out;
       }
-      outer::induced_axial_velocity(zc, faces, sigma, -Q[0], Q[N], rho, u_ind);
-      double s = 0;
-      for (int i = 0; i < N; ++i) s += u_ind[i];
-      U = s / N;
+      U = outer::slender_velocity(zc, faces, sigma, -Q[0], Q[N], rho, L, mu, u_ind);
     }
   }
 
@@ -1097,9 +1092,11 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
       be = std::make_unique<CvodeBackend>(*pb, P);
     be->set_roots(machine.root_count());
     be->set_stop_time(t_stop);
-    check_ends(0.0);
-    if (!record(0.0, be->y()))
+    if (!record(0.0, be->y())) {
+      check_ends(0.0);  // an open end without a positive rest radius is the usual cause
       throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
+    }
+    check_ends(0.0);
     if (!fixed && P.protocol.q <= M.C1 * (M.R0 - P.protocol.R_f)) {
       throw NumericalError(
           "the actuation cannot contract the tube to R_f: under protocol.q = " + fmt(P.protocol.q) +

@@ -51,9 +51,23 @@ void induced_axial_velocity(const std::vector<double>& zc, const std::vector<dou
       gprev = g;
     }
     const double d0 = z - z0, dL = z - zL;
-    const double k0 = d0 / std::pow(d0 * d0 + r2, 1.5), kL = dL / std::pow(dL * dL + r2, 1.5);
+    const double q0 = d0 * d0 + r2, qL = dL * dL + r2;
+    const double k0 = d0 / (q0 * std::sqrt(q0)), kL = dL / (qL * std::sqrt(qL));
     u[i] = c * (s + m_rear * k0 + m_front * kL);
   }
+}
+
+double slender_velocity(const std::vector<double>& zc, const std::vector<double>& faces,
+                        const std::vector<double>& sigma, double m_rear, double m_front,
+                        const std::vector<double>& rho, double L, double mu, std::vector<double>& u) {
+  induced_axial_velocity(zc, faces, sigma, m_rear, m_front, rho, u);
+  double cu = 0, c = 0;
+  for (std::size_t i = 0; i < u.size(); ++i) {
+    const double ci = slender_drag_per_length(L, rho[i], mu);
+    cu += ci * u[i];
+    c += ci;
+  }
+  return cu / c;
 }
 
 ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, double mu_, double a_in_, double a_out_,

@@ -23,6 +23,7 @@
 //   with uniform c_par = 2 pi mu / (ln(2 L / R0) - 1/2).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <numbers>
@@ -150,10 +151,18 @@ double duct_equivalent_radius(double half_width);
 /// container: F = -zeta U with lumen carried along and the annulus/free-pipe return flow.
 double confined_drag_coefficient(double R, double L, double a_in, double a_out, double Rc, double P, double mu);
 
-/// Resistive-force coefficient per length for the unbounded slender body.
-inline double slender_drag_per_length(double L, double R0, double mu) {
-  return 2.0 * pi * mu / (std::log(2.0 * L / R0) - 0.5);
+/// Resistive-force coefficient per length of a slender body of length L and local radius R,
+/// 2 pi mu / (ln(2 L / R) - 1/2); the logarithm is floored at 0.1 (ln(2L/R) - 1/2 reaches 0
+/// near L = 0.82 R, where slender-body theory has long lost its meaning).
+inline double slender_drag_per_length(double L, double R, double mu) {
+  return 2.0 * pi * mu / std::max(std::log(2.0 * L / R) - 0.5, 0.1);
 }
+
+/// Swimming velocity of the force-free slender body: with the resistive-force law
+/// f(z) = c_par(R_o(z)) (U - u_ind(z)) and int f = 0, U = sum c_i u_i / sum c_i over the cells.
+double slender_velocity(const std::vector<double>& zc, const std::vector<double>& faces,
+                        const std::vector<double>& sigma, double m_rear, double m_front,
+                        const std::vector<double>& rho, double L, double mu, std::vector<double>& u);
 
 /// Lumen force on the tube wall from a linear-in-interval pressure and radius, split into
 /// the wall shear -pi int R^2 p' and the pressure on the tapered wall -pi int p (R^2)'. Both

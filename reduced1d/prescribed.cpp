@@ -127,10 +127,7 @@ struct PrescribedModel {
     e.QN = Q[N];
     if (force_free) {  // unbounded: slender-body average of the induced axial flow
       for (int i = 0; i < N; ++i) rho[i] = Rpt[i + 1] + a_out;
-      outer::induced_axial_velocity(zc, faces, At, -Q[0], Q[N], rho, u_ind);
-      double s = 0;
-      for (double v : u_ind) s += v;
-      e.U = s / N;
+      e.U = outer::slender_velocity(zc, faces, At, -Q[0], Q[N], rho, L, mu, u_ind);
       return e;
     }
     if (flow_closure) {

@@ -1,0 +1,153 @@
+// The force-free 1D swimmer through the whole solver: grid convergence, the small-amplitude
+// law U ~ b^2, no coasting after the stroke, volume conservation, Stokes time invariance,
+// and the exact Newton matrix of the confined model.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <vector>
+
+#include "reduced1d/internal.hpp"
+#include "reduced1d/report.hpp"
+#include "reduced1d/solver.hpp"
+
+using namespace swim::reduced1d;
+
+namespace {
+
+Params sine(int N, double contracted_ratio, OuterFlow outer) {
+  Params p;
+  p.swimmer.outer = outer;
+  p.wave = WaveKind::Sine;
+  p.numerics.cells = N;
+  p.numerics.rtol = 1e-10;
+  p.numerics.atol_scale = 1e-12;
+  p.sine.amplitude = (1.0 - contracted_ratio) * p.geometry.R0;
+  p.sine.wavelength = p.geometry.L;
+  p.numerics.output_interval = end_time(p) / 8;
+  return p;
+}
+
+Params force_free_cycle(int N) {
+  Params p;  // defaults: force-free, confined, force-driven protocol
+  p.wave = WaveKind::ForceDriven;
+  p.numerics.cells = N;
+  p.numerics.output_interval = 2e-3;
+  return p;
+}
+
+double order(double e_coarse, double e_fine) { return std::log2(e_coarse / e_fine); }
+
+}  // namespace
+
+// Prescribed sine wave in the confined container: X(T) and U(T/2) converge at second order
+// in the cell width (reference N = 1600).
+TEST(ForceFree, ConfinedSineWaveIsSecondOrderInSpace) {
+  auto run = [](int N) {
+    const Result r = solve(sine(N, 0.6, OuterFlow::Confined));
+    EXPECT_FALSE(r.failure);
+    return std::pair{r.series.back().X, r.series[4].W};  // sample 4 of 8 is T/2
+  };
+  const auto ref = run(1600);
+  std::vector<std::pair<double, double>> e;
+  for (int N : {25, 50, 100, 200}) {
+    const auto v = run(N);
+    e.push_back({std::abs(v.first - ref.first), std::abs(v.second - ref.second)});
+  }
+  for (std::size_t k = 0; k + 1 < e.size(); ++k) {
+    EXPECT_GE(order(e[k].first, e[k + 1].first), 1.8) << "X, step " << k;
+    EXPECT_GE(order(e[k].second, e[k + 1].second), 1.8) << "U, step " << k;
+  }
+  EXPECT_GT(ref.first, 0.0) << "the tube swims against its wave (the wave travels in -z)";
+}
+
+// Small amplitude b: the net displacement per period scales as b^2 (exponent 2 +- 0.05 for
+// b/R0 from 0.01 to 0.05) in both outer flows. Direction: confined, against the wave (+z);
+// unbounded slender body on a long tube (L = 4 wavelengths), with the wave (-z): the
+// regularised source line moves the tube towards its thinner parts (docs/outer-flow-1d.md).
+TEST(ForceFree, SmallAmplitudeDisplacementScalesWithTheSquareOfTheAmplitude) {
+  for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded}) {
+    std::vector<double> b, X;
+    for (double bb : {0.01, 0.02, 0.05}) {
+      Params p = sine(240, 1.0 - 2.0 * bb, outer);  // R = R0 - b (1 - cos): amplitude a = 2 b
+      p.geometry.L = 2e-6;
+      p.sine.wavelength = 0.5e-6;
+      p.container.period = 8e-6;
+      p.numerics.output_interval = end_time(p) / 4;
+      const Result r = solve(p);
+      ASSERT_FALSE(r.failure) << r.failure->what();
+      b.push_back(bb);
+      X.push_back(r.series.back().X);
+    }
+    const double slope = std::log(std::abs(X[2] / X[0])) / std::log(b[2] / b[0]);
+    const double slope1 = std::log(std::abs(X[1] / X[0])) / std::log(b[1] / b[0]);
+    EXPECT_NEAR(slope, 2.0, 0.05) << (outer == OuterFlow::Confined ? "confined" : "unbounded");
+    EXPECT_NEAR(slope1, 2.0, 0.05);
+    if (outer == OuterFlow::Confined)
+      for (double x : X) EXPECT_GT(x, 0.0);
+    else
+      for (double x : X) EXPECT_LT(x, 0.0);
+  }
+}
+
+// A force-free Stokes swimmer cannot coast: once the wall is back at rest the velocity is
+// zero. The cycle moves the tube forward (+z, as in the 3D tier) and conserves volume:
+// tube volume change = volume in at the rear - volume out at the front.
+TEST(ForceFree, ForceDrivenCycleStopsWhenTheWallStopsAndConservesVolume) {
+  for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded}) {
+    Params p = force_free_cycle(80);
+    p.swimmer.outer = outer;
+    const Result r = solve(p);
+    ASSERT_FALSE(r.failure) << r.failure->what();
+    const auto m = metrics(p, r);
+    ASSERT_EQ(m.cycles_completed, 1);
+    double vmax = 0;
+    for (const auto& s : r.series) vmax = std::max(vmax, std::abs(s.W));
+    EXPECT_LT(std::abs(r.series.back().W), 1e-3 * vmax) << "no coasting after the stroke";
+    EXPECT_GT(m.displacement_m, 0.0);
+    EXPECT_LT(m.displacement_m, 0.5 * p.geometry.L) << "a stroke cannot outrun its wave";
+    const auto& a = r.series.front();
+    for (const auto& s : r.series) {
+      const double dV = s.tube_volume - a.tube_volume, flux = s.V_rear - s.V_front;
+      EXPECT_NEAR(dV, flux, 1e-6 * a.tube_volume);
+      EXPECT_NEAR(s.F_lumen + s.F_outer, 0.0, 1e-12 * (std::abs(s.F_lumen) + 1e-30));
+    }
+  }
+}
+
+// Stokes flow has no time scale of its own: ten times the viscosity gives the same stroke
+// ten times slower, with the same displacement.
+TEST(ForceFree, DisplacementIsIndependentOfTheViscosity) {
+  Params p = force_free_cycle(60);
+  p.numerics.rtol = 1e-8;
+  const Result a = solve(p);
+  p.fluid.mu *= 10;
+  p.numerics.output_interval *= 10;
+  const Result b = solve(p);
+  ASSERT_FALSE(a.failure);
+  ASSERT_FALSE(b.failure);
+  const auto ma = metrics(p, a), mb = metrics(p, b);
+  EXPECT_NEAR(mb.displacement_m, ma.displacement_m, 1e-4 * ma.displacement_m);
+  ASSERT_EQ(ma.cycle_times_s.size(), 1u);
+  EXPECT_NEAR(mb.cycle_times_s[0], 10 * ma.cycle_times_s[0], 1e-4 * mb.cycle_times_s[0]);
+}
+
+// The Newton matrix of the force-free models: exact tridiagonal part, one rank-1 term per
+// held segment and, when confined, two rank-1 terms for the global unknowns (W, U), against
+// central differences of the right-hand side at random states (CVODE, no wall inertia).
+TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
+  for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
+    for (int N : {37, 60}) {
+      Params p = force_free_cycle(N);
+      p.swimmer.outer = outer;
+      p.swimmer.a_in = 2e-9;
+      p.swimmer.a_out = 3e-9;
+      const int n = p.protocol.segments;
+      for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
+        for (unsigned seed : {1u, 2u}) {
+          const auto c = detail::check_jacobian(p, phase, active, seed);
+          EXPECT_LT(c.max_rel_error, 1e-6) << "N=" << N << " phase=" << phase << " active=" << active;
+          const int held = phase == 0 ? n - 1 - active : 0;
+          EXPECT_EQ(c.rank, held + (outer == OuterFlow::Confined ? 2 : 0));
+        }
+    }
+}

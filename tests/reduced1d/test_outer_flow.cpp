@@ -1,0 +1,236 @@
+// Outer flows of the force-free 1D swimmer (reduced1d/outer_flow.hpp), checked against
+// closed forms and exact properties: the lumen force cancellation, the rigid tube towed
+// through the confined container, mirror symmetry, flux balance per channel, and the
+// scallop theorem for a reciprocal stroke.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "reduced1d/outer_flow.hpp"
+
+using namespace swim::reduced1d::outer;
+
+namespace {
+
+constexpr double kR0 = 0.125e-6, kL = 0.4e-6, kMu = 1.2e-3, kRc = 0.25e-6, kP = 2e-6;
+
+/// Interval lengths of the solver's point set (half cells at both ends).
+std::vector<double> intervals(int N, double L) {
+  std::vector<double> d(N + 1, L / N);
+  d[0] = d[N] = 0.5 * L / N;
+  return d;
+}
+
+std::vector<double> random_radii(std::mt19937& g, int np, double lo, double hi) {
+  std::uniform_real_distribution<double> u(lo, hi);
+  std::vector<double> R(np);
+  for (auto& r : R) r = u(g) * kR0;
+  return R;
+}
+
+}  // namespace
+
+// Lubrication order: the wall shear -pi int R^2 p' and the pressure on the tapered wall
+// -pi int p (R^2)' cancel when both ends are at one pressure; otherwise their sum is the
+// control-volume force pi [R(0)^2 p(0) - R(L)^2 p(L)].
+TEST(OuterFlow, LumenShearAndTaperPressureCancelWithEqualEndPressures) {
+  std::mt19937 g(7);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    const int np = 5 + trial * 7;
+    const auto R = random_radii(g, np, 0.3, 1.2);
+    std::vector<double> p(np);
+    for (auto& v : p) v = n(g);
+    p.front() = p.back() = 0.0;  // both ends open to the same (gauge) pressure
+    auto f = lumen_wall_force(R.data(), p.data(), np);
+    EXPECT_GT(std::abs(f.shear), 1e-3 * kR0 * kR0) << "a non-trivial profile";
+    EXPECT_NEAR(f.shear + f.taper, 0.0, 1e-13 * std::abs(f.shear)) << trial;
+    p.front() = -0.4, p.back() = 0.7;
+    f = lumen_wall_force(R.data(), p.data(), np);
+    const double cv = pi * (R.front() * R.front() * p.front() - R.back() * R.back() * p.back());
+    EXPECT_NEAR(f.shear + f.taper, cv, 1e-13 * (std::abs(f.shear) + std::abs(cv))) << trial;
+  }
+}
+
+// A rigid straight tube (no wave: Pi = 0) pulled by a force F through the periodic
+// container: lumen (carried along), Poiseuille-Couette annulus and free pipe. The closed form
+// is written here from the textbook annulus formulas, independently of the solver.
+TEST(OuterFlow, RigidTubeTowedThroughTheContainerMatchesTheClosedForm) {
+  for (double R : {0.5 * kR0, kR0, 1.6 * kR0})
+    for (double a_out : {0.0, 0.01e-6})
+      for (int N : {1, 4, 37}) {
+        const double a_in = 0.005e-6, F = 1e-15;
+        const double Ri = R - a_in, Ro = R + a_out, lam = std::log(kRc / Ro);
+        const double Gl = pi * Ri * Ri * Ri * Ri / (8 * kMu);
+        const double Ga = pi / (8 * kMu) * (std::pow(kRc, 4) - std::pow(Ro, 4) - std::pow(kRc * kRc - Ro * Ro, 2) / lam);
+        const double Gc = pi * std::pow(kRc, 4) / (8 * kMu);
+        const double S = pi * (kRc * kRc - Ro * Ro) / (2 * lam), K = pi * kRc * kRc - S, Ac = pi * kRc * kRc;
+        // unknowns (dp = p(L) - p(0), U): total flux Q = -(Gl + Ga) dp / L - U K;
+        // free pipe dp = (Q + U Ac) (P - L) / Gc; force F = S dp + 2 pi mu U L / lambda.
+        // => dp [1 + (Gl + Ga)(P - L)/(Gc L)] = U (Ac - K)(P - L)/Gc = U S (P - L) / Gc
+        const double a = 1 + (Gl + Ga) * (kP - kL) / (Gc * kL), b = S * (kP - kL) / Gc;
+        const double U_exact = F / (S * b / a + 2 * pi * kMu * kL / lam);
+
+        ConfinedSystem sys(N + 2, intervals(N, kL), kMu, a_in, a_out, kRc, kP, kL);
+        const std::vector<double> Rp(N + 2, R), Pi(N + 2, 0.0);
+        ASSERT_TRUE(sys.geometry(Rp.data()));
+        sys.transmural(Pi.data(), F);
+        EXPECT_NEAR(sys.U, U_exact, 1e-12 * U_exact) << "R/R0 " << R / kR0 << " N " << N;
+        EXPECT_NEAR(sys.drag_coefficient(), F / U_exact, 1e-12 * F / U_exact);
+        EXPECT_NEAR(sys.dp_tube, U_exact * b / a, 1e-11 * std::abs(U_exact * b / a));
+        if (N == 4 && a_out == 0.0 && R == kR0)
+          EXPECT_NEAR(confined_drag_coefficient(R, kL, a_in, a_out, kRc, kP, kMu), F / U_exact, 1e-12 * F / U_exact);
+      }
+}
+
+// The confined lubrication drag of the paper's geometry is several times the unbounded
+// slender-body drag (confinement matters): Rc = 2 R0, L = 0.4 um.
+TEST(OuterFlow, ConfinementRaisesTheDragAboveTheSlenderBodyValue) {
+  const double conf = confined_drag_coefficient(kR0, kL, 0, 0, kRc, kP, kMu);
+  const double free = slender_drag_per_length(kL, kR0, kMu) * kL;
+  EXPECT_GT(conf / free, 3.0);
+  EXPECT_LT(conf / free, 10.0);
+  // and it falls towards the unbounded value as the container widens
+  const double wide = confined_drag_coefficient(kR0, kL, 0, 0, 20 * kR0, 40 * kL, kMu);
+  EXPECT_LT(wide, conf / 3.0);
+}
+
+// Mirror z -> L - z: every radius profile, transmural pressure and wall velocity mirrored
+// gives the opposite swimming velocity and total flux (both closures of the confined system
+// and the slender body).
+TEST(OuterFlow, MirroredProfilesSwimTheOtherWay) {
+  std::mt19937 g(11);
+  std::normal_distribution<double> n(0.0, 1.0);
+  for (int N : {8, 33}) {
+    const auto d = intervals(N, kL);
+    auto R = random_radii(g, N + 2, 0.4, 1.3);
+    std::vector<double> Pi(N + 2);
+    for (auto& v : Pi) v = n(g);
+    Pi.front() = Pi.back() = 0;
+    std::vector<double> Rm(R.rbegin(), R.rend()), Pim(Pi.rbegin(), Pi.rend());
+    ConfinedSystem a(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL), b(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
+    ASSERT_TRUE(a.geometry(R.data()));
+    ASSERT_TRUE(b.geometry(Rm.data()));
+    a.transmural(Pi.data());
+    b.transmural(Pim.data());
+    EXPECT_GT(std::abs(a.U), 0.0);
+    EXPECT_NEAR(b.U, -a.U, 1e-12 * std::abs(a.U));
+    EXPECT_NEAR(b.Q_tot, -a.Q_tot, 1e-11 * std::abs(a.Q_tot));
+    // kinematic closure: cell area rates At_i, cumulative s_j = h sum_{i<j} At_i
+    std::vector<double> At(N), s(N + 1), sm(N + 1);
+    for (auto& v : At) v = 1e-15 * n(g);
+    const double h = kL / N;
+    for (int j = 0; j < N; ++j) s[j + 1] = s[j] + h * At[j];
+    for (int j = 0; j <= N; ++j) sm[j] = s[N] - s[N - j];  // mirrored rates summed from the other end
+    a.kinematic(s.data());
+    b.kinematic(sm.data());
+    EXPECT_GT(std::abs(a.U), 0.0);
+    EXPECT_NEAR(b.U, -a.U, 1e-11 * std::abs(a.U));
+    // slender body: mirrored line sources, the two end point sources exchanged
+    std::vector<double> zc(N), faces(N + 1), rho(N), rhom(N), u;
+    for (int i = 0; i < N; ++i) zc[i] = (i + 0.5) * h, rho[i] = R[i + 1], rhom[i] = R[N - i];
+    for (int j = 0; j <= N; ++j) faces[j] = j * h;
+    std::vector<double> Atm(At.rbegin(), At.rend());
+    const double Ua = slender_velocity(zc, faces, At, 1e-16, -3e-16, rho, kL, kMu, u);
+    const double Ub = slender_velocity(zc, faces, Atm, -3e-16, 1e-16, rhom, kL, kMu, u);
+    EXPECT_NEAR(Ub, -Ua, 1e-12 * std::abs(Ua));
+  }
+}
+
+// Mass balance per channel: the annulus flux reconstructed from its own law,
+// Q_out = -(dp_out + c U) / r_out with dp_out = dp_in - dPi, adds to the lumen flux to the
+// same total at every face; the pressure is periodic over the container period.
+TEST(OuterFlow, ChannelFluxesAddToOneTotalAndThePressureIsPeriodic) {
+  std::mt19937 g(5);
+  std::normal_distribution<double> n(0.0, 1.0);
+  const int N = 40;
+  const auto d = intervals(N, kL);
+  auto R = random_radii(g, N + 2, 0.5, 1.1);
+  std::vector<double> Pi(N + 2);
+  for (auto& v : Pi) v = n(g);
+  Pi.front() = Pi.back() = 0;
+  ConfinedSystem sys(N + 2, d, kMu, 0.0, 0.0, kRc, kP, kL);
+  ASSERT_TRUE(sys.geometry(R.data()));
+  sys.transmural(Pi.data());
+  double drop = 0;
+  for (int j = 0; j <= N; ++j) {
+    const auto& k = sys.k[j];
+    const double dp_in = -k.rl * sys.Q_in[j];
+    const double Q_out = -((dp_in - (Pi[j + 1] - Pi[j])) + k.c * sys.U) / k.ra;
+    EXPECT_NEAR(sys.Q_in[j] + Q_out, sys.Q_tot, 1e-10 * (std::abs(sys.Q_in[j]) + std::abs(Q_out))) << j;
+    drop += dp_in;
+  }
+  const double free_drop = -(sys.Q_tot + sys.U * pi * kRc * kRc) * (kP - kL) * 8 * kMu / (pi * std::pow(kRc, 4));
+  EXPECT_NEAR(drop + free_drop, 0.0, 1e-10 * std::abs(drop));
+}
+
+// Square duct of half-width a: the circular pipe with the same Poiseuille conductance has
+// R = 1.0939 a (conductance 0.5623 a^4 / mu of the square duct).
+TEST(OuterFlow, DuctEquivalentRadius) { EXPECT_NEAR(duct_equivalent_radius(1.0), 1.09391, 2e-5); }
+
+// Scallop theorem: in Stokes flow U is linear in the wall velocity for a given shape, so a
+// reciprocal stroke (the same shapes forward, then backward at another pace) gives zero net
+// displacement, while the swimmer does move during each half. A travelling wave does not
+// retrace its shapes and gives a net displacement. Integrated with Gauss-Legendre in time.
+TEST(OuterFlow, ReciprocalStrokesGiveNoNetDisplacement) {
+  const int N = 60;
+  const double h = kL / N, a = 0.35 * kR0;
+  const auto d = intervals(N, kL);
+  std::vector<double> zpt(N + 2);
+  zpt[0] = 0, zpt[N + 1] = kL;
+  for (int i = 0; i < N; ++i) zpt[i + 1] = (i + 0.5) * h;
+  // shape: an asymmetric contraction near the rear, amplitude s in [0, 1]
+  auto shape = [&](double z) { return std::exp(-std::pow((z - 0.3 * kL) / (0.12 * kL), 2)); };
+  ConfinedSystem sys(N + 2, d, kMu, 0, 0, kRc, kP, kL);
+  std::vector<double> R(N + 2), s(N + 1);
+  // U at time t of a stroke with amplitude s(t), rate sd(t), or of a travelling wave
+  auto velocity = [&](double amp, double rate, bool travelling, double t) {
+    for (int k = 0; k < N + 2; ++k) {
+      const double ph = travelling ? 2 * pi * (zpt[k] + 1e-5 * t) / kL : 0.0;
+      R[k] = kR0 - a * (travelling ? 0.5 * (1 - std::cos(ph)) : amp * shape(zpt[k]));
+    }
+    double cum = 0;
+    for (int i = 0; i < N; ++i) {
+      s[i] = cum;
+      const double z = zpt[i + 1];
+      const double Rt = travelling ? -a * 0.5 * std::sin(2 * pi * (z + 1e-5 * t) / kL) * 2 * pi * 1e-5 / kL
+                                   : -a * rate * shape(z);
+      cum += h * 2 * pi * R[i + 1] * Rt;
+    }
+    s[N] = cum;
+    if (!sys.geometry(R.data())) ADD_FAILURE();
+    sys.kinematic(s.data());
+    return sys.U;
+  };
+  // 10-point Gauss-Legendre on each of many sub-intervals
+  const double xg[5] = {0.1488743389816312, 0.4333953941292472, 0.6794095682990244, 0.8650633666889845,
+                        0.9739065285171717};
+  const double wg[5] = {0.2955242247147529, 0.2692667193099963, 0.2190863625159820, 0.1494513318108240,
+                        0.0666713443086881};
+  auto integrate = [&](auto f, double t0, double t1, int pieces) {
+    double sum = 0;
+    for (int p = 0; p < pieces; ++p) {
+      const double a0 = t0 + (t1 - t0) * p / pieces, a1 = t0 + (t1 - t0) * (p + 1) / pieces;
+      const double c = 0.5 * (a0 + a1), r = 0.5 * (a1 - a0);
+      for (int k = 0; k < 5; ++k) sum += wg[k] * r * (f(c - r * xg[k]) + f(c + r * xg[k]));
+    }
+    return sum;
+  };
+  const double T1 = 0.1, T2 = 0.3;  // contract in 0.1 s, release in 0.3 s
+  const double forward = integrate([&](double t) {
+    const double x = pi * t / (2 * T1);
+    return velocity(std::sin(x) * std::sin(x), 2 * std::sin(x) * std::cos(x) * pi / (2 * T1), false, t);
+  }, 0.0, T1, 20);
+  const double back = integrate([&](double t) {
+    const double x = pi * (t - T1) / (2 * T2);
+    return velocity(std::cos(x) * std::cos(x), -2 * std::sin(x) * std::cos(x) * pi / (2 * T2), false, t);
+  }, T1, T1 + T2, 20);
+  EXPECT_GT(std::abs(forward), 1e-3 * kR0) << "the asymmetric contraction moves the tube";
+  EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
+  // the travelling wave over one period L / s
+  const double wave = integrate([&](double t) { return velocity(0, 0, true, t); }, 0.0, kL / 1e-5, 40);
+  EXPECT_GT(std::abs(wave), 1e-4 * std::abs(forward));
+  EXPECT_GT(wave, 0.0) << "confined: the tube swims against its wave (the wave here travels in -z)";
+}
