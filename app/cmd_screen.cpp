@@ -6,6 +6,7 @@
 #include "app/app.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/si_format.hpp"
 #include "common/progress.hpp"
 #include "common/sweep.hpp"
 #include "reduced1d/scene1d.hpp"
@@ -117,9 +118,15 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     std::fprintf(stderr, "swim: every design failed numerically; see %s/designs.csv for the causes\n", out.c_str());
     return 3;
   }
-  std::printf("best by %s (%s): design %ld: %s -> %.6g\n  -> %s/designs.csv, %s/screen.png\n", sw.metric.c_str(),
-              sw.maximize ? "max" : "min", best, describe(sw, best).c_str(),
-              reduced1d::metric_value(results[best].metrics, sw.metric), out.c_str(), out.c_str());
+  const std::string unit = reduced1d::metric_unit(sw.metric);
+  const double bv = reduced1d::metric_value(results[best].metrics, sw.metric);
+  char value[64];
+  if (unit == "m" || unit == "m/s" || unit == "m^3" || unit == "s")
+    std::snprintf(value, sizeof value, "%s", si(bv, unit).c_str());
+  else
+    std::snprintf(value, sizeof value, "%.4g%s%s", bv, unit.empty() ? "" : " ", unit.c_str());
+  std::printf("best by %s (%s): design %ld: %s -> %s\n  -> %s/designs.csv, %s/screen.png\n", sw.metric.c_str(),
+              sw.maximize ? "max" : "min", best, describe(sw, best).c_str(), value, out.c_str(), out.c_str());
   return 0;
 }
 

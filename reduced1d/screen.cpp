@@ -45,8 +45,21 @@ std::vector<DesignOutcome> run_designs(const std::vector<Params>& designs, int j
 const std::vector<std::string>& metric_names() {
   static const std::vector<std::string> names = {
       "displacement_m",      "mean_velocity_m_per_s", "body_lengths_per_s", "pumped_volume_m3",
-      "max_velocity_m_per_s", "final_velocity_m_per_s", "mean_cycle_time_s"};
+      "max_velocity_m_per_s", "final_velocity_m_per_s", "mean_cycle_time_s", "displacement_per_cycle_m",
+      "mean_velocity_per_cycle_m_per_s", "directed_to_diffusive_ratio"};
   return names;
+}
+
+std::string metric_unit(const std::string& name) {
+  auto ends = [&](const std::string& suffix) {
+    return name.size() >= suffix.size() && name.compare(name.size() - suffix.size(), suffix.size(), suffix) == 0;
+  };
+  if (name == "body_lengths_per_s") return "body lengths/s";
+  if (ends("_m_per_s")) return "m/s";
+  if (ends("_m3")) return "m^3";
+  if (ends("_m")) return "m";
+  if (ends("_s")) return "s";
+  return "";
 }
 
 double metric_value(const Metrics& m, const std::string& name) {
@@ -57,6 +70,9 @@ double metric_value(const Metrics& m, const std::string& name) {
   if (name == "max_velocity_m_per_s") return m.max_velocity_m_per_s;
   if (name == "final_velocity_m_per_s") return m.final_velocity_m_per_s;
   if (name == "mean_cycle_time_s") return m.mean_cycle_time_s;
+  if (name == "displacement_per_cycle_m") return m.displacement_per_cycle_m;
+  if (name == "mean_velocity_per_cycle_m_per_s") return m.mean_velocity_per_cycle_m_per_s;
+  if (name == "directed_to_diffusive_ratio") return m.directed_to_diffusive;
   throw std::logic_error("unknown metric " + name);
 }
 

@@ -24,6 +24,8 @@ std::vector<DesignOutcome> run_designs(const std::vector<Params>& designs, int j
 
 /// Metric names a sweep may rank designs by.
 const std::vector<std::string>& metric_names();
+/// Unit of a metric for printouts ("m/s", "m", "m^3", "s", "body lengths/s"; "" if none).
+std::string metric_unit(const std::string& name);
 double metric_value(const Metrics& m, const std::string& name);
 
 }  // namespace swim::reduced1d
