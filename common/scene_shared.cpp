@@ -73,7 +73,7 @@ WallSpec read_wall(Reader& top, double R0) {
     w.calibration = r.text("calibration", "");
   if (one_of(r, {"mass_per_area", "mass_per_length"}, "mass_per_length") == "mass_per_area")
     w.mass_per_area = r.quantity("mass_per_area", "kg/m^2", "", Range::positive());
-  else  // notes section 1: mass per unit length m_l = 2 pi R0 m
+  else  // source-equations.md §1: mass per unit length m_l = 2 pi R0 m
     w.mass_per_area = r.quantity("mass_per_length", "kg/m", "2.25e-3 ug/um", Range::positive()) / (2.0 * M_PI * R0);
   r.finish();
   return w;

@@ -38,7 +38,7 @@ struct WallSpec {
   std::string stiffness;    ///< "C1", "spring_constant" or "calibration"
   double value = 0;         ///< C1 [Pa/m] or k_s [N/m]; 0 for a calibration file
   std::string calibration;  ///< path, for "calibration"
-  double mass_per_area = 0; ///< [kg/m^2] (mass_per_length converted with 2 pi R0, notes section 1)
+  double mass_per_area = 0; ///< [kg/m^2] (mass_per_length converted with 2 pi R0, source-equations.md §1)
 };
 /// Reads (and finishes) the wall section.
 WallSpec read_wall(Reader& top, double R0);

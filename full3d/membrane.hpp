@@ -14,7 +14,7 @@
 // theta_l is the signed angle between the outward normals of the two
 // triangles sharing interior edge l (positive for a convex fold), L_l the
 // current edge length. BendingForm::ReferenceAngle uses theta0_l of the
-// reference mesh (notes section 6: the undeformed tube is an equilibrium);
+// reference mesh (source-equations.md §6: the undeformed tube is an equilibrium);
 // BendingForm::Printed uses theta0_l = 0 as eq. (8) is printed. Boundary
 // edges (open ends) carry no bending term. Forces F_i = -dE/dX_i (eq. 9) are the
 // exact analytic gradients.

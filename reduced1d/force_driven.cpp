@@ -245,12 +245,12 @@ struct ForceModel {
 
   /// Face resistances and fluxes (faces j = 0..N at z = j h; p = 0 at both ends), and the
   /// swimmer velocity U of the force-free model.
-  void fluxes() {
+  void fluxes(bool derivatives = false) {
     if (confined) {
       Rpt[0] = Rb0;
       Rpt[N + 1] = RbL;
       for (int i = 0; i < N; ++i) Rpt[i + 1] = R[i], Pipt[i + 1] = p[i];
-      geometry_ok = sys->geometry(Rpt.data());
+      geometry_ok = sys->geometry(Rpt.data(), derivatives);
       if (!geometry_ok) {
         std::fill(Q.begin(), Q.end(), std::nan(""));
         U = std::nan("");
@@ -438,7 +438,7 @@ struct ForceModel {
   template <class Band>
   int jacobian(const double* y, Band band, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
-    fluxes();
+    fluxes(true);
     FluxSens& s = sens_;
     flux_sensitivities(s, true);
     const double c = 1.0 / (h * pi * R0 * R0);
@@ -585,7 +585,7 @@ struct ForceModel {
   /// difference quotients with the segment actuation frozen). Same layout as jacobian().
   int residual_low_rank(const double* y, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
-    fluxes();
+    fluxes(true);
     FluxSens& s = sens_;
     flux_sensitivities(s, false);
     const double cv = 1.0 / (m * Vel_s);

@@ -89,13 +89,17 @@ ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, doubl
       pts_(npoints),
       dpts_(npoints) {}
 
-bool ConfinedSystem::geometry(const double* Rpt) {
+bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   for (int p = 0; p < np; ++p) {
     const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
     if (!(Ro < Rc * (1.0 - 1e-3)) || !(Ri > 0)) return false;
-    const AnnulusPointD a = annulus_point_d(Ro, Rc, mu);
-    pts_[p] = a.f;
-    dpts_[p] = a.df;
+    if (derivatives) {
+      const AnnulusPointD a = annulus_point_d(Ro, Rc, mu);
+      pts_[p] = a.f;
+      dpts_[p] = a.df;
+    } else {
+      pts_[p] = annulus_point<double>(Ro, Rc, mu);
+    }
   }
   for (int j = 0; j < ni; ++j) {
     const double ai = Rpt[j] - a_in, bi = Rpt[j + 1] - a_in, ab = ai * bi;

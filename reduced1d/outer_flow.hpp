@@ -94,7 +94,8 @@ class ConfinedSystem {
 
   /// Interval coefficients for the point radii (returns false if the wall reaches the
   /// container or the lumen closes: then nothing else is valid).
-  bool geometry(const double* Rpt);
+  /// `derivatives`: also the d/dR_o of the point functions (for the Newton matrix).
+  bool geometry(const double* Rpt, bool derivatives = false);
   void transmural(const double* Pi, double F_ext = 0.0);
   /// d/dR_o of the point functions at point p (valid after geometry()).
   const AnnulusPoint<double>& point_derivative(int p) const { return dpts_[p]; }

@@ -55,10 +55,10 @@ enum class ContainerKind { Cylinder, Duct, Box };
 /// Pressure gradient used in the swimmer-velocity relation (45)/(51) (paper mode).
 enum class Closure {
   TubeLaw,  ///< paper: dp/dz = C1 dR/dz (eq. 50)
-  Flow,     ///< notes section 3: dp/dz from lubrication flow with open ends
+  Flow,     ///< source-equations.md §3: dp/dz from lubrication flow with open ends
 };
 
-/// Which force balance defines W (notes section 4).
+/// Which force balance defines W (source-equations.md §4).
 enum class Balance { PerArea, PerLength };
 
 /// External drag on the swimmer body in paper mode. Not in the paper.
@@ -106,7 +106,7 @@ struct SineWave {
   double speed = 1.0e-5;               ///< s > 0 [m/s]
 };
 
-/// Force-driven protocol of Section 3 mapped to 1D (notes section 7).
+/// Force-driven protocol of Section 3 mapped to 1D (source-equations.md §7).
 /// Segment k = 0..n-1 covers [z_k, z_{k+1}); the rightmost segment (k = n-1) is the first one
 /// driven and the shortest: its length is first_ratio times the length of each other segment.
 struct Protocol {

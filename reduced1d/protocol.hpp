@@ -1,4 +1,4 @@
-// Discrete state and actuation laws of the Section-3 protocol mapped to 1D (notes section 7).
+// Discrete state and actuation laws of the Section-3 protocol mapped to 1D (source-equations.md §7).
 //
 // Contraction (phase 0): segments k = n-1 (rightmost, shortest) down to 0 are driven in turn
 // with q = +protocol.q until their MEAN cell radius reaches R_f (a located root: a discrete

@@ -46,7 +46,7 @@ TEST(Reduced1dForceDriven, UniformStaticLoadRelaxesToTubeLawRadius) {
     const int N = 40;
     const std::size_t last = r.radius_times.size() - 1;
     for (int i = 0; i < N; ++i) EXPECT_NEAR(r.radius[last * N + i], R_eq, 1e-4 * p.geometry.R0) << i;
-    // Calibration relation of notes section 1: C1 = pressure / (R0 - R).
+    // Calibration relation of source-equations.md §1: C1 = pressure / (R0 - R).
     const double R_mid = r.radius[last * N + N / 2];
     EXPECT_NEAR(q / (p.geometry.R0 - R_mid), p.wall.C1, 1e-3 * p.wall.C1);
     EXPECT_TRUE(all_finite(r));

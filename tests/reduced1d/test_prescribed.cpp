@@ -1,5 +1,5 @@
-// Prescribed Step/Sine waves: closed form (52), sharp-front limit (note 2), per-length vs
-// per-area balance (note 4), volume conservation and grid convergence of the flow closure.
+// Prescribed Step/Sine waves: closed form (52), sharp-front limit (source-equations.md §2), per-length vs
+// per-area balance (source-equations.md §4), volume conservation and grid convergence of the flow closure.
 #include <gsl/gsl_integration.h>
 #include <gtest/gtest.h>
 
