@@ -191,6 +191,11 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
       q.finish();
     }
     p.wall.inertia = m.boolean("wall_inertia", false);
+    if (p.wall.inertia && p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.outer == OuterFlow::Confined)
+      throw InputError(m.path("wall_inertia"), "true",
+                       "wall inertia is available with model1d.outer_flow = \"unbounded\" and model1d.model = "
+                       "\"paper\"; the confined force-free model runs without it (at Re ~ 1e-6 the wall's inertia "
+                       "is negligible: its time scale 2 pi sqrt(m / C1) is below 0.1 ms)");
     if (p.wall.inertia && !forced)
       throw InputError(m.path("wall_inertia"), "true", "wall inertia only applies to wave.kind = \"force_driven\" "
                                                        "(a prescribed wave fixes R(z,t))");

@@ -51,6 +51,8 @@ void validate(const Params& p) {
   }
   require(p.swimmer.a_in >= 0 && p.swimmer.a_in < 0.5 * R0, "model1d.hydraulic_offsets.inner", p.swimmer.a_in,
           "must be in [0, R0/2)");
+  if (p.wall.inertia && p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.outer == OuterFlow::Confined)
+    throw InputError("model1d.wall_inertia", "true", "not available with the confined force-free model");
   require(p.swimmer.a_out >= 0, "model1d.hydraulic_offsets.outer", p.swimmer.a_out, "must be >= 0");
   switch (p.wave) {
     case WaveKind::Step:
