@@ -55,18 +55,7 @@ std::pair<double, double> hydraulic_offsets_from_calibration(const std::string& 
 }
 
 double c1_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir) {
-  namespace fs = std::filesystem;
-  fs::path p(path);
-  if (p.is_relative() && !fs::exists(p)) p = fs::path(scene_dir) / path;
-  std::ifstream in(p);
-  if (!in) throw InputError(key, "\"" + path + "\"", "calibration file not found (relative paths are tried from the "
-                                                     "working directory, then from the scene's directory)");
-  json j;
-  try {
-    j = json::parse(in);
-  } catch (const json::parse_error& e) {
-    throw InputError(key, "\"" + path + "\"", std::string("calibration file is not valid JSON: ") + e.what());
-  }
+  const json j = load_calibration(key, path, scene_dir);
   if (!j.is_object() || !j.contains("C1_Pa_per_m") || !j["C1_Pa_per_m"].is_number())
     throw InputError(key, "\"" + path + "\"", "calibration file must hold a number \"C1_Pa_per_m\"");
   const double c1 = j["C1_Pa_per_m"].get<double>();
