@@ -875,7 +875,7 @@ class IdaBackend final : public Backend {
     const double* id = sun::data(id_.get());
     if (pb_.M.res(y, zero_.data(), tmp_.data()) != 0)
       throw NumericalError("non-finite state at a protocol switch",
-                           "tighten numerics.rtol or lower protocol.q", t);
+                           "tighten numerics1d.rtol or lower the actuation (protocol.pressure)", t);
     for (int k = 0; k < pb_.M.n; ++k) yp[k] = id[k] > 0 ? -tmp_[k] : 0.0;
     void* mem = mem_.get();
     sun::check(IDAReInit(mem, t, y_.get(), yp_.get()), "IDAReInit", last_msg);
@@ -1073,7 +1073,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
       throw NumericalError(
           "tube radius collapsed to zero at z = " + fmt(left ? 0.0 : M.L) +
               " m: under its actuation the open end has no positive rest radius (R0 - q/C1 <= 0)",
-          "lower protocol.q (the actuation pressure / total force) below C1 R0 = " + fmt(M.C1 * M.R0) +
+          "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) below C1 R0 = " + fmt(M.C1 * M.R0) +
               " Pa or raise wall.C1",
           tt);
     }
@@ -1099,11 +1099,11 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     check_ends(0.0);
     if (!fixed && P.protocol.q <= M.C1 * (M.R0 - P.protocol.R_f)) {
       throw NumericalError(
-          "the actuation cannot contract the tube to R_f: under protocol.q = " + fmt(P.protocol.q) +
+          "the actuation cannot contract the tube to R_f: under the actuation pressure q = " + fmt(P.protocol.q) +
               " Pa the static radius R0 - q/C1 = " + fmt(M.R0 - P.protocol.q / M.C1) +
               " m is not below R_f = " + fmt(P.protocol.R_f) + " m",
-          "raise protocol.q above C1 (R0 - R_f) = " + fmt(M.C1 * (M.R0 - P.protocol.R_f)) +
-              " Pa or raise protocol.R_f",
+          "raise the actuation (protocol.pressure) above C1 (R0 - R_f) = " + fmt(M.C1 * (M.R0 - P.protocol.R_f)) +
+              " Pa or raise wave.contracted_ratio",
           0.0);
     }
     if (M.inertia) be->restart(0.0);  // consistent initial derivatives (IDACalcIC)
@@ -1117,14 +1117,14 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
       if (t_stop - tout < 1e-9 * dt_out) tout = t_stop;
       const long used = steps_before + be->steps();
       const long remaining = P.numerics.max_steps - used;
-      if (remaining <= 0) throw NumericalError("integrator step budget numerics.max_steps exhausted",
-                                               "raise numerics.max_steps or loosen numerics.rtol", t);
+      if (remaining <= 0) throw NumericalError("integrator step budget numerics1d.max_steps exhausted",
+                                               "raise numerics1d.max_steps or loosen numerics1d.rtol", t);
       be->set_max_steps(remaining);
       const int st = be->advance(tout, t);
       if (st == -1)
-        throw NumericalError("integrator step budget numerics.max_steps exhausted (" +
+        throw NumericalError("integrator step budget numerics1d.max_steps exhausted (" +
                                  std::to_string(P.numerics.max_steps) + " steps)",
-                             "raise numerics.max_steps or loosen numerics.rtol/atol_scale", t);
+                             "raise numerics1d.max_steps or loosen numerics1d.rtol or numerics1d.atol_scale", t);
       if (st == 1) {
         found.assign(std::max(machine.root_count(), 2), 0);
         be->root_info(found.data());
@@ -1134,7 +1134,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
           const int imin = int(std::min_element(Rcells.begin(), Rcells.end()) - Rcells.begin());
           record(t, be->y());
           throw NumericalError("tube radius collapsed to zero at z = " + fmt(res.z[imin]) + " m",
-                               "lower protocol.q (pressure / total force) or raise protocol.R_f", t);
+                               "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) or raise wave.contracted_ratio", t);
         }
         if (machine.cycle_completed()) {
           res.cycle_end.push_back(t);
@@ -1157,14 +1157,17 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
         continue;
       }
       if (!record(t, be->y()))
-        throw NumericalError("non-finite state", "tighten numerics.rtol or refine numerics.cells", t);
+        throw NumericalError("non-finite state", P.numerics.cells < 100000
+                                                     ? "tighten numerics1d.rtol or refine numerics1d.cells"
+                                                     : "tighten numerics1d.rtol",
+                             t);
       if (tout >= t_stop) {
         if (stop_fails)
           throw NumericalError(
               "the protocol did not complete " + std::to_string(P.protocol.cycles) +
                   " cycle(s) by t = " + fmt(t_stop) + " s (the end_time bound; phase " +
                   std::to_string(machine.phase()) + ")",
-              "raise protocol.q, protocol.delta or protocol.energy_tol, or set duration", t);
+              "raise the actuation (protocol.pressure), protocol.tolerance_ratio or protocol.energy_tolerance, or set time.duration", t);
         done = true;
       }
       ++k;
@@ -1175,11 +1178,11 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     if (M.confined && !M.geometry_ok)
       res.failure = NumericalError(
           "the tube wall reached the container wall (outer hydraulic radius R + a_out >= container radius)",
-          "raise container.radius or lower protocol.q (the recovery overshoots R0)", t);
+          "raise container.radius or lower the actuation (protocol.pressure) (the recovery overshoots R0)", t);
     else res.failure = NumericalError(
         std::string(M.inertia ? "IDA" : "CVODE") + " failed: " + e.what(),
-        "tighten numerics.rtol/atol_scale or raise numerics.cells; if the radius nearly closes, "
-        "lower protocol.q or raise protocol.R_f",
+        "tighten numerics1d.rtol or numerics1d.atol_scale or raise numerics1d.cells; if the radius nearly closes, "
+        "lower the actuation (protocol.pressure) or raise wave.contracted_ratio",
         t);
   }
   if (be) be->harvest(res.stats);

@@ -254,16 +254,16 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress) {
       const long remaining = p.numerics.max_steps - nst;
       if (remaining <= 0)
         throw NumericalError("integrator step budget exhausted",
-                             "raise numerics.max_steps or loosen numerics.rtol/atol_scale", t);
+                             "raise numerics1d.max_steps or loosen numerics1d.rtol or numerics1d.atol_scale", t);
       sun::check(CVodeSetMaxNumSteps(mem, remaining), "CVodeSetMaxNumSteps");
       int flag = CVode(mem, tout, y.get(), &t, CV_NORMAL);
       if (flag == CV_TOO_MUCH_WORK)
-        throw NumericalError("integrator step budget numerics.max_steps exhausted",
-                             "raise numerics.max_steps or loosen numerics.rtol/atol_scale", t);
+        throw NumericalError("integrator step budget numerics1d.max_steps exhausted",
+                             "raise numerics1d.max_steps or loosen numerics1d.rtol or numerics1d.atol_scale", t);
       sun::check(flag, "CVode", last_msg);
       if (!record(t, sun::data(y.get())))
         throw NumericalError("non-finite swimmer quantities",
-                             "tighten numerics.rtol or check the wave parameters", t);
+                             "tighten numerics1d.rtol or check the wave parameters", t);
       if (tout >= t_end) break;
       ++k;
     }
@@ -283,7 +283,7 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress) {
     res.failure = e;
   } catch (const sun::SundialsError& e) {
     res.failure = NumericalError("CVODE failed on the prescribed-wave quadratures: " + std::string(e.what()),
-                                 "tighten or loosen numerics.rtol/atol_scale, or check the wave parameters", t);
+                                 "tighten or loosen numerics1d.rtol or numerics1d.atol_scale, or check the wave parameters", t);
   }
   return res;
 }

@@ -26,23 +26,23 @@ void require(bool ok, const char* key, double value, const char* allowed) {
 
 void validate(const Params& p) {
   const double R0 = p.geometry.R0;
-  require(p.geometry.R0 > 0 && std::isfinite(R0), "geometry.R0", R0, "must be a positive length");
-  require(p.geometry.L > 0 && std::isfinite(p.geometry.L), "geometry.L", p.geometry.L,
+  require(p.geometry.R0 > 0 && std::isfinite(R0), "swimmer.radius", R0, "must be a positive length");
+  require(p.geometry.L > 0 && std::isfinite(p.geometry.L), "swimmer.length", p.geometry.L,
           "must be a positive length");
-  require(p.fluid.mu > 0 && std::isfinite(p.fluid.mu), "fluid.mu", p.fluid.mu, "must be positive");
-  require(p.fluid.rho >= 0 && std::isfinite(p.fluid.rho), "fluid.rho", p.fluid.rho, "must be >= 0");
+  require(p.fluid.mu > 0 && std::isfinite(p.fluid.mu), "fluid.viscosity", p.fluid.mu, "must be positive");
+  require(p.fluid.rho >= 0 && std::isfinite(p.fluid.rho), "fluid.density", p.fluid.rho, "must be >= 0");
   require(p.wall.C1 > 0 && std::isfinite(p.wall.C1), "wall.C1", p.wall.C1, "must be positive");
-  require(p.wall.m > 0 && std::isfinite(p.wall.m), "wall.m", p.wall.m, "must be positive");
-  require(p.numerics.cells >= 2, "numerics.cells", p.numerics.cells, "must be >= 2");
-  require(p.numerics.rtol > 0 && p.numerics.rtol < 1, "numerics.rtol", p.numerics.rtol,
+  require(p.wall.m > 0 && std::isfinite(p.wall.m), "wall.mass_per_area", p.wall.m, "must be positive");
+  require(p.numerics.cells >= 2, "numerics1d.cells", p.numerics.cells, "must be >= 2");
+  require(p.numerics.rtol > 0 && p.numerics.rtol < 1, "numerics1d.rtol", p.numerics.rtol,
           "must be in (0, 1)");
-  require(p.numerics.atol_scale > 0 && p.numerics.atol_scale < 1, "numerics.atol_scale",
+  require(p.numerics.atol_scale > 0 && p.numerics.atol_scale < 1, "numerics1d.atol_scale",
           p.numerics.atol_scale, "must be in (0, 1)");
-  require(p.numerics.output_interval > 0, "numerics.output_interval", p.numerics.output_interval,
+  require(p.numerics.output_interval > 0, "time.output_interval", p.numerics.output_interval,
           "must be positive");
-  require(p.numerics.max_steps > 0, "numerics.max_steps", double(p.numerics.max_steps),
+  require(p.numerics.max_steps > 0, "numerics1d.max_steps", double(p.numerics.max_steps),
           "must be positive");
-  require(p.duration >= 0 && std::isfinite(p.duration), "duration", p.duration, "must be >= 0");
+  require(p.duration >= 0 && std::isfinite(p.duration), "time.duration", p.duration, "must be >= 0");
   if (p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.outer == OuterFlow::Confined) {
     require(p.container.radius_eff > R0 + p.swimmer.a_out, "container.radius", p.container.radius,
             "must exceed swimmer.radius + model1d.hydraulic_offsets.outer");
@@ -56,27 +56,27 @@ void validate(const Params& p) {
   require(p.swimmer.a_out >= 0, "model1d.hydraulic_offsets.outer", p.swimmer.a_out, "must be >= 0");
   switch (p.wave) {
     case WaveKind::Step:
-      require(p.step.R_min > 0, "step.R_min", p.step.R_min, "must be positive");
-      require(p.step.speed > 0, "step.speed", p.step.speed, "must be positive");
-      require(p.step.width > 0, "step.width", p.step.width, "must be positive");
+      require(p.step.R_min > 0, "wave.contracted_radius", p.step.R_min, "must be positive");
+      require(p.step.speed > 0, "wave.speed", p.step.speed, "must be positive");
+      require(p.step.width > 0, "wave.width", p.step.width, "must be positive");
       break;
     case WaveKind::Sine:
-      require(p.sine.amplitude >= 0 && p.sine.amplitude < R0, "sine.amplitude", p.sine.amplitude,
+      require(p.sine.amplitude >= 0 && p.sine.amplitude < R0, "wave.contracted_radius", p.sine.amplitude,
               "must be in [0, R0)");
-      require(p.sine.wavelength > 0, "sine.wavelength", p.sine.wavelength, "must be positive");
-      require(p.sine.speed > 0, "sine.speed", p.sine.speed, "must be positive");
+      require(p.sine.wavelength > 0, "wave.wavelength", p.sine.wavelength, "must be positive");
+      require(p.sine.speed > 0, "wave.speed", p.sine.speed, "must be positive");
       break;
     case WaveKind::ForceDriven: {
       const auto& q = p.protocol;
-      require(q.R_f > 0 && q.R_f < R0, "protocol.R_f", q.R_f, "must be in (0, R0)");
-      require(q.q > 0 && std::isfinite(q.q), "protocol.q", q.q, "must be a positive pressure");
+      require(q.R_f > 0 && q.R_f < R0, "wave.contracted_radius", q.R_f, "must be in (0, R0)");
+      require(q.q > 0 && std::isfinite(q.q), "protocol.pressure", q.q, "must be a positive pressure");
       require(q.segments >= 2, "protocol.segments", q.segments, "must be >= 2");
-      require(q.first_ratio > 0 && std::isfinite(q.first_ratio), "protocol.first_ratio",
+      require(q.first_ratio > 0 && std::isfinite(q.first_ratio), "protocol.first_segment_ratio",
               q.first_ratio, "must be positive");
       require(q.delta > 0 && q.delta < 0.2 * R0 && q.delta < q.R_f && q.delta < R0 - q.R_f,
-              "protocol.delta", q.delta,
+              "protocol.tolerance_ratio", q.delta,
               "must be positive and below 0.2 R0, R_f and R0 - R_f (the bands must be ordered)");
-      require(q.energy_tol > 0 && q.energy_tol < 1, "protocol.energy_tol", q.energy_tol,
+      require(q.energy_tol > 0 && q.energy_tol < 1, "protocol.energy_tolerance", q.energy_tol,
               "must be in (0, 1)");
       require(q.cycles >= 1, "protocol.cycles", q.cycles, "must be >= 1");
       const auto b = segment_bounds(p);
@@ -84,7 +84,7 @@ void validate(const Params& p) {
       for (int k = 0; k < q.segments; ++k) shortest = std::min(shortest, b[k + 1] - b[k]);
       const int needed = static_cast<int>(std::ceil(p.geometry.L / shortest - 1e-9));
       if (p.numerics.cells < needed)
-        throw InputError("numerics.cells", std::to_string(p.numerics.cells),
+        throw InputError("numerics1d.cells", std::to_string(p.numerics.cells),
                          "must be >= " + std::to_string(needed) +
                              " so that the cell width does not exceed the shortest protocol segment");
       break;
