@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
 #include <fstream>
 
 #include "common/output.hpp"
@@ -102,7 +103,16 @@ TEST(Executable, ScreenRanksASmallSweep) {
                         {"wave.contracted_ratio", {0.4, 0.8}}}},
                       {"metric", "displacement_m"}};
   std::ofstream(dir / "sweep.json") << sweep.dump();
-  ASSERT_EQ(run("screen \"" + (dir / "sweep.json").string() + "\" --quiet --jobs 2 --out \"" + (dir / "out").string() + "\""), 0);
+  const std::string printed = (dir / "stdout.txt").string();
+  ASSERT_EQ(std::system(("\"" SWIM_BINARY_DIR "/bin/swim\" screen \"" + (dir / "sweep.json").string() +
+                         "\" --quiet --jobs 2 --out \"" + (dir / "out").string() + "\" > \"" + printed + "\" 2>&1")
+                            .c_str()),
+            0);
+  {  // the best value is printed with an SI-prefixed unit, e.g. "-> 16.2 nm"
+    std::ifstream o(printed);
+    const std::string text((std::istreambuf_iterator<char>(o)), std::istreambuf_iterator<char>());
+    EXPECT_NE(text.find("nm\n"), std::string::npos) << text;
+  }
   std::ifstream in(dir / "out" / "screen.json");
   const json s = json::parse(in);
   EXPECT_EQ(s["designs"], 4);
