@@ -229,6 +229,22 @@ TEST(OuterFlow, ReciprocalStrokesGiveNoNetDisplacement) {
   }, T1, T1 + T2, 20);
   EXPECT_GT(std::abs(forward), 1e-3 * kR0) << "the asymmetric contraction moves the tube";
   EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
+  // uniform contraction and release: front-back symmetric at every instant, so U = 0 throughout
+  double umax = 0;
+  for (double t : {0.01, 0.05, 0.09}) {
+    const double x = pi * t / (2 * T1);
+    for (int k = 0; k < N + 2; ++k) R[k] = kR0 - a * std::sin(x) * std::sin(x);
+    double cum = 0;
+    for (int i = 0; i < N; ++i) {
+      s[i] = cum;
+      cum += h * 2 * pi * R[i + 1] * (-a * 2 * std::sin(x) * std::cos(x) * pi / (2 * T1));
+    }
+    s[N] = cum;
+    ASSERT_TRUE(sys.geometry(R.data()));
+    sys.kinematic(s.data());
+    umax = std::max(umax, std::abs(sys.U));
+  }
+  EXPECT_LT(umax, 1e-12 * std::abs(forward) / T1) << "uniform contraction: no motion at any instant";
   // the travelling wave over one period L / s
   const double wave = integrate([&](double t) { return velocity(0, 0, true, t); }, 0.0, kL / 1e-5, 40);
   EXPECT_GT(std::abs(wave), 1e-4 * std::abs(forward));
