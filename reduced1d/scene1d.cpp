@@ -47,6 +47,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   resolved = json::object();
   Reader top(scene, "", resolved);
   p.name = top.text("name", "unnamed");
+  scene::check_name(p.name);
   top.text("description", "");
 
   const scene::Body body = scene::read_body(top);
@@ -158,6 +159,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     t.finish();
   }
   top.pass_through("full3d");
+  scene::read_output(top);
   top.finish();
   return p;
 }

@@ -1,0 +1,17 @@
+#include "reduced1d/scene1d_keys.hpp"
+
+namespace swim::reduced1d {
+
+const scene::json& section_keys() {
+  static const scene::json keys = {
+      {"model1d",
+       {{"closure", "choice:tube_law|flow"},
+        {"balance", "choice:per_area|per_length"},
+        {"thrust", "boolean"},
+        {"external_drag", "choice:none|resistive_force"},
+        {"wall_inertia", "boolean"}}},
+      {"numerics1d", {{"cells", "integer"}, {"rtol", "number"}, {"atol_scale", "number"}, {"max_steps", "integer"}}}};
+  return keys;
+}
+
+}  // namespace swim::reduced1d
