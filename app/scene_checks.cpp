@@ -36,6 +36,10 @@ void check_other_tier(const scene::json& sc, const std::string& tier) {
 }
 
 OutputEstimate estimate_output(const reduced1d::Params& p) {
+  // The span is known for a given duration and for a prescribed wave (its transit time);
+  // a force-driven run with duration "auto" lasts until its cycles complete, which is only
+  // known when it ends (end_time() is a loose upper bound): no estimate.
+  if (!(p.duration > 0) && p.wave == reduced1d::WaveKind::ForceDriven) return {0.0, "time.duration"};
   const double span = reduced1d::end_time(p);
   const double samples = std::floor(span / p.numerics.output_interval) + 2;
   const double series = samples * 12 * kCsvValue;
@@ -44,7 +48,10 @@ OutputEstimate estimate_output(const reduced1d::Params& p) {
 }
 
 OutputEstimate estimate_output(const full3d::Params3d& p) {
-  const double span = p.duration > 0 ? p.duration : p.time_limit;
+  // duration "auto": the run ends with its cycles, far below the full3d.time_limit cap as a
+  // rule; the span is unknown before the run, so there is no estimate
+  if (!(p.duration > 0)) return {0.0, "time.duration"};
+  const double span = p.duration;
   const auto frames = [&](double interval) { return std::floor(span / std::max(interval, p.dt)) + 2; };
   // mesh size as the reference mesh (make_mesh): rings of n_theta nodes, edges below factor h/2
   const double edge = p.spacing_factor * 0.5 * p.h;

@@ -17,7 +17,8 @@ namespace swim::app {
 void check_other_tier(const scene::json& scene, const std::string& running_tier);
 
 /// Estimated bytes a run writes (series, radius samples, VTK frames), and the key whose
-/// interval dominates the estimate.
+/// interval dominates the estimate. Zero when the run's span is not known before it runs
+/// (force-driven with time.duration "auto").
 struct OutputEstimate {
   double bytes = 0;
   std::string key;

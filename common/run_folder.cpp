@@ -115,7 +115,6 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
          it.increment(ec)) {
       const std::string rel = fs::relative(it->path(), dir_, ec).generic_string();
       if (rel == kLock) continue;
-      if (it->is_directory(ec) && rel == "vtk") continue;
       (is_result_name(rel) || listed.count(rel) ? results : foreign).push_back(rel);
     }
     if (ec) throw InputError(o.key, shown, "cannot list the output folder: " + ec.message());

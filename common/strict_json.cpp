@@ -59,6 +59,11 @@ class Builder {
       // "[json.exception.parse_error.101] parse error at line 3, column 7: ..." -> keep the part
       // after the id; the last token is echoed through message_text by InputError.
       if (const auto p = m.find("] "); p != std::string::npos) m = m.substr(p + 2);
+      if (ex.id == 406) {  // out_of_range: a number beyond the range of a double
+        error_ = Problem{where(), last_token.empty() ? "" : "'" + last_token + "'",
+                         "number does not fit a double (magnitude above 1.8e308)"};
+        return false;
+      }
       error_ = Problem{where(), last_token.empty() ? "" : "'" + last_token + "'",
                        "is not valid JSON (" + m + ") near byte " + std::to_string(position)};
     }
