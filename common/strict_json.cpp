@@ -64,8 +64,16 @@ class Builder {
                          "number does not fit a double (magnitude above 1.8e308)"};
         return false;
       }
-      error_ = Problem{where(), last_token.empty() ? "" : "'" + last_token + "'",
-                       "is not valid JSON (" + m + ") near byte " + std::to_string(position)};
+      // A bad string (not UTF-8, a control character) belongs to its key; any other syntax
+      // error to the text as a whole, with the key path it was found at.
+      const std::string at = where();
+      if (m.find("invalid string") != std::string::npos)
+        error_ = Problem{at, last_token.empty() ? "" : "'" + last_token + "'",
+                         "is not valid JSON text (" + m + ") near byte " + std::to_string(position)};
+      else
+        error_ = Problem{what_, last_token.empty() ? "" : "'" + last_token + "'",
+                         "is not valid JSON (" + m + ") near byte " + std::to_string(position) +
+                             (at == what_ ? "" : ", in " + at)};
     }
     return false;
   }
