@@ -1,3 +1,5 @@
+#include <sys/statvfs.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -49,7 +51,11 @@ namespace {
     std::fprintf(stderr, "swim: partial results in %s are %s\n", folder.dir().c_str(),
                  marked ? "marked failed in summary.json" : "incomplete (summary.json removed)");
     if (dynamic_cast<const OutputError*>(&e)) throw;
-    throw OutputError(m.substr(13), "write failed");
+    // "cannot write checkpoint <path>": name the file and say whether the disk is full
+    struct statvfs fs_stat {};
+    const bool full = ::statvfs(folder.dir().c_str(), &fs_stat) == 0 && fs_stat.f_bavail == 0;
+    const std::string file = m.find("checkpoint") != std::string::npos ? "checkpoint.bin" : m.substr(13);
+    throw OutputError(file, full ? "disk full" : "write error");
   }
   if (!dynamic_cast<const InputError*>(&e)) folder.mark_failed(m);
   throw;

@@ -173,11 +173,7 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
     AtomicFile f((fs::path(dir_) / kOwner).string());
     f.stream() << rec.dump(2) << "\n";
     f.commit();
-  } catch (const OutputError& e) {
-    ::close(lock_fd_);
-    lock_fd_ = -1;
-    throw InputError(o.key, shown, std::string("cannot take the output folder: ") + e.what());
-  } catch (...) {
+  } catch (...) {  // InputError (exit 2), or OutputError (exit 3: the run's record cannot be written)
     ::close(lock_fd_);
     lock_fd_ = -1;
     throw;

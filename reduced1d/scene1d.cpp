@@ -32,7 +32,7 @@ double c1_from_calibration(const std::string& key, const std::string& path, cons
   json j;
   try {
     j = json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, and numbers beyond a double (out_of_range)
     throw InputError(key, "\"" + path + "\"", std::string("calibration file is not valid JSON: ") + e.what());
   }
   if (!j.is_object() || !j.contains("C1_Pa_per_m") || !j["C1_Pa_per_m"].is_number())

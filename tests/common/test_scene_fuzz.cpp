@@ -212,9 +212,14 @@ Outcome read_like_run(const std::string& text, const std::vector<std::string>& s
     const auto p = swim::reduced1d::read_scene(sc, resolved);
     swim::app::check_other_tier(sc, "1d");
     swim::app::check_output_size(swim::app::estimate_output(p), sc);
-    // the resolved scene is itself a valid scene (it is echoed into every run folder)
+    // the resolved scene is itself a valid scene (it is echoed into every run folder): a
+    // rejection here is a failure of the reader, not of the case
     json again;
-    swim::reduced1d::read_scene(resolved, again);
+    try {
+      swim::reduced1d::read_scene(resolved, again);
+    } catch (const InputError& e) {
+      throw std::logic_error(std::string("the resolved scene of an accepted scene is rejected: ") + e.what());
+    }
   }
   return Outcome::Accepted;
 }
