@@ -149,8 +149,13 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
         throw InputError(o.key, shown,
                          "holds files swim did not write (" + list(foreign) +
                              "); choose an empty or new folder (they are never removed, even with --overwrite)");
-      const bool same_run = owner.is_object() && owner.value("scene_hash", std::string()) == hash &&
-                            old_tier == o.tier && old_status.rfind("running", 0) != 0 && !old_status.empty();
+      // the scene of the old run: its record, or (folders written before records existed) its summary
+      const std::string old_hash = owner.is_object() ? owner.value("scene_hash", std::string())
+                                   : old_summary.is_object() && old_summary.contains("scene")
+                                       ? json_hash(old_summary["scene"])
+                                       : "";
+      const bool same_run =
+          old_hash == hash && old_tier == o.tier && old_status.rfind("running", 0) != 0 && !old_status.empty();
       if (!o.overwrite && !same_run)
         throw InputError(o.key, shown,
                          "holds the results of another run (" + (old_tier.empty() ? "" : old_tier + ", ") +

@@ -239,6 +239,11 @@ TEST(RunFolderCli, StaleResultsOfAnotherRunAreRefusedOrClearedWithOverwrite) {
   // re-running the identical scene replaces its own finished results
   EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d).code, 0);
   expect_consistent_folder(out);
+  // also in a folder written before run records existed (identified by its summary's scene)
+  fs::remove(out / ".swim-run.json");
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d).code, 0);
+  fs::remove(out / ".swim-run.json");
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\" --set swimmer.length='0.3 um'", d).code, 2);
   fs::remove_all(d);
 }
 
