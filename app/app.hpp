@@ -15,6 +15,7 @@ struct RunOptions {
   int progress = -1;  ///< -1 auto (terminal), 0 off, 1 on
   bool plot = false;
   std::string resume;  ///< 3D: continue the run whose output folder (with checkpoint.bin) is given
+  bool overwrite = false;  ///< replace another run's results in the output folder
 };
 
 int run(const RunOptions& o);

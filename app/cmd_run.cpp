@@ -1,3 +1,5 @@
+#include <sys/statvfs.h>
+
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -5,8 +7,10 @@
 #include <filesystem>
 
 #include "app/app.hpp"
+#include "app/scene_checks.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/run_folder.hpp"
 #include "common/progress.hpp"
 #include "common/scene.hpp"
 #include "common/si_format.hpp"
@@ -62,20 +66,48 @@ void print_summary_1d(const std::string& name, const scene::json& s, double wall
     std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
 }
 
+// A failure after the folder was taken: the summary says so (exit 3 for a write failure).
+// Errors of the checkpoint writer (full3d/checkpoint.cpp) arrive as "cannot write ...".
+[[noreturn]] void fail_run(output::RunFolder& folder, const std::exception& e) {
+  const std::string m = e.what();
+  if (dynamic_cast<const OutputError*>(&e) || m.rfind("cannot write", 0) == 0) {
+    const bool marked = folder.mark_failed(m);
+    std::fprintf(stderr, "swim: partial results in %s are %s\n", folder.dir().c_str(),
+                 marked ? "marked failed in summary.json" : "incomplete (summary.json removed)");
+    if (dynamic_cast<const OutputError*>(&e)) throw;
+    // "cannot write checkpoint <path>": name the file and say whether the disk is full
+    struct statvfs fs_stat {};
+    const bool full = ::statvfs(folder.dir().c_str(), &fs_stat) == 0 && fs_stat.f_bavail == 0;
+    const std::string file = m.find("checkpoint") != std::string::npos ? "checkpoint.bin" : m.substr(13);
+    throw OutputError(file, full ? "disk full" : "write error");
+  }
+  if (!dynamic_cast<const InputError*>(&e)) folder.mark_failed(m);
+  throw;
+}
+
 // The 3D tier: read and validate, run (full3d/run3d.hpp), report.
 int run3d(const RunOptions& o, const scene::json& sc) {
   scene::json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+  check_other_tier(sc, "3d");
+  check_output_size(estimate_output(p), sc);
   if (!o.resume.empty() && !o.out.empty() && fs::path(o.out) != fs::path(o.resume))
     throw InputError("--out", o.out, "with --resume the run continues in the resumed folder; omit --out");
+  if (!o.resume.empty() && o.overwrite)
+    throw InputError("--overwrite", "", "cannot be combined with --resume (it would remove the run to continue)");
   const std::string out = !o.resume.empty() ? o.resume : o.out.empty() ? "out/" + p.name + "-3d" : o.out;
   if (!o.resume.empty() && !fs::exists(full3d::checkpoint_path(out)))
     throw InputError("--resume", o.resume, "no checkpoint.bin in this folder");
-  output::make_dir(out);
+  output::RunFolder folder(out, {"3d", resolved, o.overwrite, !o.resume.empty(), o.resume.empty() ? "--out" : "--resume"});
   full3d::RunControl ctl;
   ctl.progress = o.progress;
   ctl.resume = !o.resume.empty();
-  const full3d::RunOutcome r = full3d::run3d(p, resolved, out, ctl);
+  full3d::RunOutcome r;
+  try {
+    r = full3d::run3d(p, resolved, out, ctl);
+  } catch (const std::exception& e) {
+    fail_run(folder, e);
+  }
   const auto& s = r.summary;
   std::printf("%s (3d): displacement %.6g m, mean velocity %.6g m/s (%.4g body lengths/s), %d cycle(s), "
               "pumped volume %.6g m^3, %ld steps, wall time %.3g s\n  -> %s/summary.json\n",
@@ -101,18 +133,25 @@ int run(const RunOptions& o) {
   scene::json resolved;
   const std::string scene_dir = fs::path(o.scene).parent_path().string();
   const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir.empty() ? "." : scene_dir);
+  check_other_tier(sc, "1d");
+  check_output_size(estimate_output(p), sc);
   const std::string out = o.out.empty() ? "out/" + p.name + "-1d" : o.out;
 
-  // 2. Run.
-  output::make_dir(out);
+  // 2. Take the folder, run.
+  output::RunFolder folder(out, {"1d", resolved, o.overwrite, false, "--out"});
   const auto t0 = std::chrono::steady_clock::now();
   Progress progress("1d " + p.name, reduced1d::end_time(p), o.progress);
   const reduced1d::Result r = reduced1d::solve(p, [&](double t, double) { progress.update(t); });
   progress.done();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // 3. Write (partial results too), report.
-  const scene::json summary = reduced1d::write_run(out, p, resolved, r, wall);
+  // 3. Write (partial results too; summary.json last), report.
+  scene::json summary;
+  try {
+    summary = reduced1d::write_run(out, p, resolved, r, wall);
+  } catch (const std::exception& e) {
+    fail_run(folder, e);
+  }
   if (o.plot) plot("plot_run.py", {out});
   print_summary_1d(p.name, summary, wall, out);
   if (r.failure) {

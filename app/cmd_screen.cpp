@@ -61,7 +61,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   // designs.csv: axis values as given and in SI, then every metric; failed designs keep
   // their status and leave the metric cells empty (never NaN).
   const auto& names = reduced1d::metric_names();
-  std::ofstream csv(out + "/designs.csv");
+  output::AtomicFile csv_file(out + "/designs.csv");  // published complete, or not at all
+  std::ostream& csv = csv_file.stream();
   csv << "design";
   for (const auto& a : sw.axes) csv << "," << a.key << "," << a.key << "_si" << (a.si_unit.empty() ? "" : "[" + a.si_unit + "]");
   csv << ",status";
@@ -92,7 +93,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
                                  : v < reduced1d::metric_value(results[best].metrics, sw.metric)))
       best = static_cast<long>(k);
   }
-  csv.close();
+  csv_file.commit();
 
   scene::json summary = {{"sweep", sweep_path},
                          {"designs", results.size()},

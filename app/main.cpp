@@ -1,13 +1,14 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
-//   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR]
+//   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
 //   swim screen SWEEP.json [--out DIR] [--jobs N]
 //   swim bench [--out DIR]
 //   swim scenes
 //   swim demo
 //
-// Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure (partial
-// results kept), 1 anything unexpected.
+// Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure or a result
+// file that could not be written (partial results kept, marked failed), 1 anything
+// unexpected.
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
@@ -35,6 +36,8 @@ int main(int argc, char** argv) {
   run->add_option("--set", ro.sets, "Override a scene value: key.path=value (same unit syntax as the file)");
   run->add_flag("--plot", ro.plot, "Also write plots (PNG) of the run");
   run->add_option("--resume", ro.resume, "3D: continue an interrupted run from the checkpoint in this output folder");
+  run->add_flag("--overwrite", ro.overwrite,
+                "Replace the results of another run in the output folder (its files are removed first)");
   add_progress(run);
 
   std::string out;
@@ -93,6 +96,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "swim: %s\n", e.what());
     return 2;
   } catch (const NumericalError& e) {
+    std::fprintf(stderr, "swim: %s\n", e.what());
+    return 3;
+  } catch (const OutputError& e) {
     std::fprintf(stderr, "swim: %s\n", e.what());
     return 3;
   } catch (const std::exception& e) {

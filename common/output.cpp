@@ -2,11 +2,14 @@
 
 #include <cmath>
 #include <cstdio>
+#include <exception>
 #include <filesystem>
 
 #include "common/errors.hpp"
 
 namespace swim::output {
+
+namespace fs = std::filesystem;
 
 void make_dir(const std::string& dir) {
   std::error_code ec;
@@ -25,29 +28,59 @@ bool all_finite(const json& v) {
 void write_json(const std::string& path, const json& value) {
   if (!all_finite(value))
     throw NumericalError("a non-finite number reached " + path, "report this scene; the solver should have stopped earlier");
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
-  out << value.dump(2) << "\n";
+  const fs::path p(path);
+  const bool summary = p.filename() == "summary.json";
+  const json* out = &value;
+  json with_files;
+  if (summary) {
+    const std::string dir = p.parent_path().string();
+    // the commit point of the run: never after a failed file
+    if (const Failure f = first_failure(dir); !f.file.empty()) throw OutputError(f.file, f.reason);
+    with_files = value;
+    json files = json::array();
+    for (const auto& r : committed_files(dir))
+      if (r.name != "summary.json" && r.name[0] != '.') files.push_back({{"name", r.name}, {"bytes", r.bytes}, {"fnv1a64", r.fnv1a64}});
+    with_files["files"] = files;
+    out = &with_files;
+  }
+  AtomicFile f(path);
+  f.stream() << out->dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+  f.commit();
 }
 
 CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> header)
-    : out_(path), header_(std::move(header)), path_(path) {
-  if (!out_) throw std::runtime_error("cannot write " + path);
-  for (size_t i = 0; i < header_.size(); ++i) out_ << (i ? "," : "") << header_[i];
-  out_ << "\n";
+    : out_(std::make_unique<AtomicFile>(path)), header_(std::move(header)), path_(path),
+      exceptions_at_start_(std::uncaught_exceptions()) {
+  auto& o = out_->stream();
+  for (size_t i = 0; i < header_.size(); ++i) o << (i ? "," : "") << header_[i];
+  o << "\n";
 }
+
+CsvWriter::~CsvWriter() {
+  // Closed by scope: publish unless an exception is unwinding through the writer (then
+  // the file is partial and stays unpublished). A failure cannot be thrown from here; the
+  // ledger keeps it and the folder's summary.json is refused.
+  if (out_->committed() || std::uncaught_exceptions() > exceptions_at_start_) return;
+  try {
+    out_->commit();
+  } catch (const std::exception&) {
+  }
+}
+
+void CsvWriter::close() { out_->commit(); }
 
 void CsvWriter::row(const std::vector<double>& values) {
   if (values.size() != header_.size()) throw std::logic_error("CSV row width mismatch in " + path_);
   char b[40];
+  auto& o = out_->stream();
   for (size_t i = 0; i < values.size(); ++i) {
     if (!std::isfinite(values[i]))
       throw NumericalError("non-finite value in column '" + header_[i] + "' of " + path_,
                            "tighten the solver tolerances or reduce the time step");
     std::snprintf(b, sizeof b, "%.10g", values[i]);
-    out_ << (i ? "," : "") << b;
+    o << (i ? "," : "") << b;
   }
-  out_ << "\n";
+  o << "\n";
 }
 
 }  // namespace swim::output

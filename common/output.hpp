@@ -1,12 +1,20 @@
 // Output writers shared by both tiers: summary.json, series CSV files, solver statistics.
 // No writer ever emits NaN or Inf: a non-finite value is a numerical failure (exit 3).
+//
+// Every file goes through output::AtomicFile (common/atomic_file.hpp): written to a
+// temporary name, checked, renamed. A write failure is a swim::OutputError (exit 3) naming
+// the file. Writing a folder's summary.json is the run's commit point: it is refused when
+// any file of the folder failed, and it lists every file written with its size and checksum
+// ("files").
 #pragma once
 
-#include <fstream>
 #include <initializer_list>
+#include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
+
+#include "common/atomic_file.hpp"
 
 namespace swim::output {
 
@@ -15,24 +23,32 @@ using json = nlohmann::ordered_json;
 /// Create `dir` (and parents). Throws InputError (key "--out") when it cannot be created.
 void make_dir(const std::string& dir);
 
-/// Write `value` as indented JSON to `path`; every number must be finite.
+/// Write `value` as indented JSON to `path`, atomically; every number must be finite.
+/// For a file named summary.json, a "files" list (name, bytes, fnv1a64) of the files
+/// written into its folder is added, and a folder with a failed file is an OutputError.
 void write_json(const std::string& path, const json& value);
 
 /// True when `value` holds no NaN/Inf number anywhere.
 bool all_finite(const json& value);
 
 /// A CSV file with a fixed header; rows of doubles written with 10 significant digits.
+/// The file appears under its name at close() (or when the writer goes out of scope
+/// normally; a failure there is recorded and refuses the folder's summary.json).
 class CsvWriter {
  public:
   CsvWriter(const std::string& path, std::vector<std::string> header);
+  ~CsvWriter();
   /// Throws swim::NumericalError naming the column when a value is not finite.
   void row(const std::vector<double>& values);
-  void flush() { out_.flush(); }
+  void flush() { out_->stream().flush(); }
+  /// Check and publish the file; throws OutputError.
+  void close();
 
  private:
-  std::ofstream out_;
+  std::unique_ptr<AtomicFile> out_;
   std::vector<std::string> header_;
   std::string path_;
+  int exceptions_at_start_ = 0;
 };
 
 }  // namespace swim::output

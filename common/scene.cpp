@@ -1,12 +1,14 @@
 #include "common/scene.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "common/errors.hpp"
+#include "common/strict_json.hpp"
 #include "common/units.hpp"
 
 namespace swim::scene {
@@ -32,21 +34,21 @@ std::string join(const std::vector<std::string>& v) {
 }  // namespace
 
 std::string show(const json& value) {
-  std::string s = value.dump();
-  if (s.size() > 80) s = s.substr(0, 77) + "...";
+  // Scalars are cut before dumping (a megabyte string is never copied twice); invalid
+  // UTF-8 (only possible in values built in the program) is replaced, never thrown on.
+  if (value.is_string() && value.get_ref<const std::string&>().size() > 200)
+    return json(value.get_ref<const std::string&>().substr(0, 200))
+               .dump(-1, ' ', false, json::error_handler_t::replace) + "... (" +
+           std::to_string(value.get_ref<const std::string&>().size()) + " bytes)";
+  std::string s = value.dump(-1, ' ', false, json::error_handler_t::replace);
+  if (s.size() > 80) s = message_text(s, 77);
   return s;
 }
 
 json load_file(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("scene", "\"" + path + "\"", "file cannot be opened; give an existing JSON scene file");
-  try {
-    json j = json::parse(in, nullptr, true, /*ignore_comments=*/false);
-    if (!j.is_object()) throw InputError("scene", "\"" + path + "\"", "the top level must be a JSON object");
-    return j;
-  } catch (const json::parse_error& e) {
-    throw InputError("scene", "\"" + path + "\"", std::string("is not valid JSON: ") + e.what());
-  }
+  json j = strict_json::parse_file(path, "scene");
+  if (!j.is_object()) throw InputError("scene", "\"" + path + "\"", "the top level must be a JSON object");
+  return j;
 }
 
 void apply_override(json& scene, const std::string& assignment) {
@@ -55,19 +57,34 @@ void apply_override(json& scene, const std::string& assignment) {
     throw InputError("--set", "\"" + assignment + "\"", "expected key.path=value, e.g. --set swimmer.length=\"0.2 um\"");
   const std::string key = assignment.substr(0, eq);
   const std::string value_text = assignment.substr(eq + 1);
+  if (size_t bad = 0; !valid_utf8(assignment, &bad))
+    throw InputError("--set", "\"" + assignment + "\"",
+                     "is not UTF-8 text (bad byte at offset " + std::to_string(bad) + ")");
+  std::vector<std::string> parts;
+  for (size_t a = 0;;) {  // "a..b", ".a" and "a." have empty components
+    const size_t b = key.find('.', a);
+    parts.push_back(key.substr(a, b == std::string::npos ? std::string::npos : b - a));
+    if (b == std::string::npos) break;
+    a = b + 1;
+  }
+  for (const auto& part : parts)
+    if (part.empty())
+      throw InputError("--set", "\"" + assignment + "\"",
+                       "empty component in the key path; expected key.path=value with non-empty names between the dots");
+  // The value is JSON when it reads as JSON (numbers, true/false, objects), else a string
+  // ("0.2 um"). JSON that is well-formed but breaks the strict rules (duplicate keys, 1e400,
+  // depth) is an error, not a string.
   json value;
   try {
-    value = json::parse(value_text);
-  } catch (const json::parse_error&) {
+    value = strict_json::parse(value_text, key);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    if (m.find("is not valid JSON") == std::string::npos) throw;
     value = value_text;
   }
   json* node = &scene;
-  std::stringstream ss(key);
-  std::string part, walked;
-  std::vector<std::string> parts;
-  while (std::getline(ss, part, '.')) parts.push_back(part);
+  std::string walked;
   for (size_t i = 0; i < parts.size(); ++i) {
-    if (parts[i].empty()) throw InputError("--set", "\"" + assignment + "\"", "empty component in key path");
     walked += (i ? "." : "") + parts[i];
     if (!node->is_object())
       throw InputError(walked, show(*node), "is not an object, so --set " + key + " cannot be applied");
@@ -155,7 +172,8 @@ long Reader::integer(const std::string& key, long default_value, long lo, long h
   long v = default_value;
   if (has(key)) {
     const json& j = node_->at(key);
-    if (!j.is_number_integer())
+    if (!j.is_number_integer() ||
+        (j.is_number_unsigned() && j.get<json::number_unsigned_t>() > static_cast<json::number_unsigned_t>(hi)))
       throw InputError(path(key), show(j), "must be an integer in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
     v = j.get<long>();
   }
@@ -216,6 +234,75 @@ Reader Reader::child(const std::string& key) {
 void Reader::pass_through(const std::string& key) {
   mark(key);
   if (has(key)) (*resolved_)[key] = node_->at(key);
+}
+
+void check_section(const json& node, const std::string& path, const json& schema) {
+  if (!node.is_object()) throw InputError(path, show(node), "must be a JSON object");
+  std::vector<std::string> keys;
+  for (auto it = schema.begin(); it != schema.end(); ++it) keys.push_back(it.key());
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    const std::string key = path + "." + it.key();
+    if (!schema.contains(it.key()))
+      throw InputError(key, show(it.value()), "unknown key; allowed here: " + join(keys));
+    const json& kind = schema.at(it.key());
+    const json& v = it.value();
+    if (kind.is_object()) {
+      check_section(v, key, kind);
+      continue;
+    }
+    const std::string k = kind.get<std::string>();
+    if (k.rfind("quantity:", 0) == 0) {
+      const std::string unit = k.substr(9);
+      if (!v.is_string())
+        throw InputError(key, show(v), "must be a string \"<number> <unit>\" with a unit convertible to " + unit);
+      units::parse(key, v.get<std::string>(), unit);
+    } else if (k == "number") {
+      if (!v.is_number()) throw InputError(key, show(v), "must be a number (dimensionless)");
+    } else if (k == "integer") {
+      if (!v.is_number_integer()) throw InputError(key, show(v), "must be an integer");
+    } else if (k == "boolean") {
+      if (!v.is_boolean()) throw InputError(key, show(v), "must be true or false");
+    } else if (k == "text") {
+      if (!v.is_string()) throw InputError(key, show(v), "must be a string");
+    } else if (k.rfind("choice:", 0) == 0) {
+      std::vector<std::string> allowed;
+      for (size_t a = 7;;) {
+        const size_t b = k.find('|', a);
+        allowed.push_back(k.substr(a, b == std::string::npos ? std::string::npos : b - a));
+        if (b == std::string::npos) break;
+        a = b + 1;
+      }
+      if (!v.is_string() || std::find(allowed.begin(), allowed.end(), v.get<std::string>()) == allowed.end())
+        throw InputError(key, show(v), "must be one of: " + join(allowed));
+    } else {
+      throw std::logic_error("internal: unknown kind '" + k + "' in the section schema of " + key);
+    }
+  }
+}
+
+void check_name(const std::string& name) {
+  const auto ok = [](char c) {
+    return std::isalnum(static_cast<unsigned char>(c)) || c == '.' || c == '_' || c == '-' || c == '+';
+  };
+  if (name.empty() || name.size() > 100 || name[0] == '.' || name[0] == '-' ||
+      !std::all_of(name.begin(), name.end(), ok))
+    throw InputError("name", "\"" + name + "\"",
+                     "must be 1 to 100 characters of letters, digits, '.', '_', '-' and '+', not starting with '.' "
+                     "or '-' (it names the output folder under out/)");
+}
+
+OutputLimits read_output(Reader& top) {
+  OutputLimits o;
+  Reader r = top.child("output");
+  o.max_bytes = r.integer("max_bytes", o.max_bytes, 1000, 1000000000000000L);
+  r.finish();
+  return o;
+}
+
+OutputLimits output_limits(const json& scene) {
+  json resolved = json::object();
+  Reader top(scene, "", resolved);
+  return read_output(top);
 }
 
 void Reader::finish() const {

@@ -75,4 +75,25 @@ class Reader {
 /// JSON value as short text for messages.
 std::string show(const json& value);
 
+/// The keys and value kinds of a section another tier reads, so that a tier that only
+/// passes the section through still rejects a malformed one (the resolved scene must run on
+/// both tiers). `schema` is an object: key -> nested object (a sub-section) or a kind
+/// string: "quantity:<SI unit>", "number", "integer", "boolean", "text" or
+/// "choice:<a>|<b>|...". Values are checked for kind, unit and choice, not for range.
+/// Throws InputError naming the full key (`path`.key).
+void check_section(const json& node, const std::string& path, const json& schema);
+
+/// A scene `name` becomes a folder name under out/: 1 to 100 characters of letters,
+/// digits, '.', '_', '-' and '+', not starting with '.' or '-'. Throws InputError("name").
+void check_name(const std::string& name);
+
+/// The `output` section, read by both tiers: limits on what a run may write.
+struct OutputLimits {
+  long long max_bytes = 1000000000;  ///< output.max_bytes: refuse runs whose estimated output is larger
+};
+/// Reads (and finishes) the `output` section of `top`.
+OutputLimits read_output(Reader& top);
+/// The `output` section of a scene, read on its own (the tiers read it with the rest).
+OutputLimits output_limits(const json& scene);
+
 }  // namespace swim::scene

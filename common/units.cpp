@@ -5,6 +5,7 @@
 #include <cctype>
 #include <cmath>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
 #include <memory>
 #include <mutex>
@@ -52,19 +53,77 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a);
 }
 
+// Strict "<number> <unit>": a decimal number ([sign] digits [. digits] [e [sign] digits];
+// no hex, inf, nan), then one unit expression. Returns the number and the unit text, or
+// throws InputError naming `key`. The unit must not carry a numeric factor of its own
+// ("0.1 0.2 um", "um*1000", "um/2"): UDUNITS-2 would multiply it in silently.
+std::pair<double, std::string> split_strict(const std::string& key, const std::string& text, const std::string& allowed) {
+  const std::string quoted = "\"" + text + "\"";
+  const std::string t = trim(text);
+  size_t i = 0;
+  const auto digits = [&] {
+    const size_t a = i;
+    while (i < t.size() && std::isdigit(static_cast<unsigned char>(t[i]))) ++i;
+    return i - a;
+  };
+  if (i < t.size() && (t[i] == '+' || t[i] == '-')) ++i;
+  size_t mantissa = digits();
+  if (i < t.size() && t[i] == '.') {
+    ++i;
+    mantissa += digits();
+  }
+  if (mantissa == 0) throw InputError(key, quoted, "no number; expected " + allowed);
+  if (i < t.size() && (t[i] == 'x' || t[i] == 'X') && i == 1 + (t[0] == '+' || t[0] == '-'))
+    throw InputError(key, quoted, "hexadecimal numbers are not accepted; expected " + allowed);
+  if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
+    size_t j = i + 1;
+    if (j < t.size() && (t[j] == '+' || t[j] == '-')) ++j;
+    size_t k = j;
+    while (k < t.size() && std::isdigit(static_cast<unsigned char>(t[k]))) ++k;
+    if (k > j) i = k;  // else the 'e' starts the unit? No unit starts with a bare e: rejected below
+  }
+  const std::string number_text = t.substr(0, i);
+  errno = 0;
+  const double number = std::strtod(number_text.c_str(), nullptr);
+  if (!std::isfinite(number)) throw InputError(key, quoted, "number does not fit a double; expected " + allowed);
+  if (number == 0.0 && number_text.find_first_of("123456789") < number_text.find_first_of("eE"))
+    throw InputError(key, quoted, "number underflows to zero in a double; expected " + allowed);
+  const std::string unit = trim(t.substr(i));
+  if (unit.empty()) throw InputError(key, quoted, "missing unit; expected " + allowed);
+  // The unit starts with a letter or "(" and no factor in it is a bare number: split at
+  // the operators of a unit expression and look at each factor's first character.
+  if (!(std::isalpha(static_cast<unsigned char>(unit[0])) || unit[0] == '(' ||
+        static_cast<unsigned char>(unit[0]) >= 0x80))
+    throw InputError(key, quoted, "expected exactly one number followed by one unit (got '" + unit +
+                                      "' after the number); expected " + allowed);
+  size_t a = 0;
+  while (a < unit.size()) {
+    size_t b = unit.find_first_of(" \t*/().@", a);
+    if (b == std::string::npos) b = unit.size();
+    if (unit[b < unit.size() ? b : 0] == '@' && b < unit.size())
+      throw InputError(key, quoted, "unit '" + unit + "' has an origin shift; expected " + allowed);
+    if (b > a) {
+      const char c = unit[a];
+      if (std::isdigit(static_cast<unsigned char>(c)) || c == '+' || c == '-')
+        throw InputError(key, quoted, "expected exactly one number followed by one unit; the unit '" + unit +
+                                          "' holds a numeric factor '" + unit.substr(a, b - a) + "'");
+      if (unit.compare(a, b - a, "since") == 0 || unit.compare(a, b - a, "from") == 0 ||
+          unit.compare(a, b - a, "after") == 0 || unit.compare(a, b - a, "ref") == 0)
+        throw InputError(key, quoted, "unit '" + unit + "' is a time-stamp or offset unit; expected " + allowed);
+    }
+    // "." between two numbers would be a decimal point; between factors UDUNITS reads it as *
+    a = b + 1;
+  }
+  return {number, unit};
+}
+
 }  // namespace
 
 Quantity parse(const std::string& key, const std::string& text, const std::string& si_unit) {
   const std::string quoted = "\"" + text + "\"";
   const std::string allowed = "a number followed by a unit convertible to " + si_unit + " (e.g. \"1 " +
                               si_unit + "\")";
-  const std::string t = trim(text);
-  char* end = nullptr;
-  const double number = std::strtod(t.c_str(), &end);
-  if (end == t.c_str()) throw InputError(key, quoted, "no number; expected " + allowed);
-  if (!std::isfinite(number)) throw InputError(key, quoted, "number is not finite; expected " + allowed);
-  const std::string unit = trim(std::string(end));
-  if (unit.empty()) throw InputError(key, quoted, "missing unit; expected " + allowed);
+  const auto [number, unit] = split_strict(key, text, allowed);
 
   std::lock_guard lock(system().mutex);
   UnitPtr from = parse_unit(unit);
@@ -78,7 +137,7 @@ Quantity parse(const std::string& key, const std::string& text, const std::strin
   // Offset units (degC) are meaningless for the quantities of this product: reject them.
   if (cv_convert_double(conv.get(), 0.0) != 0.0)
     throw InputError(key, quoted, "unit '" + unit + "' has an offset; expected " + allowed);
-  return Quantity{cv_convert_double(conv.get(), number), t};
+  return Quantity{cv_convert_double(conv.get(), number), trim(text)};
 }
 
 bool known_unit(const std::string& unit) {
@@ -97,13 +156,7 @@ std::string format(double value_si, const std::string& si_unit) {
 namespace swim::units {
 
 std::pair<double, std::string> split(const std::string& key, const std::string& text) {
-  const std::string t = trim(text);
-  char* end = nullptr;
-  const double number = std::strtod(t.c_str(), &end);
-  if (end == t.c_str() || !std::isfinite(number))
-    throw InputError(key, "\"" + text + "\"", "expected \"<number> <unit>\"");
-  const std::string unit = trim(std::string(end));
-  if (unit.empty()) throw InputError(key, "\"" + text + "\"", "missing unit; expected \"<number> <unit>\"");
+  const auto [number, unit] = split_strict(key, text, "\"<number> <unit>\"");
   if (!known_unit(unit)) throw InputError(key, "\"" + text + "\"", "unknown unit '" + unit + "'");
   return {number, unit};
 }

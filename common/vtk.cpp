@@ -5,12 +5,13 @@
 #include <fstream>
 #include <stdexcept>
 
+#include "common/atomic_file.hpp"
 #include "common/errors.hpp"
 
 namespace swim::vtk {
 
 namespace {
-void put_values(std::ofstream& out, const std::vector<double>& v, const std::string& what) {
+void put_values(std::ostream& out, const std::vector<double>& v, const std::string& what) {
   char b[32];
   for (size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]))
@@ -25,8 +26,8 @@ void put_values(std::ofstream& out, const std::vector<double>& v, const std::str
 void write_polydata(const std::string& path, const std::vector<double>& xyz,
                     const std::vector<std::array<int, 3>>& triangles, const std::vector<PointArray>& arrays) {
   const size_t n = xyz.size() / 3;
-  std::ofstream out(path);
-  if (!out) throw std::runtime_error("cannot write " + path);
+  output::AtomicFile file(path);
+  std::ostream& out = file.stream();
   out << "<?xml version=\"1.0\"?>\n"
       << "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
       << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
@@ -47,6 +48,7 @@ void write_polydata(const std::string& path, const std::vector<double>& xyz,
   out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
   for (size_t k = 0; k < triangles.size(); ++k) out << 3 * (k + 1) << ((k + 1) % 12 == 0 ? "\n" : " ");
   out << "\n</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  file.commit();
 }
 
 void Collection::add(double time_s, const std::string& file) { frames_.emplace_back(time_s, file); }
@@ -56,8 +58,8 @@ void Collection::truncate_after(double t) {
 }
 
 void Collection::write() const {
-  std::ofstream out(path_);
-  if (!out) throw std::runtime_error("cannot write " + path_);
+  output::AtomicFile file(path_);
+  std::ostream& out = file.stream();
   out << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\">\n<Collection>\n";
   char b[32];
   for (const auto& [t, f] : frames_) {
@@ -65,6 +67,7 @@ void Collection::write() const {
     out << "  <DataSet timestep=\"" << b << "\" part=\"0\" file=\"" << f << "\"/>\n";
   }
   out << "</Collection>\n</VTKFile>\n";
+  file.commit();
 }
 
 }  // namespace swim::vtk

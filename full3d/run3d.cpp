@@ -317,8 +317,8 @@ class Runner {
     std::snprintf(name, sizeof name, "vtk/fluid_%06d.vti", int(fluid_pvd_.frames().size()));
     const MacGrid& g = *grid_;
     const int nx = g.nx(), ny = g.ny(), nz = g.nz();
-    std::ofstream o(out_ + "/" + name);
-    if (!o) throw std::runtime_error("cannot write " + out_ + "/" + name);
+    output::AtomicFile file(out_ + "/" + name);
+    std::ostream& o = file.stream();
     const double h = g.h();
     o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
       << "<ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\" Origin=\"0 0 0\" Spacing=\"" << h
@@ -344,6 +344,7 @@ class Runner {
       o << b;
     }
     o << "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
+    file.commit();
     fluid_pvd_.add(s_.t, name);
     fluid_pvd_.write();
   }

@@ -48,6 +48,7 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   resolved = json::object();
   Reader top(scene, "", resolved);
   p.name = top.text("name", "unnamed");
+  scene::check_name(p.name);
   top.text("description", "");
 
   const scene::Body body = scene::read_body(top);
@@ -170,6 +171,7 @@ Params3d read_scene3d(const json& scene, json& resolved) {
     p.threads = static_cast<int>(f.integer("threads", 1, 1, 256));
     f.finish();
   }
+  scene::read_output(top);
   top.finish();
 
   // Consistency (before anything is written).

@@ -33,7 +33,7 @@ json load_calibration(const std::string& key, const std::string& path, const std
                                                      "working directory, then from the scene's directory)");
   try {
     return json::parse(in);
-  } catch (const json::parse_error& e) {
+  } catch (const json::exception& e) {  // syntax, and numbers beyond a double (out_of_range)
     throw InputError(key, "\"" + path + "\"", std::string("calibration file is not valid JSON: ") + e.what());
   }
 }
@@ -68,6 +68,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   resolved = json::object();
   Reader top(scene, "", resolved);
   p.name = top.text("name", "unnamed");
+  scene::check_name(p.name);
   top.text("description", "");
 
   const scene::Body body = scene::read_body(top);
@@ -233,6 +234,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     t.finish();
   }
   top.pass_through("full3d");
+  scene::read_output(top);
   top.finish();
   return p;
 }

@@ -1,0 +1,80 @@
+#include "app/scene_checks.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include "common/errors.hpp"
+#include "full3d/scene3d_keys.hpp"
+#include "reduced1d/scene1d_keys.hpp"
+#include "reduced1d/solver.hpp"
+
+namespace swim::app {
+
+namespace {
+// Bytes per value of a CSV or ASCII VTK file ("%.10g" and a separator).
+constexpr double kCsvValue = 17.0, kVtkValue = 16.0;
+
+std::string human(double bytes) {
+  char b[48];
+  if (bytes >= 1e9) std::snprintf(b, sizeof b, "%.3g GB", bytes / 1e9);
+  else if (bytes >= 1e6) std::snprintf(b, sizeof b, "%.3g MB", bytes / 1e6);
+  else std::snprintf(b, sizeof b, "%.3g kB", bytes / 1e3);
+  return b;
+}
+}  // namespace
+
+void check_other_tier(const scene::json& sc, const std::string& tier) {
+  if (!sc.is_object()) return;
+  if (tier == "1d") {
+    if (sc.contains("full3d")) scene::check_section(sc.at("full3d"), "full3d", full3d::section_keys());
+    return;
+  }
+  const scene::json& keys = reduced1d::section_keys();
+  for (auto it = keys.begin(); it != keys.end(); ++it)
+    if (sc.contains(it.key())) scene::check_section(sc.at(it.key()), it.key(), it.value());
+}
+
+OutputEstimate estimate_output(const reduced1d::Params& p) {
+  // The span is known for a given duration and for a prescribed wave (its transit time);
+  // a force-driven run with duration "auto" lasts until its cycles complete, which is only
+  // known when it ends (end_time() is a loose upper bound): no estimate.
+  if (!(p.duration > 0) && p.wave == reduced1d::WaveKind::ForceDriven) return {0.0, "time.duration"};
+  const double span = reduced1d::end_time(p);
+  const double samples = std::floor(span / p.numerics.output_interval) + 2;
+  const double series = samples * 19 * kCsvValue;  // the columns of series.csv
+  const double radius = samples * p.numerics.cells * 3 * kCsvValue;
+  return {series + radius, "time.output_interval"};
+}
+
+OutputEstimate estimate_output(const full3d::Params3d& p) {
+  // duration "auto": the run ends with its cycles, far below the full3d.time_limit cap as a
+  // rule; the span is unknown before the run, so there is no estimate
+  if (!(p.duration > 0)) return {0.0, "time.duration"};
+  const double span = p.duration;
+  const auto frames = [&](double interval) { return std::floor(span / std::max(interval, p.dt)) + 2; };
+  // mesh size as the reference mesh (make_mesh): rings of n_theta nodes, edges below factor h/2
+  const double edge = p.spacing_factor * 0.5 * p.h;
+  const double n_theta = std::max(3.0, std::ceil(2.0 * M_PI * p.R0 / edge));
+  const double rings = std::max(2.0, std::ceil(p.L / edge) + 1);
+  const double nodes = n_theta * rings;
+  const double samples = frames(p.output_interval) * (21 + 3 * rings) * kCsvValue;
+  const double vtk = p.vtk ? frames(p.vtk_interval) * (nodes * 13 * kVtkValue + 2 * nodes * 12.0) : 0.0;
+  const double cells = double(p.nx) * p.ny * p.nz;
+  const double fluid = p.fluid_fields ? frames(p.fluid_interval) * cells * 4 * 15.0 : 0.0;
+  OutputEstimate e{samples + vtk + fluid, "time.output_interval"};
+  if (vtk > samples && vtk >= fluid) e.key = "full3d.output.vtk_interval";
+  if (fluid > samples && fluid > vtk) e.key = "full3d.output.fluid_interval";
+  return e;
+}
+
+void check_output_size(const OutputEstimate& e, const scene::json& sc) {
+  const scene::OutputLimits lim = scene::output_limits(sc);
+  if (e.bytes > static_cast<double>(lim.max_bytes))
+    throw InputError(e.key, "",
+                     "the run would write about " + human(e.bytes) + ", above output.max_bytes = " +
+                         std::to_string(lim.max_bytes) + " bytes; raise the interval, shorten time.duration, or raise "
+                         "output.max_bytes");
+}
+
+}  // namespace swim::app

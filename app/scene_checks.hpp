@@ -1,0 +1,33 @@
+// Checks the command line applies to a scene on top of the tier's own reader, shared with
+// the tests (tests/common/test_scene_fuzz.cpp runs them in process):
+//   - the other tier's sections must be well-formed (so the resolved scene runs on both),
+//   - the estimated output must stay below output.max_bytes.
+#pragma once
+
+#include <string>
+
+#include "common/scene.hpp"
+#include "full3d/scene3d.hpp"
+#include "reduced1d/params.hpp"
+
+namespace swim::app {
+
+/// Throws InputError naming the key when a section of the tier that is not running
+/// (`running_tier` "1d": full3d; "3d": model1d and numerics1d) is malformed.
+void check_other_tier(const scene::json& scene, const std::string& running_tier);
+
+/// Estimated bytes a run writes (series, radius samples, VTK frames), and the key whose
+/// interval dominates the estimate. Zero when the run's span is not known before it runs
+/// (force-driven with time.duration "auto").
+struct OutputEstimate {
+  double bytes = 0;
+  std::string key;
+};
+OutputEstimate estimate_output(const reduced1d::Params& p);
+OutputEstimate estimate_output(const full3d::Params3d& p);
+
+/// Throws InputError (naming the dominant interval key) when the estimate exceeds
+/// output.max_bytes of the scene.
+void check_output_size(const OutputEstimate& e, const scene::json& scene);
+
+}  // namespace swim::app

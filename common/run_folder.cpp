@@ -1,0 +1,210 @@
+#include "common/run_folder.hpp"
+
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <set>
+
+#include "common/atomic_file.hpp"
+#include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/strict_json.hpp"
+
+namespace swim::output {
+namespace fs = std::filesystem;
+
+namespace {
+
+const char* kLock = ".swim.lock";
+const char* kOwner = ".swim-run.json";
+
+std::string read_text(const fs::path& p, std::size_t limit = 1 << 20) {
+  std::ifstream in(p, std::ios::binary);
+  std::string s;
+  if (!in) return s;
+  s.resize(limit);
+  in.read(s.data(), static_cast<std::streamsize>(limit));
+  s.resize(static_cast<std::size_t>(in.gcount()));
+  return s;
+}
+
+// A JSON file of the folder, or null when absent or unreadable.
+scene::json read_json(const fs::path& p) {
+  try {
+    std::error_code ec;
+    if (!fs::is_regular_file(p, ec)) return nullptr;
+    return strict_json::parse(read_text(p, 64u << 20), p.filename().string());
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+std::string list(const std::vector<std::string>& v, std::size_t max = 5) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size() && i < max; ++i) s += (i ? ", " : "") + v[i];
+  if (v.size() > max) s += ", ... (" + std::to_string(v.size()) + " entries)";
+  return s;
+}
+
+}  // namespace
+
+std::string json_hash(const scene::json& value) {
+  const std::string s = value.dump(-1, ' ', false, scene::json::error_handler_t::replace);
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
+  char b[20];
+  std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h));
+  return b;
+}
+
+bool RunFolder::is_result_name(const std::string& rel) {
+  static const std::set<std::string> fixed = {"summary.json",  "series.csv",     "radius.csv",  "solver_stats.json",
+                                              "scene.resolved.json", "checkpoint.bin", "membrane.pvd", "fluid.pvd",
+                                              "run.png",       "vtk",            kOwner};
+  if (fixed.count(rel)) return true;
+  static const std::regex frames(R"(vtk/(membrane_\d+\.vtp|fluid_\d+\.vti))");
+  static const std::regex temps(R"((vtk/)?\.[^/]+\.tmp(-\d+)?)");
+  return std::regex_match(rel, frames) || std::regex_match(rel, temps);
+}
+
+RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::move(dir)) {
+  const std::string shown = "\"" + dir_ + "\"";
+  std::error_code ec;
+  if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
+    throw InputError(o.key, shown, "is not a folder; give a folder for the run's results");
+  fs::create_directories(dir_, ec);
+  if (ec) throw InputError(o.key, shown, "cannot create the output folder: " + ec.message());
+
+  // 1. The lock: one run per folder at a time.
+  const std::string lock_path = (fs::path(dir_) / kLock).string();
+  lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+  if (lock_fd_ < 0)
+    throw InputError(o.key, shown, std::string("cannot create the lock file .swim.lock: ") + std::strerror(errno) +
+                                       " (is the folder writable?)");
+  if (::flock(lock_fd_, LOCK_EX | LOCK_NB) != 0) {
+    const std::string pid = read_text(lock_path, 64);
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    throw InputError(o.key, shown,
+                     "is in use by another swim run (PID " + (pid.empty() ? std::string("unknown") : pid) +
+                         "); wait for it to finish or choose another --out");
+  }
+  const std::string me = std::to_string(::getpid());
+  if (::ftruncate(lock_fd_, 0) != 0 || ::pwrite(lock_fd_, me.data(), me.size(), 0) != static_cast<ssize_t>(me.size())) {
+    // the PID is only informative; the lock itself is held
+  }
+
+  try {
+    // 2. What the folder holds.
+    std::vector<std::string> results, foreign;
+    const scene::json old_summary = read_json(fs::path(dir_) / "summary.json");
+    std::set<std::string> listed;
+    if (old_summary.is_object() && old_summary.contains("files") && old_summary["files"].is_array())
+      for (const auto& f : old_summary["files"])
+        if (f.is_object() && f.contains("name") && f["name"].is_string()) listed.insert(f["name"].get<std::string>());
+    for (auto it = fs::recursive_directory_iterator(dir_, ec); !ec && it != fs::recursive_directory_iterator();
+         it.increment(ec)) {
+      const std::string rel = fs::relative(it->path(), dir_, ec).generic_string();
+      if (rel == kLock) continue;
+      (is_result_name(rel) || listed.count(rel) ? results : foreign).push_back(rel);
+    }
+    if (ec) throw InputError(o.key, shown, "cannot list the output folder: " + ec.message());
+    std::sort(results.begin(), results.end());
+    std::sort(foreign.begin(), foreign.end());
+
+    const scene::json owner = read_json(fs::path(dir_) / kOwner);
+    const std::string hash = json_hash(o.resolved);
+    const std::string old_tier = owner.is_object() && owner.contains("tier") && owner["tier"].is_string()
+                                     ? owner["tier"].get<std::string>()
+                                 : old_summary.is_object() && old_summary.contains("tier") && old_summary["tier"].is_string()
+                                     ? old_summary["tier"].get<std::string>()
+                                     : "";
+    const std::string old_status = old_summary.is_object() && old_summary.contains("status") &&
+                                           old_summary["status"].is_string()
+                                       ? old_summary["status"].get<std::string>()
+                                       : "";
+
+    if (o.resume) {
+      // 3a. --resume: only the run this folder belongs to.
+      if (!old_tier.empty() && old_tier != o.tier)
+        throw InputError("--resume", shown,
+                         "holds the results of a " + old_tier + " run; --resume continues only a " + o.tier +
+                             " run in its own folder");
+      if (!fs::exists(fs::path(dir_) / "checkpoint.bin"))
+        throw InputError("--resume", shown, "holds no checkpoint.bin, so there is no run to continue");
+      if (!foreign.empty())
+        throw InputError("--resume", shown, "holds files swim did not write (" + list(foreign) + ")");
+    } else if (!results.empty() || !foreign.empty()) {
+      // 3b. A new run into a non-empty folder.
+      if (!foreign.empty())
+        throw InputError(o.key, shown,
+                         "holds files swim did not write (" + list(foreign) +
+                             "); choose an empty or new folder (they are never removed, even with --overwrite)");
+      // the scene of the old run: its record, or (folders written before records existed) its summary
+      const std::string old_hash = owner.is_object() ? owner.value("scene_hash", std::string())
+                                   : old_summary.is_object() && old_summary.contains("scene")
+                                       ? json_hash(old_summary["scene"])
+                                       : "";
+      const bool same_run =
+          old_hash == hash && old_tier == o.tier && old_status.rfind("running", 0) != 0 && !old_status.empty();
+      if (!o.overwrite && !same_run)
+        throw InputError(o.key, shown,
+                         "holds the results of another run (" + (old_tier.empty() ? "" : old_tier + ", ") +
+                             (old_status.empty() ? "no summary" : "status \"" + message_text(old_status, 60) + "\"") +
+                             ": " + list(results) +
+                             "); give --overwrite to replace them, --resume to continue an interrupted 3D run, or "
+                             "another --out");
+      // Clear the old run's files: the summary first (it would otherwise claim them).
+      fs::remove(fs::path(dir_) / "summary.json", ec);
+      std::sort(results.begin(), results.end(), [](const std::string& a, const std::string& b) { return a > b; });
+      for (const auto& r : results) {
+        fs::remove(fs::path(dir_) / r, ec);  // files first (reverse order puts vtk/x before vtk)
+        if (ec) throw InputError(o.key, shown, "cannot remove the old result " + r + ": " + ec.message());
+      }
+    }
+    // 4. This run owns the folder.
+    reset_ledger(dir_);
+    scene::json rec = {{"tier", o.tier}, {"scene_hash", hash}, {"pid", static_cast<long>(::getpid())}};
+    if (o.resume && owner.is_object()) rec["scene_hash"] = owner.value("scene_hash", hash);
+    AtomicFile f((fs::path(dir_) / kOwner).string());
+    f.stream() << rec.dump(2) << "\n";
+    f.commit();
+  } catch (...) {  // InputError (exit 2), or OutputError (exit 3: the run's record cannot be written)
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    throw;
+  }
+}
+
+RunFolder::~RunFolder() {
+  if (lock_fd_ >= 0) ::close(lock_fd_);  // releases the flock; the file stays (see header)
+}
+
+bool RunFolder::mark_failed(const std::string& message) noexcept {
+  const fs::path summary = fs::path(dir_) / "summary.json";
+  try {
+    scene::json s = read_json(summary);
+    if (!s.is_object()) s = scene::json::object();
+    s["status"] = "failed: " + message;
+    s.erase("files");  // the listed files may be the partial ones
+    AtomicFile f(summary.string());
+    f.stream() << s.dump(2, ' ', false, scene::json::error_handler_t::replace) << "\n";
+    f.commit();
+    return true;
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(summary, ec);
+    return false;
+  }
+}
+
+}  // namespace swim::output

@@ -1,0 +1,58 @@
+// A run folder belongs to one run.
+//
+//   - The run takes a lock (".swim.lock", flock: released by the kernel when the process
+//     ends, even on kill -9). A second run into a locked folder is an InputError (exit 2)
+//     naming the PID that holds it.
+//   - The owner is recorded in ".swim-run.json" (tier, scene hash, PID). A new run into a
+//     folder that holds another run's results is refused (exit 2) unless `overwrite`; then
+//     the old run's files are removed first. Re-running the identical resolved scene on
+//     the same tier replaces a finished run's results (its files are removed first) without
+//     --overwrite; an interrupted (resumable) run is only replaced with --overwrite.
+//   - Files swim did not write (not a result name, not listed in the old summary.json) are
+//     never removed: such a folder is refused even with --overwrite.
+//   - `resume` continues only a run of the same tier whose folder holds a checkpoint.
+//   - mark_failed(): a write failure leaves summary.json saying "failed: ..." (or no
+//     summary.json at all when even that cannot be written): nothing claims success.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/scene.hpp"
+
+namespace swim::output {
+
+struct RunFolderOptions {
+  std::string tier;        ///< "1d" or "3d"
+  scene::json resolved;    ///< the resolved scene of this run (its hash identifies the run)
+  bool overwrite = false;  ///< --overwrite
+  bool resume = false;     ///< --resume
+  std::string key = "--out";  ///< the flag named in messages
+};
+
+class RunFolder {
+ public:
+  /// Creates the folder if needed, takes the lock, checks ownership (InputError, exit 2),
+  /// clears replaced results and records this run as the owner.
+  RunFolder(std::string dir, const RunFolderOptions& options);
+  ~RunFolder();
+  RunFolder(const RunFolder&) = delete;
+  RunFolder& operator=(const RunFolder&) = delete;
+
+  const std::string& dir() const { return dir_; }
+  /// Best effort, never throws: summary.json's status becomes "failed: <message>" (the
+  /// file is removed when it cannot be rewritten). Returns false when it had to be removed.
+  bool mark_failed(const std::string& message) noexcept;
+
+  /// Names of the result files a swim run may write into its folder (for clearing).
+  static bool is_result_name(const std::string& relative_path);
+
+ private:
+  std::string dir_;
+  int lock_fd_ = -1;
+};
+
+/// FNV-1a 64-bit hash of the compact dump of `value`, 16 hex digits.
+std::string json_hash(const scene::json& value);
+
+}  // namespace swim::output

@@ -1,0 +1,336 @@
+// A run folder belongs to one run, and its files never lie: atomic result files, exit 3 on a
+// write failure (injected full disk) with nothing claiming success, the lock against two
+// runs on one folder, stale results from another run refused or cleared with --overwrite,
+// --resume only for the run the folder belongs to, and the output-size limit.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <regex>
+#include <set>
+#include <string>
+
+#include "common/atomic_file.hpp"
+#include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/run_folder.hpp"
+
+namespace fs = std::filesystem;
+using swim::scene::json;
+
+namespace {
+
+const std::string kDemo = SWIM_SOURCE_DIR "/data/scenes/demo.json";
+const std::string kTiny3d = SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json";
+const std::string kTiny3dFast =
+    " --set full3d.dt='\"1 ms\"' --set time.duration='\"12 ms\"' --set full3d.output.vtk_interval='\"5 ms\"'";
+
+fs::path tmpdir(const std::string& tag) {
+  const fs::path d = fs::temp_directory_path() / ("swim_folder_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+struct Cli {
+  int code = -1;
+  std::string err;
+};
+
+// Runs the executable; `env` is prepended to the command line (e.g. "SWIM_TEST_FAIL_WRITE=x").
+Cli swim_cli(const std::string& args, const fs::path& scratch, const std::string& env = "") {
+  const fs::path err = scratch / ("stderr_" + std::to_string(::getpid()) + ".txt");
+  const std::string cmd = env + (env.empty() ? "" : " ") + "\"" + SWIM_BINARY_DIR + "/bin/swim\" " + args +
+                          " --quiet > /dev/null 2> \"" + err.string() + "\"";
+  const int status = std::system(cmd.c_str());
+  Cli c;
+  c.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  c.err = slurp(err);
+  fs::remove(err);
+  return c;
+}
+
+json summary_of(const fs::path& dir) {
+  const std::string t = slurp(dir / "summary.json");
+  return t.empty() ? json(nullptr) : json::parse(t);
+}
+
+// Nothing in the folder claims success: no summary, or one whose status is not "ok".
+void expect_no_success_claim(const fs::path& dir) {
+  const json s = summary_of(dir);
+  if (s.is_null()) return;
+  ASSERT_TRUE(s.contains("status"));
+  EXPECT_EQ(s["status"].get<std::string>().rfind("failed", 0), 0u) << s["status"];
+}
+
+// Every file the summary lists exists with the recorded size and checksum; no temporary
+// files remain; nothing else than the listed files, the summary and the run's records.
+void expect_consistent_folder(const fs::path& dir) {
+  const json s = summary_of(dir);
+  ASSERT_TRUE(s.is_object());
+  ASSERT_TRUE(s.contains("files"));
+  std::set<std::string> listed = {"summary.json", ".swim.lock", ".swim-run.json"};
+  for (const auto& f : s["files"]) {
+    const fs::path p = dir / f["name"].get<std::string>();
+    ASSERT_TRUE(fs::exists(p)) << p;
+    EXPECT_EQ(fs::file_size(p), f["bytes"].get<std::uintmax_t>()) << p;
+    EXPECT_EQ(swim::output::file_checksum(p.string()), f["fnv1a64"].get<std::string>()) << p;
+    listed.insert(f["name"].get<std::string>());
+  }
+  for (const auto& e : fs::recursive_directory_iterator(dir)) {
+    if (e.is_directory()) continue;
+    const std::string rel = fs::relative(e.path(), dir).generic_string();
+    EXPECT_TRUE(listed.count(rel)) << "file not from this run: " << rel;
+    EXPECT_EQ(rel.find(".tmp"), std::string::npos) << "temporary file left: " << rel;
+  }
+}
+
+}  // namespace
+
+TEST(AtomicFile, AFileAppearsOnlyWhenCompleteAndAFailedRewriteKeepsTheOldOne) {
+  const fs::path d = tmpdir("atomic");
+  const std::string p = (d / "a.txt").string();
+  {
+    swim::output::AtomicFile f(p);
+    f.stream() << "partial";
+    EXPECT_FALSE(fs::exists(p));  // not yet published
+  }                               // not committed: discarded
+  EXPECT_FALSE(fs::exists(p));
+  EXPECT_TRUE(fs::is_empty(d)) << "temporary file left behind";
+  {
+    swim::output::AtomicFile f(p);
+    f.stream() << "complete\n";
+    f.commit();
+  }
+  EXPECT_EQ(slurp(p), "complete\n");
+  ::setenv("SWIM_TEST_FAIL_WRITE", "a.txt:4", 1);
+  try {
+    swim::output::AtomicFile f(p);
+    f.stream() << std::string(100000, 'x');
+    f.commit();
+    ADD_FAILURE() << "a failed write was committed";
+  } catch (const swim::OutputError& e) {
+    EXPECT_EQ(e.file(), "a.txt");
+    EXPECT_NE(std::string(e.what()).find("disk full while writing a.txt"), std::string::npos) << e.what();
+  }
+  ::unsetenv("SWIM_TEST_FAIL_WRITE");
+  EXPECT_EQ(slurp(p), "complete\n") << "the old file was damaged by a failed rewrite";
+  // the folder's summary is refused after a failure in it
+  EXPECT_THROW(swim::output::write_json((d / "summary.json").string(), json{{"status", "ok"}}), swim::OutputError);
+  EXPECT_FALSE(fs::exists(d / "summary.json"));
+  // a writer whose folder is gone (read-only or missing) fails with OutputError, not a crash
+  EXPECT_THROW(swim::output::AtomicFile((d / "missing" / "x.csv").string()), swim::OutputError);
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, AFullDiskIsExitThreeNamingTheFileAndNothingClaimsSuccess) {
+  const fs::path d = tmpdir("full");
+  for (const std::string f : {"radius.csv", "series.csv", "solver_stats.json", "scene.resolved.json", "summary.json"}) {
+    SCOPED_TRACE(f);
+    const fs::path out = d / ("run_" + f);
+    const Cli c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d,
+                           "SWIM_TEST_FAIL_WRITE=" + f + ":100");
+    EXPECT_EQ(c.code, 3) << c.err;
+    EXPECT_NE(c.err.find("disk full while writing " + f), std::string::npos) << c.err;
+    expect_no_success_claim(out);
+    if (f != "summary.json") {
+      EXPECT_FALSE(fs::exists(out / f)) << "a partial " << f << " was published";
+    }
+    for (const auto& e : fs::directory_iterator(out))
+      EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+  }
+  // 3D: a membrane frame in the middle of the run
+  const fs::path out3 = d / "run3d";
+  const Cli c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out3.string() + "\"" + kTiny3dFast, d,
+                         "SWIM_TEST_FAIL_WRITE=membrane_000001.vtp:500");
+  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_NE(c.err.find("disk full while writing membrane_000001.vtp"), std::string::npos) << c.err;
+  expect_no_success_claim(out3);
+  EXPECT_FALSE(fs::exists(out3 / "vtk" / "membrane_000001.vtp"));
+  // the same run without the failure succeeds, and its folder is consistent
+  const fs::path ok = d / "ok";
+  ASSERT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + ok.string() + "\"", d).code, 0);
+  EXPECT_EQ(summary_of(ok)["status"], "ok");
+  expect_consistent_folder(ok);
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, ASecondRunIntoALockedFolderExitsTwoNamingThePid) {
+  const fs::path d = tmpdir("lock");
+  const fs::path out = d / "run";
+  {
+    swim::output::RunFolder held(out.string(), {"1d", json::object(), false, false, "--out"});
+    const Cli c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\" --overwrite", d);
+    EXPECT_EQ(c.code, 2) << c.err;
+    EXPECT_NE(c.err.find("PID " + std::to_string(::getpid())), std::string::npos) << c.err;
+    EXPECT_FALSE(fs::exists(out / "summary.json"));
+    // in process too
+    EXPECT_THROW(swim::output::RunFolder(out.string(), {"1d", json::object(), true, false, "--out"}), swim::InputError);
+  }
+  // released: the folder can be used (the lock is a kernel lock, so a killed run never blocks it)
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\" --overwrite", d).code, 0);
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, TwoRunsStartedOnOneFolderNeverMix) {
+  const fs::path d = tmpdir("two");
+  const fs::path out = d / "run";
+  const std::string bin = std::string("\"") + SWIM_BINARY_DIR + "/bin/swim\"";
+  const std::string a = bin + " run \"" + kDemo + "\" --quiet --out \"" + out.string() + "\" --set swimmer.length='0.3 um'";
+  const std::string b = bin + " run \"" + kDemo + "\" --quiet --out \"" + out.string() + "\" --set swimmer.length='0.5 um'";
+  const std::string cmd = "cd \"" + d.string() + "\"; (" + a + " >/dev/null 2>a.err; echo $? > a.code) & (" + b +
+                          " >/dev/null 2>b.err; echo $? > b.code) & wait";
+  ASSERT_EQ(std::system(("bash -c '" + std::regex_replace(cmd, std::regex("'"), "'\\''") + "'").c_str()), 0);
+  const int ca = std::stoi(slurp(d / "a.code")), cb = std::stoi(slurp(d / "b.code"));
+  EXPECT_EQ(std::min(ca, cb), 0) << slurp(d / "a.err") << slurp(d / "b.err");
+  EXPECT_EQ(std::max(ca, cb), 2) << slurp(d / "a.err") << slurp(d / "b.err");
+  const json s = summary_of(out);
+  ASSERT_TRUE(s.is_object());
+  EXPECT_EQ(s["scene"]["swimmer"]["length"], ca == 0 ? "0.3 um" : "0.5 um");
+  EXPECT_EQ(s["status"], "ok");
+  EXPECT_EQ(json::parse(slurp(out / "scene.resolved.json"))["swimmer"]["length"], s["scene"]["swimmer"]["length"]);
+  expect_consistent_folder(out);
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, StaleResultsOfAnotherRunAreRefusedOrClearedWithOverwrite) {
+  const fs::path d = tmpdir("stale");
+  const fs::path out = d / "run";
+  // a longer 3D run's results
+  ASSERT_EQ(swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() + "\"" + kTiny3dFast, d).code, 0);
+  ASSERT_TRUE(fs::exists(out / "vtk" / "membrane_000002.vtp"));
+  // a 1D run into it is refused, and leaves it untouched
+  const std::string before = slurp(out / "summary.json");
+  Cli c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("--overwrite"), std::string::npos) << c.err;
+  EXPECT_EQ(slurp(out / "summary.json"), before);
+  // a shorter 3D run (another scene) too
+  c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() + "\"" + kTiny3dFast +
+                   " --set time.duration='\"6 ms\"'",
+               d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  // --resume of the 3D folder as a 1D run is refused
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --resume \"" + out.string() + "\"", d).code, 2);
+  // with --overwrite the old files are gone first: nothing of the 3D run is left
+  c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\" --overwrite", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_FALSE(fs::exists(out / "vtk"));
+  EXPECT_FALSE(fs::exists(out / "checkpoint.bin"));
+  EXPECT_FALSE(fs::exists(out / "membrane.pvd"));
+  EXPECT_EQ(summary_of(out)["tier"], "1d");
+  expect_consistent_folder(out);
+  // now a 3D --resume on the 1D folder is refused (it would replace the 1D results)
+  std::ofstream(out / "checkpoint.bin") << "not a checkpoint";
+  c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --resume \"" + out.string() + "\"" + kTiny3dFast, d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("1d run"), std::string::npos) << c.err;
+  EXPECT_EQ(summary_of(out)["tier"], "1d");
+  fs::remove(out / "checkpoint.bin");
+  // re-running the identical scene replaces its own finished results
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d).code, 0);
+  expect_consistent_folder(out);
+  // also in a folder written before run records existed (identified by its summary's scene)
+  fs::remove(out / ".swim-run.json");
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d).code, 0);
+  fs::remove(out / ".swim-run.json");
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\" --set swimmer.length='0.3 um'", d).code, 2);
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, FilesSwimDidNotWriteAreNeverRemoved) {
+  const fs::path d = tmpdir("foreign");
+  const fs::path out = d / "run";
+  fs::create_directories(out);
+  std::ofstream(out / "notes.txt") << "mine";
+  for (const std::string flag : {"", " --overwrite"}) {
+    const Cli c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"" + flag, d);
+    EXPECT_EQ(c.code, 2) << c.err;
+    EXPECT_NE(c.err.find("notes.txt"), std::string::npos) << c.err;
+  }
+  EXPECT_EQ(slurp(out / "notes.txt"), "mine");
+  EXPECT_FALSE(fs::exists(out / "summary.json"));
+  // a directory where a result file should be: exit 2 before anything is written
+  const fs::path out2 = d / "run2";
+  fs::create_directories(out2 / "radius.csv" / "x");
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + out2.string() + "\" --overwrite", d).code, 2);
+  EXPECT_FALSE(fs::exists(out2 / "summary.json"));
+  // --out naming a file
+  std::ofstream(d / "plain") << "x";
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "plain").string() + "\"", d).code, 2);
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, ARunWhoseOutputWouldExceedTheLimitIsRefused) {
+  const fs::path d = tmpdir("limit");
+  const fs::path out = d / "run";
+  const std::string demo20 = "run \"" + kDemo + "\" --out \"" + out.string() + "\" --set time.duration='20 ms'";
+  Cli c = swim_cli(demo20 + " --set output.max_bytes=100000", d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("'time.output_interval'"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("output.max_bytes"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  // the estimate is realistic: within a factor 2 of what the run then writes
+  std::smatch m;
+  ASSERT_TRUE(std::regex_search(c.err, m, std::regex(R"(about ([0-9.]+) (kB|MB|GB))"))) << c.err;
+  const double estimate = std::stod(m[1]) * (m[2] == "kB" ? 1e3 : m[2] == "MB" ? 1e6 : 1e9);
+  ASSERT_EQ(swim_cli(demo20, d).code, 0);
+  double total = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    if (e.is_regular_file()) total += static_cast<double>(e.file_size());
+  EXPECT_GT(estimate, 0.5 * total);
+  EXPECT_LT(estimate, 2.0 * total);
+  fs::remove_all(out);
+  // the default limit (1 GB) refuses a long run with a fine interval
+  c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() +
+                   "\" --set time.duration='1000 s' --set time.output_interval='10 us'",
+               d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("'time.output_interval'"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  // 3D: the VTK frames dominate
+  c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() + "\"" + kTiny3dFast +
+                   " --set output.max_bytes=200000 --set full3d.output.vtk_interval='\"1 ms\"'",
+               d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("'full3d.output.vtk_interval'"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(d);
+}
+
+TEST(RunFolderCli, ARealFullFilesystemIsExitThreeAndNothingClaimsSuccess) {
+  // A 600 kB tmpfs: the 1D demo's radius.csv (3.5 MB) cannot fit. Needs the right to mount
+  // (root in a container that allows it); skipped otherwise -- the injected failure above
+  // covers the same code path.
+  const fs::path d = tmpdir("tmpfs");
+  const fs::path mnt = d / "mnt";
+  fs::create_directories(mnt);
+  if (::geteuid() != 0 ||
+      std::system(("mount -t tmpfs -o size=600k tmpfs \"" + mnt.string() + "\" 2>/dev/null").c_str()) != 0) {
+    fs::remove_all(d);
+    GTEST_SKIP() << "cannot mount a tmpfs here";
+  }
+  struct Cleanup {
+    fs::path mnt, dir;
+    ~Cleanup() {
+      if (std::system(("umount \"" + mnt.string() + "\"").c_str()) == 0) fs::remove_all(dir);
+    }
+  } cleanup{mnt, d};
+  const fs::path out = mnt / "run";
+  const Cli c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d);
+  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_NE(c.err.find("disk full while writing radius.csv"), std::string::npos) << c.err;
+  expect_no_success_claim(out);
+  EXPECT_FALSE(fs::exists(out / "radius.csv"));
+  for (const auto& e : fs::directory_iterator(out))
+    EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
