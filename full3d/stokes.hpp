@@ -94,7 +94,8 @@ struct FluidParams {
 ///              and the Staircase cylinder wall only.
 ///   Iterative: the multiplier PCG below (every wall kind).
 ///   Auto:      plain duct and supported Staircase cylinder: Capacitance; other Staircase cylinders:
-///              Direct; each only when its estimated factor memory for two dt values is below
+///              Direct; each only when its estimated factor memory for the cached dt values (six
+///              for Capacitance, two for Direct) is below
 ///              direct_memory_limit_gib (a cylinder over the limit for Capacitance tries Direct),
 ///              else Iterative.
 enum class StokesMethod { Auto, Direct, Iterative, Capacitance };
@@ -105,7 +106,7 @@ struct StokesOptions {
   /// Direct: threads for the per-mode factorisations and solves; 0 = std::thread::hardware_concurrency().
   /// Capacitance: threads for the transforms and per-mode solves (parallel.hpp); 0 = fft.threads.
   int direct_threads = 0;
-  /// Auto: largest estimated factor memory (two cached dt values) for which Direct or
+  /// Auto: largest estimated factor memory (all cached dt values) for which Direct or
   /// Capacitance is chosen, GiB.
   double direct_memory_limit_gib = 4.0;
   /// Direct / Capacitance: follow the solve by the exact Neumann projection of the iterative path
