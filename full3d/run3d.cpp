@@ -442,33 +442,21 @@ class Runner {
     std::snprintf(name, sizeof name, "vtk/fluid_%06d.vti", int(fluid_pvd_.frames().size()));
     const MacGrid& g = *grid_;
     const int nx = g.nx(), ny = g.ny(), nz = g.nz();
-    std::ofstream o(out_ + "/" + name);
-    if (!o) throw std::runtime_error("cannot write " + out_ + "/" + name);
-    const double h = g.h();
-    o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "<ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\" Origin=\"0 0 0\" Spacing=\"" << h
-      << " " << h << " " << h << "\">\n<Piece Extent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\">\n<CellData>\n"
-      << "<DataArray type=\"Float64\" Name=\"velocity_m_per_s\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    char b[96];
     const auto du = g.dims(0), dv = g.dims(1), dw = g.dims(2);
+    vtk::PointArray vel{"velocity_m_per_s", 3, std::vector<double>(3 * std::size_t(nx) * ny * nz)};
+    std::size_t q = 0;
     for (int k = 0; k < nz; ++k)
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {  // cell-centre averages of the face values
           const int ip = (i + 1) % nx;
           const int jp = g.periodic(1) ? (j + 1) % ny : j + 1;
           const int kp = g.periodic(2) ? (k + 1) % nz : k + 1;
-          const double u = 0.5 * (s_.u.c[0][MacGrid::index(du, i, j, k)] + s_.u.c[0][MacGrid::index(du, ip, j, k)]);
-          const double v = 0.5 * (s_.u.c[1][MacGrid::index(dv, i, j, k)] + s_.u.c[1][MacGrid::index(dv, i, jp, k)]);
-          const double w = 0.5 * (s_.u.c[2][MacGrid::index(dw, i, j, k)] + s_.u.c[2][MacGrid::index(dw, i, j, kp)]);
-          std::snprintf(b, sizeof b, "%.7g %.7g %.7g\n", u, v, w);
-          o << b;
+          vel.values[q++] = 0.5 * (s_.u.c[0][MacGrid::index(du, i, j, k)] + s_.u.c[0][MacGrid::index(du, ip, j, k)]);
+          vel.values[q++] = 0.5 * (s_.u.c[1][MacGrid::index(dv, i, j, k)] + s_.u.c[1][MacGrid::index(dv, i, jp, k)]);
+          vel.values[q++] = 0.5 * (s_.u.c[2][MacGrid::index(dw, i, j, k)] + s_.u.c[2][MacGrid::index(dw, i, j, kp)]);
         }
-    o << "</DataArray>\n<DataArray type=\"Float64\" Name=\"pressure_Pa\" format=\"ascii\">\n";
-    for (double v : ib_->stokes().pressure().v) {
-      std::snprintf(b, sizeof b, "%.7g\n", v);
-      o << b;
-    }
-    o << "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
+    vtk::PointArray pr{"pressure_Pa", 1, ib_->stokes().pressure().v};
+    vtk::write_image_data(out_ + "/" + name, {nx, ny, nz}, g.h(), {vel, pr});
     fluid_pvd_.add(s_.t, name);
     fluid_pvd_.write();
   }
