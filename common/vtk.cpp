@@ -1,7 +1,9 @@
 #include "common/vtk.hpp"
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <fstream>
 #include <stdexcept>
 
@@ -11,43 +13,117 @@
 namespace swim::vtk {
 
 namespace {
-void put_values(std::ostream& out, const std::vector<double>& v, const std::string& what) {
-  char b[32];
-  for (size_t i = 0; i < v.size(); ++i) {
+
+constexpr char kB64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
+
+}  // namespace
+
+std::string base64(const unsigned char* p, std::size_t n) {
+  std::string s;
+  s.reserve(4 * ((n + 2) / 3));
+  std::size_t i = 0;
+  for (; i + 2 < n; i += 3) {
+    const std::uint32_t v = (std::uint32_t(p[i]) << 16) | (std::uint32_t(p[i + 1]) << 8) | p[i + 2];
+    s += kB64[v >> 18];
+    s += kB64[(v >> 12) & 63];
+    s += kB64[(v >> 6) & 63];
+    s += kB64[v & 63];
+  }
+  if (i < n) {
+    const std::uint32_t v = (std::uint32_t(p[i]) << 16) | (i + 1 < n ? std::uint32_t(p[i + 1]) << 8 : 0u);
+    s += kB64[v >> 18];
+    s += kB64[(v >> 12) & 63];
+    s += i + 1 < n ? kB64[(v >> 6) & 63] : '=';
+    s += '=';
+  }
+  return s;
+}
+
+std::string encode_block(const void* data, std::size_t bytes) {
+  if (bytes > 0xFFFFFFFFull) throw std::length_error("VTK array larger than 4 GiB");
+  std::vector<unsigned char> buf(4 + bytes);
+  const std::uint32_t header = static_cast<std::uint32_t>(bytes);  // little-endian host (x86-64, aarch64)
+  std::memcpy(buf.data(), &header, 4);
+  if (bytes) std::memcpy(buf.data() + 4, data, bytes);
+  return base64(buf.data(), buf.size());
+}
+
+std::string float32_block(const std::vector<double>& v, const std::string& what) {
+  std::vector<float> f(v.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
     if (!std::isfinite(v[i]))
       throw NumericalError("non-finite value in VTK array '" + what + "'", "reduce the time step");
-    std::snprintf(b, sizeof b, "%.9g", v[i]);
-    out << b << ((i + 1) % 9 == 0 ? "\n" : " ");
+    f[i] = static_cast<float>(v[i]);
   }
-  out << "\n";
+  return encode_block(f.data(), f.size() * sizeof(float));
 }
+
+namespace {
+
+void float_array(std::ostream& out, const std::string& name, int components, const std::vector<double>& v) {
+  out << "<DataArray type=\"Float32\"";
+  if (!name.empty()) out << " Name=\"" << name << "\"";
+  out << " NumberOfComponents=\"" << components << "\" format=\"binary\">\n" << float32_block(v, name.empty() ? "Points" : name)
+      << "\n</DataArray>\n";
+}
+
+void int_array(std::ostream& out, const std::string& name, const std::vector<std::int32_t>& v) {
+  out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"binary\">\n"
+      << encode_block(v.data(), v.size() * sizeof(std::int32_t)) << "\n</DataArray>\n";
+}
+
+const char* kHeader = "<?xml version=\"1.0\"?>\n";
+
 }  // namespace
 
 void write_polydata(const std::string& path, const std::vector<double>& xyz,
                     const std::vector<std::array<int, 3>>& triangles, const std::vector<PointArray>& arrays) {
   const size_t n = xyz.size() / 3;
+  for (const auto& a : arrays)
+    if (a.values.size() != n * static_cast<size_t>(a.components))
+      throw std::logic_error("VTK array " + a.name + " has the wrong size");
   output::AtomicFile file(path);
   std::ostream& out = file.stream();
-  out << "<?xml version=\"1.0\"?>\n"
+  out << kHeader
       << "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
       << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
       << "NumberOfPolys=\"" << triangles.size() << "\">\n";
   out << "<PointData>\n";
-  for (const auto& a : arrays) {
+  for (const auto& a : arrays) float_array(out, a.name, a.components, a.values);
+  out << "</PointData>\n<Points>\n";
+  float_array(out, "", 3, xyz);
+  out << "</Points>\n<Polys>\n";
+  std::vector<std::int32_t> conn, offs;
+  conn.reserve(3 * triangles.size());
+  offs.reserve(triangles.size());
+  for (size_t k = 0; k < triangles.size(); ++k) {
+    for (int c = 0; c < 3; ++c) conn.push_back(triangles[k][c]);
+    offs.push_back(static_cast<std::int32_t>(3 * (k + 1)));
+  }
+  int_array(out, "connectivity", conn);
+  int_array(out, "offsets", offs);
+  out << "</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  file.commit();
+}
+
+void write_image_data(const std::string& path, std::array<int, 3> cells, double spacing,
+                      const std::vector<PointArray>& cell_arrays) {
+  const size_t n = size_t(cells[0]) * cells[1] * cells[2];
+  for (const auto& a : cell_arrays)
     if (a.values.size() != n * static_cast<size_t>(a.components))
       throw std::logic_error("VTK array " + a.name + " has the wrong size");
-    out << "<DataArray type=\"Float64\" Name=\"" << a.name << "\" NumberOfComponents=\"" << a.components
-        << "\" format=\"ascii\">\n";
-    put_values(out, a.values, a.name);
-    out << "</DataArray>\n";
-  }
-  out << "</PointData>\n<Points>\n<DataArray type=\"Float64\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-  put_values(out, xyz, "Points");
-  out << "</DataArray>\n</Points>\n<Polys>\n<DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
-  for (const auto& t : triangles) out << t[0] << " " << t[1] << " " << t[2] << "\n";
-  out << "</DataArray>\n<DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
-  for (size_t k = 0; k < triangles.size(); ++k) out << 3 * (k + 1) << ((k + 1) % 12 == 0 ? "\n" : " ");
-  out << "\n</DataArray>\n</Polys>\n</Piece>\n</PolyData>\n</VTKFile>\n";
+  output::AtomicFile file(path);
+  std::ostream& out = file.stream();
+  char h[32];
+  std::snprintf(h, sizeof h, "%.17g", spacing);
+  const std::string extent = "0 " + std::to_string(cells[0]) + " 0 " + std::to_string(cells[1]) + " 0 " +
+                             std::to_string(cells[2]);
+  out << kHeader
+      << "<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<ImageData WholeExtent=\"" << extent << "\" Origin=\"0 0 0\" Spacing=\"" << h << " " << h << " " << h
+      << "\">\n<Piece Extent=\"" << extent << "\">\n<CellData>\n";
+  for (const auto& a : cell_arrays) float_array(out, a.name, a.components, a.values);
+  out << "</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
   file.commit();
 }
 

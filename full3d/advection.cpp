@@ -91,7 +91,7 @@ double advect(const MacGrid& g, VectorField& u, double dt, const AdvectionOption
   if (!(cfl <= opt.max_cfl))
     throw NumericalError("fluid advection CFL number " + num(cfl) + " exceeds " + num(opt.max_cfl) +
                              " (sum_d max|u_d| dt/h of the Navier-Stokes advection sub-step)",
-                         "reduce the time step dt (or raise stokes.advection.max_cfl)");
+                         "reduce the time step full3d.dt (or raise StokesOptions::advection.max_cfl through the API)");
   VectorField N(g);
   if (opt.scheme == AdvectionScheme::Rk2) {
     // Heun: u1 = u - dt N(u);  u <- (u + u1 - dt N(u1)) / 2

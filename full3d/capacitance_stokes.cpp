@@ -182,8 +182,19 @@ struct CapacitanceStokes::Impl {
     std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> u0llt;
     std::size_t bytes = 0;
   };
-  std::array<Factors, 2> cache;
-  int next_slot = 0;
+  // The factors of the last kCacheSlots alpha values (least recently used replaced): the
+  // adaptive time step of the run driver moves over a ladder of a few dt values.
+  static constexpr int kCacheSlots = 6;
+  std::array<Factors, kCacheSlots> cache;
+  std::array<long, kCacheSlots> used_at{};
+  long use_clock = 0;
+  Factors& free_slot() {
+    int best = 0;
+    for (int k = 1; k < kCacheSlots; ++k)
+      if (used_at[k] < used_at[best]) best = k;
+    used_at[best] = ++use_clock;
+    return cache[best];
+  }
   double factor_seconds = 0.0;
   bool factorized_last = false;
 
@@ -223,7 +234,8 @@ struct CapacitanceStokes::Impl {
     if (!L.wall_nodes_masked)
       throw InputError("container.radius", std::to_string(radius),
                        "the capacitance cylinder solver needs every wall-adjacent tangential face outside the "
-                       "cylinder (radius <= duct half-width - h/2); use stokes.method = direct");
+                       "cylinder (radius <= duct half-width - h/2); use a smaller radius or "
+                       "full3d.cylinder_wall = \"ghost_linear\" (iterative solver)");
     cyl = true;
     const double h = grid.h();
     row_masked.assign(std::size_t(off[3]), 0);
@@ -379,7 +391,8 @@ struct CapacitanceStokes::Impl {
     auto llt = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>>(A);
     if (llt->info() != Eigen::Success)
       throw NumericalError("axial-mean factorisation of the cylinder capacitance solver failed",
-                           "use stokes.method = direct");
+                           "change the grid (full3d.grid.cells_across) or use full3d.cylinder_wall = "
+                           "\"ghost_linear\" (iterative solver)");
     return llt;
   }
 
@@ -964,8 +977,7 @@ struct CapacitanceStokes::Impl {
       }
     });
     auto u0llt = factor_mean_x(alpha);
-    Factors& f = cache[next_slot];
-    next_slot = 1 - next_slot;
+    Factors& f = free_slot();
     f.alpha = alpha;
     f.chol = std::move(chol);
     f.u0llt = std::move(u0llt);
@@ -1029,10 +1041,11 @@ struct CapacitanceStokes::Impl {
   }
 
   const Factors& factors(double alpha) {
-    for (auto& f : cache)
-      if (!f.chol.empty() && f.alpha == alpha) {
+    for (int k = 0; k < kCacheSlots; ++k)
+      if (!cache[k].chol.empty() && cache[k].alpha == alpha) {
+        used_at[k] = ++use_clock;
         factorized_last = false;
-        return f;
+        return cache[k];
       }
     if (cyl) return factors_cyl(alpha);
     const auto t0 = std::chrono::steady_clock::now();
@@ -1043,8 +1056,7 @@ struct CapacitanceStokes::Impl {
         factor_blocks(C, chol[kx], kx, alpha, "duct");
       }
     });
-    Factors& f = cache[next_slot];
-    next_slot = 1 - next_slot;
+    Factors& f = free_slot();
     f.alpha = alpha;
     f.chol = std::move(chol);
     f.bytes = std::size_t(nxh) * chol_off[4] * sizeof(double);
@@ -1073,7 +1085,8 @@ struct CapacitanceStokes::Impl {
             throw NumericalError(
                 std::string("capacitance matrix of the ") + what +
                     " Stokes solver is not positive definite for axial mode " + std::to_string(kx) + " (rho/dt = " + std::to_string(alpha) + ")",
-                "use stokes.method = direct or iterative");
+                "change the time step or the grid (full3d.grid.cells_across), or use full3d.cylinder_wall = "
+                "\"ghost_linear\" (iterative solver)");
           const Eigen::MatrixXd& lm = llt.matrixLLT();  // lower triangle holds L
           double* dst = l.data() + chol_off[cl];
           for (int j = 0; j < n; ++j)

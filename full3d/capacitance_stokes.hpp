@@ -34,7 +34,7 @@
 // C(kx) is assembled column by column from m unit solves (in transform space, all
 // partial transforms below), split into four blocks of about m/4 by the reflection
 // symmetries y -> Ly - y, z -> Lz - z of the duct (which C commutes with), and each block is
-// Cholesky-factorised once per alpha; the factors of the last two alpha values are kept
+// Cholesky-factorised once per alpha; the factors of the last six alpha values are kept
 // (the midpoint IB scheme alternates dt/2 and dt).
 //
 // The axial mean (kx = 0) of the x component decouples from p and is solved directly in the
@@ -108,7 +108,7 @@ class CapacitanceStokes {
   /// Solves A u + G p = b, D u = 0 with the no-slip duct walls, A = alpha - mu L.
   /// b: right-hand side on the faces (wall-face entries ignored). u, p: outputs (wall
   /// faces zero, p with zero mean). Factorises the capacitance matrices on the first call
-  /// with a new alpha (two alpha values cached).
+  /// with a new alpha (six alpha values cached).
   /// Throws swim::NumericalError if a capacitance matrix is not positive definite.
   void solve(const VectorField& b, VectorField& u, ScalarField& p, double alpha);
   /// The backward-Euler step itself: u (in u^n, out u^{n+1}) and p solve the system above with

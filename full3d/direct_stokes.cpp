@@ -247,7 +247,8 @@ struct DirectStokes::Impl {
       if (l->info() != Eigen::Success)
         throw NumericalError("sparse LU of the direct Stokes solver failed for axial mode " + std::to_string(kx) +
                                  ": " + l->lastErrorMessage(),
-                             "use stokes.method = iterative");
+                             "change the grid (full3d.grid.cells_across) or use full3d.cylinder_wall = "
+                             "\"ghost_linear\" (iterative solver)");
       bytes[kx] = std::size_t(l->nnzL() + l->nnzU()) * (sizeof(double) + sizeof(int));
       lu[kx] = std::move(l);
     });

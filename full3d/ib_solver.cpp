@@ -1,7 +1,9 @@
 #include "full3d/ib_solver.hpp"
 
 #include <chrono>
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <string>
 #include <utility>
@@ -24,9 +26,9 @@ IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh m
     : grid_(grid), mesh_(std::move(mesh)), membrane_(membrane), mass_(std::move(node_mass)), opt_(opt),
       stokes_(grid, fluid, opt.stokes) {
   if (mass_.size() != mesh_.nodes())
-    throw InputError("swimmer.node_mass", std::to_string(mass_.size()) + " values",
+    throw InputError("IbSolver node_mass", std::to_string(mass_.size()) + " values",
                      "one mass per membrane node (" + std::to_string(mesh_.nodes()) + ")");
-  if (!(opt_.max_cfl > 0.0)) throw InputError("ib.max_cfl", num(opt_.max_cfl), "a positive number");
+  if (!(opt_.max_cfl > 0.0)) throw InputError("full3d.max_cfl", num(opt_.max_cfl), "a positive number");
 }
 
 IbState IbSolver::initial_state() const {
@@ -104,6 +106,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     interpolate(grid_, uh, s.X, U, opt_.threads);
     lap(st.time_interp);
     guard_finite(U, "node velocity", s.t);
+    const Eigen::Matrix3Xd U0 = U;
     const Eigen::Matrix3Xd Xh = s.X + 0.5 * dt * U;
     F = fluid_force(Xh, s.t + 0.5 * dt, accel);
     guard_finite(F, "membrane force", s.t);
@@ -117,11 +120,16 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     interpolate(grid_, u, Xh, U, opt_.threads);
     lap(st.time_interp);
     Xnew = s.X + dt * U;
+    st.max_velocity_change = (U - U0).colwise().norm().maxCoeff();
   }
   guard_finite(U, "node velocity", s.t);
   guard_finite(Xnew, "node position", s.t);
   st.max_node_speed = U.colwise().norm().maxCoeff();
   st.cfl = st.max_node_speed * dt / grid_.h();
+  if (st.cfl > opt_.max_cfl && opt_.reject_on_cfl) {
+    st.rejected = true;
+    return st;
+  }
   if (st.cfl > opt_.max_cfl)
     throw NumericalError("advective CFL number " + num(st.cfl) + " exceeds " + num(opt_.max_cfl) +
                              " (nodes move " + num(st.cfl) + " cells per step)",
@@ -141,6 +149,47 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   std::swap(s.u, u);  // u (work_u_) keeps the old buffers for the next step
   s.t += dt;
   return st;
+}
+
+double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
+  const Eigen::Index n = s.X.cols();
+  // membrane forces only: the actuation relays are saturating (their level moves by at most
+  // one over a ramp of a fraction of delta), so their steep slope bounds an oscillation to the
+  // ramp width instead of growing it
+  const Eigen::Matrix3Xd F0 = elastic_forces(mesh_, s.X, membrane_, opt_.threads);
+  // fixed pseudo-random start (a linear congruential sequence): reproducible on resume
+  Eigen::Matrix3Xd v(3, n);
+  std::uint64_t r = 0x9E3779B97F4A7C15ull;
+  for (Eigen::Index i = 0; i < v.size(); ++i) {
+    r = r * 6364136223846793005ull + 1442695040888963407ull;
+    v.data()[i] = double(r >> 11) * (1.0 / 9007199254740992.0) - 0.5;
+  }
+  const double eps = 1e-4 * grid_.h();  // finite-difference amplitude (max node displacement)
+  VectorField& f = work_f_;
+  VectorField& u = work_uh_;
+  Eigen::Matrix3Xd U;
+  double lambda = 0.0;
+  // the pressure is state for the duct's warm-started PCG: the estimate must not change it
+  const ScalarField p_keep = stokes_.pressure();
+  struct Restore {
+    StokesSolver& s;
+    const ScalarField& p;
+    ~Restore() { s.set_pressure(p); }
+  } restore{stokes_, p_keep};
+  for (int it = 0; it < iterations; ++it) {
+    const double vmax = v.cwiseAbs().maxCoeff();
+    if (!(vmax > 0.0) || !std::isfinite(vmax)) return lambda;
+    v /= vmax;
+    const Eigen::Matrix3Xd dF = (elastic_forces(mesh_, s.X + eps * v, membrane_, opt_.threads) - F0) / eps;
+    spread(grid_, s.X, dF, f, opt_.threads);
+    u = s.u;
+    for (auto& c : u.c) std::fill(c.begin(), c.end(), 0.0);
+    stokes_.step(u, f, dt);
+    interpolate(grid_, u, s.X, U, opt_.threads);
+    lambda = U.norm() / v.norm();  // |A v| / |v|
+    v = -U;
+  }
+  return lambda;
 }
 
 }  // namespace swim::full3d

@@ -35,6 +35,9 @@ struct IbOptions {
   IbScheme scheme = IbScheme::ForwardEuler;
   double max_cfl = 0.5;       ///< max |U| dt / h allowed
   bool check_no_leak = true;  ///< enforce max edge < h/2 after every step
+  /// true: a step whose CFL number exceeds max_cfl is rejected (IbStepStats::rejected, state
+  /// unchanged) instead of throwing; the adaptive run driver then retries with a smaller dt.
+  bool reject_on_cfl = false;
   std::string dt_key = "dt";  ///< name of the time step in remedies (the run driver passes "full3d.dt")
   int threads = 1;            ///< threads for spreading, interpolation and membrane forces (parallel.hpp)
   StokesOptions stokes{};
@@ -54,6 +57,10 @@ struct IbStepStats {
   int stokes_iterations = 0;
   double max_divergence = 0.0;  ///< 1/s
   double max_edge = 0.0;        ///< m
+  /// Midpoint: max over nodes of |U(u^{n+1}; X*) - U(u*; X^n)|, m/s (the embedded
+  /// forward-Euler error estimate: dt times this is twice its local error)
+  double max_velocity_change = 0.0;
+  bool rejected = false;        ///< IbOptions::reject_on_cfl: CFL above max_cfl, state unchanged
   // wall time of the parts of this step, s (for swim bench)
   double time_forces = 0.0;     ///< membrane + actuation forces
   double time_spread = 0.0;     ///< spreading (eq. 19)
@@ -76,6 +83,14 @@ class IbSolver {
 
   /// Advances s by dt. Throws swim::NumericalError (state left at the last good step).
   IbStepStats step(IbState& s, double dt);
+
+  /// Largest decay rate lambda_max (1/s) of the linearised explicit coupling at s.X: the
+  /// dominant eigenvalue of X' = U(F(X)) linearised, i.e. of v -> -I S J v with J = dF/dX
+  /// (membrane forces, finite differences; the actuation relays saturate and are left out), S the Stokes solve with the step dt on
+  /// u^n = 0 (the quasi-steady mobility) and I / spreading the IB transfer operators.
+  /// Forward Euler is stable while dt lambda_max < 2. Power iteration from a fixed
+  /// pseudo-random start (reproducible), `iterations` coupled solves. Leaves s unchanged.
+  double explicit_rate(const IbState& s, double dt, int iterations = 10);
 
   /// Force the structure exerts on the fluid, -Fbar of eq. (16), N per node.
   Eigen::Matrix3Xd fluid_force(const Eigen::Matrix3Xd& X, double t, const Eigen::Matrix3Xd& accel) const;

@@ -6,6 +6,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 
@@ -54,7 +56,19 @@ const std::vector<std::string> kSeriesColumns = {
     "t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m", "flux_rear_m3_per_s",
     "flux_front_m3_per_s", "volume_rear_m3", "volume_front_m3", "tube_volume_m3", "phase", "elastic_energy_J",
     "bending_energy_J", "kinetic_energy_J", "active_segment", "cycles_completed", "cfl", "stokes_iterations",
-    "max_divergence_per_s", "max_edge_m"};
+    "max_divergence_per_s", "max_edge_m", "dt_s"};
+
+/// Adaptive step: re-estimate the explicit-coupling limit at least every this many steps
+/// (and after every protocol event).
+constexpr long kStabilityEvery = 200;
+/// Power iterations per estimate of the explicit-coupling rate.
+constexpr int kStabilityIterations = 10;
+
+/// true when (t0, t1] contains a positive multiple of interval (time-based output cadence).
+bool crossed(double t0, double t1, double interval) {
+  const double eps = 1e-9;
+  return std::floor(t1 / interval + eps) > std::floor(t0 / interval + eps);
+}
 
 /// The scene as it must match on resume: everything except the keys that only steer
 /// output cadence and parallelism.
@@ -76,6 +90,8 @@ class Runner {
         e_ref_(uniform_contraction_energy(mesh_, p.membrane, p.protocol.R_f)),
         protocol_(effective_protocol(p, mesh_), mesh_, e_ref_),
         pvd_(out_ + "/membrane.pvd"), fluid_pvd_(out_ + "/fluid.pvd") {
+    adaptive_ = p.adaptive.enabled && !p.dry;
+    dt_key_ = adaptive_ ? "full3d.adaptive.dt_max" : "full3d.dt";
     const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
     e_cap_ = p.energy_growth * e_ref_ * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
     out_every_ = steps_for(p.output_interval, p.dt);
@@ -88,7 +104,9 @@ class Runner {
     fluid_on_ = p.fluid_fields && !p.dry && !ctl.quiet_vtk;
     if (!p.dry) {
       grid_.emplace(p.nx, p.ny, p.nz, p.h, p.container_kind());
-      const IbOptions o = ib_options(p);
+      IbOptions o = ib_options(p);
+      o.reject_on_cfl = adaptive_;
+      o.dt_key = dt_key_;
       const Eigen::VectorXd m = p.wall_inertia ? mass_ : Eigen::VectorXd::Zero(mesh_.nodes());
       ib_ = std::make_unique<IbSolver>(*grid_, p.fluid, mesh_, p.membrane, m, o);
       ib_->set_external_force([this](double, const Eigen::Matrix3Xd& X) { return protocol_.force(X); });
@@ -99,6 +117,8 @@ class Runner {
       s_.V_prev = s_.V;
     }
     build_discs();
+    dt_last_ = dt_before_last_ = p.dt;
+    if (adaptive_) dt_next_ = dt_last_ = dt_before_last_ = ladder(p.adaptive.event_dt);
   }
 
   RunOutcome run() {
@@ -109,6 +129,7 @@ class Runner {
     } else {
       protocol_.start(0.0, s_.X);
       x_center0_ = s_.X.row(0).mean();
+      step_marks_.push_back(0.0);
       record();
       if (vtk_on_) write_vtk_frame();
       if (fluid_on_) write_fluid_frame();
@@ -122,17 +143,18 @@ class Runner {
     std::optional<NumericalError> failure;
     try {
       while (!finished()) {
-        if (n_end_ < 0 && n_ >= n_limit_)
+        if (n_end_ < 0 && (adaptive_ ? s_.t >= p_.time_limit * (1.0 - 1e-12) : n_ >= n_limit_))
           throw NumericalError("the protocol did not complete " + std::to_string(p_.protocol.cycles) +
                                    " cycle(s) within full3d.time_limit = " + num(p_.time_limit) + " s",
                                "raise full3d.time_limit, or give a time.duration", s_.t);
+        t_prev_ = s_.t;
         advance();
         ++n_;
         ++this_process;
-        if (n_ % out_every_ == 0) record();
-        if (vtk_on_ && n_ % vtk_every_ == 0) write_vtk_frame();
-        if (fluid_on_ && n_ % fluid_every_ == 0) write_fluid_frame();
-        if (n_ % ckpt_every_ == 0) save_checkpoint(wall_before_ + seconds_since(t0));
+        if (due(out_every_, p_.output_interval)) record();
+        if (vtk_on_ && due(vtk_every_, p_.vtk_interval)) write_vtk_frame();
+        if (fluid_on_ && due(fluid_every_, p_.fluid_interval)) write_fluid_frame();
+        if (due(ckpt_every_, p_.checkpoint_interval)) save_checkpoint(wall_before_ + seconds_since(t0));
         progress.update(s_.t);
         if (ctl_.stop_after_steps > 0 && this_process >= ctl_.stop_after_steps && !finished()) {
           res.interrupted = true;
@@ -141,7 +163,7 @@ class Runner {
         }
       }
       if (last_recorded_ != n_) record();
-      if (vtk_on_ && n_ % vtk_every_ != 0) write_vtk_frame();
+      if (vtk_on_ && !(n_ > 0 && due(vtk_every_, p_.vtk_interval))) write_vtk_frame();
     } catch (const NumericalError& e) {
       failure = e;
       // the state is the last step the solver accepted; record it when it is finite
@@ -161,7 +183,22 @@ class Runner {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   }
 
-  bool finished() const { return n_end_ > 0 ? n_ >= n_end_ : protocol_.finished(); }
+  bool finished() const {
+    if (n_end_ <= 0) return protocol_.finished();
+    return adaptive_ ? s_.t >= p_.duration * (1.0 - 1e-12) : n_ >= n_end_;
+  }
+
+  /// Output cadence: every `every` steps (fixed step) or at each multiple of `interval`
+  /// crossed by the last step (adaptive step).
+  bool due(long every, double interval) const { return adaptive_ ? crossed(t_prev_, s_.t, interval) : n_ % every == 0; }
+
+  /// dt snapped down to the ladder dt_max 2^(-k/4), k >= 0.
+  double ladder(double dt) const {
+    const double top = p_.adaptive.dt_max;
+    if (dt >= top) return top;
+    const double k = std::ceil(4.0 * std::log2(top / dt) - 1e-9);
+    return top * std::exp2(-k / 4.0);
+  }
 
   // --- one time step -------------------------------------------------------
   void advance() {
@@ -171,21 +208,109 @@ class Runner {
       last_iterations_ = 0;
       last_divergence_ = 0;
     } else {
-      const IbStepStats st = ib_->step(s_, p_.dt);
+      double dt = adaptive_ ? dt_next_ : p_.dt;
+      if (adaptive_ && p_.duration > 0) dt = std::min(dt, p_.duration - s_.t);  // land on the end
+      IbStepStats st;
+      for (;;) {
+        st = ib_->step(s_, dt);
+        if (!st.rejected) break;
+        // CFL above the guard: retry from the same state with a step at the CFL target
+        ++rejected_;
+        dt = ladder(std::min(0.5 * dt, 0.9 * dt * p_.adaptive.cfl / st.cfl));
+        if (dt < p_.adaptive.dt_min)
+          throw NumericalError("the adaptive step fell below full3d.adaptive.dt_min = " + num(p_.adaptive.dt_min) +
+                                   " s at the CFL limit (nodes at " + num(st.max_node_speed) + " m/s)",
+                               "lower full3d.adaptive.dt_min, or lower the actuation (protocol.pressure / load_factor)",
+                               s_.t);
+      }
+      dt_before_last_ = dt_last_;
+      dt_last_ = dt;
+      dt_used_min_ = std::min(dt_used_min_, dt);
+      dt_used_max_ = std::max(dt_used_max_, dt);
+      last_speed_ = st.max_node_speed;
+      last_dv_ = st.max_velocity_change;
       last_cfl_ = st.cfl;
       last_iterations_ = st.stokes_iterations;
       last_divergence_ = st.max_divergence;
       max_cfl_ = std::max(max_cfl_, st.cfl);
       iterations_total_ += st.stokes_iterations;
       measure_fluxes();
-      vol_rear_ += 0.5 * p_.dt * (q_rear_prev_ + q_rear_);
-      vol_front_ += 0.5 * p_.dt * (q_front_prev_ + q_front_);
+      vol_rear_ += 0.5 * dt * (q_rear_prev_ + q_rear_);
+      vol_front_ += 0.5 * dt * (q_front_prev_ + q_front_);
       q_rear_prev_ = q_rear_;
       q_front_prev_ = q_front_;
     }
     const double e = wall_energy();
     guards(e);
-    protocol_.update(s_.t, s_.X, e);
+    const int cycles_before = protocol_.state().cycles_completed;
+    const int switches = protocol_.update(s_.t, s_.X, e);
+    if (protocol_.state().cycles_completed > cycles_before) step_marks_.push_back(double(n_ + 1));
+    if (adaptive_) next_step(switches);
+  }
+
+  // --- adaptive step (docs/full3d.md, "Adaptive time step") --------------------------
+  void next_step(int switches) {
+    const AdaptiveStep& a = p_.adaptive;
+    const double h = p_.h;
+    double dt = std::min(a.dt_max, 2.0 * dt_last_);  // growth at most 2x per step
+    const char* bound = "growth";
+    auto limit = [&](double v, const char* why) {
+      if (v < dt) {
+        dt = v;
+        bound = why;
+      }
+    };
+    if (last_speed_ > 0.0) limit(a.cfl * h / last_speed_, "cfl");
+    // local error of the forward-Euler position update, 0.5 dt^2 |X''|, with X'' from the
+    // change of node velocity between the last two steps (skipped across a protocol event,
+    // where the actuation law changed)
+    // (midpoint: X'' from the predictor and corrector velocities of the step itself; the
+    // accepted second-order update is then far more accurate than the tolerance)
+    if (p_.scheme == IbScheme::Midpoint) {
+      const double acc = last_dv_ / (0.5 * dt_last_);
+      if (acc > 0.0) limit(std::sqrt(2.0 * a.tolerance * h / acc), "accuracy");
+    } else if (!after_event_) {
+      const double dv = (s_.V - s_.V_prev).colwise().norm().maxCoeff();
+      const double acc = dv / dt_before_last_;
+      if (acc > 0.0) limit(std::sqrt(2.0 * a.tolerance * h / acc), "accuracy");
+    }
+    // stability of the explicit coupling: dt lambda_max < 2
+    const long step = n_ + 1;
+    if (switches > 0 || lambda_step_ < 0 || step - lambda_step_ >= kStabilityEvery) {
+      lambda_ = ib_->explicit_rate(s_, dt_last_, kStabilityIterations);
+      lambda_step_ = step;
+      lambda_max_seen_ = std::max(lambda_max_seen_, lambda_);
+      ++estimates_;
+    }
+    if (lambda_ > 0.0) limit(a.stability_fraction * 2.0 / lambda_, "stability");
+    // protocol events: the step after an event restarts at event_dt; approaching the next
+    // contraction event, the step is cut to land just past it (event times resolved to event_dt)
+    const auto& ps = protocol_.state();
+    double r_active = std::numeric_limits<double>::quiet_NaN();
+    if (ps.phase == 0) r_active = protocol_.segment_radii(s_.X)[ps.active];
+    if (switches > 0) {
+      limit(a.event_dt, "event");
+    } else if (ps.phase == 0 && std::isfinite(r_active_prev_)) {
+      const double rate = (r_active_prev_ - r_active) / dt_last_;
+      if (rate > 0.0) {
+        const double t_event = (r_active - p_.protocol.R_f) / rate;
+        if (t_event < dt) limit(std::max(a.event_dt, 1.02 * t_event), "event");
+      }
+    }
+    r_active_prev_ = switches > 0 ? std::numeric_limits<double>::quiet_NaN() : r_active;
+    after_event_ = switches > 0;
+    if (dt < a.dt_min)
+      throw NumericalError("the adaptive step (" + num(dt) + " s, bound: " + bound +
+                               ") fell below full3d.adaptive.dt_min = " + num(a.dt_min) + " s",
+                           std::string("lower full3d.adaptive.dt_min") +
+                               (std::string(bound) == "cfl"         ? ", or raise full3d.adaptive.cfl"
+                                : std::string(bound) == "accuracy"  ? ", or raise full3d.adaptive.tolerance"
+                                : std::string(bound) == "stability" ? ", or raise full3d.adaptive.stability_fraction"
+                                : std::string(bound) == "event"     ? ", or lower full3d.adaptive.event_dt"
+                                                                    : ""),
+                           s_.t);
+    dt_next_ = ladder(dt);
+    ++bound_count_[bound];
   }
 
   void dry_step() {
@@ -203,7 +328,7 @@ class Runner {
 
   void guards(double e) {
     if (!std::isfinite(e))
-      throw NumericalError("non-finite wall energy", "reduce the time step full3d.dt", s_.t);
+      throw NumericalError("non-finite wall energy", "reduce the time step " + dt_key_, s_.t);
     const double rmin = node_radii(mesh_, s_.X).minCoeff();
     if (e > e_cap_) {
       // Below about 0.55 R0 of hoop contraction the linear spring lattice has a negative
@@ -220,13 +345,13 @@ class Runner {
                        : ": the explicit coupling is unstable"),
           lattice ? "raise wave.contracted_ratio (>= 0.6), lower the actuation overshoot (protocol.load_factor), or run "
                     "with fluid (full3d.dry = false)"
-                  : "reduce the time step full3d.dt (or raise full3d.energy_growth_limit if the growth is physical)",
+                  : "reduce the time step " + dt_key_ + " (or raise full3d.energy_growth_limit if the growth is physical)",
           s_.t);
     }
     rmin_seen_ = std::min(rmin_seen_, rmin);
     if (rmin < 0.02 * p_.R0)
       throw NumericalError("the tube collapsed: a node came within " + num(rmin) + " m of the axis",
-                           "lower the actuation (protocol.total_force / pressure / load_factor) or reduce full3d.dt",
+                           "lower the actuation (protocol.total_force / pressure / load_factor) or reduce " + dt_key_,
                            s_.t);
   }
 
@@ -286,7 +411,7 @@ class Runner {
     series_.push_back({s_.t, s_.X.row(0).mean() - x_center0_, s_.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                        rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                        double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
-                       last_divergence_, max_edge_length(mesh_, s_.X)});
+                       last_divergence_, max_edge_length(mesh_, s_.X), n_ > 0 ? dt_last_ : 0.0});
     radius_times_.push_back(s_.t);
     radius_.insert(radius_.end(), rr.data(), rr.data() + rr.size());
     last_recorded_ = n_;
@@ -317,34 +442,21 @@ class Runner {
     std::snprintf(name, sizeof name, "vtk/fluid_%06d.vti", int(fluid_pvd_.frames().size()));
     const MacGrid& g = *grid_;
     const int nx = g.nx(), ny = g.ny(), nz = g.nz();
-    output::AtomicFile file(out_ + "/" + name);
-    std::ostream& o = file.stream();
-    const double h = g.h();
-    o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
-      << "<ImageData WholeExtent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\" Origin=\"0 0 0\" Spacing=\"" << h
-      << " " << h << " " << h << "\">\n<Piece Extent=\"0 " << nx << " 0 " << ny << " 0 " << nz << "\">\n<CellData>\n"
-      << "<DataArray type=\"Float64\" Name=\"velocity_m_per_s\" NumberOfComponents=\"3\" format=\"ascii\">\n";
-    char b[96];
     const auto du = g.dims(0), dv = g.dims(1), dw = g.dims(2);
+    vtk::PointArray vel{"velocity_m_per_s", 3, std::vector<double>(3 * std::size_t(nx) * ny * nz)};
+    std::size_t q = 0;
     for (int k = 0; k < nz; ++k)
       for (int j = 0; j < ny; ++j)
         for (int i = 0; i < nx; ++i) {  // cell-centre averages of the face values
           const int ip = (i + 1) % nx;
           const int jp = g.periodic(1) ? (j + 1) % ny : j + 1;
           const int kp = g.periodic(2) ? (k + 1) % nz : k + 1;
-          const double u = 0.5 * (s_.u.c[0][MacGrid::index(du, i, j, k)] + s_.u.c[0][MacGrid::index(du, ip, j, k)]);
-          const double v = 0.5 * (s_.u.c[1][MacGrid::index(dv, i, j, k)] + s_.u.c[1][MacGrid::index(dv, i, jp, k)]);
-          const double w = 0.5 * (s_.u.c[2][MacGrid::index(dw, i, j, k)] + s_.u.c[2][MacGrid::index(dw, i, j, kp)]);
-          std::snprintf(b, sizeof b, "%.7g %.7g %.7g\n", u, v, w);
-          o << b;
+          vel.values[q++] = 0.5 * (s_.u.c[0][MacGrid::index(du, i, j, k)] + s_.u.c[0][MacGrid::index(du, ip, j, k)]);
+          vel.values[q++] = 0.5 * (s_.u.c[1][MacGrid::index(dv, i, j, k)] + s_.u.c[1][MacGrid::index(dv, i, jp, k)]);
+          vel.values[q++] = 0.5 * (s_.u.c[2][MacGrid::index(dw, i, j, k)] + s_.u.c[2][MacGrid::index(dw, i, j, kp)]);
         }
-    o << "</DataArray>\n<DataArray type=\"Float64\" Name=\"pressure_Pa\" format=\"ascii\">\n";
-    for (double v : ib_->stokes().pressure().v) {
-      std::snprintf(b, sizeof b, "%.7g\n", v);
-      o << b;
-    }
-    o << "</DataArray>\n</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
-    file.commit();
+    vtk::PointArray pr{"pressure_Pa", 1, ib_->stokes().pressure().v};
+    vtk::write_image_data(out_ + "/" + name, {nx, ny, nz}, g.h(), {vel, pr});
     fluid_pvd_.add(s_.t, name);
     fluid_pvd_.write();
   }
@@ -386,6 +498,26 @@ class Runner {
     ft.clear();
     for (const auto& f : fluid_pvd_.frames()) ft.push_back(f.first);
     w.put("fluid_frames", ft);
+    // step control and per-cycle step counts, by name
+    w.put("dt_next", dt_next_);
+    w.put("dt_last", dt_last_);
+    w.put("dt_before_last", dt_before_last_);
+    w.put("dt_used_min", dt_used_min_);
+    w.put("dt_used_max", dt_used_max_);
+    w.put("last_speed", last_speed_);
+    w.put("lambda", lambda_);
+    w.put("lambda_max_seen", lambda_max_seen_);
+    w.put("lambda_step", std::int64_t(lambda_step_));
+    w.put("estimates", std::int64_t(estimates_));
+    w.put("rejected", std::int64_t(rejected_));
+    w.put("after_event", std::int64_t(after_event_ ? 1 : 0));
+    w.put("r_active_prev", std::isfinite(r_active_prev_) ? r_active_prev_ : -1.0);
+    w.put("step_marks", step_marks_);
+    {
+      std::vector<double> counts;
+      for (const auto& [k, v] : bound_count_) counts.push_back(double(v));
+      w.put("bound_counts", counts);
+    }
     w.save(checkpoint_path(out_));
     // partial results next to the checkpoint, so that a killed run still has them
     write_outputs("running: last checkpoint at t = " + num(s_.t) + " s (resume with --resume " + out_ + ")", wall);
@@ -443,6 +575,7 @@ class Runner {
     const auto flat = r.get_vector("series");
     const size_t nc = kSeriesColumns.size();
     series_.clear();
+    if (flat.size() % nc != 0) throw InputError("--resume", out_, "the checkpoint's series has another column layout");
     for (size_t k = 0; k + nc <= flat.size(); k += nc) series_.emplace_back(flat.begin() + k, flat.begin() + k + nc);
     radius_times_ = r.get_vector("radius_times");
     radius_ = r.get_vector("radius");
@@ -457,6 +590,28 @@ class Runner {
       std::snprintf(name, sizeof name, "vtk/fluid_%06d.vti", int(fluid_pvd_.frames().size()));
       fluid_pvd_.add(t, name);
     }
+    dt_next_ = r.get_double("dt_next");
+    dt_last_ = r.get_double("dt_last");
+    dt_before_last_ = r.get_double("dt_before_last");
+    dt_used_min_ = r.get_double("dt_used_min");
+    dt_used_max_ = r.get_double("dt_used_max");
+    last_speed_ = r.get_double("last_speed");
+    lambda_ = r.get_double("lambda");
+    lambda_max_seen_ = r.get_double("lambda_max_seen");
+    lambda_step_ = r.get_int("lambda_step");
+    estimates_ = r.get_int("estimates");
+    rejected_ = r.get_int("rejected");
+    after_event_ = r.get_int("after_event") != 0;
+    const double rp = r.get_double("r_active_prev");
+    r_active_prev_ = rp >= 0.0 ? rp : std::numeric_limits<double>::quiet_NaN();
+    step_marks_ = r.get_vector("step_marks");
+    {
+      const auto counts = r.get_vector("bound_counts");
+      if (counts.size() != bound_count_.size()) throw InputError("--resume", out_, "checkpoint step-control record of the wrong size");
+      size_t k = 0;
+      for (auto& [name, v] : bound_count_) v = long(counts[k++]);
+    }
+    t_prev_ = s_.t;
     if (vtk_on_) pvd_.write();
     if (fluid_on_) fluid_pvd_.write();
   }
@@ -498,6 +653,7 @@ class Runner {
     s["protocol_switches"] = st.switches;
     s["segment_reached_s"] = st.segment_reached;
     s["steps"] = n_;
+    s["steps_per_cycle"] = steps_per_cycle();
     s["derived"] = {{"C1_estimate_Pa_per_m", p_.c1_estimate()},
                     {"mass_per_area_kg_per_m2", p_.mass_per_area},
                     {"mass_per_length_kg_per_m", p_.mass_per_area * 2.0 * M_PI * p_.R0},
@@ -526,8 +682,27 @@ class Runner {
       for (size_t k = 0; k < radius_times_.size(); ++k)
         for (int r = 0; r < nr; ++r) csv.row({radius_times_[k], r * mesh_.ring_spacing, radius_[k * nr + r]});
     }
+    json time_step = json::object();
+    if (adaptive_) {
+      json bounds = json::object();
+      for (const auto& [k, v] : bound_count_) bounds[k] = v;
+      time_step = {{"control", "adaptive"},
+                   {"dt_min_used_s", n_ > 0 ? dt_used_min_ : 0.0},
+                   {"dt_max_used_s", dt_used_max_},
+                   {"dt_mean_s", n_ > 0 ? s_.t / double(n_) : 0.0},
+                   {"rejected_steps", rejected_},
+                   {"explicit_rate_per_s", lambda_},
+                   {"explicit_rate_max_per_s", lambda_max_seen_},
+                   {"explicit_limit_s", lambda_max_seen_ > 0 ? 2.0 / lambda_max_seen_ : 0.0},
+                   {"stability_estimates", estimates_},
+                   {"steps_by_bound", bounds}};
+    } else {
+      time_step = {{"control", "fixed"}, {"dt_s", p_.dt}};
+    }
     json stats = {{"steps", n_},
-                  {"dt_s", p_.dt},
+                  {"steps_per_cycle", steps_per_cycle()},
+                  {"time_step", time_step},
+                  {"dt_s", adaptive_ ? (n_ > 0 ? s_.t / double(n_) : 0.0) : p_.dt},
                   {"mode", p_.dry ? "dry" : "fluid"},
                   {"stokes_iterations_total", iterations_total_},
                   {"max_cfl", max_cfl_},
@@ -540,6 +715,13 @@ class Runner {
     output::write_json(out_ + "/scene.resolved.json", resolved_);
     output::write_json(out_ + "/summary.json", s);
     return s;
+  }
+
+  /// Steps taken by each completed cycle.
+  std::vector<long> steps_per_cycle() const {
+    std::vector<long> v;
+    for (size_t k = 0; k + 1 < step_marks_.size(); ++k) v.push_back(std::lround(step_marks_[k + 1] - step_marks_[k]));
+    return v;
   }
 
   const Params3d& p_;
@@ -564,6 +746,18 @@ class Runner {
   double rmin_seen_ = 1e300;
   double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0, wall_before_ = 0;
   long iterations_total_ = 0, last_iterations_ = 0;
+  // step control (adaptive: full3d.adaptive)
+  bool adaptive_ = false;
+  std::string dt_key_ = "full3d.dt";
+  double t_prev_ = 0.0;  ///< time before the last step (time-based output cadence)
+  double dt_next_ = 0.0, dt_last_ = 0.0, dt_before_last_ = 0.0;
+  double dt_used_min_ = 1e300, dt_used_max_ = 0.0, last_speed_ = 0.0, last_dv_ = 0.0;
+  double lambda_ = 0.0, lambda_max_seen_ = 0.0;  ///< explicit-coupling rate estimates, 1/s
+  long lambda_step_ = -1, estimates_ = 0, rejected_ = 0;
+  bool after_event_ = true;
+  double r_active_prev_ = std::numeric_limits<double>::quiet_NaN();
+  std::map<std::string, long> bound_count_ = {{"growth", 0}, {"cfl", 0}, {"accuracy", 0}, {"stability", 0}, {"event", 0}};
+  std::vector<double> step_marks_;  ///< step index at each cycle start (and the end of the last)
   std::vector<std::vector<double>> series_;
   std::vector<double> radius_times_, radius_;
 };

@@ -138,6 +138,22 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       g.finish();
     }
     p.dt = f.quantity("dt", "s", "1 ms", Range::positive());
+    {
+      Reader a = f.child("adaptive");
+      AdaptiveStep& q = p.adaptive;
+      q.enabled = a.boolean("enabled", false);
+      q.cfl = a.number("cfl", 0.25, Range::open(0.0, 2.0));
+      q.tolerance = a.number("tolerance", 1e-3, Range::open(0.0, 1.0));
+      q.dt_max = a.quantity("dt_max", "s", "16 ms", Range::positive());
+      q.dt_min = a.quantity("dt_min", "s", "1 us", Range::positive());
+      q.event_dt = a.quantity("event_dt", "s", "0.25 ms", Range::positive());
+      q.stability_fraction = a.number("stability_fraction", 0.5, Range::open(0.0, 1.0));
+      if (!(q.dt_min <= q.event_dt && q.event_dt <= q.dt_max))
+        throw InputError(a.path("event_dt"), fmt(q.event_dt, "s"),
+                         "must lie between full3d.adaptive.dt_min = " + fmt(q.dt_min, "s") +
+                             " and full3d.adaptive.dt_max = " + fmt(q.dt_max, "s"));
+      a.finish();
+    }
     p.scheme = f.choice("scheme", "forward_euler", {"forward_euler", "midpoint"}) == "midpoint" ? IbScheme::Midpoint
                                                                                                : IbScheme::ForwardEuler;
     {
@@ -156,6 +172,9 @@ Params3d read_scene3d(const json& scene, json& resolved) {
     p.dry = f.boolean("dry", false);
     p.dry_damping = f.quantity("dry_damping", "kg/(m^2*s)", "1e4 kg/(m^2*s)", Range::non_negative());
     p.max_cfl = f.number("max_cfl", 0.5, Range::open(0.0, 2.0));
+    if (p.adaptive.enabled && !(p.adaptive.cfl < p.max_cfl))
+      throw InputError("full3d.adaptive.cfl", fmt(p.adaptive.cfl, ""),
+                       "must be below the CFL guard full3d.max_cfl = " + fmt(p.max_cfl, ""));
     p.energy_growth = f.number("energy_growth_limit", 50.0, Range::open(1.0, 1e12));
     p.time_limit = f.quantity("time_limit", "s", "2 s", Range::positive());
     {
@@ -179,6 +198,9 @@ Params3d read_scene3d(const json& scene, json& resolved) {
     throw InputError("full3d.dry_damping", "0 kg/(m^2*s)",
                      "an undamped dry swimmer never recovers (the energy criterion is never met): give a positive "
                      "damping or a time.duration");
+  if (p.dry && p.adaptive.enabled)
+    throw InputError("full3d.adaptive.enabled", "true",
+                     "the adaptive step controls the fluid-coupled run; the dry swimmer uses the fixed full3d.dt");
   if (p.dry && !(p.mass_per_area > 0))
     throw InputError("wall.mass_per_area", "", "the dry swimmer needs a positive wall mass");
   if (!(R0 + 2.0 * p.h < p.container_radius))

@@ -21,6 +21,22 @@
 
 namespace swim::full3d {
 
+/// Adaptive time-step control of the fluid-coupled run (full3d.adaptive; docs/full3d.md,
+/// "Adaptive time step"). Each step is the smallest of: dt_max; growth-limited previous
+/// step; the CFL target cfl h / max|U|; stability_fraction times the explicit-coupling limit
+/// 2 / lambda_max (IbSolver::explicit_rate); the local-error bound sqrt(2 tolerance h / |dU/dt|);
+/// the predicted time to the next contraction event. Snapped down to the ladder
+/// dt_max 2^(-k/4) so that the fluid solver's per-dt factorisations are reused.
+struct AdaptiveStep {
+  bool enabled = false;
+  double cfl = 0.25;                ///< target max|U| dt / h (below full3d.max_cfl)
+  double tolerance = 1e-3;          ///< local position error per step, in cells (h)
+  double dt_min = 1e-6;             ///< s; a smaller step ends the run (exit 3)
+  double dt_max = 16e-3;            ///< s
+  double event_dt = 0.25e-3;        ///< s; first step and the step after each protocol event
+  double stability_fraction = 0.5;  ///< dt <= fraction * 2 / lambda_max
+};
+
 struct Params3d {
   std::string name = "unnamed";
   // shared physics (SI)
@@ -38,7 +54,8 @@ struct Params3d {
   int nx = 128, ny = 32, nz = 32;  ///< grid cells
   double h = 0.5e-6 / 32;          ///< cell size, m
   double spacing_factor = 0.6;     ///< longest reference edge < factor * h/2 (docs/full3d.md)
-  double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md)
+  double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md); fixed step
+  AdaptiveStep adaptive{};         ///< full3d.adaptive: step control instead of the fixed dt
   IbScheme scheme = IbScheme::ForwardEuler;
   bool wall_inertia = false;       ///< -m a term of eq. (16) in the fluid-coupled run
   bool navier_stokes = false;      ///< StokesOptions::advection (eq. 28 sub-step before each Stokes step)

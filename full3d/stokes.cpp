@@ -213,24 +213,26 @@ struct StokesSolver::Impl {
       }
       const bool direct_applies = !o.cylinder.enabled || o.cylinder.wall == CylinderWall::Staircase;
       if (o.method == StokesMethod::Direct && !direct_applies)
-        throw InputError("stokes.method", "direct",
-                         "the direct solver supports the plain duct and the staircase cylinder wall only; use "
-                         "auto or iterative");
+        throw InputError("full3d.cylinder_wall", "not staircase",
+                         "the direct solver (StokesOptions::method = Direct) supports the plain duct and the "
+                         "staircase cylinder wall only: use full3d.cylinder_wall = \"staircase\", or the Auto or "
+                         "Iterative method");
       // the capacitance solver: plain duct, or the staircase cylinder at least half a cell
       // inside the duct walls (CapacitanceStokes::supports_cylinder)
       const bool capacitance_applies =
           !o.cylinder.enabled ||
           (o.cylinder.wall == CylinderWall::Staircase && CapacitanceStokes::supports_cylinder(g, o.cylinder));
       if (o.method == StokesMethod::Capacitance && !capacitance_applies)
-        throw InputError("stokes.method", "capacitance",
-                         "the capacitance solver supports the plain duct and the staircase cylinder (radius <= "
-                         "duct half-width - h/2) only; use auto, direct or iterative");
+        throw InputError("full3d.cylinder_wall", "not staircase",
+                         "the capacitance solver (StokesOptions::method = Capacitance) supports the plain duct "
+                         "and the staircase cylinder (radius <= duct half-width - h/2) only: use "
+                         "full3d.cylinder_wall = \"staircase\", or the Auto, Direct or Iterative method");
       const CylinderOptions* cyl = o.cylinder.enabled ? &o.cylinder : nullptr;
       const double limit = o.direct_memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
       const bool use_capacitance =
           o.method == StokesMethod::Capacitance ||
           (o.method == StokesMethod::Auto && capacitance_applies &&
-           2.0 * double(CapacitanceStokes::estimate_bytes(g, cyl)) <= limit);
+           6.0 * double(CapacitanceStokes::estimate_bytes(g, cyl)) <= limit);
       const bool use_direct =
           o.method == StokesMethod::Direct ||
           (o.method == StokesMethod::Auto && !use_capacitance && o.cylinder.enabled && direct_applies &&
@@ -370,7 +372,7 @@ struct StokesSolver::Impl {
         if (it >= opt.cg_max_iterations)
           throw NumericalError("Stokes multiplier PCG did not converge in " + std::to_string(it) +
                                    " iterations (relative residual " + std::to_string(rnorm / ref) + ")",
-                               "raise stokes.cg_max_iterations or loosen stokes.cg_rtol");
+                               "raise StokesOptions::cg_max_iterations or loosen StokesOptions::cg_rtol (API), or use full3d.cylinder_wall = \"staircase\" (direct solvers)");
         gradient(grid, dp, w1);
         if (con) con->scatter_add(dl, 1.0, w1);
         apply_Ainv(w1, w2, alpha);

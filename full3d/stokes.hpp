@@ -45,7 +45,7 @@
 //   so it is solved like the box. No-slip differs by a diagonal term on the m = 4(ny+nz)-8
 //   wall-adjacent tangential nodes, A_ns = A_fs + U Dg U^T, Dg = 2 mu W/h^2; per axial mode
 //   the Woodbury identity with the SPD capacitance matrix C = Dg^{-1} + U^T S_fs^{-1} U
-//   (Cholesky, once per dt, two dt cached) gives the no-slip solution from one free-slip
+//   (Cholesky, once per dt, six dt cached) gives the no-slip solution from one free-slip
 //   solve and O(n^2) partial transforms on the wall lines: about one bare solve; the
 //   transforms and per-mode solves are split over direct_threads (parallel.hpp).
 //   Staircase cylinder (when every wall-adjacent tangential face is masked, i.e. the cylinder
@@ -94,7 +94,8 @@ struct FluidParams {
 ///              and the Staircase cylinder wall only.
 ///   Iterative: the multiplier PCG below (every wall kind).
 ///   Auto:      plain duct and supported Staircase cylinder: Capacitance; other Staircase cylinders:
-///              Direct; each only when its estimated factor memory for two dt values is below
+///              Direct; each only when its estimated factor memory for the cached dt values (six
+///              for Capacitance, two for Direct) is below
 ///              direct_memory_limit_gib (a cylinder over the limit for Capacitance tries Direct),
 ///              else Iterative.
 enum class StokesMethod { Auto, Direct, Iterative, Capacitance };
@@ -105,7 +106,7 @@ struct StokesOptions {
   /// Direct: threads for the per-mode factorisations and solves; 0 = std::thread::hardware_concurrency().
   /// Capacitance: threads for the transforms and per-mode solves (parallel.hpp); 0 = fft.threads.
   int direct_threads = 0;
-  /// Auto: largest estimated factor memory (two cached dt values) for which Direct or
+  /// Auto: largest estimated factor memory (all cached dt values) for which Direct or
   /// Capacitance is chosen, GiB.
   double direct_memory_limit_gib = 4.0;
   /// Direct / Capacitance: follow the solve by the exact Neumann projection of the iterative path
@@ -163,7 +164,7 @@ class StokesSolver {
   /// (Auto for the periodic box, which is always the exact Fourier projection).
   StokesMethod active_method() const;
   /// Direct: measured memory of the cached LU factors; Capacitance: of the cached capacitance
-  /// Cholesky factors (up to two dt values each), bytes; 0 otherwise.
+  /// Cholesky factors (up to six dt values for Capacitance, two for Direct), bytes; 0 otherwise.
   std::size_t direct_factor_bytes() const;
   /// Cylinder: the constraint rows and the multiplier of the last step (N/m^3 per row).
   /// Direct and Capacitance: the multiplier is recovered on demand, lambda = E (b - A u - G p).
