@@ -2,48 +2,105 @@
 
 usage: plot_screen.py DESIGNS_CSV OUT_PNG METRIC KEY [KEY ...]
 Keys with a single value are ignored; with two or more varying keys the first two are
-mapped (others are summarised by the best value over them).
+mapped (others are summarised by the best value over them). Colour scales are logarithmic
+when the positive values span more than a decade; axes and colour bars carry SI-prefixed
+units.
 """
 import csv
+import math
+import os
 import sys
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.colors import LogNorm  # noqa: E402
+
+PREFIXES = [(1e-21, "z"), (1e-18, "a"), (1e-15, "f"), (1e-12, "p"), (1e-9, "n"), (1e-6, "\u00b5"),
+            (1e-3, "m"), (1.0, "")]
+
+# What people call the metrics and the swept keys, with their SI units.
+LABELS = {
+    "displacement_m": ("displacement", "m"),
+    "mean_velocity_m_per_s": ("mean velocity", "m/s"),
+    "mean_velocity_per_cycle_m_per_s": ("mean velocity per cycle", "m/s"),
+    "displacement_per_cycle_m": ("displacement per cycle", "m"),
+    "body_lengths_per_s": ("body lengths per second", "1/s"),
+    "pumped_volume_m3": ("pumped volume", "m\u00b3"),
+    "max_velocity_m_per_s": ("peak velocity", "m/s"),
+    "final_velocity_m_per_s": ("final velocity", "m/s"),
+    "mean_cycle_time_s": ("cycle time", "s"),
+    "directed_to_diffusive_ratio": ("directed / diffusive displacement", ""),
+    "swimmer.length": ("swimmer length $L$", "m"),
+    "swimmer.radius": ("swimmer radius $R_0$", "m"),
+    "wave.contracted_ratio": ("contracted radius $R_f/R_0$", ""),
+    "container.radius": ("container radius", "m"),
+    "protocol.load_factor": ("actuation / static load", ""),
+}
+
+
+def si_scale(values, unit):
+    """Factor and unit label with an SI prefix for the largest |value| (m^3 not prefixed)."""
+    if not unit or unit in ("1/s", "m\u00b3"):
+        return 1.0, unit
+    big = max((abs(v) for v in values if math.isfinite(v)), default=0.0)
+    if big == 0.0:
+        return 1.0, unit
+    for factor, prefix in reversed(PREFIXES):
+        if big >= factor:
+            return 1.0 / factor, prefix + unit
+    return 1.0 / PREFIXES[0][0], PREFIXES[0][1] + unit
+
+
+def label(name, unit_label):
+    text = LABELS.get(name, (name, ""))[0]
+    return f"{text} [{unit_label}]" if unit_label else text
 
 
 def main(csv_path, png, metric, keys):
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
-    si = {}
+    swept = {}
     for k in keys:
         col = next(c for c in rows[0] if c.startswith(k + "_si"))
         vals = sorted({float(r[col]) for r in rows})
         if len(vals) > 1:
-            si[k] = (col, vals)
-    varying = list(si)
+            swept[k] = (col, vals)
+    varying = list(swept)
     panels = [m for m in ("displacement_m", "mean_velocity_m_per_s") if m != metric] + [metric]
-    fig, axes = plt.subplots(1, len(panels), figsize=(5.5 * len(panels), 4.5))
-    for ax, m in zip(axes, panels):
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.8 * len(panels), 4.8), squeeze=False)
+    name = os.path.splitext(os.path.basename(os.path.dirname(os.path.abspath(csv_path))))[0]
+    fig.suptitle(f"Design sweep {name}: {len(rows)} designs (best by {LABELS.get(metric, (metric,))[0]})")
+    for ax, m in zip(axes[0], panels):
+        unit = LABELS.get(m, (m, ""))[1]
+        vals = [float(r[m]) for r in rows if r[m]]
+        mf, mu = si_scale(vals, unit)
         if len(varying) >= 2:
-            (cx, xs), (cy, ys) = si[varying[0]], si[varying[1]]
+            (cx, xs), (cy, ys) = swept[varying[0]], swept[varying[1]]
+            xf, xu = si_scale(xs, LABELS.get(varying[0], ("", ""))[1])
+            yf, yu = si_scale(ys, LABELS.get(varying[1], ("", ""))[1])
             best = {}
             for r in rows:
                 if not r[m]:
                     continue
                 key = (float(r[cx]), float(r[cy]))
-                best[key] = max(best.get(key, -1e300), float(r[m]))
+                best[key] = max(best.get(key, -1e300), float(r[m]) * mf)
             grid = [[best.get((x, y), float("nan")) for x in xs] for y in ys]
-            im = ax.pcolormesh(xs, ys, grid, shading="auto")
-            fig.colorbar(im, ax=ax, label=m)
-            ax.set(xlabel=cx, ylabel=cy)
+            pos = [v for row in grid for v in row if math.isfinite(v) and v > 0]
+            norm = None
+            if pos and len(pos) == sum(1 for row in grid for v in row if math.isfinite(v)) and max(pos) > 10 * min(pos):
+                norm = LogNorm(vmin=min(pos), vmax=max(pos))
+            im = ax.pcolormesh([x * xf for x in xs], [y * yf for y in ys], grid, shading="auto", norm=norm)
+            fig.colorbar(im, ax=ax, label=label(m, mu) + (" (log scale)" if norm else ""))
+            ax.set(xlabel=label(varying[0], xu), ylabel=label(varying[1], yu))
         elif len(varying) == 1:
-            cx, xs = si[varying[0]]
-            pts = sorted((float(r[cx]), float(r[m])) for r in rows if r[m])
+            cx, xs = swept[varying[0]]
+            xf, xu = si_scale(xs, LABELS.get(varying[0], ("", ""))[1])
+            pts = sorted((float(r[cx]) * xf, float(r[m]) * mf) for r in rows if r[m])
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-")
-            ax.set(xlabel=cx, ylabel=m)
-        ax.set_title(m)
+            ax.set(xlabel=label(varying[0], xu), ylabel=label(m, mu))
+        ax.set_title(LABELS.get(m, (m,))[0])
     fig.tight_layout()
     fig.savefig(png, dpi=110)
 
