@@ -25,7 +25,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <complex>
 #include <numbers>
 #include <vector>
 
@@ -33,7 +32,7 @@ namespace swim::reduced1d::outer {
 
 inline constexpr double pi = std::numbers::pi;
 
-/// Point functions of the annulus between R_o and Rc (templated for complex-step derivatives).
+/// Point functions of the annulus between R_o and Rc.
 template <class T>
 struct AnnulusPoint {
   T rho;    ///< 1 / G_a [Pa s / m^4]
@@ -58,27 +57,13 @@ AnnulusPoint<T> annulus_point(T Ro, double Rc, double mu) {
 }
 
 /// Coefficients of one interval [zeta_j, zeta_{j+1}] of length d with the membrane radius
-/// linear from a to b: lumen resistance (exact mean of R_i^-4), annulus resistance, Couette
-/// coefficient c = int K_a / G_a, force weight S (mean) and Couette drag e = int 2 pi mu / lambda
-/// (trapezoid on the point functions).
+/// linear from a to b: lumen resistance rl (exact mean of R_i^-4), annulus resistance
+/// ra = int 1/G_a, Couette coefficient c = int K_a / G_a, force weight S (mean) and Couette drag
+/// e = int 2 pi mu / lambda (trapezoid rule on the point functions).
 template <class T>
 struct IntervalCoef {
   T rl, ra, c, S, e;
 };
-
-template <class T>
-IntervalCoef<T> interval_coef(T a, T b, double d, double mu, double a_in, double a_out, double Rc) {
-  const T ai = a - a_in, bi = b - a_in;
-  const T ab = ai * bi;
-  IntervalCoef<T> k;
-  k.rl = (8.0 * mu / pi) * d * (ai * ai + ab + bi * bi) / (3.0 * ab * ab * ab);
-  const AnnulusPoint<T> pa = annulus_point<T>(a + a_out, Rc, mu), pb = annulus_point<T>(b + a_out, Rc, mu);
-  k.ra = 0.5 * d * (pa.rho + pb.rho);
-  k.c = 0.5 * d * (pa.kappa + pb.kappa);
-  k.S = 0.5 * (pa.S + pb.S);
-  k.e = 0.5 * d * (pa.e + pb.e);
-  return k;
-}
 
 /// The confined lubrication system on the point set {0, z_0, ..., z_{N-1}, L} (N + 2 points,
 /// N + 1 intervals; interval j contains face j). Two ways to close it:
