@@ -86,7 +86,7 @@ CheckpointReader::CheckpointReader(const std::string& path) : path_(path) {
 
 void CheckpointReader::raw(void* p, std::size_t n) {
   if (pos_ + n > buf_.size()) throw InputError("--resume", path_, "the checkpoint file is truncated or corrupt");
-  std::memcpy(p, buf_.data() + pos_, n);
+  if (n > 0) std::memcpy(p, buf_.data() + pos_, n);  // an empty array has no storage (p may be null)
   pos_ += n;
 }
 
