@@ -10,18 +10,13 @@
 #include <sstream>
 
 #include "common/scene.hpp"
+#include "../common/message_keys.hpp"
 #include "full3d/scene3d.hpp"
 
 using namespace swim;
 namespace fs = std::filesystem;
 
 namespace {
-
-void collect(const scene::json& j, const std::string& path, std::set<std::string>& out) {
-  if (!path.empty()) out.insert(path);
-  if (j.is_object())
-    for (auto it = j.begin(); it != j.end(); ++it) collect(it.value(), path.empty() ? it.key() : path + "." + it.key(), out);
-}
 
 /// Every key path the 3D reader resolves (it echoes every value it uses) for a few variants
 /// that switch on the conditional keys.
@@ -38,7 +33,7 @@ std::set<std::string> accepted_keys() {
     for (const auto& s : sets) scene::apply_override(sc, s);
     scene::json resolved;
     swim::full3d::read_scene3d(sc, resolved);
-    collect(resolved, "", keys);
+    swim::testing::collect_keys(resolved, "", keys);
   }
   return keys;
 }
@@ -50,28 +45,10 @@ TEST(MessageKeys3d, EveryNamedFull3dKeyExists) {
   ASSERT_TRUE(keys.count("full3d.dt"));
   ASSERT_TRUE(keys.count("full3d.cylinder_wall"));
   ASSERT_TRUE(keys.count("full3d.adaptive.dt_min"));
-  const std::regex literal(R"("(?:[^"\\]|\\.)*")");
   const std::regex key(R"(\b(?:full3d|stokes|ib)\.[a-z_0-9]+(?:\.[a-z_0-9]+)*)");
-  const std::set<std::string> file_ext = {"md", "hpp", "cpp", "json", "vti", "vtp", "pvd", "csv", "bin"};
-  int named = 0;
-  for (const auto& e : fs::directory_iterator(SWIM_SOURCE_DIR "/full3d")) {
-    const std::string ext = e.path().extension().string();
-    if (ext != ".cpp" && ext != ".hpp") continue;
-    std::ifstream in(e.path());
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string text = ss.str();
-    for (std::sregex_iterator l(text.begin(), text.end(), literal), end; l != end; ++l) {
-      const std::string lit = l->str();
-      for (std::sregex_iterator k(lit.begin(), lit.end(), key); k != end; ++k) {
-        const std::string name = k->str();
-        if (file_ext.count(name.substr(name.rfind('.') + 1))) continue;  // a file name (docs/full3d.md)
-        ++named;
-        EXPECT_TRUE(keys.count(name)) << e.path().filename() << " names \"" << name
-                                      << "\", which the scene reader does not accept";
-      }
-    }
-  }
-  std::printf("%d scene keys named in full3d/ messages, all accepted\n", named);
-  EXPECT_GT(named, 20);
+  const auto named = swim::testing::named_keys(SWIM_SOURCE_DIR "/full3d", key, {"md", "hpp", "cpp", "json", "vti", "vtp", "pvd", "csv", "bin"});
+  for (const auto& [file, name] : named)
+    EXPECT_TRUE(keys.count(name)) << file << " names \"" << name << "\", which the scene reader does not accept";
+  std::printf("%zu scene keys named in full3d/ messages, all accepted\n", named.size());
+  EXPECT_GT(named.size(), 20u);
 }

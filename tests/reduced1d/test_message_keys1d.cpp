@@ -10,18 +10,13 @@
 #include <sstream>
 
 #include "common/scene.hpp"
+#include "../common/message_keys.hpp"
 #include "reduced1d/scene1d.hpp"
 
 using namespace swim;
 namespace fs = std::filesystem;
 
 namespace {
-
-void collect(const scene::json& j, const std::string& path, std::set<std::string>& out) {
-  if (!path.empty()) out.insert(path);
-  if (j.is_object())
-    for (auto it = j.begin(); it != j.end(); ++it) collect(it.value(), path.empty() ? it.key() : path + "." + it.key(), out);
-}
 
 /// Every key path the 1D reader resolves, for variants that switch on the conditional keys.
 std::set<std::string> accepted_keys() {
@@ -40,7 +35,7 @@ std::set<std::string> accepted_keys() {
     for (const auto& s : sets) scene::apply_override(sc, s);
     scene::json resolved;
     reduced1d::read_scene(sc, resolved);
-    collect(resolved, "", keys);
+    swim::testing::collect_keys(resolved, "", keys);
   }
   keys.insert("wall.calibration");  // needs a file to resolve; read by the same wall reader
   return keys;
@@ -53,28 +48,10 @@ TEST(MessageKeys1d, EveryNamedKeyExists) {
   ASSERT_TRUE(keys.count("numerics1d.cells"));
   ASSERT_TRUE(keys.count("model1d.paper.closure"));
   ASSERT_TRUE(keys.count("protocol.pressure"));
-  const std::regex literal(R"("(?:[^"\\]|\\.)*")");
   const std::regex key(
       R"(\b(?:swimmer|fluid|wall|container|wave|protocol|model1d|numerics1d|time)\.[a-z_0-9]+(?:\.[a-z_0-9]+)*)");
-  const std::set<std::string> file_ext = {"md", "hpp", "cpp", "json", "csv", "png"};
-  int named = 0;
-  for (const auto& e : fs::directory_iterator(SWIM_SOURCE_DIR "/reduced1d")) {
-    const std::string ext = e.path().extension().string();
-    if (ext != ".cpp" && ext != ".hpp") continue;
-    std::ifstream in(e.path());
-    std::stringstream ss;
-    ss << in.rdbuf();
-    const std::string text = ss.str();
-    for (std::sregex_iterator l(text.begin(), text.end(), literal), end; l != end; ++l) {
-      const std::string lit = l->str();
-      for (std::sregex_iterator k(lit.begin(), lit.end(), key); k != end; ++k) {
-        const std::string name = k->str();
-        if (file_ext.count(name.substr(name.rfind('.') + 1))) continue;  // a file name
-        ++named;
-        EXPECT_TRUE(keys.count(name)) << e.path().filename() << " names \"" << name
-                                      << "\", which the scene reader does not accept";
-      }
-    }
-  }
-  EXPECT_GT(named, 30) << "the scan found the messages";
+  const auto named = swim::testing::named_keys(SWIM_SOURCE_DIR "/reduced1d", key, {"md", "hpp", "cpp", "json", "csv", "png"});
+  for (const auto& [file, name] : named)
+    EXPECT_TRUE(keys.count(name)) << file << " names \"" << name << "\", which the scene reader does not accept";
+  EXPECT_GT(named.size(), 30u) << "the scan found the messages";
 }
