@@ -23,6 +23,22 @@ inline void collect_keys(const scene::json& j, const std::string& path, std::set
       collect_keys(it.value(), path.empty() ? it.key() : path + "." + it.key(), out);
 }
 
+/// Every key path `read(scene, resolved)` resolves for `base` with each list of `--set`
+/// assignments in `variants` (variants switch on the conditional keys).
+template <class Read>
+std::set<std::string> resolved_keys(const scene::json& base, const std::vector<std::vector<std::string>>& variants,
+                                    Read read) {
+  std::set<std::string> keys;
+  for (const auto& sets : variants) {
+    scene::json sc = base;
+    for (const auto& s : sets) scene::apply_override(sc, s);
+    scene::json resolved;
+    read(sc, resolved);
+    collect_keys(resolved, "", keys);
+  }
+  return keys;
+}
+
 /// (file name, key) for every match of `key` inside a string literal of the .cpp/.hpp files
 /// of `dir`, file names (an extension in `file_ext`) excepted.
 inline std::vector<std::pair<std::string, std::string>> named_keys(const std::string& dir, const std::regex& key,

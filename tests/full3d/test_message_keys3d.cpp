@@ -21,20 +21,14 @@ namespace {
 /// Every key path the 3D reader resolves (it echoes every value it uses) for a few variants
 /// that switch on the conditional keys.
 std::set<std::string> accepted_keys() {
-  std::set<std::string> keys;
   const std::vector<std::vector<std::string>> variants = {
       {},
       {"container.kind=\"cylinder\""},
       {"full3d.grid.cell_size=null", "full3d.grid.cells_across=12"},
       {"full3d.adaptive.enabled=true", "full3d.output.fluid_fields=true"},
   };
-  for (const auto& sets : variants) {
-    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json");
-    for (const auto& s : sets) scene::apply_override(sc, s);
-    scene::json resolved;
-    swim::full3d::read_scene3d(sc, resolved);
-    swim::testing::collect_keys(resolved, "", keys);
-  }
+  std::set<std::string> keys = swim::testing::resolved_keys(scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json"), variants,
+                                                            [](const scene::json& sc, scene::json& r) { swim::full3d::read_scene3d(sc, r); });
   return keys;
 }
 

@@ -20,7 +20,6 @@ namespace {
 
 /// Every key path the 1D reader resolves, for variants that switch on the conditional keys.
 std::set<std::string> accepted_keys() {
-  std::set<std::string> keys;
   const std::vector<std::vector<std::string>> variants = {
       {},
       {"model1d.model=paper"},
@@ -30,13 +29,8 @@ std::set<std::string> accepted_keys() {
       {"wave.kind=sine", "protocol=null", "wave.contracted_ratio=null", "wave.contracted_radius=0.1 um"},
       {"wall.spring_constant=null", "wall.C1=4e6 Pa/m", "wall.mass_per_length=null", "wall.mass_per_area=1e-3 kg/m^2"},
   };
-  for (const auto& sets : variants) {
-    scene::json sc = scene::json::object();
-    for (const auto& s : sets) scene::apply_override(sc, s);
-    scene::json resolved;
-    reduced1d::read_scene(sc, resolved);
-    swim::testing::collect_keys(resolved, "", keys);
-  }
+  std::set<std::string> keys = swim::testing::resolved_keys(scene::json::object(), variants,
+                                                            [](const scene::json& sc, scene::json& r) { reduced1d::read_scene(sc, r); });
   keys.insert("wall.calibration");  // needs a file to resolve; read by the same wall reader
   return keys;
 }
