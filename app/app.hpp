@@ -23,6 +23,8 @@ int demo(const std::string& out, int progress);
 int screen(const std::string& sweep, const std::string& out, int jobs, int progress);
 int bench(const std::string& out, bool quick, bool paper_cycle);
 int scenes();
+/// swim calibrate: C1 of the 1D tier from 3D uniform loads (validation/calibration.hpp).
+int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out);
 
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
 std::string data_dir();

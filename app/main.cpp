@@ -64,7 +64,11 @@ int main(int argc, char** argv) {
   CLI::App* sc = cli.add_subcommand("scenes", "List the shipped scenes");
 
   CLI::App* cal = cli.add_subcommand("calibrate", "Fit the 1D wall stiffness C1 from 3D uniform-load runs");
-  cal->allow_extras();
+  std::string cal_scene, cal_out;
+  std::vector<std::string> cal_sets;
+  cal->add_option("scene", cal_scene, "Scene file (JSON)")->required();
+  cal->add_option("--out", cal_out, "Output directory (default out/<name>-calibration)");
+  cal->add_option("--set", cal_sets, "Override a scene value: key.path=value");
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation report");
   val->allow_extras();
 
@@ -88,8 +92,9 @@ int main(int argc, char** argv) {
     if (*scr) return app::screen(sweep, out, jobs, progress);
     if (*ben) return app::bench(out, quick, paper_cycle);
     if (*sc) return app::scenes();
-    if (*cal || *val)
-      throw InputError(*cal ? "calibrate" : "validate", "",
+    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out);
+    if (*val)
+      throw InputError("validate", "",
                        "is not implemented yet (it needs the 1D-vs-3D validation layer); available: run --tier 1d|3d, "
                        "screen, bench, scenes, demo");
   } catch (const InputError& e) {

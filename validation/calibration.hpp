@@ -1,0 +1,53 @@
+// Calibration of the 1D tier from the 3D membrane: the wall stiffness C1 from uniform loads
+// (the paper's Figure 10, done with pressures: source-equations.md §1).
+//
+// For each pressure P of a series, the 3D spring-network membrane of the scene is relaxed to
+// equilibrium under the uniform inward load P A_i e_r per node (full3d::relax_under_pressure,
+// the static "dry" path), and the radial displacement delta = R0 - R_mid of the middle
+// ring(s), away from the tube's ends, is measured. C1 is fitted to P = C1 delta with GSL:
+// through the origin (gsl_fit_mul) and with an intercept (gsl_fit_linear), over the loads for
+// which the response stays linear (secant P / delta within 1 % of the smallest load's).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "common/scene.hpp"
+#include "full3d/scene3d.hpp"
+
+namespace swim::validation {
+
+struct LoadPoint {
+  double pressure_Pa = 0;
+  double displacement_m = 0;   ///< R0 - R_mid
+  double secant_C1_Pa_per_m = 0;
+  int iterations = 0;
+  bool in_linear_range = false;
+};
+
+struct C1Fit {
+  double c1 = 0, c1_stderr = 0, r2 = 0;           ///< through the origin, Pa/m
+  double slope = 0, slope_stderr = 0;             ///< with an intercept, Pa/m
+  double intercept = 0, intercept_stderr = 0, r2_linear = 0;  ///< Pa
+  double linear_up_to_Pa = 0;                     ///< largest load within 1 % of linear
+  int points = 0;                                 ///< loads used in the fits
+};
+
+struct StaticCalibration {
+  std::vector<LoadPoint> loads;
+  C1Fit fit;
+  double spring_network_c1 = 0;  ///< 2 k_s / (sqrt 3 R0^2), Pa/m
+  int n_theta = 0, n_rings = 0, nodes = 0;
+};
+
+/// Loads as fractions of the static load C1_net (R0 - R_f) that holds the scene's target
+/// radius (C1_net the spring-network estimate): a geometric series from 2 % to 150 %.
+std::vector<double> default_loads(const full3d::Params3d& p);
+
+/// Throws NumericalError if a relaxation does not converge, InputError for loads <= 0.
+StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures);
+
+/// calibration.json: the fit, the load points, the wall mass per area, the grid and the scene.
+scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const scene::json& resolved);
+
+}  // namespace swim::validation
