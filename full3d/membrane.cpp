@@ -1,9 +1,9 @@
 #include "full3d/membrane.hpp"
 
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
-#include <deque>
 #include <map>
 #include <numbers>
 #include <string>
@@ -321,88 +321,123 @@ Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) 
 
 PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
                                       double tol_force, int max_iterations) {
-  const Eigen::Index n = 3 * mesh.X0.cols();
-  // objective Pi(X) = E(X) + P sum A_i r_i ; gradient = -F_el + P A_i e_r
-  auto eval = [&](const Eigen::VectorXd& x, Eigen::VectorXd& grad) {
-    const Eigen::Map<const Eigen::Matrix3Xd> X(x.data(), 3, mesh.X0.cols());
-    const Eigen::Matrix3Xd Xm = X;
-    Eigen::Matrix3Xd G = -elastic_forces(mesh, Xm, p);
-    const Eigen::Matrix3Xd er = radial_directions(mesh, Xm);
-    const Eigen::VectorXd r = node_radii(mesh, Xm);
-    double pi = elastic_energy(mesh, Xm, p);
-    for (Eigen::Index i = 0; i < Xm.cols(); ++i) {
-      G.col(i) += pressure * mesh.node_area[i] * er.col(i);
-      pi += pressure * mesh.node_area[i] * r[i];
+  // The mesh is invariant under rotation by 2 pi / n_theta about the axis and under the
+  // mirror theta -> -theta, and so is the load; the equilibrium therefore has every ring a
+  // circle of radius r_k at axial position x_k, each node at its reference angle. The
+  // stationarity conditions restricted to that family are the generalised forces
+  //   G_r,k = sum_{i in ring k} g_i . e_r,i,   G_x,k = sum_{i in ring k} g_i . e_x,
+  // g = grad (E + P sum A_i r_i) = -F_el + P A_i e_r; by the symmetry, G = 0 makes the full
+  // gradient vanish (checked on every node below). Newton on the 2 n_rings - 1 unknowns
+  // (x_0 is held: axial translation is free and sum_k G_x,k = 0 identically), with the
+  // banded Jacobian from central differences, 5 rings per colour (a hinge couples at most
+  // 3 consecutive rings, so a ring's generalised force depends on rings k-2..k+2).
+  const int nr = mesh.n_rings, nt = mesh.n_theta;
+  const int nn = mesh.nodes();
+  Eigen::VectorXd cph(nn), sph(nn);
+  for (int i = 0; i < nn; ++i) {
+    const V3 d = mesh.X0.col(i) - mesh.axis_start;
+    const double r = std::hypot(d.y(), d.z());
+    cph[i] = d.y() / r;
+    sph[i] = d.z() / r;
+  }
+  auto positions = [&](const Eigen::VectorXd& rk, const Eigen::VectorXd& xk) {
+    Eigen::Matrix3Xd X(3, nn);
+    for (int i = 0; i < nn; ++i) {
+      const int k = i / nt;
+      X.col(i) = mesh.axis_start + V3(xk[k], rk[k] * cph[i], rk[k] * sph[i]);
     }
-    grad = Eigen::Map<Eigen::VectorXd>(G.data(), n);
-    return pi;
+    return X;
   };
+  // full gradient g (3 x N) of the loaded energy at X
+  auto gradient = [&](const Eigen::Matrix3Xd& X) {
+    Eigen::Matrix3Xd G = -elastic_forces(mesh, X, p);
+    for (int i = 0; i < nn; ++i) {
+      G(1, i) += pressure * mesh.node_area[i] * cph[i];
+      G(2, i) += pressure * mesh.node_area[i] * sph[i];
+    }
+    return G;
+  };
+  auto generalised = [&](const Eigen::Matrix3Xd& G) {
+    Eigen::VectorXd out = Eigen::VectorXd::Zero(2 * nr);
+    for (int i = 0; i < nn; ++i) {
+      const int k = i / nt;
+      out[k] += G(1, i) * cph[i] + G(2, i) * sph[i];
+      out[nr + k] += G(0, i);
+    }
+    return out;
+  };
+  auto max_node_force = [&](const Eigen::Matrix3Xd& G) { return G.colwise().norm().maxCoeff(); };
   if (tol_force <= 0.0) tol_force = 1e-7 * std::abs(pressure) * mesh.node_area.maxCoeff() + 1e-30;
-  auto max_node_force = [&](const Eigen::VectorXd& g) {
-    double m = 0.0;
-    for (Eigen::Index i = 0; i < n; i += 3) m = std::max(m, g.segment<3>(i).norm());
-    return m;
-  };
 
-  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(mesh.X0.data(), n), g(n), xn(n), gn(n);
-  double f = eval(x, g);
-  std::deque<Eigen::VectorXd> S, Y;
-  std::deque<double> rho;
-  const int mem = 12;
+  Eigen::VectorXd rk = Eigen::VectorXd::Constant(nr, mesh.radius), xk(nr);
+  for (int k = 0; k < nr; ++k) xk[k] = mesh.X0(0, mesh.node(k, 0)) - mesh.axis_start.x();
+  Eigen::Matrix3Xd G = gradient(positions(rk, xk));
+  Eigen::VectorXd res = generalised(G);
+  const int nu = 2 * nr - 1;  // unknowns r_0..r_{nr-1}, x_1..x_{nr-1}; equations likewise
+  auto reduced = [&](const Eigen::VectorXd& full) {
+    Eigen::VectorXd v(nu);
+    v.head(nr) = full.head(nr);
+    v.tail(nr - 1) = full.tail(nr - 1);
+    return v;
+  };
+  const double eps = 1e-6 * mesh.radius;
   int it = 0;
-  double step_scale = 1.0;
-  for (; it < max_iterations && max_node_force(g) > tol_force; ++it) {
-    // two-loop recursion
-    Eigen::VectorXd q = g;
-    std::vector<double> al(S.size());
-    for (int k = int(S.size()) - 1; k >= 0; --k) {
-      al[k] = rho[k] * S[k].dot(q);
-      q -= al[k] * Y[k];
-    }
-    if (!S.empty()) q *= S.back().dot(Y.back()) / Y.back().squaredNorm();
-    else q *= 1e-3 * mesh.rest_length.minCoeff() / (g.norm() + 1e-300) * step_scale;
-    for (std::size_t k = 0; k < S.size(); ++k) {
-      const double b = rho[k] * Y[k].dot(q);
-      q += S[k] * (al[k] - b);
-    }
-    Eigen::VectorXd dir = -q;
-    if (dir.dot(g) >= 0.0) {  // not a descent direction: reset memory
-      S.clear(); Y.clear(); rho.clear();
-      dir = -g * (1e-3 * mesh.rest_length.minCoeff() / g.norm());
-    }
+  for (; it < max_iterations && max_node_force(G) > tol_force; ++it) {
+    Eigen::MatrixXd J = Eigen::MatrixXd::Zero(nu, nu);
+    for (int comp = 0; comp < 2; ++comp)
+      for (int colour = 0; colour < 5; ++colour) {
+        Eigen::VectorXd rp = rk, xp = xk, rm = rk, xm = xk;
+        bool any = false;
+        for (int k = colour; k < nr; k += 5) {
+          if (comp == 1 && k == 0) continue;
+          any = true;
+          (comp == 0 ? rp : xp)[k] += eps;
+          (comp == 0 ? rm : xm)[k] -= eps;
+        }
+        if (!any) continue;
+        const Eigen::VectorXd d =
+            reduced((generalised(gradient(positions(rp, xp))) - generalised(gradient(positions(rm, xm)))) /
+                    (2.0 * eps));
+        for (int k = colour; k < nr; k += 5) {
+          if (comp == 1 && k == 0) continue;
+          const int col = comp == 0 ? k : nr + k - 1;
+          for (int j = std::max(0, k - 2); j <= std::min(nr - 1, k + 2); ++j) {
+            J(j, col) = d[j];
+            if (j > 0) J(nr + j - 1, col) = d[nr + j - 1];
+          }
+        }
+      }
+    const Eigen::VectorXd step = J.partialPivLu().solve(-reduced(res));
+    if (!step.allFinite()) break;
+    // backtracking on the generalised residual
     double t = 1.0;
-    const double slope = dir.dot(g);
     bool accepted = false;
-    for (int ls = 0; ls < 40; ++ls) {
-      xn = x + t * dir;
-      const double fn = eval(xn, gn);
-      // Armijo, or (near round-off in the energy) a non-increase with a smaller gradient
-      if (std::isfinite(fn) && (fn <= f + 1e-4 * t * slope ||
-                                (fn - f <= 1e-13 * std::abs(f) && gn.norm() < g.norm()))) {
+    for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
+      Eigen::VectorXd rn = rk + t * step.head(nr), xn = xk;
+      xn.tail(nr - 1) += t * step.tail(nr - 1);
+      if (!(rn.minCoeff() > 0.0)) continue;
+      const Eigen::Matrix3Xd Gn = gradient(positions(rn, xn));
+      const Eigen::VectorXd resn = generalised(Gn);
+      if (resn.allFinite() && (resn.norm() < res.norm() || max_node_force(Gn) <= tol_force)) {
+        rk = rn;
+        xk = xn;
+        G = Gn;
+        res = resn;
         accepted = true;
-        f = fn;
         break;
       }
-      t *= 0.5;
     }
     if (!accepted) break;
-    const Eigen::VectorXd s = xn - x, y = gn - g;
-    const double sy = s.dot(y);
-    if (sy > 1e-300) {
-      S.push_back(s); Y.push_back(y); rho.push_back(1.0 / sy);
-      if (int(S.size()) > mem) { S.pop_front(); Y.pop_front(); rho.pop_front(); }
-    }
-    x = xn;
-    g = gn;
   }
   PressureResponse out;
-  out.X = Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, mesh.X0.cols());
+  out.X = positions(rk, xk);
   out.iterations = it;
-  out.max_residual_force = max_node_force(g);
-  if (out.max_residual_force > tol_force)
+  out.max_residual_force = max_node_force(G);
+  if (!(out.max_residual_force <= tol_force))
     throw NumericalError("membrane static relaxation stalled at residual force " + num(out.max_residual_force) +
-                             " N after " + std::to_string(it) + " iterations",
-                         "reduce the applied pressure or raise max_iterations");
+                             " N (tolerance " + num(tol_force) + " N) after " + std::to_string(it) +
+                             " Newton iterations",
+                         "reduce the applied pressure (protocol.pressure sets the scale of the calibration loads)");
   out.ring_radius = ring_radii(mesh, out.X);
   const int r0 = (mesh.n_rings - 1) / 2, r1 = mesh.n_rings / 2;
   out.mid_radius = 0.5 * (out.ring_radius[r0] + out.ring_radius[r1]);

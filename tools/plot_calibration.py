@@ -1,5 +1,6 @@
 """Figure 10 done with pressures: uniform inward pressure against the radial displacement
-of the middle ring, with the C1 fit through the origin.
+of the middle ring, with the C1 fit through the origin, the secant stiffness against the load,
+and the ring's stiffness against ovalisation (ring buckling where it turns negative).
 
 usage: plot_calibration.py DIR   (reads DIR/calibration.json, writes DIR/calibration.png)
 """
@@ -18,25 +19,44 @@ def main(d):
     pts = c["load_points"]
     x = [p["displacement_m"] * 1e9 for p in pts]
     y = [p["pressure_Pa"] * 1e3 for p in pts]
-    lin = [p["in_linear_range"] for p in pts]
-    fig, ax = plt.subplots(1, 2, figsize=(11, 4.5))
+    fitted = [p["in_linear_range"] and p["stable_to_ring_buckling"] for p in pts]
+    unstable = [not p["stable_to_ring_buckling"] for p in pts]
+    nonlin = [not f and not u for f, u in zip(fitted, unstable)]
+    fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
     name = c["scene"].get("name", d)
     fig.suptitle(f"Wall stiffness from uniform loads: {name} ({c['grid']['membrane_nodes']} membrane nodes)")
-    ax[0].plot([v for v, l in zip(x, lin) if l], [v for v, l in zip(y, lin) if l], "o", label="linear range (fit)")
-    ax[0].plot([v for v, l in zip(x, lin) if not l], [v for v, l in zip(y, lin) if not l], "s", mfc="none",
-               label="beyond 1 % of linear")
+
+    def sel(v, m):
+        return [a for a, b in zip(v, m) if b]
+
+    ax[0].plot(sel(x, fitted), sel(y, fitted), "o", label="fitted (linear, stable)")
+    if any(nonlin):
+        ax[0].plot(sel(x, nonlin), sel(y, nonlin), "s", mfc="none", label="beyond 1 % of linear")
+    if any(unstable):
+        ax[0].plot(sel(x, unstable), sel(y, unstable), "x", ms=8, label="unstable to ring buckling")
     xm = max(x)
     ax[0].plot([0, xm], [0, c["C1_Pa_per_m"] * xm * 1e-9 * 1e3], "k-", lw=1,
                label=f"C1 = {c['C1_Pa_per_m'] / 1e6:.4g} MPa/m (fit)")
     ax[0].plot([0, xm], [0, c["C1_spring_network_Pa_per_m"] * xm * 1e-9 * 1e3], "k:", lw=1,
-               label=f"2 k_s / (\u221a3 R0\u00b2) = {c['C1_spring_network_Pa_per_m'] / 1e6:.4g} MPa/m")
-    ax[0].set(xlabel="radial displacement R0 \u2212 R_mid [nm]", ylabel="pressure [mPa]",
+               label=f"2 k\u209b / (\u221a3 R\u2080\u00b2) = {c['C1_spring_network_Pa_per_m'] / 1e6:.4g} MPa/m")
+    ax[0].set(xlabel="radial displacement R\u2080 \u2212 R_mid [nm]", ylabel="pressure [mPa]",
               title="pressure against displacement")
     ax[0].legend(loc="upper left", fontsize="small", frameon=False)
-    ax[1].semilogx([p["pressure_Pa"] * 1e3 for p in pts], [p["secant_C1_Pa_per_m"] / 1e6 for p in pts], "o-")
-    ax[1].axhline(c["C1_spring_network_Pa_per_m"] / 1e6, color="k", ls=":", lw=1)
-    ax[1].set(xlabel="pressure [mPa]", ylabel="secant C1 = P / (R0 \u2212 R_mid) [MPa/m]",
-              title="stiffness against load (log scale)")
+
+    P = [p["pressure_Pa"] * 1e3 for p in pts]
+    sec = [p["secant_C1_Pa_per_m"] / 1e6 for p in pts]
+    ax[1].semilogx(P, sec, "o-", label="secant P / (R\u2080 \u2212 R_mid)")
+    ax[1].axhspan(sec[0] * 0.99, sec[0] * 1.01, color="0.9", label="\u00b11 % of the smallest load's")
+    ax[1].axhline(c["C1_spring_network_Pa_per_m"] / 1e6, color="k", ls=":", lw=1, label="spring-network value")
+    ax[1].set(xlabel="pressure [mPa] (log scale)", ylabel="secant C1 [MPa/m]", title="stiffness against load")
+    ax[1].legend(loc="lower left", fontsize="small", frameon=False)
+
+    for n, key in ((2, "ovalisation_stiffness_n2_N_per_m"), (3, "ovalisation_stiffness_n3_N_per_m")):
+        ax[2].semilogx(P, [p[key] * 1e12 for p in pts], "o-", label=f"mode n = {n}")
+    ax[2].axhline(0, color="k", lw=1)
+    ax[2].set(xlabel="pressure [mPa] (log scale)", ylabel="ovalisation stiffness [pN/m]",
+              title="ring buckling: unstable below zero")
+    ax[2].legend(loc="lower left", fontsize="small", frameon=False)
     fig.tight_layout()
     fig.savefig(f"{d}/calibration.png", dpi=110)
 

@@ -10,6 +10,29 @@
 
 namespace swim::validation {
 
+namespace {
+// d^2/ds^2 of E(X + sV) + P sum A_i r_i(X + sV) for the unit mode V_i ~ cos(n phi_i) e_r,i,
+// by central differences of the exact gradient: V . (g(X + sV) - g(X - sV)) / (2 s).
+double ovalisation_stiffness(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p, double pressure,
+                             const Eigen::Matrix3Xd& X, int n) {
+  const Eigen::Matrix3Xd er = full3d::radial_directions(mesh, X);
+  Eigen::Matrix3Xd V(3, X.cols());
+  for (Eigen::Index i = 0; i < X.cols(); ++i) {
+    const double phi = std::atan2(er(2, i), er(1, i));
+    V.col(i) = std::cos(n * phi) * er.col(i);
+  }
+  V /= V.norm();
+  auto grad = [&](const Eigen::Matrix3Xd& Y) {
+    Eigen::Matrix3Xd g = -full3d::elastic_forces(mesh, Y, p);
+    const Eigen::Matrix3Xd e = full3d::radial_directions(mesh, Y);
+    for (Eigen::Index i = 0; i < Y.cols(); ++i) g.col(i) += pressure * mesh.node_area[i] * e.col(i);
+    return g;
+  };
+  const double s = 1e-4 * mesh.rest_length.minCoeff();
+  return V.cwiseProduct(grad(X + s * V) - grad(X - s * V)).sum() / (2.0 * s);
+}
+}  // namespace
+
 std::vector<double> default_loads(const full3d::Params3d& p) {
   const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
   std::vector<double> out;
@@ -35,20 +58,28 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
     lp.displacement_m = p.R0 - r.mid_radius;
     lp.secant_C1_Pa_per_m = r.c1;
     lp.iterations = r.iterations;
+    lp.ovalisation_stiffness_n2_N_per_m = ovalisation_stiffness(mesh, p.membrane, pr, r.X, 2);
+    lp.ovalisation_stiffness_n3_N_per_m = ovalisation_stiffness(mesh, p.membrane, pr, r.X, 3);
     c.loads.push_back(lp);
   }
   // linear range: secant within 1 % of the smallest load's
   const double c_small = c.loads.front().secant_C1_Pa_per_m;
   std::vector<double> x, y;
+  c.fit.linear_over_all_loads = true;
   for (auto& lp : c.loads) {
     lp.in_linear_range = std::abs(lp.secant_C1_Pa_per_m / c_small - 1.0) <= 0.01;
-    if (!lp.in_linear_range) continue;
+    if (!lp.in_linear_range) c.fit.linear_over_all_loads = false;
+    if (!lp.in_linear_range || !lp.stable()) continue;
     x.push_back(lp.displacement_m);
     y.push_back(lp.pressure_Pa);
     c.fit.linear_up_to_Pa = lp.pressure_Pa;
   }
   const int n = int(x.size());
   c.fit.points = n;
+  if (n < 2)
+    throw NumericalError("only " + std::to_string(n) + " of " + std::to_string(c.loads.size()) +
+                             " calibration loads are linear and stable to ring buckling; no C1 fit",
+                         "lower protocol.pressure or raise full3d.membrane.bending_constant");
   double ymean = 0;
   for (double v : y) ymean += v / n;
   double sstot = 0;
@@ -79,6 +110,9 @@ scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const
                    {"displacement_m", lp.displacement_m},
                    {"secant_C1_Pa_per_m", lp.secant_C1_Pa_per_m},
                    {"in_linear_range", lp.in_linear_range},
+                   {"ovalisation_stiffness_n2_N_per_m", lp.ovalisation_stiffness_n2_N_per_m},
+                   {"ovalisation_stiffness_n3_N_per_m", lp.ovalisation_stiffness_n3_N_per_m},
+                   {"stable_to_ring_buckling", lp.stable()},
                    {"iterations", lp.iterations}});
   scene::json j = scene::json::object();
   j["C1_Pa_per_m"] = c.fit.c1;
@@ -90,6 +124,7 @@ scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const
                             {"intercept_stderr_Pa", c.fit.intercept_stderr},
                             {"r2", c.fit.r2_linear}};
   j["linear_within_1_percent_up_to_Pa"] = c.fit.linear_up_to_Pa;
+  j["linear_over_all_loads"] = c.fit.linear_over_all_loads;
   j["fit_points"] = c.fit.points;
   j["load_points"] = pts;
   j["C1_spring_network_Pa_per_m"] = c.spring_network_c1;

@@ -23,6 +23,11 @@ struct LoadPoint {
   double secant_C1_Pa_per_m = 0;
   int iterations = 0;
   bool in_linear_range = false;
+  /// Second derivative of the loaded energy along the unit ovalisation modes
+  /// V_i = cos(n phi_i) e_r,i / |V| (n = 2, 3) at the equilibrium, N/m: the symmetric
+  /// equilibrium is unstable to ring buckling when one is negative.
+  double ovalisation_stiffness_n2_N_per_m = 0, ovalisation_stiffness_n3_N_per_m = 0;
+  bool stable() const { return ovalisation_stiffness_n2_N_per_m > 0 && ovalisation_stiffness_n3_N_per_m > 0; }
 };
 
 struct C1Fit {
@@ -30,6 +35,7 @@ struct C1Fit {
   double slope = 0, slope_stderr = 0;             ///< with an intercept, Pa/m
   double intercept = 0, intercept_stderr = 0, r2_linear = 0;  ///< Pa
   double linear_up_to_Pa = 0;                     ///< largest load within 1 % of linear
+  bool linear_over_all_loads = false;             ///< no load left the 1 % band: the range is a lower bound
   int points = 0;                                 ///< loads used in the fits
 };
 
@@ -45,6 +51,8 @@ struct StaticCalibration {
 std::vector<double> default_loads(const full3d::Params3d& p);
 
 /// Throws NumericalError if a relaxation does not converge, InputError for loads <= 0.
+/// Points that are unstable to ring buckling (LoadPoint::stable) are reported and left out of
+/// the fits.
 StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures);
 
 /// calibration.json: the fit, the load points, the wall mass per area, the grid and the scene.
