@@ -9,6 +9,7 @@
 #include "full3d/membrane.hpp"
 #include "full3d/scene3d.hpp"
 #include "validation/calibration.hpp"
+#include "validation/hydraulic.hpp"
 
 using namespace swim;
 
@@ -65,4 +66,22 @@ TEST(StaticCalibration, RejectsNonPositiveLoads) {
   const full3d::Params3d p = paper_scene();
   EXPECT_THROW(validation::calibrate_static(p, {0.0}), InputError);
   EXPECT_THROW(validation::calibrate_static(p, {-1.0}), InputError);
+}
+
+// Hydraulic radii of the immersed wall at the paper's default grid: the no-slip surfaces the
+// flow sees lie about one cell inside and outside R0 (the 4-point kernel's smearing), and the
+// fitted lumen Poiseuille profile carries the measured lumen flux.
+TEST(HydraulicRadii, HeldTubeInPaperCylinder) {
+  const full3d::Params3d p = paper_scene();
+  const validation::HydraulicRadii r = validation::measure_hydraulic_radii(p);
+  EXPECT_GT(r.a_in_m, 0.5 * p.h);
+  EXPECT_LT(r.a_in_m, 2.0 * p.h);
+  EXPECT_GT(r.a_out_m, 0.5 * p.h);
+  EXPECT_LT(r.a_out_m, 2.0 * p.h);
+  EXPECT_LT(r.a_in_uncertainty_m, 0.2 * r.a_in_m);
+  EXPECT_LT(r.a_out_uncertainty_m, 0.2 * r.a_out_m);
+  EXPECT_NEAR(r.lumen_flux_poiseuille_m3_per_s / r.lumen_flux_m3_per_s, 1.0, 0.05);
+  EXPECT_LT(r.max_node_speed_m_per_s, 1e-2 * r.max_fluid_speed_m_per_s);  // the wall is held
+  // the container's no-slip surface is within a cell of its nominal radius
+  EXPECT_NEAR(r.container_radius_effective_m, p.container_radius, p.h);
 }
