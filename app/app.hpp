@@ -26,6 +26,9 @@ int scenes();
 /// swim calibrate: C1 of the 1D tier from 3D uniform loads (validation/calibration.hpp).
 int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out);
 
+/// swim validate: the 1D-vs-3D validation suite and its report (validation/suite.hpp).
+int validate(const std::string& suite, bool quick, const std::string& out, int threads, int progress);
+
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
 std::string data_dir();
 /// Run a plotting script of tools/ with Debian's python3; returns false (with a warning on

@@ -69,8 +69,15 @@ int main(int argc, char** argv) {
   cal->add_option("scene", cal_scene, "Scene file (JSON)")->required();
   cal->add_option("--out", cal_out, "Output directory (default out/<name>-calibration)");
   cal->add_option("--set", cal_sets, "Override a scene value: key.path=value");
-  CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation report");
-  val->allow_extras();
+  CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
+  std::string val_suite, val_out;
+  bool val_quick = false;
+  int val_threads = 2;
+  val->add_option("suite", val_suite, "Suite file (default: data/validation/default.json, or quick.json with --quick)");
+  val->add_flag("--quick", val_quick, "The reduced suite (small grids, minutes)");
+  val->add_option("--out", val_out, "Output directory (default out/validation-<suite name>); completed runs in it are reused");
+  val->add_option("--threads", val_threads, "Threads of the 3D runs (default 2)");
+  add_progress(val);
 
   try {
     cli.parse(argc, argv);
@@ -93,10 +100,7 @@ int main(int argc, char** argv) {
     if (*ben) return app::bench(out, quick, paper_cycle);
     if (*sc) return app::scenes();
     if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out);
-    if (*val)
-      throw InputError("validate", "",
-                       "is not implemented yet (it needs the 1D-vs-3D validation layer); available: run --tier 1d|3d, "
-                       "screen, bench, scenes, demo");
+    if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress);
   } catch (const InputError& e) {
     std::fprintf(stderr, "swim: %s\n", e.what());
     return 2;

@@ -1,0 +1,47 @@
+// swim validate [SUITE] [--quick]: the 1D-vs-3D validation report (validation/suite.hpp).
+#include <cstdio>
+#include <filesystem>
+
+#include "app/app.hpp"
+#include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/si_format.hpp"
+#include "validation/suite.hpp"
+
+namespace fs = std::filesystem;
+
+namespace swim::app {
+
+int validate(const std::string& suite_opt, bool quick, const std::string& out_opt, int threads, int progress) {
+  const std::string suite =
+      !suite_opt.empty() ? suite_opt : data_dir() + "/validation/" + (quick ? "quick.json" : "default.json");
+  if (!fs::is_regular_file(suite))
+    throw InputError("suite", "\"" + suite + "\"", "a suite file (shipped: data/validation/default.json, quick.json)");
+  if (threads < 1 || threads > 64) throw InputError("--threads", std::to_string(threads), "an integer from 1 to 64");
+  const scene::json s = validation::load_suite(suite);  // bad input stops here, before anything is written
+  const std::string name = s.value("name", fs::path(suite).stem().string());
+  const std::string out = out_opt.empty() ? "out/validation-" + name : out_opt;
+  fs::create_directories(out);
+  validation::SuiteOptions o;
+  o.suite = suite;
+  o.out_dir = out;
+  o.data_dir = data_dir();
+  o.threads = threads;
+  if (progress != 0) o.progress = [](const std::string& line) { std::fprintf(stderr, "validate: %s\n", line.c_str()); };
+  const scene::json report = validation::run_suite(o);
+  output::write_json(out + "/report.json", report);
+  const bool plotted = plot("plot_validation.py", {out});
+  int pass = 0, fail = 0;
+  for (const auto& c : report["cases"])
+    for (const auto& m : c["models1d"])
+      if (m.contains("verdicts"))
+        for (const auto& [k, v] : m["verdicts"].items()) (v == "pass" ? pass : fail) += (v == "pass" || v == "fail");
+  std::printf("validation suite %s: %zu case(s), %d verdicts pass, %d fail; wall time %s\n  -> %s/report.json%s\n",
+              name.c_str(), report["cases"].size(), pass, fail, si(report["wall_time_s"].get<double>(), "s").c_str(),
+              out.c_str(), plotted ? ", report.md, report.html and figures" : "");
+  for (const auto& f : report["findings"])
+    std::printf("  %-13s %s\n", f["status"].get<std::string>().c_str(), f["claim"].get<std::string>().c_str());
+  return 0;
+}
+
+}  // namespace swim::app

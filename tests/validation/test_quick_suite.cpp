@@ -1,0 +1,67 @@
+// The quick validation suite end to end (swim validate --quick, without the figures): three
+// coarse 3D grids of the small duct scene, the calibration, every 1D model, the report.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+
+#include "validation/suite.hpp"
+
+using namespace swim;
+namespace fs = std::filesystem;
+
+TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
+  const std::string out = testing::TempDir() + "/swim_quick_suite";
+  fs::remove_all(out);
+  fs::create_directories(out);
+  validation::SuiteOptions o;
+  o.suite = SWIM_SOURCE_DIR "/data/validation/quick.json";
+  o.out_dir = out;
+  o.data_dir = SWIM_SOURCE_DIR "/data";
+  o.threads = 1;
+  const scene::json r = validation::run_suite(o);
+  ASSERT_EQ(r["cases"].size(), 1u);
+  const scene::json& c = r["cases"][0];
+  // every 3D grid completes its cycle and moves the swimmer forwards
+  ASSERT_EQ(c["runs3d"].size(), 3u);
+  for (const auto& run : c["runs3d"]) {
+    EXPECT_EQ(run["status"], "ok");
+    EXPECT_GT(run["displacement_per_cycle_m"].get<double>(), 0.0);
+    EXPECT_FALSE(run["cached"].get<bool>());
+  }
+  ASSERT_TRUE(c["reference3d"].contains("displacement_per_cycle_m"));
+  // calibration at the finest grid: C1 within 2 % of the spring network, offsets about a cell
+  const scene::json& cal = c["calibration"];
+  ASSERT_TRUE(cal.contains("C1_Pa_per_m")) << cal.dump();
+  EXPECT_NEAR(cal["C1_Pa_per_m"].get<double>() / cal["C1_spring_network_Pa_per_m"].get<double>(), 1.0, 0.02);
+  const double h = c["runs3d"][2]["cell_size_m"];
+  EXPECT_GT(cal["hydraulic_offset_inner_m"].get<double>(), 0.3 * h);
+  EXPECT_LT(cal["hydraulic_offset_inner_m"].get<double>(), 2.0 * h);
+  // every model of the suite ran and carries its verdicts
+  ASSERT_EQ(c["models1d"].size(), 4u);
+  for (const auto& m : c["models1d"]) {
+    EXPECT_EQ(m["status"], "ok") << m["label"];
+    ASSERT_TRUE(m.contains("verdicts")) << m["label"];
+    for (const auto& [k, v] : m["verdicts"].items()) EXPECT_TRUE(v == "pass" || v == "fail") << k;
+  }
+  // the force-free models swim the way 3D does; the paper's reproduction overestimates the
+  // displacement by orders of magnitude (its thrust has no opposing force but wall inertia)
+  const double ref = c["reference3d"]["displacement_per_cycle_m"]["value"];
+  EXPECT_GT(c["models1d"][0]["displacement_per_cycle_m"].get<double>(), 0.0);
+  EXPECT_GT(c["models1d"][1]["displacement_per_cycle_m"].get<double>(), 0.0);
+  EXPECT_GT(c["models1d"][3]["displacement_per_cycle_m"].get<double>(), 100.0 * ref);
+  // speed/accuracy: 1D at three cell counts and 3D at three grids
+  EXPECT_EQ(c["speed_accuracy"].size(), 6u);
+  EXPECT_GT(c["wall_time_ratio_3d_over_1d"].get<double>(), 10.0);
+  ASSERT_EQ(r["findings"].size(), 6u);
+
+  // a second run reuses every 3D run and the calibration, with identical figures
+  const scene::json r2 = validation::run_suite(o);
+  const scene::json& c2 = r2["cases"][0];
+  for (std::size_t g = 0; g < 3; ++g) {
+    EXPECT_TRUE(c2["runs3d"][g]["cached"].get<bool>());
+    EXPECT_EQ(c2["runs3d"][g]["displacement_per_cycle_m"], c["runs3d"][g]["displacement_per_cycle_m"]);
+  }
+  EXPECT_EQ(c2["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
+  EXPECT_EQ(c2["models1d"][0]["displacement_per_cycle_m"], c["models1d"][0]["displacement_per_cycle_m"]);
+}

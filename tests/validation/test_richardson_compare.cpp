@@ -1,0 +1,107 @@
+// Richardson extrapolation, U(t) comparison and suite-file checks of the validation layer.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+#include "common/errors.hpp"
+#include "validation/compare.hpp"
+#include "validation/richardson.hpp"
+#include "validation/suite.hpp"
+
+using namespace swim;
+using namespace swim::validation;
+
+// f(h) = f0 + C h^p exactly: the observed order and the limit are recovered, for a constant
+// and for a varying refinement ratio.
+TEST(Richardson, RecoversOrderAndLimitOfAnExactPowerLaw) {
+  for (double p : {1.0, 1.5, 2.0}) {
+    for (const std::vector<double>& h : {std::vector<double>{0.04, 0.02, 0.01}, std::vector<double>{15.6, 12.5, 10.4}}) {
+      std::vector<double> f;
+      for (double x : h) f.push_back(29.0 - 3.0 * std::pow(x, p));
+      const Extrapolation e = richardson(h, f);
+      EXPECT_TRUE(e.asymptotic);
+      EXPECT_NEAR(e.order, p, 1e-9);
+      EXPECT_NEAR(e.value, 29.0, 1e-9);
+    }
+  }
+}
+
+// The grids may come in any order.
+TEST(Richardson, OrderOfTheGridsDoesNotMatter) {
+  const Extrapolation a = richardson({0.01, 0.04, 0.02}, {29.0 - 0.03, 29.0 - 0.12, 29.0 - 0.06});
+  EXPECT_NEAR(a.value, 29.0, 1e-9);
+  EXPECT_NEAR(a.order, 1.0, 1e-9);
+}
+
+// Differences of opposite sign: not asymptotic, the finest value with the spread as error.
+TEST(Richardson, NonMonotoneSequenceIsReportedNotExtrapolated) {
+  const Extrapolation e = richardson({3, 2, 1}, {10.0, 12.0, 11.0});
+  EXPECT_FALSE(e.asymptotic);
+  EXPECT_DOUBLE_EQ(e.value, 11.0);
+  EXPECT_DOUBLE_EQ(e.error, 2.0);
+}
+
+// Two grids: the assumed order is used. f = 1 + h: from h = 2, 1 the limit is 1.
+TEST(Richardson, TwoGridsUseTheAssumedOrder) {
+  const Extrapolation e = richardson({2, 1}, {3.0, 2.0}, 1.0);
+  EXPECT_NEAR(e.value, 1.0, 1e-12);
+  EXPECT_THROW(richardson({1}, {1.0}), InputError);
+  EXPECT_THROW(richardson({1, 1}, {1.0, 2.0}), InputError);
+}
+
+namespace {
+void sample(double T, double sign, std::vector<double>& t, std::vector<double>& u) {
+  for (int k = 0; k <= 1000; ++k) {
+    t.push_back(T * k / 1000.0);
+    u.push_back(sign * std::sin(2 * M_PI * k / 1000.0) + 0.3);
+  }
+}
+}  // namespace
+
+// A velocity history and the same history on a cycle 4x longer: identical against phase,
+// different against time. A mirrored history anticorrelates.
+TEST(CompareSeries, PhaseNormalisationAndCorrelation) {
+  std::vector<double> t1, u1, t2, u2, t3, u3;
+  sample(1.0, 1.0, t1, u1);
+  sample(4.0, 1.0, t2, u2);
+  sample(1.0, -1.0, t3, u3);
+  const SeriesComparison ph = compare_series(t1, u1, 1.0, t2, u2, 4.0, true);
+  EXPECT_LT(ph.l2_relative, 1e-5);
+  EXPECT_NEAR(ph.correlation, 1.0, 1e-9);
+  const SeriesComparison ab = compare_series(t1, u1, 1.0, t2, u2, 4.0, false);
+  EXPECT_GT(ab.l2_relative, 0.5);
+  const SeriesComparison mir = compare_series(t3, u3, 1.0, t1, u1, 1.0, true);
+  EXPECT_NEAR(mir.correlation, -1.0, 1e-9);
+  EXPECT_THROW(compare_series({0.0}, {1.0}, 1.0, t1, u1, 1.0, true), InputError);
+}
+
+// A malformed suite is rejected naming the key, before any run.
+TEST(SuiteFile, MalformedSuitesNameTheKey) {
+  const std::string path = testing::TempDir() + "/bad_suite.json";
+  auto expect_key = [&](const std::string& text, const std::string& key) {
+    std::ofstream(path) << text;
+    try {
+      load_suite(path);
+      ADD_FAILURE() << "accepted: " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  const std::string models = R"("models1d": [{"label": "m"}])";
+  const std::string th = R"("thresholds": {"displacement_per_cycle_relative": 0.2, "cycle_time_relative": 0.5,
+      "mean_velocity_per_cycle_relative": 0.5, "velocity_phase_correlation": 0.8})";
+  expect_key("{" + models + ", " + th + "}", "suite.cases");
+  expect_key(R"({"cases": [{"scene": "x.json", "grids": [32]}], )" + models + ", " + th + "}", "grids");
+  expect_key(R"({"cases": [{"scene": "x.json", "grids": [32, 40], "calibration_grid": 5}], )" + models + ", " + th + "}",
+             "calibration_grid");
+  expect_key(R"({"cases": [{"scene": "x.json", "grids": [32, 40]}], )" + models + "}", "thresholds");
+  expect_key(R"({"cases": [{"grids": [32, 40]}], )" + models + ", " + th + "}", "scene");
+}
+
+// The shipped suites are well formed.
+TEST(SuiteFile, ShippedSuitesLoad) {
+  for (const char* s : {"quick.json", "default.json"})
+    EXPECT_NO_THROW(load_suite(std::string(SWIM_SOURCE_DIR "/data/validation/") + s)) << s;
+}

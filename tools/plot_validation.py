@@ -1,0 +1,348 @@
+"""Figures and human-readable reports of a validation suite run.
+
+usage: plot_validation.py DIR   (reads DIR/report.json; writes DIR/report.md, DIR/report.html
+                                 and DIR/fig_*.png)
+"""
+import base64
+import html
+import json
+import math
+import os
+import sys
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import plot_calibration  # noqa: E402
+
+MODEL_STYLES = ["C1-", "C2--", "C3-.", "C4:", "C5-", "C6--"]
+
+
+def si(v, unit, digits=3):
+    """Value with an SI prefix: si(4.2e-8, 'm') -> '42 nm'."""
+    if v is None or (isinstance(v, float) and not math.isfinite(v)):
+        return "—"
+    if v == 0:
+        return f"0 {unit}"
+    prefixes = [(1e-15, "f"), (1e-12, "p"), (1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1, ""), (1e3, "k"), (1e6, "M")]
+    a = abs(v)
+    scale, p = prefixes[0]
+    for s, q in prefixes:
+        if a >= s:
+            scale, p = s, q
+    return f"{v / scale:.{digits}g} {p}{unit}"
+
+
+def pct(v):
+    return "—" if v is None else f"{100 * v:+.1f} %"
+
+
+def velocity_figure(case, path):
+    fig, ax = plt.subplots(1, 2, figsize=(12, 4.4))
+    runs = [r for r in case["runs3d"] if r.get("has_cycle")]
+    ref_scale = 0.0
+    for k, r in enumerate(runs):
+        s = r["series"]
+        finest = k == len(runs) - 1
+        T = r["cycle_time_s"]
+        u = [v * 1e9 for v in s["velocity_m_per_s"]]
+        ref_scale = max(ref_scale, max(abs(v) for v in u) if u else 0.0)
+        kw = dict(color="k", lw=2 if finest else 0.8, alpha=1.0 if finest else 0.4,
+                  label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm")
+        ax[0].plot(s["t_s"], u, **kw)
+        ax[1].plot([t / T for t in s["t_s"]], u, **kw)
+    off = []
+    for k, m in enumerate(case["models1d"]):
+        if "series" not in m or not m.get("has_cycle"):
+            continue
+        s = m["series"]
+        u = [v * 1e9 for v in s["velocity_m_per_s"]]
+        if ref_scale > 0 and max(abs(v) for v in u) > 50 * ref_scale:
+            off.append(f"{m['label']} (peak {si(max(abs(v) for v in u) * 1e-9, 'm/s')})")
+            continue
+        T = m["cycle_time_s"]
+        st = MODEL_STYLES[k % len(MODEL_STYLES)]
+        ax[0].plot(s["t_s"], u, st, lw=1.4, label=f"1D: {m['label']}")
+        ax[1].plot([t / T for t in s["t_s"]], u, st, lw=1.4, label=f"1D: {m['label']}")
+    ax[0].set(xlabel="time t [s]", ylabel="swimmer velocity U [nm/s]", title="U(t) over the cycle")
+    ax[1].set(xlabel="cycle phase t / T_cycle (each tier on its own cycle time)", ylabel="U [nm/s]",
+              title="U against cycle phase")
+    for a in ax:
+        a.axhline(0, color="0.6", lw=0.6)
+    title = f"{case['name']}: swimmer velocity, 1D against 3D"
+    if off:
+        title += "\noff scale, not drawn: " + "; ".join(off)
+    fig.suptitle(title)
+    handles, labels = ax[0].get_legend_handles_labels()
+    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize="small", frameon=False)
+    fig.tight_layout(rect=(0, 0.14, 1, 1))
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
+def convergence_figure(case, path):
+    runs = [r for r in case["runs3d"] if r.get("has_cycle")]
+    if not runs:
+        return False
+    fig, ax = plt.subplots(figsize=(6.5, 4.4))
+    h = [r["cell_size_m"] * 1e9 for r in runs]
+    d = [r["displacement_per_cycle_m"] * 1e9 for r in runs]
+    ax.plot(h, d, "ko-", label="3D runs")
+    ref = case["reference3d"].get("displacement_per_cycle_m")
+    if ref:
+        ax.errorbar([0], [ref["value"] * 1e9], yerr=[ref["error"] * 1e9], fmt="rs", capsize=4,
+                    label="extrapolated h → 0" + (f" (order {ref['order']:.2f})" if ref["asymptotic"] else
+                                                  " (not asymptotic: finest)"))
+    for k, m in enumerate(case["models1d"]):
+        if m.get("has_cycle") and ref and abs(m["displacement_per_cycle_m"]) < 20 * abs(ref["value"]):
+            ax.axhline(m["displacement_per_cycle_m"] * 1e9, color=f"C{k + 1}", ls="--", lw=1, label=f"1D: {m['label']}")
+    ax.set(xlabel="cell size h [nm]", ylabel="displacement per cycle [nm]",
+           title=f"{case['name']}: 3D grid convergence")
+    ax.set_xlim(left=-0.05 * max(h))
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def pareto_figure(report, path):
+    fig, ax = plt.subplots(figsize=(8, 4.8))
+    any_pt = False
+    for c in report["cases"]:
+        pts = c.get("speed_accuracy", [])
+        for tier, mk in (("1d", "o"), ("3d", "s")):
+            p = [q for q in pts if q["tier"] == tier and q["displacement_per_cycle_error"] > 0]
+            if not p:
+                continue
+            any_pt = True
+            ax.loglog([q["wall_time_s"] for q in p], [100 * q["displacement_per_cycle_error"] for q in p], mk + "-",
+                      label=f"{c['name']}, {tier.upper()}")
+            for q in p:
+                ax.annotate(q["resolution"], (q["wall_time_s"], 100 * q["displacement_per_cycle_error"]),
+                            fontsize=7, xytext=(-4, 4), textcoords="offset points", ha="right")
+    if not any_pt:
+        plt.close(fig)
+        return False
+    ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)",
+           title=f"Speed against accuracy: {report['suite']} suite\n(error against the extrapolated 3D reference)")
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title):
+    cases = sorted([c for c in report["cases"] if c.get("group") == group and c.get("sweep_value") is not None],
+                   key=lambda c: c["sweep_value"])
+    if len(cases) < 2:
+        return False
+    fig, ax = plt.subplots(figsize=(7, 4.6))
+    x = [c["sweep_value"] for c in cases]
+    y, e = [], []
+    for c in cases:
+        ref = c["reference3d"].get(key)
+        y.append(ref["value"] * scale if ref else float("nan"))
+        e.append(ref["error"] * scale if ref else 0)
+    ax.errorbar(x, y, yerr=e, fmt="ks-", capsize=4, label="3D, extrapolated")
+    labels = [m["label"] for m in cases[0]["models1d"]]
+    for k, lab in enumerate(labels):
+        v = []
+        for c in cases:
+            m = next((m for m in c["models1d"] if m["label"] == lab), None)
+            v.append(m[key] * scale if m and key in m else float("nan"))
+        if all(not math.isfinite(a) or abs(a) > 50 * max(abs(b) for b in y if math.isfinite(b)) for a in v):
+            continue
+        ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
+    ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def multicycle_figure(report, path):
+    cases = [c for c in report["cases"] if c.get("group") == "optimal"]
+    if not cases:
+        return False
+    fig, ax = plt.subplots(figsize=(7, 4.6))
+    for c in cases:
+        r = c["runs3d"][-1]
+        ax.plot(r["series"]["t_s"], [v * 1e9 for v in r["series"]["x_m"]], "k-", label=f"{c['name']}, 3D finest")
+        for k, m in enumerate(c["models1d"]):
+            if "series" in m:
+                ax.plot(m["series"]["t_s"], [v * 1e9 for v in m["series"]["x_m"]], MODEL_STYLES[k % 6],
+                        label=f"1D: {m['label']}")
+    ax.set(xlabel="time [s]", ylabel="centre displacement [nm]", title="Multi-cycle centre histories")
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def markdown(report, figs):
+    th = report["thresholds"]
+    out = [f"# Validation report: {report['suite']} suite", "", report.get("description", ""), "",
+           f"Wall time of the suite: {si(report['wall_time_s'], 's')}. Thresholds: displacement per cycle "
+           f"±{100 * th['displacement_per_cycle_relative']:.0f} %, cycle time ±{100 * th['cycle_time_relative']:.0f} %, "
+           f"mean velocity per cycle ±{100 * th['mean_velocity_per_cycle_relative']:.0f} % (1D against the "
+           f"extrapolated 3D reference); U(t) phase correlation ≥ {th['velocity_phase_correlation']} "
+           "(against the finest 3D run).", "", "## The paper's conclusions", "",
+           "| claim | status | evidence |", "|---|---|---|"]
+    for f in report["findings"]:
+        ev = "; ".join(", ".join(f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in e.items())
+                       for e in f["evidence"]) or "the suite has no cases for it"
+        out.append(f"| {f['claim']} | **{f['status']}** | {ev} |")
+    for c in report["cases"]:
+        out += ["", f"## {c['name']}", "", c.get("description", ""), "", "### 3D runs", "",
+                "| grid | h | status | displacement / cycle | cycle time | mean velocity / cycle | steps | wall time |",
+                "|---|---|---|---|---|---|---|---|"]
+        for r in c["runs3d"]:
+            out.append(f"| {json.dumps(r['grid_value'])} | {si(r['cell_size_m'], 'm')} | {r['status'][:60]} | "
+                       f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
+                       f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {r['steps']} | "
+                       f"{si(r['wall_time_s'], 's')}{' (cached)' if r['cached'] else ''} |")
+        ref = c["reference3d"]
+        out += ["", "Extrapolated 3D reference (h → 0):", ""]
+        for key, unit in (("displacement_per_cycle_m", "m"), ("cycle_time_s", "s"),
+                          ("mean_velocity_per_cycle_m_per_s", "m/s")):
+            if key in ref:
+                e = ref[key]
+                out.append(f"- {key.rsplit('_', 1)[0] if unit != 'm/s' else 'mean velocity per cycle'}: "
+                           f"{si(e['value'], unit)} ± {si(e['error'], unit)}; {e['note']}"
+                           + (f", order {e['order']:.2f}" if e["asymptotic"] and e["order"] else ""))
+        if "note" in ref:
+            out.append(f"- {ref['note']}")
+        if c.get("paper"):
+            p = c["paper"]
+            out += ["", f"Paper: maximum displacement {si(p.get('max_displacement_m'), 'm')} ({p.get('source', '')}); "
+                    f"here, finest 3D run's displacement per cycle "
+                    f"{si(c['runs3d'][-1].get('displacement_per_cycle_m'), 'm')}."]
+        cal = c["calibration"]
+        out += ["", "### Calibration (at grid " + json.dumps(cal["grid_value"]) + ")", ""]
+        if "C1_Pa_per_m" in cal:
+            out.append(f"C1 = {si(cal['C1_Pa_per_m'], 'Pa/m', 5)} ± {si(cal['C1_stderr_Pa_per_m'], 'Pa/m')} "
+                       f"(spring-network value {si(cal['C1_spring_network_Pa_per_m'], 'Pa/m', 5)}); hydraulic offsets "
+                       f"a_in = {si(cal.get('hydraulic_offset_inner_m'), 'm')} ± "
+                       f"{si(cal.get('hydraulic_offset_inner_uncertainty_m'), 'm')}, a_out = "
+                       f"{si(cal.get('hydraulic_offset_outer_m'), 'm')} ± "
+                       f"{si(cal.get('hydraulic_offset_outer_uncertainty_m'), 'm')}.")
+        else:
+            out.append(f"Not available: {cal.get('status', 'unknown')}")
+        out += ["", "### 1D models", "",
+                "| model | displacement / cycle | vs ref | cycle time | vs ref | mean velocity / cycle | vs ref | "
+                "U(t) phase corr. | verdicts | wall time |", "|---|---|---|---|---|---|---|---|---|---|"]
+        for m in c["models1d"]:
+            if not m.get("has_cycle"):
+                out.append(f"| {m['label']} | {m.get('status', '')[:80]} {m.get('no_cycle_reason', '')} "
+                           "| | | | | | | | |")
+                continue
+            e = m.get("relative_error_vs_reference", {})
+            v = m.get("velocity_vs_finest3d", {})
+            verd = ", ".join(f"{k}: {w}" for k, w in m.get("verdicts", {}).items())
+            corr = v.get("phase_correlation")
+            out.append(f"| {m['label']} | {si(m['displacement_per_cycle_m'], 'm')} | {pct(e.get('displacement_per_cycle'))} | "
+                       f"{si(m['cycle_time_s'], 's')} | {pct(e.get('cycle_time'))} | "
+                       f"{si(m['mean_velocity_per_cycle_m_per_s'], 'm/s')} | {pct(e.get('mean_velocity_per_cycle'))} | "
+                       f"{'—' if corr is None else f'{corr:.2f}'} | {verd} | {si(m['wall_time_s'], 's')} |")
+        if "wall_time_ratio_3d_over_1d" in c:
+            out += ["", f"Wall time, 3D run at the calibration grid against the first 1D model: "
+                        f"{c['wall_time_ratio_3d_over_1d']:.3g} ×."]
+        for f in figs.get(c["name"], []):
+            out += ["", f"![{f}]({f})"]
+    for f in figs.get("", []):
+        out += ["", f"![{f}]({f})"]
+    return "\n".join(out) + "\n"
+
+
+def to_html(md, d):
+    """A small Markdown subset (headings, tables, lists, images, bold) to one self-contained page."""
+    body, table = [], False
+    for line in md.splitlines():
+        if line.startswith("|"):
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            if all(set(c) <= set("-") for c in cells):
+                continue
+            if not table:
+                body.append("<table>")
+                table = True
+                body.append("<tr>" + "".join(f"<th>{html.escape(c)}</th>" for c in cells) + "</tr>")
+                continue
+            body.append("<tr>" + "".join(f"<td>{html.escape(c).replace('**', '')}</td>" for c in cells) + "</tr>")
+            continue
+        if table:
+            body.append("</table>")
+            table = False
+        if line.startswith("!["):
+            f = line[line.index("(") + 1:-1]
+            with open(os.path.join(d, f), "rb") as fh:
+                b = base64.b64encode(fh.read()).decode()
+            body.append(f'<p><img alt="{html.escape(f)}" src="data:image/png;base64,{b}" style="max-width:100%"></p>')
+        elif line.startswith("### "):
+            body.append(f"<h3>{html.escape(line[4:])}</h3>")
+        elif line.startswith("## "):
+            body.append(f"<h2>{html.escape(line[3:])}</h2>")
+        elif line.startswith("# "):
+            body.append(f"<h1>{html.escape(line[2:])}</h1>")
+        elif line.startswith("- "):
+            body.append(f"<li>{html.escape(line[2:])}</li>")
+        elif line.strip():
+            body.append(f"<p>{html.escape(line)}</p>")
+    if table:
+        body.append("</table>")
+    style = ("body{font-family:sans-serif;max-width:1200px;margin:auto}table{border-collapse:collapse}"
+             "td,th{border:1px solid #bbb;padding:3px 6px;font-size:90%}")
+    return f"<!DOCTYPE html><html><head><meta charset='utf-8'><title>Validation report</title><style>{style}</style>" \
+           f"</head><body>{''.join(body)}</body></html>\n"
+
+
+def main(d):
+    with open(f"{d}/report.json") as f:
+        report = json.load(f)
+    figs = {}
+    for c in report["cases"]:
+        name = c["name"]
+        lst = figs.setdefault(name, [])
+        if any(r.get("has_cycle") for r in c["runs3d"]):
+            velocity_figure(c, f"{d}/fig_velocity_{name}.png")
+            lst.append(f"fig_velocity_{name}.png")
+        if convergence_figure(c, f"{d}/fig_convergence_{name}.png"):
+            lst.append(f"fig_convergence_{name}.png")
+        cal = c["calibration"].get("file")
+        if cal and os.path.exists(cal):
+            cd = os.path.dirname(cal)
+            plot_calibration.main(cd)
+            dst = f"fig_calibration_{name}.png"
+            os.replace(f"{cd}/calibration.png", f"{d}/{dst}")
+            lst.append(dst)
+    glob = figs.setdefault("", [])
+    if sweep_figure(report, "aspect", "swimmer length L [µm]", "displacement_per_cycle_m", "displacement per cycle [nm]",
+                    1e9, f"{d}/fig_distance_vs_length.png", "Distance per cycle against swimmer length (Figure 12)"):
+        glob.append("fig_distance_vs_length.png")
+    if sweep_figure(report, "amplitude", "contracted radius R_f / R₀", "displacement_per_cycle_m",
+                    "displacement per cycle [nm]", 1e9, f"{d}/fig_distance_vs_amplitude.png",
+                    "Distance per cycle against contraction (Figure 12)"):
+        glob.append("fig_distance_vs_amplitude.png")
+    if sweep_figure(report, "aspect", "swimmer length L [µm]", "mean_velocity_per_cycle_m_per_s",
+                    "mean velocity per cycle [nm/s]", 1e9, f"{d}/fig_velocity_vs_length.png",
+                    "Mean velocity per cycle against swimmer length (Figure 13)"):
+        glob.append("fig_velocity_vs_length.png")
+    if multicycle_figure(report, f"{d}/fig_multicycle.png"):
+        glob.append("fig_multicycle.png")
+    if pareto_figure(report, f"{d}/fig_pareto.png"):
+        glob.append("fig_pareto.png")
+    md = markdown(report, figs)
+    with open(f"{d}/report.md", "w") as f:
+        f.write(md)
+    with open(f"{d}/report.html", "w") as f:
+        f.write(to_html(md, d))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1])

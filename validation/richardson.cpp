@@ -1,0 +1,72 @@
+#include "validation/richardson.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numeric>
+
+#include "common/errors.hpp"
+
+namespace swim::validation {
+
+Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order) {
+  if (h.size() != f.size() || h.size() < 2)
+    throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
+  std::vector<std::size_t> idx(h.size());
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return h[a] > h[b]; });
+  std::vector<double> hs, fs;
+  for (std::size_t i : idx) {
+    hs.push_back(h[i]);
+    fs.push_back(f[i]);
+  }
+  for (std::size_t i = 1; i < hs.size(); ++i)
+    if (!(hs[i] < hs[i - 1])) throw InputError("validation grids", std::to_string(hs[i]), "distinct grid spacings");
+  const std::size_t n = hs.size();
+  const double f3 = fs[n - 1], f2 = fs[n - 2], h3 = hs[n - 1], h2 = hs[n - 2];
+  Extrapolation e;
+  auto extrapolate = [&](double p) { return f3 + (f3 - f2) / (std::pow(h2 / h3, p) - 1.0); };
+  if (n == 2) {
+    e.order = assumed_order;
+    e.value = extrapolate(assumed_order);
+    e.error = std::abs(e.value - f3);
+    e.asymptotic = true;
+    e.note = "two grids, assumed order " + std::to_string(assumed_order);
+    return e;
+  }
+  const double f1 = fs[n - 3], h1 = hs[n - 3];
+  const double d12 = f1 - f2, d23 = f2 - f3;
+  const double spread = *std::max_element(fs.end() - 3, fs.end()) - *std::min_element(fs.end() - 3, fs.end());
+  auto not_asymptotic = [&](const std::string& why) {
+    e.value = f3;
+    e.error = spread;
+    e.order = 0;
+    e.asymptotic = false;
+    e.note = "not in the asymptotic range (" + why + "): finest grid, error = spread of the three";
+    return e;
+  };
+  if (d23 == 0.0 && d12 == 0.0) {
+    e.value = f3;
+    e.asymptotic = true;
+    e.note = "identical on the three grids";
+    return e;
+  }
+  if (!(d12 * d23 > 0)) return not_asymptotic("the differences change sign");
+  const double ratio = d12 / d23;
+  auto g = [&](double p) {
+    return (std::pow(h1, p) - std::pow(h2, p)) / (std::pow(h2, p) - std::pow(h3, p)) - ratio;
+  };
+  double lo = 0.25, hi = 8.0;
+  if (g(lo) * g(hi) > 0) return not_asymptotic("observed order outside [0.25, 8]");
+  for (int it = 0; it < 200; ++it) {
+    const double m = 0.5 * (lo + hi);
+    (g(lo) * g(m) <= 0 ? hi : lo) = m;
+  }
+  e.order = 0.5 * (lo + hi);
+  e.value = extrapolate(e.order);
+  e.error = std::abs(e.value - f3);
+  e.asymptotic = true;
+  e.note = "Richardson with the observed order";
+  return e;
+}
+
+}  // namespace swim::validation

@@ -1,0 +1,648 @@
+#include "validation/suite.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/run_folder.hpp"
+#include "common/units.hpp"
+#include "full3d/run3d.hpp"
+#include "full3d/scene3d.hpp"
+#include "reduced1d/report.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "reduced1d/solver.hpp"
+#include "validation/calibration.hpp"
+#include "validation/compare.hpp"
+#include "validation/hydraulic.hpp"
+#include "validation/richardson.hpp"
+
+namespace fs = std::filesystem;
+
+namespace swim::validation {
+
+using scene::json;
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+// ---- suite file ----------------------------------------------------------------------
+
+const json& member(const json& j, const std::string& key, const std::string& path) {
+  if (!j.is_object() || !j.contains(key)) throw InputError(path + "." + key, "(missing)", "required by a suite file");
+  return j.at(key);
+}
+
+std::string find_scene(const std::string& name, const std::string& suite_dir, const std::string& data_dir) {
+  for (const fs::path& p : {fs::path(name), fs::path(suite_dir) / name, fs::path(data_dir) / "scenes" / name})
+    if (fs::is_regular_file(p)) return p.string();
+  throw InputError("cases[].scene", "\"" + name + "\"",
+                   "a scene file (tried as given, beside the suite file and in the shipped data/scenes/)");
+}
+
+/// Sets a dotted key of a scene to a JSON value, creating the objects on the way.
+void set_key(json& sc, const std::string& dotted, const json& value) {
+  json* node = &sc;
+  std::stringstream ss(dotted);
+  std::string part;
+  std::vector<std::string> parts;
+  while (std::getline(ss, part, '.')) parts.push_back(part);
+  for (std::size_t i = 0; i + 1 < parts.size(); ++i) {
+    if (!node->contains(parts[i]) || !(*node)[parts[i]].is_object()) (*node)[parts[i]] = json::object();
+    node = &(*node)[parts[i]];
+  }
+  (*node)[parts.back()] = value;
+}
+
+void apply_sets(json& sc, const json& sets) {
+  if (sets.is_null()) return;
+  for (const auto& [k, v] : sets.items()) set_key(sc, k, v);
+}
+
+// ---- series ----------------------------------------------------------------------------
+
+struct Series {
+  std::vector<double> t, x, u;
+};
+
+/// The 3D run's own series.csv in its cache folder (t_s, x_center_m, velocity_m_per_s).
+Series read_series_csv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw NumericalError("the cached 3D run has no series.csv (" + path + ")", "remove the run's cache folder");
+  std::string line;
+  std::getline(in, line);
+  std::vector<std::string> cols;
+  {
+    std::stringstream ss(line);
+    std::string c;
+    while (std::getline(ss, c, ',')) cols.push_back(c);
+  }
+  auto col = [&](const std::string& name) {
+    for (std::size_t i = 0; i < cols.size(); ++i)
+      if (cols[i] == name) return i;
+    throw NumericalError("series.csv has no column " + name, "remove the run's cache folder");
+  };
+  const std::size_t it = col("t_s"), ix = col("x_center_m"), iu = col("velocity_m_per_s");
+  Series s;
+  while (std::getline(in, line)) {
+    std::vector<double> v;
+    std::stringstream ss(line);
+    std::string c;
+    while (std::getline(ss, c, ',')) v.push_back(std::strtod(c.c_str(), nullptr));
+    if (v.size() < cols.size()) continue;
+    if (!s.t.empty() && !(v[it] > s.t.back())) continue;
+    s.t.push_back(v[it]);
+    s.x.push_back(v[ix]);
+    s.u.push_back(v[iu]);
+  }
+  return s;
+}
+
+json downsample(const Series& s, double t_end, int n = 400) {
+  json t = json::array(), u = json::array(), x = json::array();
+  if (s.t.size() < 2) return {{"t_s", t}, {"velocity_m_per_s", u}, {"x_m", x}};
+  for (int k = 0; k <= n; ++k) {
+    const double tk = t_end * k / n;
+    t.push_back(tk);
+    u.push_back(interpolate_linear(s.t, s.u, tk));
+    x.push_back(interpolate_linear(s.t, s.x, tk));
+  }
+  return {{"t_s", t}, {"velocity_m_per_s", u}, {"x_m", x}};
+}
+
+/// Per-cycle figures from the cycle start/end times and the centre history.
+struct CycleFigures {
+  bool has_cycle = false;
+  double displacement_per_cycle_m = 0, cycle_time_s = 0, mean_velocity_per_cycle_m_per_s = 0;
+};
+
+CycleFigures cycle_figures(const Series& s, const std::vector<double>& starts, const std::vector<double>& ends) {
+  CycleFigures c;
+  const std::size_t n = std::min(starts.size(), ends.size());
+  if (n == 0 || s.t.size() < 2) return c;
+  double d = 0, T = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    d += interpolate_linear(s.t, s.x, ends[k]) - interpolate_linear(s.t, s.x, starts[k]);
+    T += ends[k] - starts[k];
+  }
+  c.has_cycle = true;
+  c.displacement_per_cycle_m = d / double(n);
+  c.cycle_time_s = T / double(n);
+  c.mean_velocity_per_cycle_m_per_s = d / T;
+  return c;
+}
+
+std::vector<double> doubles(const json& j, const std::string& key) {
+  std::vector<double> v;
+  if (j.contains(key) && j[key].is_array())
+    for (const auto& x : j[key]) v.push_back(x.get<double>());
+  return v;
+}
+
+// ---- one 3D run (cached) --------------------------------------------------------------
+
+struct Run3d {
+  json record;  ///< report entry
+  Series series;
+  CycleFigures cyc;
+  double h = 0, wall = 0, length = 0;
+  bool ok = false;
+};
+
+Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached) {
+  json s = sc;
+  set_key(s, "full3d.threads", threads);
+  set_key(s, "full3d.output.vtk", false);
+  json resolved;
+  const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+  const std::string dir = runs_dir + "/" + p.name + "-3d-" + output::json_hash(resolved);
+  Run3d r;
+  r.h = p.h;
+  r.length = p.L;
+  json summary;
+  *cached = false;
+  if (fs::exists(dir + "/summary.json")) {
+    std::ifstream in(dir + "/summary.json");
+    summary = json::parse(in, nullptr, false);
+    if (summary.is_discarded() || !summary.contains("status") || summary["status"] == "running") summary = json();
+    else *cached = true;
+  }
+  if (!*cached) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    full3d::RunControl ctl;
+    ctl.progress = 0;
+    ctl.quiet_vtk = true;
+    const full3d::RunOutcome out = full3d::run3d(p, resolved, dir, ctl);
+    summary = out.summary;
+  }
+  const std::string status = summary.value("status", std::string("unknown"));
+  r.ok = status == "ok";
+  r.wall = summary.value("wall_time_s", 0.0);
+  r.series = read_series_csv(dir + "/series.csv");
+  r.cyc = cycle_figures(r.series, doubles(summary, "cycle_start_times_s"), doubles(summary, "cycle_end_times_s"));
+  r.record = {{"cell_size_m", p.h},
+              {"grid", {p.nx, p.ny, p.nz}},
+              {"status", status},
+              {"cached", *cached},
+              {"folder", dir},
+              {"wall_time_s", r.wall},
+              {"steps", summary.value("steps", 0L)},
+              {"cycles_completed", summary.value("cycles_completed", 0)},
+              {"pumped_volume_m3", summary.value("pumped_volume_m3", 0.0)},
+              {"has_cycle", r.cyc.has_cycle}};
+  if (r.cyc.has_cycle) {
+    r.record["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
+    r.record["cycle_time_s"] = r.cyc.cycle_time_s;
+    r.record["mean_velocity_per_cycle_m_per_s"] = r.cyc.mean_velocity_per_cycle_m_per_s;
+  }
+  const double t_end = r.series.t.empty() ? 0.0 : r.series.t.back();
+  r.record["series"] = downsample(r.series, r.cyc.has_cycle ? r.cyc.cycle_time_s : t_end);
+  return r;
+}
+
+// ---- one 1D run --------------------------------------------------------------------------
+
+struct Run1d {
+  json record;
+  Series series;
+  CycleFigures cyc;
+  double wall = 0;
+  bool ok = false;
+};
+
+Run1d run_1d(const json& sc, const std::string& label, const std::string& scene_dir) {
+  json resolved;
+  Run1d r;
+  r.record = {{"label", label}};
+  try {
+    const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir);
+    const auto t0 = std::chrono::steady_clock::now();
+    const reduced1d::Result res = reduced1d::solve(p);
+    r.wall = seconds_since(t0);
+    const reduced1d::Metrics m = reduced1d::metrics(p, res);
+    for (const auto& smp : res.series) {
+      if (!r.series.t.empty() && !(smp.t > r.series.t.back())) continue;
+      r.series.t.push_back(smp.t);
+      r.series.x.push_back(smp.X);
+      r.series.u.push_back(smp.W);
+    }
+    r.ok = !res.failure.has_value();
+    r.cyc.has_cycle = m.has_cycle;
+    if (m.has_cycle) {
+      r.cyc.displacement_per_cycle_m = m.displacement_per_cycle_m;
+      r.cyc.cycle_time_s = m.mean_cycle_time_s;
+      r.cyc.mean_velocity_per_cycle_m_per_s = m.mean_velocity_per_cycle_m_per_s;
+    }
+    r.record["status"] = r.ok ? "ok" : std::string("failed: ") + res.failure->what();
+    r.record["wall_time_s"] = r.wall;
+    r.record["cells"] = p.numerics.cells;
+    r.record["has_cycle"] = m.has_cycle;
+    r.record["pumped_volume_m3"] = m.pumped_volume_m3;
+    if (m.has_cycle) {
+      r.record["displacement_per_cycle_m"] = m.displacement_per_cycle_m;
+      r.record["cycle_time_s"] = m.mean_cycle_time_s;
+      r.record["mean_velocity_per_cycle_m_per_s"] = m.mean_velocity_per_cycle_m_per_s;
+    } else {
+      r.record["no_cycle_reason"] = m.no_cycle_reason;
+    }
+    r.record["plausible"] = m.implausible.empty();
+    r.record["series"] = downsample(r.series, m.has_cycle ? m.mean_cycle_time_s : m.t_end_s);
+  } catch (const InputError& e) {
+    r.record["status"] = std::string("not run: ") + e.what();
+  } catch (const NumericalError& e) {
+    r.record["status"] = std::string("failed: ") + e.what();
+  }
+  return r;
+}
+
+json relative(double value, double ref) {
+  if (!(std::abs(ref) > 0)) return nullptr;
+  return (value - ref) / std::abs(ref);
+}
+
+json verdict(const json& rel, double threshold) {
+  if (rel.is_null()) return "not assessed";
+  return std::abs(rel.get<double>()) <= threshold ? "pass" : "fail";
+}
+
+// The paper's conclusions, judged on the 3D reference (extrapolated where available, else the
+// finest grid) of the cases of each sweep group.
+double reference_value(const json& c, const std::string& key) {
+  const json& ref = c["reference3d"];
+  if (ref.contains(key)) return ref[key]["value"].get<double>();
+  for (auto it = c["runs3d"].rbegin(); it != c["runs3d"].rend(); ++it)
+    if (it->contains(key)) return (*it)[key].get<double>();
+  return std::nan("");
+}
+
+json findings(const json& cases, double th_d) {
+  auto group = [&](const std::string& g) {
+    std::vector<const json*> v;
+    for (const auto& c : cases)
+      if (c["group"] == g && c["sweep_value"].is_number()) v.push_back(&c);
+    std::sort(v.begin(), v.end(), [](const json* a, const json* b) { return (*a)["sweep_value"] < (*b)["sweep_value"]; });
+    return v;
+  };
+  auto finding = [](const std::string& claim, const std::string& status, const json& evidence) {
+    return json{{"claim", claim}, {"status", status}, {"evidence", evidence}};
+  };
+  json out = json::array();
+  auto monotone = [&](const std::vector<const json*>& v, const std::string& key, bool increasing, json& ev) {
+    bool ok = true;
+    double prev = std::nan("");
+    for (const json* c : v) {
+      const double x = reference_value(*c, key);
+      ev.push_back({{"case", (*c)["name"]}, {"sweep_value", (*c)["sweep_value"]}, {key, x}});
+      if (!std::isfinite(x)) return std::string("not assessed");
+      if (std::isfinite(prev) && (increasing ? x <= prev : x >= prev)) ok = false;
+      prev = x;
+    }
+    return std::string(ok ? "reproduced" : "refuted");
+  };
+  {
+    const auto a = group("aspect"), m = group("amplitude");
+    json ev = json::array(), ev2 = json::array();
+    const std::string s1 = a.size() >= 2 ? monotone(a, "displacement_per_cycle_m", true, ev) : "not assessed";
+    // amplitude sweep_value is R_f / R0: deformation grows as it falls
+    const std::string s2 = m.size() >= 2 ? monotone(m, "displacement_per_cycle_m", false, ev2) : "not assessed";
+    out.push_back(finding("distance per cycle grows with the swimmer length L", s1, ev));
+    out.push_back(finding("distance per cycle grows with the deformation amplitude", s2, ev2));
+  }
+  {
+    const auto a = group("aspect");
+    json ev = json::array();
+    std::string st = "not assessed";
+    if (a.size() >= 2) {
+      std::size_t best = 0;
+      double bv = -1e300;
+      for (std::size_t i = 0; i < a.size(); ++i) {
+        const double v = reference_value(*a[i], "mean_velocity_per_cycle_m_per_s");
+        ev.push_back({{"case", (*a[i])["name"]}, {"mean_velocity_per_cycle_m_per_s", v}});
+        if (v > bv) bv = v, best = i;
+      }
+      st = best == 0 ? "reproduced" : "refuted";
+    }
+    out.push_back(finding("mean velocity per cycle is largest for the shortest swimmer", st, ev));
+  }
+  {
+    const auto m = group("amplitude");
+    json ev = json::array();
+    std::string st = "not assessed";
+    if (m.size() >= 2) {
+      std::size_t best = 0;
+      double bv = -1e300;
+      for (std::size_t i = 0; i < m.size(); ++i) {
+        const double v = reference_value(*m[i], "mean_velocity_per_cycle_m_per_s");
+        ev.push_back({{"case", (*m[i])["name"]}, {"R_f_over_R0", (*m[i])["sweep_value"]}, {"mean_velocity_per_cycle_m_per_s", v}});
+        if (v > bv) bv = v, best = i;
+      }
+      const double rf = (*m[best])["sweep_value"];
+      st = std::abs(rf - 0.5) <= 0.1 ? "reproduced" : "refuted";
+    }
+    out.push_back(finding("mean velocity per cycle is largest at about 50 % deformation", st, ev));
+  }
+  {
+    const auto m = group("amplitude");
+    json ev = json::array();
+    std::string st = "not assessed";
+    bool any = false, all = true;
+    for (const json* c : m) {
+      if ((*c)["sweep_value"].get<double>() < 0.5) continue;
+      for (const auto& md : (*c)["models1d"]) {
+        if (!md.contains("verdicts") || !md["verdicts"].contains("displacement_per_cycle")) continue;
+        any = true;
+        ev.push_back({{"case", (*c)["name"]}, {"model", md["label"]}, {"verdict", md["verdicts"]["displacement_per_cycle"]},
+                      {"relative_error", md["relative_error_vs_reference"]["displacement_per_cycle"]}});
+      }
+      const auto& md0 = (*c)["models1d"][0];
+      if (!(md0.contains("verdicts") && md0["verdicts"].value("displacement_per_cycle", "") == "pass")) all = false;
+    }
+    if (any) st = all ? "reproduced" : "refuted";
+    out.push_back(finding("1D agrees with 3D up to 50 % deformation (displacement per cycle within " +
+                              std::to_string(int(std::lround(100 * th_d))) + " %, the suite's default 1D model)",
+                          st, ev));
+  }
+  {
+    const auto o = group("optimal");
+    json ev = json::array();
+    std::string st = "not assessed";
+    for (const json* c : o) {
+      const double v = reference_value(*c, "mean_velocity_per_cycle_m_per_s"), L = (*c)["length_m"];
+      const double bl = v / L;
+      ev.push_back({{"case", (*c)["name"]}, {"body_lengths_per_s", bl}, {"paper_body_lengths_per_s", 1.5}});
+      st = std::isfinite(bl) && std::abs(bl / 1.5 - 1.0) <= 0.2 ? "reproduced" : "refuted";
+    }
+    out.push_back(finding("the optimal swimmer makes 1.5 body lengths/s (within 20 %)", st, ev));
+  }
+  return out;
+}
+
+}  // namespace
+
+json load_suite(const std::string& path) {
+  const json s = scene::load_file(path);
+  if (!s.is_object()) throw InputError("suite", path, "a JSON object with \"cases\" and \"models1d\"");
+  const json& cases = member(s, "cases", "suite");
+  if (!cases.is_array() || cases.empty()) throw InputError("suite.cases", scene::show(cases), "a non-empty array");
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string at = "suite.cases[" + std::to_string(i) + "]";
+    member(cases[i], "scene", at);
+    const json& g = member(cases[i], "grids", at);
+    if (!g.is_array() || g.size() < 2) throw InputError(at + ".grids", scene::show(g), "two or more grid values");
+    if (cases[i].contains("calibration_grid")) {
+      const json& c = cases[i]["calibration_grid"];
+      if (!c.is_number_integer() || c.get<long>() < 0 || c.get<long>() >= long(g.size()))
+        throw InputError(at + ".calibration_grid", scene::show(c),
+                         "an index into grids, 0 to " + std::to_string(g.size() - 1));
+    }
+  }
+  const json& models = member(s, "models1d", "suite");
+  if (!models.is_array() || models.empty()) throw InputError("suite.models1d", scene::show(models), "a non-empty array");
+  for (std::size_t i = 0; i < models.size(); ++i) member(models[i], "label", "suite.models1d[" + std::to_string(i) + "]");
+  const json& th = member(s, "thresholds", "suite");
+  for (const char* k : {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative",
+                        "velocity_phase_correlation"})
+    if (!member(th, k, "suite.thresholds").is_number()) throw InputError(std::string("suite.thresholds.") + k, scene::show(th[k]), "a number");
+  return s;
+}
+
+json run_suite(const SuiteOptions& o) {
+  const json suite = load_suite(o.suite);
+  const std::string suite_dir = fs::path(o.suite).parent_path().string();
+  const json& th = suite["thresholds"];
+  const double th_d = th["displacement_per_cycle_relative"], th_T = th["cycle_time_relative"],
+               th_v = th["mean_velocity_per_cycle_relative"], th_c = th["velocity_phase_correlation"];
+  const std::string runs_dir = o.out_dir + "/runs", cal_dir = o.out_dir + "/calibrations";
+  fs::create_directories(runs_dir);
+  fs::create_directories(cal_dir);
+  auto say = [&](const std::string& s) {
+    if (o.progress) o.progress(s);
+  };
+  const auto t_suite = std::chrono::steady_clock::now();
+
+  json report = {{"suite", suite.value("name", fs::path(o.suite).stem().string())},
+                 {"description", suite.value("description", std::string())},
+                 {"thresholds", th},
+                 {"cases", json::array()}};
+  const json& cases = suite["cases"];
+  for (std::size_t ci = 0; ci < cases.size(); ++ci) {
+    const json& cs = cases[ci];
+    const std::string scene_path = find_scene(cs["scene"], suite_dir, o.data_dir);
+    const std::string scene_dir = fs::path(scene_path).parent_path().string();
+    json base = scene::load_file(scene_path);
+    apply_sets(base, cs.value("set", json()));
+    const std::string name = base.value("name", fs::path(scene_path).stem().string());
+    const std::string grid_key = cs.value("grid_key", std::string("full3d.grid.cells_across"));
+    const std::string tag = "case " + std::to_string(ci + 1) + "/" + std::to_string(cases.size()) + " (" + name + ")";
+    json cr = {{"name", name}, {"scene", scene_path}, {"group", cs.value("group", json())},
+               {"grid_key", grid_key}, {"paper", cs.value("paper", json())}};
+    cr["description"] = base.value("description", std::string());
+    cr["sweep_value"] = cs.value("sweep_value", json());
+
+    // 1. the 3D resolution study
+    std::vector<Run3d> runs;
+    json runs_j = json::array();
+    const json& grids = cs["grids"];
+    for (std::size_t g = 0; g < grids.size(); ++g) {
+      json s = base;
+      set_key(s, grid_key, grids[g]);
+      say(tag + ": 3D grid " + std::to_string(g + 1) + "/" + std::to_string(grids.size()) + " (" + grid_key + " = " +
+          grids[g].dump() + ")");
+      bool cached = false;
+      Run3d r = run_3d(s, runs_dir, o.threads, &cached);
+      cr["length_m"] = r.length;
+      r.record["grid_value"] = grids[g];
+      runs_j.push_back(r.record);
+      runs.push_back(std::move(r));
+    }
+    cr["runs3d"] = runs_j;
+
+    // 2. the extrapolated reference over the grids that completed a cycle
+    std::vector<double> hs, fd, fT;
+    for (const auto& r : runs)
+      if (r.cyc.has_cycle) {
+        hs.push_back(r.h);
+        fd.push_back(r.cyc.displacement_per_cycle_m);
+        fT.push_back(r.cyc.cycle_time_s);
+      }
+    json ref = json::object();
+    Extrapolation ed, eT, ev;
+    const bool have_ref = hs.size() >= 2;
+    if (have_ref) {
+      ed = richardson(hs, fd);
+      eT = richardson(hs, fT);
+      // the mean velocity of the reference is its displacement over its cycle time
+      ev.value = ed.value / eT.value;
+      ev.error = std::abs(ev.value) * std::hypot(ed.error / ed.value, eT.error / eT.value);
+      ev.asymptotic = ed.asymptotic && eT.asymptotic;
+      ev.note = "extrapolated displacement per cycle / extrapolated cycle time";
+      auto ej = [](const Extrapolation& e) {
+        return json{{"value", e.value}, {"error", e.error}, {"order", e.order}, {"asymptotic", e.asymptotic},
+                    {"note", e.note}};
+      };
+      ref = {{"grids_used", hs.size()},
+             {"displacement_per_cycle_m", ej(ed)},
+             {"cycle_time_s", ej(eT)},
+             {"mean_velocity_per_cycle_m_per_s", ej(ev)}};
+    } else {
+      ref = {{"grids_used", hs.size()}, {"note", "fewer than two grids completed a cycle: no extrapolated reference"}};
+    }
+    cr["reference3d"] = ref;
+
+    // 3. calibration at the chosen grid
+    const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
+    json cal_j;
+    std::string cal_file;
+    {
+      json s = base;
+      set_key(s, grid_key, grids[cg]);
+      json resolved;
+      const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash(resolved);
+      cal_file = dir + "/calibration.json";
+      if (fs::exists(cal_file)) {
+        std::ifstream in(cal_file);
+        cal_j = json::parse(in);
+      } else {
+        say(tag + ": calibration at grid " + std::to_string(cg + 1));
+        try {
+          const auto t0 = std::chrono::steady_clock::now();
+          const StaticCalibration c = calibrate_static(p, default_loads(p));
+          const HydraulicRadii hr = measure_hydraulic_radii(p);
+          cal_j = to_json(c, p, resolved);
+          json hj = to_json(hr);
+          hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
+          hj.erase("wall_time_s");
+          cal_j.update(hj);
+          cal_j["wall_time_s"] = seconds_since(t0);
+          fs::create_directories(dir);
+          output::write_json(cal_file, cal_j);
+        } catch (const NumericalError& e) {
+          cal_j = {{"status", std::string("failed: ") + e.what()}};
+          cal_file.clear();
+        }
+      }
+    }
+    cr["calibration"] = {{"grid_index", cg}, {"grid_value", grids[cg]}, {"file", cal_file}};
+    for (const char* k : {"C1_Pa_per_m", "C1_stderr_Pa_per_m", "C1_spring_network_Pa_per_m", "hydraulic_offset_inner_m",
+                          "hydraulic_offset_inner_uncertainty_m", "hydraulic_offset_outer_m",
+                          "hydraulic_offset_outer_uncertainty_m", "status", "wall_time_s"})
+      if (cal_j.contains(k)) cr["calibration"][k] = cal_j[k];
+
+    // 4. every 1D model
+    const Run3d& finest = runs.back();
+    const Run3d& at_cal = runs[cg];
+    json models_j = json::array();
+    for (const json& m : suite["models1d"]) {
+      const std::string label = m["label"];
+      json s = base;
+      apply_sets(s, m.value("set", json()));
+      const bool calibrated = m.value("calibrated", false);
+      json entry;
+      Run1d r;
+      if (calibrated && cal_file.empty()) {
+        r.record = {{"label", label}, {"status", "not run: the calibration failed"}};
+      } else {
+        if (calibrated) {
+          if (s.contains("wall")) {
+            s["wall"].erase("spring_constant");
+            s["wall"].erase("C1");
+          }
+          set_key(s, "wall.calibration", fs::absolute(cal_file).string());
+        }
+        say(tag + ": 1D " + label);
+        r = run_1d(s, label, scene_dir);
+      }
+      entry = r.record;
+      entry["calibrated"] = calibrated;
+      if (r.cyc.has_cycle) {
+        json vs_ref = json::object(), vs_cal = json::object();
+        if (have_ref) {
+          vs_ref["displacement_per_cycle"] = relative(r.cyc.displacement_per_cycle_m, ed.value);
+          vs_ref["cycle_time"] = relative(r.cyc.cycle_time_s, eT.value);
+          vs_ref["mean_velocity_per_cycle"] = relative(r.cyc.mean_velocity_per_cycle_m_per_s, ev.value);
+        }
+        if (at_cal.cyc.has_cycle) {
+          vs_cal["displacement_per_cycle"] = relative(r.cyc.displacement_per_cycle_m, at_cal.cyc.displacement_per_cycle_m);
+          vs_cal["cycle_time"] = relative(r.cyc.cycle_time_s, at_cal.cyc.cycle_time_s);
+          vs_cal["mean_velocity_per_cycle"] =
+              relative(r.cyc.mean_velocity_per_cycle_m_per_s, at_cal.cyc.mean_velocity_per_cycle_m_per_s);
+        }
+        entry["relative_error_vs_reference"] = vs_ref;
+        entry["relative_error_vs_calibration_grid"] = vs_cal;
+        if (finest.cyc.has_cycle && r.series.t.size() > 1 && finest.series.t.size() > 1) {
+          const SeriesComparison ph = compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, finest.series.t,
+                                                     finest.series.u, finest.cyc.cycle_time_s, true);
+          const SeriesComparison ab = compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, finest.series.t,
+                                                     finest.series.u, finest.cyc.cycle_time_s, false);
+          entry["velocity_vs_finest3d"] = {{"phase_l2_relative", ph.l2_relative},
+                                          {"phase_correlation", ph.correlation},
+                                          {"time_l2_relative", ab.l2_relative},
+                                          {"time_correlation", ab.correlation}};
+          entry["verdicts"]["velocity_phase_correlation"] = ph.correlation >= th_c ? "pass" : "fail";
+        }
+        if (have_ref) {
+          entry["verdicts"]["displacement_per_cycle"] = verdict(vs_ref["displacement_per_cycle"], th_d);
+          entry["verdicts"]["cycle_time"] = verdict(vs_ref["cycle_time"], th_T);
+          entry["verdicts"]["mean_velocity_per_cycle"] = verdict(vs_ref["mean_velocity_per_cycle"], th_v);
+        }
+        if (at_cal.record.value("pumped_volume_m3", 0.0) != 0.0)
+          entry["pumped_volume_relative_vs_calibration_grid"] =
+              relative(r.record.value("pumped_volume_m3", 0.0), at_cal.record["pumped_volume_m3"].get<double>());
+      }
+      models_j.push_back(entry);
+    }
+    cr["models1d"] = models_j;
+
+    // 5. speed/accuracy of the first 1D model: cell counts
+    json trade = json::array();
+    if (have_ref) {
+      const json& m0 = suite["models1d"][0];
+      for (long cells : suite.value("cells1d", std::vector<long>{50, 100, 200, 400})) {
+        json s = base;
+        apply_sets(s, m0.value("set", json()));
+        if (m0.value("calibrated", false)) {
+          if (cal_file.empty()) break;
+          if (s.contains("wall")) s["wall"].erase("spring_constant");
+          set_key(s, "wall.calibration", fs::absolute(cal_file).string());
+        }
+        set_key(s, "numerics1d.cells", cells);
+        const Run1d r = run_1d(s, m0["label"], scene_dir);
+        if (!r.cyc.has_cycle) continue;
+        trade.push_back({{"tier", "1d"},
+                         {"resolution", "N = " + std::to_string(cells)},
+                         {"wall_time_s", r.wall},
+                         {"displacement_per_cycle_error", std::abs(r.cyc.displacement_per_cycle_m - ed.value) / std::abs(ed.value)}});
+      }
+      for (const auto& r : runs)
+        if (r.cyc.has_cycle)
+          trade.push_back({{"tier", "3d"},
+                           {"resolution", "h = " + std::to_string(r.h * 1e9).substr(0, 5) + " nm"},
+                           {"wall_time_s", r.wall},
+                           {"displacement_per_cycle_error",
+                            std::abs(r.cyc.displacement_per_cycle_m - ed.value) / std::abs(ed.value)}});
+    }
+    cr["speed_accuracy"] = trade;
+    double w3 = 0, w1 = 0;
+    for (const auto& r : runs) w3 += r.wall;
+    for (const auto& m : models_j) w1 += m.value("wall_time_s", 0.0);
+    cr["wall_time_3d_s"] = w3;
+    cr["wall_time_1d_s"] = w1;
+    if (at_cal.wall > 0 && !models_j.empty() && models_j[0].value("wall_time_s", 0.0) > 0)
+      cr["wall_time_ratio_3d_over_1d"] = at_cal.wall / models_j[0]["wall_time_s"].get<double>();
+    report["cases"].push_back(cr);
+  }
+  report["findings"] = findings(report["cases"], th_d);
+  report["wall_time_s"] = seconds_since(t_suite);
+  return report;
+}
+
+}  // namespace swim::validation
