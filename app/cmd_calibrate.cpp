@@ -33,11 +33,22 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   j.update(hj);
   output::write_json(out + "/calibration.json", j);
   plot("plot_calibration.py", {out});
-  std::printf("%s: C1 = %.5g Pa/m +- %.2g (through the origin, %d loads, R^2 = %.6f; linear within 1 %% up to %s); "
-              "spring-network value %.5g Pa/m (%+.2f %%); %d membrane nodes; wall time %s\n  -> %s/calibration.json\n",
-              p.name.c_str(), c.fit.c1, c.fit.c1_stderr, c.fit.points, c.fit.r2, si(c.fit.linear_up_to_Pa, "Pa").c_str(),
-              c.spring_network_c1, 100.0 * (c.fit.c1 / c.spring_network_c1 - 1.0), c.nodes, si(wall, "s").c_str(),
-              out.c_str());
+  int stable = 0;
+  double stable_up_to = 0;
+  for (const auto& lp : c.loads)
+    if (lp.stable()) {
+      ++stable;
+      stable_up_to = lp.pressure_Pa;
+    }
+  std::printf("%s: C1 = %s +- %s (through the origin, %d of %zu loads, R^2 = %.6f); spring-network value %s "
+              "(%+.2f %%)\n  response linear within 1 %% %s %s; stable to ring buckling up to %s (%d loads)\n"
+              "  %d membrane nodes; wall time %s -> %s/calibration.json\n",
+              p.name.c_str(), si(c.fit.c1, "Pa/m", 5).c_str(), si(c.fit.c1_stderr, "Pa/m").c_str(), c.fit.points,
+              c.loads.size(), c.fit.r2, si(c.spring_network_c1, "Pa/m", 5).c_str(),
+              100.0 * (c.fit.c1 / c.spring_network_c1 - 1.0),
+              c.fit.linear_over_all_loads ? "over every load, up to" : "up to",
+              si(c.fit.linear_over_all_loads ? c.loads.back().pressure_Pa : c.fit.linear_up_to_Pa, "Pa").c_str(),
+              si(stable_up_to, "Pa").c_str(), stable, c.nodes, si(wall, "s").c_str(), out.c_str());
   std::printf("  hydraulic offsets: a_in = %s +- %s, a_out = %s +- %s (h = %s; held-tube solve %d CG iterations, %s)\n",
               si(hr.a_in_m, "m").c_str(), si(hr.a_in_uncertainty_m, "m").c_str(), si(hr.a_out_m, "m").c_str(),
               si(hr.a_out_uncertainty_m, "m").c_str(), si(p.h, "m").c_str(), hr.cg_iterations,
