@@ -109,11 +109,21 @@ int run3d(const RunOptions& o, const scene::json& sc) {
     fail_run(folder, e);
   }
   const auto& s = r.summary;
-  std::printf("%s (3d): displacement %.6g m, mean velocity %.6g m/s (%.4g body lengths/s), %d cycle(s), "
-              "pumped volume %.6g m^3, %ld steps, wall time %.3g s\n  -> %s/summary.json\n",
-              p.name.c_str(), s["displacement_m"].get<double>(), s["mean_velocity_m_per_s"].get<double>(),
-              s["body_lengths_per_s"].get<double>(), s["cycles_completed"].get<int>(),
-              s["pumped_volume_m3"].get<double>(), r.steps, s["wall_time_s"].get<double>(), out.c_str());
+  const int cycles = s["cycles_completed"].get<int>();
+  std::string per_cycle = "no cycle completed";
+  if (cycles > 0 && s.contains("cycle_times_s") && !s["cycle_times_s"].empty()) {
+    double T = 0;
+    for (const auto& v : s["cycle_times_s"]) T += v.get<double>();
+    T /= double(s["cycle_times_s"].size());
+    per_cycle = std::to_string(cycles) + " cycle(s) of " + si(T, "s");
+  }
+  std::printf("%s (3d): displacement %s, mean velocity %s (%.3g body lengths/s); %s; pumped %s; %ld steps; "
+              "wall time %s\n  -> %s/summary.json\n",
+              p.name.c_str(), si(s["displacement_m"].get<double>(), "m").c_str(),
+              si(s["mean_velocity_m_per_s"].get<double>(), "m/s").c_str(), s["body_lengths_per_s"].get<double>(),
+              per_cycle.c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps,
+              si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
+  if (o.plot) plot("plot_run.py", {out});
   if (r.failed) {
     std::fprintf(stderr, "swim: %s\n  partial results and the last checkpoint kept in %s\n", r.message.c_str(),
                  out.c_str());
