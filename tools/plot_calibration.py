@@ -1,6 +1,6 @@
 """Figure 10 done with pressures: uniform inward pressure against the radial displacement
 of the middle ring, with the C1 fit through the origin, the secant stiffness against the load,
-and the ring's stiffness against ovalisation (ring buckling where it turns negative).
+and the ring's stiffness against its modes cos(n phi) (ring buckling where it turns negative).
 
 usage: plot_calibration.py DIR   (reads DIR/calibration.json, writes DIR/calibration.png)
 """
@@ -51,10 +51,14 @@ def main(d):
     ax[1].set(xlabel="pressure [mPa] (log scale)", ylabel="secant C1 [MPa/m]", title="stiffness against load")
     ax[1].legend(loc="lower left", fontsize="small", frameon=False)
 
-    for n, key in ((2, "ovalisation_stiffness_n2_N_per_m"), (3, "ovalisation_stiffness_n3_N_per_m")):
-        ax[2].semilogx(P, [p[key] * 1e12 for p in pts], "o-", label=f"mode n = {n}")
+    for n in (2, 3):
+        ax[2].semilogx(P, [p["ring_mode_stiffness_N_per_m"][n - 2] * 1e12 for p in pts], "o-", label=f"mode n = {n}")
+    ax[2].semilogx(P, [p["softest_ring_mode_stiffness_N_per_m"] * 1e12 for p in pts], "ks--", label="softest mode")
+    for p in pts:
+        ax[2].annotate(f"n={p['softest_ring_mode']}", (p["pressure_Pa"] * 1e3, p["softest_ring_mode_stiffness_N_per_m"] * 1e12),
+                       fontsize=7, xytext=(-3, -11), textcoords="offset points", ha="right")
     ax[2].axhline(0, color="k", lw=1)
-    ax[2].set(xlabel="pressure [mPa] (log scale)", ylabel="ovalisation stiffness [pN/m]",
+    ax[2].set(xlabel="pressure [mPa] (log scale)", ylabel="ring-mode stiffness [pN/m]",
               title="ring buckling: unstable below zero")
     ax[2].legend(loc="lower left", fontsize="small", frameon=False)
     fig.tight_layout()

@@ -3,25 +3,24 @@
 #include <gsl/gsl_fit.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "common/errors.hpp"
+#include "full3d/grid.hpp"
+#include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
+#include "full3d/run3d.hpp"
 
 namespace swim::validation {
 
 namespace {
-// d^2/ds^2 of E(X + sV) + P sum A_i r_i(X + sV) for the unit mode V_i ~ cos(n phi_i) e_r,i,
-// by central differences of the exact gradient: V . (g(X + sV) - g(X - sV)) / (2 s).
-double ovalisation_stiffness(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p, double pressure,
-                             const Eigen::Matrix3Xd& X, int n) {
+// d^2/ds^2 of E(X + sV) + P sum A_i r_i(X + sV) for the unit ring modes V_i ~ cos(n phi_i) e_r,i,
+// n = 2 .. n_theta/2 (see the scan below), by central differences of the exact gradient: V . (g(X + sV) - g(X - sV)) / (2 s).
+// (Modes with an axial variation cos(k pi x / L) are stiffer than k = 0 on the paper's tube.)
+std::vector<double> ring_mode_stiffness(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p,
+                                        double pressure, const Eigen::Matrix3Xd& X) {
   const Eigen::Matrix3Xd er = full3d::radial_directions(mesh, X);
-  Eigen::Matrix3Xd V(3, X.cols());
-  for (Eigen::Index i = 0; i < X.cols(); ++i) {
-    const double phi = std::atan2(er(2, i), er(1, i));
-    V.col(i) = std::cos(n * phi) * er.col(i);
-  }
-  V /= V.norm();
   auto grad = [&](const Eigen::Matrix3Xd& Y) {
     Eigen::Matrix3Xd g = -full3d::elastic_forces(mesh, Y, p);
     const Eigen::Matrix3Xd e = full3d::radial_directions(mesh, Y);
@@ -29,14 +28,24 @@ double ovalisation_stiffness(const full3d::CylinderMesh& mesh, const full3d::Mem
     return g;
   };
   const double s = 1e-4 * mesh.rest_length.minCoeff();
-  return V.cwiseProduct(grad(X + s * V) - grad(X - s * V)).sum() / (2.0 * s);
+  // the stiffness grows as n^4 past its minimum: scan n = 2..32, and further only while the
+  // softest mode is the last one scanned
+  std::vector<double> k;
+  for (int n = 2; n <= mesh.n_theta / 2; ++n) {
+    if (n > 32 && std::min_element(k.begin(), k.end()) != k.end() - 1) break;
+    Eigen::Matrix3Xd V(3, X.cols());
+    for (Eigen::Index i = 0; i < X.cols(); ++i) V.col(i) = std::cos(n * std::atan2(er(2, i), er(1, i))) * er.col(i);
+    V /= V.norm();
+    k.push_back(V.cwiseProduct(grad(X + s * V) - grad(X - s * V)).sum() / (2.0 * s));
+  }
+  return k;
 }
 }  // namespace
 
 std::vector<double> default_loads(const full3d::Params3d& p) {
   const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
   std::vector<double> out;
-  for (double f : {0.02, 0.05, 0.1, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5}) out.push_back(f * q_static);
+  for (double f : {0.01, 0.02, 0.03, 0.05, 0.075, 0.1, 0.15, 0.2, 0.35, 0.5, 0.75, 1.0, 1.5}) out.push_back(f * q_static);
   return out;
 }
 
@@ -58,8 +67,11 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
     lp.displacement_m = p.R0 - r.mid_radius;
     lp.secant_C1_Pa_per_m = r.c1;
     lp.iterations = r.iterations;
-    lp.ovalisation_stiffness_n2_N_per_m = ovalisation_stiffness(mesh, p.membrane, pr, r.X, 2);
-    lp.ovalisation_stiffness_n3_N_per_m = ovalisation_stiffness(mesh, p.membrane, pr, r.X, 3);
+    lp.ring_mode_stiffness_N_per_m = ring_mode_stiffness(mesh, p.membrane, pr, r.X);
+    const auto& k = lp.ring_mode_stiffness_N_per_m;
+    const auto soft = std::min_element(k.begin(), k.end());
+    lp.softest_ring_mode = int(soft - k.begin()) + 2;
+    lp.softest_ring_mode_stiffness_N_per_m = *soft;
     c.loads.push_back(lp);
   }
   // linear range: secant within 1 % of the smallest load's
@@ -76,9 +88,9 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
   }
   const int n = int(x.size());
   c.fit.points = n;
-  if (n < 2)
-    throw NumericalError("only " + std::to_string(n) + " of " + std::to_string(c.loads.size()) +
-                             " calibration loads are linear and stable to ring buckling; no C1 fit",
+  if (n < 1)
+    throw NumericalError("none of " + std::to_string(c.loads.size()) +
+                             " calibration loads is linear and stable to ring buckling; no C1 fit",
                          "lower protocol.pressure or raise full3d.membrane.bending_constant");
   double ymean = 0;
   for (double v : y) ymean += v / n;
@@ -103,6 +115,59 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
   return c;
 }
 
+WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
+  const full3d::CylinderMesh mesh = full3d::make_mesh(p);
+  full3d::IbOptions opt = full3d::ib_options(p);
+  opt.dt_key = "full3d.dt";
+  full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), opt);
+  const Eigen::VectorXd area = mesh.node_area;
+  ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) {
+    Eigen::Matrix3Xd F = full3d::radial_directions(mesh, X);
+    for (Eigen::Index i = 0; i < X.cols(); ++i) F.col(i) *= -pressure * area[i];
+    return F;
+  });
+  full3d::IbState s = ib.initial_state();
+  // half the explicit stability limit dt lambda_max < 2, from the undeformed and from a
+  // contracted state (the rate grows as the tube contracts)
+  double dt = std::min(p.dt, 1.0 / ib.explicit_rate(s, p.dt));
+  const int r0 = (mesh.n_rings - 1) / 2, r1 = mesh.n_rings / 2;
+  auto delta = [&](const full3d::IbState& st) {
+    const Eigen::VectorXd rr = full3d::ring_radii(mesh, st.X);
+    return mesh.radius - 0.5 * (rr[r0] + rr[r1]);
+  };
+  WetConfirmation w;
+  w.pressure_Pa = pressure;
+  w.static_displacement_m = static_displacement_m;
+  std::vector<double> t_hist, d_hist;
+  int steps = 0;
+  for (; steps < 4000; ++steps) {
+    if (steps == 50) dt = std::min(dt, 1.0 / ib.explicit_rate(s, dt));
+    ib.step(s, dt);
+    t_hist.push_back(s.t);
+    d_hist.push_back(delta(s));
+    if (steps >= 100) {
+      // the displacement a tenth of the elapsed time ago
+      const double t_back = 0.9 * s.t;
+      std::size_t k = 0;
+      while (k + 1 < t_hist.size() && t_hist[k + 1] <= t_back) ++k;
+      if (std::abs(d_hist.back() - d_hist[k]) < 1e-3 * std::abs(d_hist.back())) {
+        w.steady = true;
+        ++steps;
+        break;
+      }
+    }
+  }
+  w.steps = steps;
+  w.dt_s = dt;
+  w.simulated_time_s = s.t;
+  w.displacement_m = d_hist.back();
+  w.relative_difference = w.displacement_m / static_displacement_m - 1.0;
+  w.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return w;
+}
+
 scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const scene::json& resolved) {
   scene::json pts = scene::json::array();
   for (const auto& lp : c.loads)
@@ -110,8 +175,9 @@ scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const
                    {"displacement_m", lp.displacement_m},
                    {"secant_C1_Pa_per_m", lp.secant_C1_Pa_per_m},
                    {"in_linear_range", lp.in_linear_range},
-                   {"ovalisation_stiffness_n2_N_per_m", lp.ovalisation_stiffness_n2_N_per_m},
-                   {"ovalisation_stiffness_n3_N_per_m", lp.ovalisation_stiffness_n3_N_per_m},
+                   {"ring_mode_stiffness_N_per_m", lp.ring_mode_stiffness_N_per_m},
+                   {"softest_ring_mode", lp.softest_ring_mode},
+                   {"softest_ring_mode_stiffness_N_per_m", lp.softest_ring_mode_stiffness_N_per_m},
                    {"stable_to_ring_buckling", lp.stable()},
                    {"iterations", lp.iterations}});
   scene::json j = scene::json::object();

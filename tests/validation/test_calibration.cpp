@@ -40,9 +40,10 @@ TEST(StaticCalibration, SmallLoadC1IsTheSpringNetworkValue) {
   }
 }
 
-// Ring buckling: the compressed ring's stiffness against ovalisation falls linearly with the
-// load (geometric stiffness) and changes sign inside the range the paper's protocol needs
-// (the static load that holds R_f); such points are reported unstable and left out of the fit.
+// Ring buckling: the compressed ring's stiffness against each ring mode cos(n phi) falls
+// linearly with the load (geometric stiffness) and changes sign inside the range the paper's
+// protocol needs (the static load that holds R_f); such points are reported unstable and left
+// out of the fit. On the paper's tube the first modes to go are n = 5..8, at about 15 % of it.
 TEST(StaticCalibration, DetectsRingBucklingAndLeavesItOutOfTheFit) {
   const full3d::Params3d p = paper_scene();
   const double q = p.c1_estimate() * (p.R0 - p.protocol.R_f);
@@ -52,10 +53,11 @@ TEST(StaticCalibration, DetectsRingBucklingAndLeavesItOutOfTheFit) {
   // the smallest load is stable, the static load that holds R_f is not
   EXPECT_TRUE(c.loads[0].stable());
   EXPECT_FALSE(c.loads[4].stable());
-  EXPECT_LT(c.loads[4].ovalisation_stiffness_n3_N_per_m, 0.0);
+  EXPECT_LT(c.loads[4].softest_ring_mode_stiffness_N_per_m, 0.0);
+  EXPECT_GE(c.loads[4].softest_ring_mode, 2);
   EXPECT_LT(c.fit.points, 5);
   // linear in the load: the slope from loads 1-2 predicts load 3 within 2 %
-  const auto k = [&](int i) { return c.loads[std::size_t(i)].ovalisation_stiffness_n2_N_per_m; };
+  const auto k = [&](int i) { return c.loads[std::size_t(i)].ring_mode_stiffness_N_per_m[0]; };  // n = 2
   const auto pr = [&](int i) { return c.loads[std::size_t(i)].pressure_Pa; };
   const double slope = (k(1) - k(0)) / (pr(1) - pr(0));
   EXPECT_LT(slope, 0.0);
