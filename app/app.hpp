@@ -24,10 +24,13 @@ int screen(const std::string& sweep, const std::string& out, int jobs, int progr
 int bench(const std::string& out, bool quick, bool paper_cycle);
 int scenes();
 /// swim calibrate: C1 of the 1D tier from 3D uniform loads (validation/calibration.hpp).
-int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out);
+/// wet: also confirm one load with a fluid-coupled 3D run (minutes at the default grid).
+int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out, bool wet);
 
 /// swim validate: the 1D-vs-3D validation suite and its report (validation/suite.hpp).
-int validate(const std::string& suite, bool quick, const std::string& out, int threads, int progress);
+/// only: case filter (scene file names); empty: every case.
+int validate(const std::string& suite, bool quick, const std::string& out, int threads, int progress,
+             const std::vector<std::string>& only);
 
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
 std::string data_dir();

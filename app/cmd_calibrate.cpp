@@ -13,7 +13,8 @@
 
 namespace swim::app {
 
-int calibrate(const std::string& scene_path, const std::vector<std::string>& sets, const std::string& out_opt) {
+int calibrate(const std::string& scene_path, const std::vector<std::string>& sets, const std::string& out_opt,
+              bool wet) {
   scene::json sc = scene::load_file(scene_path);
   for (const auto& s : sets) scene::apply_override(sc, s);
   scene::json resolved;
@@ -23,6 +24,12 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   const auto loads = validation::default_loads(p);
   const validation::StaticCalibration c = validation::calibrate_static(p, loads);
   const validation::HydraulicRadii hr = validation::measure_hydraulic_radii(p);
+  // wet confirmation at the largest load of the fit
+  validation::WetConfirmation w;
+  const validation::LoadPoint* confirm = nullptr;
+  for (const auto& lp : c.loads)
+    if (lp.in_linear_range && lp.stable()) confirm = &lp;
+  if (wet && confirm) w = validation::confirm_wet(p, confirm->pressure_Pa, confirm->displacement_m);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   output::make_dir(out);
   scene::json j = validation::to_json(c, p, resolved);
@@ -31,6 +38,18 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
   hj.erase("wall_time_s");
   j.update(hj);
+  if (wet && confirm)
+    j["wet_confirmation"] = {{"pressure_Pa", w.pressure_Pa},
+                             {"displacement_m", w.displacement_m},
+                             {"static_displacement_m", w.static_displacement_m},
+                             {"relative_difference", w.relative_difference},
+                             {"steady", w.steady},
+                             {"steps", w.steps},
+                             {"dt_s", w.dt_s},
+                             {"simulated_time_s", w.simulated_time_s},
+                             {"wall_time_s", w.wall_time_s},
+                             {"method", "fluid-coupled immersed-boundary run of the same uniform load, stepped until "
+                                        "the middle radius is steady"}};
   output::write_json(out + "/calibration.json", j);
   plot("plot_calibration.py", {out});
   int stable = 0;
@@ -53,6 +72,11 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
               si(hr.a_in_m, "m").c_str(), si(hr.a_in_uncertainty_m, "m").c_str(), si(hr.a_out_m, "m").c_str(),
               si(hr.a_out_uncertainty_m, "m").c_str(), si(p.h, "m").c_str(), hr.cg_iterations,
               si(hr.wall_time_s, "s").c_str());
+  if (wet && confirm)
+    std::printf("  wet confirmation at %s: displacement %s against %s static (%+.2f %%), %s after %d steps of %s\n",
+                si(w.pressure_Pa, "Pa").c_str(), si(w.displacement_m, "m").c_str(),
+                si(w.static_displacement_m, "m").c_str(), 100.0 * w.relative_difference,
+                w.steady ? "steady" : "NOT steady", w.steps, si(w.dt_s, "s").c_str());
   return 0;
 }
 

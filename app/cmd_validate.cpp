@@ -12,13 +12,22 @@ namespace fs = std::filesystem;
 
 namespace swim::app {
 
-int validate(const std::string& suite_opt, bool quick, const std::string& out_opt, int threads, int progress) {
+int validate(const std::string& suite_opt, bool quick, const std::string& out_opt, int threads, int progress,
+             const std::vector<std::string>& only) {
   const std::string suite =
       !suite_opt.empty() ? suite_opt : data_dir() + "/validation/" + (quick ? "quick.json" : "default.json");
   if (!fs::is_regular_file(suite))
     throw InputError("suite", "\"" + suite + "\"", "a suite file (shipped: data/validation/default.json, quick.json)");
   if (threads < 1 || threads > 64) throw InputError("--threads", std::to_string(threads), "an integer from 1 to 64");
   const scene::json s = validation::load_suite(suite);  // bad input stops here, before anything is written
+  for (const auto& n : only) {
+    bool found = false;
+    for (const auto& cs : s["cases"]) {
+      const std::string stem = fs::path(cs["scene"].get<std::string>()).stem().string();
+      found = found || n == stem || n == stem + ".json";
+    }
+    if (!found) throw InputError("--case", n, "the scene file name of a case of " + suite);
+  }
   const std::string name = s.value("name", fs::path(suite).stem().string());
   const std::string out = out_opt.empty() ? "out/validation-" + name : out_opt;
   fs::create_directories(out);
@@ -27,6 +36,7 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   o.out_dir = out;
   o.data_dir = data_dir();
   o.threads = threads;
+  o.only = only;
   if (progress != 0) o.progress = [](const std::string& line) { std::fprintf(stderr, "validate: %s\n", line.c_str()); };
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);

@@ -69,6 +69,8 @@ int main(int argc, char** argv) {
   cal->add_option("scene", cal_scene, "Scene file (JSON)")->required();
   cal->add_option("--out", cal_out, "Output directory (default out/<name>-calibration)");
   cal->add_option("--set", cal_sets, "Override a scene value: key.path=value");
+  bool cal_skip_wet = false;
+  cal->add_flag("--skip-wet", cal_skip_wet, "Skip the fluid-coupled confirmation of one load (the static fits only)");
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
   std::string val_suite, val_out;
   bool val_quick = false;
@@ -77,6 +79,8 @@ int main(int argc, char** argv) {
   val->add_flag("--quick", val_quick, "The reduced suite (small grids, minutes)");
   val->add_option("--out", val_out, "Output directory (default out/validation-<suite name>); completed runs in it are reused");
   val->add_option("--threads", val_threads, "Threads of the 3D runs (default 2)");
+  std::vector<std::string> val_cases;
+  val->add_option("--case", val_cases, "Run only this case (its scene file name); repeatable");
   add_progress(val);
 
   try {
@@ -99,8 +103,8 @@ int main(int argc, char** argv) {
     if (*scr) return app::screen(sweep, out, jobs, progress);
     if (*ben) return app::bench(out, quick, paper_cycle);
     if (*sc) return app::scenes();
-    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out);
-    if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress);
+    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, !cal_skip_wet);
+    if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);
   } catch (const InputError& e) {
     std::fprintf(stderr, "swim: %s\n", e.what());
     return 2;

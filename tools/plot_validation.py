@@ -188,7 +188,10 @@ def multicycle_figure(report, path):
 
 def markdown(report, figs):
     th = report["thresholds"]
+    sel = report.get("cases_selected") or []
     out = [f"# Validation report: {report['suite']} suite", "", report.get("description", ""), "",
+           *( [f"**Subset**: only the case(s) {', '.join(sel)} of the suite were run (`--case`); the paper's "
+               "conclusions that need the other cases are not assessed.", ""] if sel else []),
            f"Wall time of the suite: {si(report['wall_time_s'], 's')}. Thresholds: displacement per cycle "
            f"±{100 * th['displacement_per_cycle_relative']:.0f} %, cycle time ±{100 * th['cycle_time_relative']:.0f} %, "
            f"mean velocity per cycle ±{100 * th['mean_velocity_per_cycle_relative']:.0f} % (1D against the "

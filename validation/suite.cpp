@@ -29,6 +29,10 @@ using scene::json;
 
 namespace {
 
+/// Changes whenever calibration.json gains or renames keys: cached calibrations of an older
+/// format are then recomputed instead of read.
+constexpr int kCalibrationFormat = 2;
+
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
@@ -432,7 +436,16 @@ json run_suite(const SuiteOptions& o) {
                  {"description", suite.value("description", std::string())},
                  {"thresholds", th},
                  {"cases", json::array()}};
-  const json& cases = suite["cases"];
+  json cases = json::array();
+  for (const json& cs : suite["cases"]) {
+    const std::string stem = fs::path(cs["scene"].get<std::string>()).stem().string();
+    bool take = o.only.empty();
+    for (const auto& n : o.only) take = take || n == stem || n == stem + ".json";
+    if (take) cases.push_back(cs);
+  }
+  if (cases.empty())
+    throw InputError("--case", o.only.empty() ? "" : o.only.front(), "the scene file name of a case of the suite");
+  report["cases_selected"] = o.only;
   for (std::size_t ci = 0; ci < cases.size(); ++ci) {
     const json& cs = cases[ci];
     const std::string scene_path = find_scene(cs["scene"], suite_dir, o.data_dir);
@@ -506,7 +519,8 @@ json run_suite(const SuiteOptions& o) {
       set_key(s, grid_key, grids[cg]);
       json resolved;
       const full3d::Params3d p = full3d::read_scene3d(s, resolved);
-      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash(resolved);
+      // the calibration file's format version is part of its cache key
+      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({resolved, kCalibrationFormat});
       cal_file = dir + "/calibration.json";
       if (fs::exists(cal_file)) {
         std::ifstream in(cal_file);

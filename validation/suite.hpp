@@ -20,6 +20,7 @@
 
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "common/scene.hpp"
 
@@ -30,6 +31,8 @@ struct SuiteOptions {
   std::string out_dir;   ///< created by the caller
   std::string data_dir;  ///< shipped data (scenes are looked up relative to the suite, then data/scenes)
   int threads = 1;       ///< full3d.threads for the 3D runs
+  /// run only these cases (scene file names, with or without .json); empty: all
+  std::vector<std::string> only;
   /// progress lines ("case 2/7: 3D grid 3/3 ...") on stderr; empty: quiet
   std::function<void(const std::string&)> progress;
 };
