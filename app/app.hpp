@@ -21,7 +21,7 @@ struct RunOptions {
 int run(const RunOptions& o);
 int demo(const std::string& out, int progress);
 int screen(const std::string& sweep, const std::string& out, int jobs, int progress);
-int bench(const std::string& out, bool quick, bool paper_cycle);
+int bench(const std::string& out, bool quick, bool paper_cycle, const std::string& tier = "all");
 int scenes();
 
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
