@@ -260,7 +260,7 @@ struct ForceModel {
       for (int j = 0; j <= N; ++j) {
         Q[j] = sys->Q_in[j];
         r[j] = sys->k[j].rl;
-        cond[j] = 1.0 / (sys->k[j].rl + sys->k[j].ra);
+        cond[j] = sys->w[j];
       }
       U = sys->U;
       return;
@@ -400,7 +400,7 @@ struct ForceModel {
         double rla, rlb;
         dresistance(d, a - a_in, b - a_in, rla, rlb);
         // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
-        const double w = 1.0 / (k.rl + k.ra), Qj = sys->Q_in[j];
+        const double w = sys->w[j], Qj = sys->Q_in[j];
         auto partial = [&](const outer::AnnulusPoint<double>& dp, double drl, double& dQ, double& d1, double& d2) {
           const double dra = 0.5 * d * dp.rho, dc = 0.5 * d * dp.kappa, dS = 0.5 * dp.S, de = 0.5 * d * dp.e;
           dQ = (dra * Qt + dc * Uv - Qj * (drl + dra)) * w;
@@ -464,11 +464,12 @@ struct ForceModel {
       const double det = G[0][0] * G[1][1] - G[0][1] * G[1][0];
       Gi[0][0] = G[1][1] / det, Gi[0][1] = -G[0][1] / det, Gi[1][0] = -G[1][0] / det, Gi[1][1] = G[0][0] / det;
       fq_.assign(n, 0.0), fu_.assign(n, 0.0);
-      std::vector<double> al(N + 1), be(N + 1);
+      std::vector<double>&al = al_, &be = be_;
+      al.resize(N + 1), be.resize(N + 1);
       for (int j = 0; j <= N; ++j) {
         const auto& k = sys->k[j];
-        al[j] = k.ra / (k.rl + k.ra);
-        be[j] = (k.c - sys->A_c * k.ra) / (k.rl + k.ra);
+        al[j] = k.ra * sys->w[j];
+        be[j] = (k.c - sys->A_c * k.ra) * sys->w[j];
       }
       for (int i = 0; i < N; ++i) {
         fq_[1 + i] = c * (al[i] - al[i + 1]);
@@ -555,7 +556,7 @@ struct ForceModel {
     std::size_t off;
   };
   std::vector<SegChain> seg_x_;
-  std::vector<double> fq_, fu_, dg1pi_, dg2pi_;  // confined Jacobian workspace
+  std::vector<double> fq_, fu_, dg1pi_, dg2pi_, al_, be_;  // confined Jacobian workspace
 
   // Residual with inertia (IDA).
   int res(const double* y, const double* yp, double* F) {
