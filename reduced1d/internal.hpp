@@ -26,7 +26,10 @@ enum class PrescribedPath { Auto, Integrated };
 Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedPath path = PrescribedPath::Auto);
 
 /// Force-driven wave under the Section-3 protocol (CVODE or IDA, root-located switches).
-Result solve_force_driven(const Params& p, const ProgressFn& progress);
+/// Unbounded outer flow without wall inertia: U is evaluated once per accepted step and X
+/// integrated along the steps; `velocity_in_rhs` puts U back into every right-hand side
+/// with X as an ODE state (the reference the step quadrature is tested against).
+Result solve_force_driven(const Params& p, const ProgressFn& progress, bool velocity_in_rhs = false);
 
 /// Force-driven machinery with a FIXED actuation pressure q_cells[i] (inward positive, Pa)
 /// on every cell and no protocol: integrates from R = R0 at rest to t_end. Used for the
