@@ -1,5 +1,6 @@
 // swim bench: performance figures, measured in one run so that ratios are meaningful on a
-// shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 (best
+// shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 and,
+// at N = 200, with the unbounded outer flow and in the paper mode (best
 // of several repetitions) and screening throughput (designs per second) on all cores.
 #include <algorithm>
 #include <chrono>

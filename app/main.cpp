@@ -2,7 +2,7 @@
 //
 //   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
 //   swim screen SWEEP.json [--out DIR] [--jobs N]
-//   swim bench [--out DIR]
+//   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|all]
 //   swim scenes
 //   swim demo
 //

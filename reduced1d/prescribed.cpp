@@ -211,11 +211,17 @@ struct QuadratureContext {
   PrescribedModel& model;
   double rtol, atol;
   long evals = 0, pieces = 0;
-  bool ok = true;
+  long budget = 0;  // numerics.max_steps: evaluations allowed in the refinement
+  bool ok = true, exhausted = false;
   double t_fail = 0;
 
   bool eval(double t, QVec& f) {
-    ++evals;
+    if (++evals > budget) {
+      ok = false;
+      exhausted = true;
+      t_fail = t;
+      return false;
+    }
     const auto e = model.evaluate(t);
     if (!e.ok) {
       ok = false;
@@ -282,6 +288,7 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
   const double t_end = end_time(p);
   const double dt_out = p.numerics.output_interval;
   QuadratureContext qc{model, p.numerics.rtol, p.numerics.atol_scale};
+  qc.budget = p.numerics.max_steps;
 
   // 1. The samples at the output times (everything but the integrated states).
   std::vector<double> tk;
@@ -373,8 +380,13 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
     // the failing evaluation lies inside an interval: keep the samples before it
     kept = int(std::upper_bound(tk.begin(), tk.end(), qc.t_fail) - tk.begin()) - 1;
     kept = std::max(kept, 1);
-    res.failure = NumericalError("the prescribed wave left the model's range during the quadrature (the wall reached the container or the lumen closed)",
-                                 "check the wave parameters or raise container.radius", qc.t_fail);
+    if (qc.exhausted)
+      res.failure = NumericalError("integrator step budget numerics1d.max_steps exhausted (" +
+                                       std::to_string(p.numerics.max_steps) + " closure evaluations in the quadrature)",
+                                   "raise numerics1d.max_steps or loosen numerics1d.rtol or numerics1d.atol_scale", qc.t_fail);
+    else
+      res.failure = NumericalError("the prescribed wave left the model's range during the quadrature (the wall reached the container or the lumen closed)",
+                                   "check the wave parameters or raise container.radius", qc.t_fail);
   }
   for (int i = 0; i < kept; ++i) {
     res.series.push_back(samples[i]);

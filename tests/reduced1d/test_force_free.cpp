@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 #include <vector>
 
 #include "reduced1d/internal.hpp"
@@ -244,4 +245,20 @@ TEST(ForceFree, UnboundedVelocityQuadratureAgreesWithTheIntegratedVelocity) {
     EXPECT_NEAR(a.V_rear_lab, b.V_rear_lab, 50.0 * (rtol * std::abs(b.V_rear_lab) + atol * V0));
     EXPECT_NEAR(a.V_front_lab, b.V_front_lab, 50.0 * (rtol * std::abs(b.V_front_lab) + atol * V0));
   }
+}
+
+// The quadrature honours the step budget: with fewer closure evaluations allowed than the
+// output grid and its refinement need, the run stops with the budget named and keeps the
+// samples it completed.
+TEST(ForceFree, PrescribedQuadratureStopsAtTheStepBudget) {
+  Params p;
+  p.wave = WaveKind::Step;
+  p.numerics.cells = 60;
+  p.numerics.output_interval = end_time(p) / 4;  // five samples: adaptive Simpson everywhere
+  p.numerics.max_steps = 12;
+  const Result r = solve(p);
+  ASSERT_TRUE(r.failure);
+  EXPECT_NE(std::string(r.failure->what()).find("numerics1d.max_steps"), std::string::npos) << r.failure->what();
+  EXPECT_GE(r.series.size(), 1u);
+  for (const auto& s : r.series) EXPECT_TRUE(finite(s));
 }
