@@ -329,6 +329,34 @@ struct BandLU {
       for (long i = std::max(0L, j - kv); i < j; ++i) b[i] -= at(i, j) * bj;
     }
   }
+  /// Solve for r right-hand sides at once, stored row-major (row m: B[m * r .. m * r + r)):
+  /// the r substitution chains are independent, so they overlap instead of each waiting on
+  /// its own latency.
+  void solve_rows(double* B, int r) const {
+    for (long j = 0; j < n; ++j) {
+      const long km = std::min<long>(kl, n - 1 - j);
+      double* bj = B + std::size_t(j) * r;
+      if (piv[j] != j) {
+        double* bp = B + std::size_t(piv[j]) * r;
+        for (int k = 0; k < r; ++k) std::swap(bj[k], bp[k]);
+      }
+      for (long q = 1; q <= km; ++q) {
+        const double l = at(j + q, j);
+        double* bq = B + std::size_t(j + q) * r;
+        for (int k = 0; k < r; ++k) bq[k] -= l * bj[k];
+      }
+    }
+    for (long j = n - 1; j >= 0; --j) {
+      double* bj = B + std::size_t(j) * r;
+      const double d = dinv[j];
+      for (int k = 0; k < r; ++k) bj[k] *= d;
+      for (long i = std::max(0L, j - kv); i < j; ++i) {
+        const double u = at(i, j);
+        double* bi = B + std::size_t(i) * r;
+        for (int k = 0; k < r; ++k) bi[k] -= u * bj[k];
+      }
+    }
+  }
 };
 
 struct LowRankContent {
@@ -428,9 +456,8 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
       for (long i = 0; i < n; ++i) qk[i] *= inv;
     }
   }
-  // Z = M^{-1} Q (column-major while solving), then both Z and W = V R^T row-major
-  // (n x r, row m holds the r entries of cell m) for the fused loops of lr_solve.
-  for (int k = 0; k < r; ++k) c->lu.solve(Q.data() + n * k);
+  // Z = M^{-1} Q and W = V R^T, both row-major (n x r, row m holds the r entries of cell m)
+  // for the fused loops of lr_solve; the r solves run together.
   c->Z.assign(std::size_t(n) * r, 0.0);
   c->W.assign(std::size_t(n) * r, 0.0);
   for (long m = 0; m < n; ++m) {
@@ -443,6 +470,7 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
       Wm[i] = w;
     }
   }
+  c->lu.solve_rows(c->Z.data(), r);
   // S = I + s W^T Z, accumulated row by row (r^2 independent sums).
   c->S.assign(std::size_t(r) * r, 0.0);
   for (long m = 0; m < n; ++m) {
