@@ -218,7 +218,14 @@ struct ForceModel {
     for (int i = 0; i < N; ++i) {
       const double a = y[1 + stride * i];
       if (!(a > 0) || !std::isfinite(a)) ok = false;
-      R[i] = R0 * std::sqrt(std::max(a, 1e-300));
+    }
+    // (a separate pass so that the square roots vectorise: -fno-math-errno, CMakeLists.txt)
+    double* Rd = R.data();
+    if (stride == 1) {
+      const double* a = y + 1;
+      for (int i = 0; i < N; ++i) Rd[i] = R0 * std::sqrt(std::max(a[i], 1e-300));
+    } else {
+      for (int i = 0; i < N; ++i) Rd[i] = R0 * std::sqrt(std::max(y[1 + stride * i], 1e-300));
     }
     if (!freeze_segments) {
       for (int k = 0; k < nseg; ++k) {
