@@ -1,5 +1,6 @@
 // swim bench: performance figures, measured in one run so that ratios are meaningful on a
-// shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 (best
+// shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 and,
+// at N = 200, with the unbounded outer flow and in the paper mode (best
 // of several repetitions) and screening throughput (designs per second) on all cores.
 #include <algorithm>
 #include <chrono>
@@ -75,8 +76,9 @@ double fft_floor(int nx, int ny, int nz, int threads, int reps) {
 
 }  // namespace
 
-int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
-  const bool paper_cycle = paper_cycle_opt || !quick;
+int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const std::string& tier) {
+  const bool do1d = tier != "3d", do3d = tier != "1d";
+  const bool paper_cycle = do3d && (paper_cycle_opt || !quick);
   const std::string out = out_opt.empty() ? "out/bench" : out_opt;
   output::make_dir(out);
   scene::json report = scene::json::object();
@@ -84,6 +86,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   report["hardware_threads"] = cores;
 
+  if (do1d) {
   std::printf("== 1D tier ==\n");
   std::printf("one force-driven cycle (demo scene, best of %d):\n", reps);
   std::printf("  %6s %12s %10s %10s %10s\n", "N", "wall [ms]", "steps", "switches", "cycle [s]");
@@ -105,6 +108,27 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
                       {"cycle_time_s", m.mean_cycle_time_s}, {"ok", !r.failure}});
   }
   report["force_driven_cycle"] = cycles;
+  // The other outer flow and the paper's reproduction mode at the screening resolution.
+  scene::json variants = scene::json::array();
+  for (const std::string& v : {std::string("model1d.outer_flow=\"unbounded\""), std::string("model1d.model=\"paper\"")}) {
+    std::vector<std::string> sets = {"numerics1d.cells=200", "protocol.cycles=1", "time.duration=\"auto\"", v};
+    if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
+    const auto p = demo_params(sets);
+    double best = 1e300;
+    reduced1d::Result r;
+    for (int k = 0; k < reps; ++k) {
+      const auto t0 = std::chrono::steady_clock::now();
+      r = reduced1d::solve(p);
+      best = std::min(best, seconds_since(t0));
+    }
+    const auto m = reduced1d::metrics(p, r);
+    const long steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
+    std::printf("  %6d %12.3f %10ld %10ld %10.4g  %s%s\n", 200, 1e3 * best, steps, r.switches, m.mean_cycle_time_s,
+                v.c_str(), r.failure ? "  FAILED" : "");
+    variants.push_back({{"cells", 200}, {"set", v}, {"wall_time_s", best}, {"steps", steps},
+                        {"displacement_per_cycle_m", m.displacement_per_cycle_m}, {"ok", !r.failure}});
+  }
+  report["force_driven_cycle_variants"] = variants;
 
   // Screening throughput: a 10 x 10 grid over lambda = R_f/R0 in [0.35, 0.85] and
   // L in [0.2, 0.8] um. Force-driven designs drive at 1.4x the static load so that every
@@ -144,6 +168,8 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
                   {"failed", failed}};
   }
   report["screening"] = screening;
+  }
+  if (do3d) {
 
   // 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
   // resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
@@ -281,6 +307,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt) {
                                     {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", r.failed}};
   } else {
     std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
+  }
   }
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());

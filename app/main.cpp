@@ -2,7 +2,7 @@
 //
 //   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
 //   swim screen SWEEP.json [--out DIR] [--jobs N]
-//   swim bench [--out DIR]
+//   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|all]
 //   swim scenes
 //   swim demo
 //
@@ -58,6 +58,9 @@ int main(int argc, char** argv) {
   ben->add_option("--out", out, "Output directory (default out/bench)");
   ben->add_flag("--quick", quick, "Fewer repetitions (a smoke run); skips the paper-cycle run");
   bool paper_cycle = false;
+  std::string bench_tier = "all";
+  ben->add_option("--tier", bench_tier, "Measure only one tier: 1d, 3d or all (default)")
+      ->check(CLI::IsMember({"1d", "3d", "all"}));
   ben->add_flag("--paper-cycle", paper_cycle,
                 "Also run the paper's single-cycle 3D scene end to end with --quick (minutes)");
 
@@ -101,7 +104,7 @@ int main(int argc, char** argv) {
     }
     if (*demo) return app::demo(out, progress);
     if (*scr) return app::screen(sweep, out, jobs, progress);
-    if (*ben) return app::bench(out, quick, paper_cycle);
+    if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
     if (*sc) return app::scenes();
     if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, !cal_skip_wet);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);

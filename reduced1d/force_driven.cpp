@@ -26,6 +26,7 @@
 #include <sunmatrix/sunmatrix_band.h>
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <functional>
 #include <cmath>
@@ -103,6 +104,12 @@ struct ForceModel {
   std::vector<double> Rpt, Pipt, zc, faces, sigma, rho, u_ind;
   double U = 0;           // swimmer velocity at the last fluxes() [m/s]
   bool geometry_ok = true;
+  // Unbounded: U does not feed back into the radii. With velocity_quadrature the right-hand
+  // side leaves it out (X and the U parts of the lab-frame volumes are then integrated along
+  // the accepted steps, VelocityQuadrature below) and fluxes() computes it only when
+  // want_velocity is set.
+  bool velocity_quadrature = false;
+  bool want_velocity = true;
 
   explicit ForceModel(const Params& P)
       : N(P.numerics.cells),
@@ -211,7 +218,14 @@ struct ForceModel {
     for (int i = 0; i < N; ++i) {
       const double a = y[1 + stride * i];
       if (!(a > 0) || !std::isfinite(a)) ok = false;
-      R[i] = R0 * std::sqrt(std::max(a, 1e-300));
+    }
+    // (a separate pass so that the square roots vectorise: -fno-math-errno, CMakeLists.txt)
+    double* Rd = R.data();
+    if (stride == 1) {
+      const double* a = y + 1;
+      for (int i = 0; i < N; ++i) Rd[i] = R0 * std::sqrt(std::max(a[i], 1e-300));
+    } else {
+      for (int i = 0; i < N; ++i) Rd[i] = R0 * std::sqrt(std::max(y[1 + stride * i], 1e-300));
     }
     if (!freeze_segments) {
       for (int k = 0; k < nseg; ++k) {
@@ -260,7 +274,7 @@ struct ForceModel {
       for (int j = 0; j <= N; ++j) {
         Q[j] = sys->Q_in[j];
         r[j] = sys->k[j].rl;
-        cond[j] = 1.0 / (sys->k[j].rl + sys->k[j].ra);
+        cond[j] = sys->w[j];
       }
       U = sys->U;
       return;
@@ -274,7 +288,7 @@ struct ForceModel {
     r[N] = disc::resistance(mu, 0.5 * h, R[N - 1] - a_in, RbL - a_in);
     Q[N] = p[N - 1] / r[N];
     for (int j = 0; j <= N; ++j) cond[j] = 1.0 / r[j];
-    if (force_free) {  // unbounded: slender-body average of the induced axial flow
+    if (force_free && (!velocity_quadrature || want_velocity)) {  // unbounded: slender-body average
       for (int i = 0; i < N; ++i) {
         sigma[i] = (Q[i] - Q[i + 1]) / h;  // d(pi R^2)/dt per unit length
         rho[i] = R[i] + a_out;
@@ -327,13 +341,14 @@ struct ForceModel {
       W = bal.velocity(bal.thrust_term(I), y[iD] * D_s, y[iX] * X_s);
       dd[0] = bal.drag_integrand(I) / D_s;
     }
+    if (velocity_quadrature) W = 0.0;  // integrated outside the ODE (VelocityQuadrature)
     dd[1] = W / X_s;
     dd[2] = Q[0] / V_s;
     dd[3] = Q[N] / V_s;
     // lab frame: the lumen fluid crossing the moving end sections, Q + W pi R_end^2
     dd[4] = (Q[0] + W * pi * Rb0 * Rb0) / V_s;
     dd[5] = (Q[N] + W * pi * RbL * RbL) / V_s;
-    if (W_out) *W_out = W;
+    if (W_out) *W_out = velocity_quadrature ? U : W;
   }
 
   /// End pressures, total flux and force split at the last fluxes() (force-free model).
@@ -360,7 +375,9 @@ struct ForceModel {
   // Right-hand side without inertia (CVODE).
   int rhs(const double* y, double* yd) {
     if (!unpack(y)) return 1;  // recoverable: the integrator retries with a smaller step
+    want_velocity = false;
     fluxes();
+    want_velocity = true;
     const double c = 1.0 / (h * pi * R0 * R0);
     if (!geometry_ok) return 1;
     for (int i = 0; i < N; ++i) yd[1 + i] = (Q[i] - Q[i + 1]) * c;
@@ -400,7 +417,7 @@ struct ForceModel {
         double rla, rlb;
         dresistance(d, a - a_in, b - a_in, rla, rlb);
         // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
-        const double w = 1.0 / (k.rl + k.ra), Qj = sys->Q_in[j];
+        const double w = sys->w[j], Qj = sys->Q_in[j];
         auto partial = [&](const outer::AnnulusPoint<double>& dp, double drl, double& dQ, double& d1, double& d2) {
           const double dra = 0.5 * d * dp.rho, dc = 0.5 * d * dp.kappa, dS = 0.5 * dp.S, de = 0.5 * d * dp.e;
           dQ = (dra * Qt + dc * Uv - Qj * (drl + dra)) * w;
@@ -438,7 +455,9 @@ struct ForceModel {
   template <class Band>
   int jacobian(const double* y, Band band, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
+    want_velocity = false;
     fluxes(true);
+    want_velocity = true;
     FluxSens& s = sens_;
     flux_sensitivities(s, true);
     const double c = 1.0 / (h * pi * R0 * R0);
@@ -464,11 +483,12 @@ struct ForceModel {
       const double det = G[0][0] * G[1][1] - G[0][1] * G[1][0];
       Gi[0][0] = G[1][1] / det, Gi[0][1] = -G[0][1] / det, Gi[1][0] = -G[1][0] / det, Gi[1][1] = G[0][0] / det;
       fq_.assign(n, 0.0), fu_.assign(n, 0.0);
-      std::vector<double> al(N + 1), be(N + 1);
+      std::vector<double>&al = al_, &be = be_;
+      al.resize(N + 1), be.resize(N + 1);
       for (int j = 0; j <= N; ++j) {
         const auto& k = sys->k[j];
-        al[j] = k.ra / (k.rl + k.ra);
-        be[j] = (k.c - sys->A_c * k.ra) / (k.rl + k.ra);
+        al[j] = k.ra * sys->w[j];
+        be[j] = (k.c - sys->A_c * k.ra) * sys->w[j];
       }
       for (int i = 0; i < N; ++i) {
         fq_[1 + i] = c * (al[i] - al[i + 1]);
@@ -555,7 +575,7 @@ struct ForceModel {
     std::size_t off;
   };
   std::vector<SegChain> seg_x_;
-  std::vector<double> fq_, fu_, dg1pi_, dg2pi_;  // confined Jacobian workspace
+  std::vector<double> fq_, fu_, dg1pi_, dg2pi_, al_, be_;  // confined Jacobian workspace
 
   // Residual with inertia (IDA).
   int res(const double* y, const double* yp, double* F) {
@@ -622,6 +642,84 @@ struct ForceModel {
   }
 };
 
+
+// ---------------------------------------------------------------------------------------
+// Unbounded outer flow: U(t) = slender-body average of the flow induced by the wall motion,
+// O(N^2) per evaluation, with no feedback into the radii. It is evaluated once per accepted
+// step (not in every right-hand side and Newton iteration), and X, V_rear_lab and
+// V_front_lab (their U parts) are integrated along the steps by the quadratic through the
+// last three step points (trapezoid on the first step after a restart). The integrand jumps
+// at a protocol switch (dA/dt does), so the rule restarts there with the one-sided values.
+struct VelocityQuadrature {
+  static constexpr int kn = 3;  // X / X_s, U pi Rb0^2 / V_s, U pi RbL^2 / V_s
+  using V3 = std::array<double, kn>;
+  double t[3] = {0, 0, 0};
+  V3 f[3] = {};
+  int count = 0;     // points since the last restart (at most 3 kept)
+  V3 sum{};          // integral from 0 to t[latest]
+  long evaluations = 0;
+
+  V3 integrand(ForceModel& M, const double* y) {
+    ++evaluations;
+    M.unpack(y);
+    M.fluxes();
+    return {M.U / M.X_s, M.U * pi * M.Rb0 * M.Rb0 / M.V_s, M.U * pi * M.RbL * M.RbL / M.V_s};
+  }
+  /// Integral over [a, b] of the interpolant through the kept points (quadratic with three,
+  /// linear with two) expressed on the last interval.
+  V3 piece(double a, double b) const {
+    V3 out{};
+    if (count < 2) return out;
+    const int i1 = count - 1, i0 = count - 2;
+    if (count == 2) {
+      for (int k = 0; k < kn; ++k) {
+        const double fa = f[i0][k] + (f[i1][k] - f[i0][k]) * (a - t[i0]) / (t[i1] - t[i0]);
+        const double fb = f[i0][k] + (f[i1][k] - f[i0][k]) * (b - t[i0]) / (t[i1] - t[i0]);
+        out[k] = 0.5 * (b - a) * (fa + fb);
+      }
+      return out;
+    }
+    // quadratic through t[0], t[1], t[2]: Simpson on [a, b] is exact for it
+    const double m = 0.5 * (a + b);
+    for (int k = 0; k < kn; ++k) {
+      auto q = [&](double x) {
+        return f[0][k] * (x - t[1]) * (x - t[2]) / ((t[0] - t[1]) * (t[0] - t[2])) +
+               f[1][k] * (x - t[0]) * (x - t[2]) / ((t[1] - t[0]) * (t[1] - t[2])) +
+               f[2][k] * (x - t[0]) * (x - t[1]) / ((t[2] - t[0]) * (t[2] - t[1]));
+      };
+      out[k] = (b - a) / 6.0 * (q(a) + 4.0 * q(m) + q(b));
+    }
+    return out;
+  }
+  /// Start (t = 0) or restart after a switch at tt with the right-hand value fv.
+  void restart(double tt, const V3& fv) {
+    count = 1;
+    t[0] = tt;
+    f[0] = fv;
+  }
+  /// Accepted step to tt with value fv.
+  void step(double tt, const V3& fv) {
+    if (tt <= t[count - 1]) return;
+    if (count == 3) {
+      t[0] = t[1], t[1] = t[2], f[0] = f[1], f[1] = f[2];
+      count = 2;
+    }
+    t[count] = tt;
+    f[count] = fv;
+    ++count;
+    const V3 d = piece(t[count - 2], t[count - 1]);
+    for (int k = 0; k < kn; ++k) sum[k] += d[k];
+  }
+  /// Integral from 0 to tt (tt within the last step).
+  V3 at(double tt) const {
+    V3 out = sum;
+    if (count >= 2 && tt < t[count - 1]) {
+      const V3 d = piece(tt, t[count - 1]);
+      for (int k = 0; k < kn; ++k) out[k] -= d[k];
+    }
+    return out;
+  }
+};
 
 // ---------------------------------------------------------------------------------------
 // Root functions of the current protocol state (ProtocolMachine::root_count order).
@@ -696,6 +794,9 @@ class Backend {
   virtual long steps() = 0;  ///< steps since the last restart
   virtual void harvest(std::map<std::string, long>& stats) = 0;
   std::string last_msg;
+  /// Called after every accepted step with (t_n, y_n) (CVODE only; advance then steps one
+  /// at a time and interpolates to tout, the same steps as CV_NORMAL).
+  std::function<void(double, const double*)> on_step;
 };
 
 class CvodeBackend final : public Backend {
@@ -751,8 +852,48 @@ class CvodeBackend final : public Backend {
     if (n > 0) sun::check(CVodeSetRootDirection(mem_.get(), dirs_.data()), "CVodeSetRootDirection");
   }
   void set_stop_time(double t) override { sun::check(CVodeSetStopTime(mem_.get(), t), "CVodeSetStopTime"); }
-  void set_max_steps(long n) override { sun::check(CVodeSetMaxNumSteps(mem_.get(), n), "CVodeSetMaxNumSteps"); }
+  void set_max_steps(long n) override {
+    max_steps_ = n;
+    sun::check(CVodeSetMaxNumSteps(mem_.get(), n), "CVodeSetMaxNumSteps");
+  }
   int advance(double tout, double& t) override {
+    if (on_step) {
+      void* mem = mem_.get();
+      if (pending_root_) {  // a root beyond an earlier tout (CV_NORMAL reports the touts first)
+        if (tout < root_t_) {
+          sun::check(CVodeGetDky(mem, tout, 0, y_.get()), "CVodeGetDky", last_msg);
+          t = tout;
+          return 0;
+        }
+        pending_root_ = false;
+        std::copy(root_y_.begin(), root_y_.end(), sun::data(y_.get()));
+        t = root_t_;
+        return 1;
+      }
+      double tn = 0;
+      CVodeGetCurrentTime(mem, &tn);
+      for (long k = 0; tn < tout; ++k) {
+        if (k >= max_steps_) return -1;
+        const int flag = CVode(mem, tout, y_.get(), &t, CV_ONE_STEP);
+        if (flag == CV_ROOT_RETURN) {
+          if (t <= tout) return 1;
+          on_step(t, sun::data(y_.get()));  // the step up to the root, laws before the switch
+          pending_root_ = true;
+          root_t_ = t;
+          root_y_.assign(sun::data(y_.get()), sun::data(y_.get()) + pb_.M.n);
+          sun::check(CVodeGetDky(mem, tout, 0, y_.get()), "CVodeGetDky", last_msg);
+          t = tout;
+          return 0;
+        }
+        sun::check(flag, "CVode", last_msg);
+        tn = t;
+        on_step(tn, sun::data(y_.get()));
+        if (flag == CV_TSTOP_RETURN) return 2;
+      }
+      sun::check(CVodeGetDky(mem, tout, 0, y_.get()), "CVodeGetDky", last_msg);
+      t = tout;
+      return 0;
+    }
     const int flag = CVode(mem_.get(), tout, y_.get(), &t, CV_NORMAL);
     if (flag == CV_ROOT_RETURN) return 1;
     if (flag == CV_TSTOP_RETURN) return 2;
@@ -822,6 +963,10 @@ class CvodeBackend final : public Backend {
     return 0;
   }
   Problem& pb_;
+  long max_steps_ = 500;
+  bool pending_root_ = false;
+  double root_t_ = 0;
+  std::vector<double> root_y_;
   sun::Context ctx_;
   sun::Vector y_;
   sun::CvodeMem mem_;
@@ -991,7 +1136,8 @@ class IdaBackend final : public Backend {
 
 // ---------------------------------------------------------------------------------------
 // Event loop shared by the protocol run and the fixed-actuation run.
-Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, const ProgressFn& progress) {
+Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, const ProgressFn& progress,
+           bool velocity_in_rhs = false) {
   Result res;
   for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
                         "nonlin_iters", "nonlin_conv_fails", "root_evals", "reinits"})
@@ -1024,6 +1170,8 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
   std::unique_ptr<Backend> be;
   std::function<void(double)> check_ends;
 
+  M.velocity_quadrature = M.force_free && !M.confined && !M.inertia && !velocity_in_rhs;
+  VelocityQuadrature vq;
   auto record = [&](double tt, const double* y) -> bool {
     const bool ok = M.unpack(y);
     M.fluxes();
@@ -1032,10 +1180,11 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     M.extras(y, d, &W);
     Sample s;
     M.end_state(s);
-    s.V_rear_lab = y[M.iVrl] * M.V_s;
-    s.V_front_lab = y[M.iVfl] * M.V_s;
+    const VelocityQuadrature::V3 qv = M.velocity_quadrature ? vq.at(tt) : VelocityQuadrature::V3{};
+    s.V_rear_lab = (y[M.iVrl] + qv[1]) * M.V_s;
+    s.V_front_lab = (y[M.iVfl] + qv[2]) * M.V_s;
     s.t = tt;
-    s.X = y[M.iX] * M.X_s;
+    s.X = (y[M.iX] + qv[0]) * M.X_s;
     s.W = W;
     s.energy = M.energy();
     s.R_min = *std::min_element(M.R.begin(), M.R.end());
@@ -1092,6 +1241,10 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
       be = std::make_unique<CvodeBackend>(*pb, P);
     be->set_roots(machine.root_count());
     be->set_stop_time(t_stop);
+    if (M.velocity_quadrature) {
+      vq.restart(0.0, vq.integrand(M, be->y()));
+      be->on_step = [&](double tn, const double* y) { vq.step(tn, vq.integrand(M, y)); };
+    }
     if (!record(0.0, be->y())) {
       check_ends(0.0);  // an open end without a positive rest radius is the usual cause
       throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
@@ -1126,6 +1279,8 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
                                  std::to_string(P.numerics.max_steps) + " steps)",
                              "raise numerics1d.max_steps or loosen numerics1d.rtol or numerics1d.atol_scale", t);
       if (st == 1) {
+        // the partial step up to the root, with the laws in force before the switch
+        if (M.velocity_quadrature) vq.step(t, vq.integrand(M, be->y()));
         found.assign(std::max(machine.root_count(), 2), 0);
         be->root_info(found.data());
         const double* R = cells(be->y());
@@ -1148,6 +1303,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
           res.cycle_start.push_back(t);
         }
         apply_actuation(t);
+        if (M.velocity_quadrature) vq.restart(t, vq.integrand(M, be->y()));  // right-hand value
         be->harvest(res.stats);
         steps_before = res.stats["steps"];
         be->restart(t);
@@ -1307,8 +1463,9 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
   return out;
 }
 
-Result solve_force_driven(const Params& p, const ProgressFn& progress) {
- return run(p, {}, 0.0, progress); }
+Result solve_force_driven(const Params& p, const ProgressFn& progress, bool velocity_in_rhs) {
+  return run(p, {}, 0.0, progress, velocity_in_rhs);
+}
 
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
                              const ProgressFn& progress) {

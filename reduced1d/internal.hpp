@@ -16,11 +16,20 @@ void validate(const Params& p);
 /// inertia-free wall-flow equation is R_t = (C1 R0^3 / 16 mu) R_zz.
 double relaxation_time(const Params& p);
 
-/// Prescribed Step/Sine wave: swimmer balance as quadratures (CVODE).
-Result solve_prescribed(const Params& p, const ProgressFn& progress);
+/// How a prescribed wave's time integrals are computed: Auto = by quadrature on the output
+/// grid for the force-free model (U, Q_rear, Q_front are instantaneous functions of t) and
+/// with CVODE for the paper's model (its velocity is an ODE state); Integrated = CVODE
+/// always (the reference the quadrature is tested against).
+enum class PrescribedPath { Auto, Integrated };
+
+/// Prescribed Step/Sine wave: swimmer balance and end volumes as time integrals.
+Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedPath path = PrescribedPath::Auto);
 
 /// Force-driven wave under the Section-3 protocol (CVODE or IDA, root-located switches).
-Result solve_force_driven(const Params& p, const ProgressFn& progress);
+/// Unbounded outer flow without wall inertia: U is evaluated once per accepted step and X
+/// integrated along the steps; `velocity_in_rhs` puts U back into every right-hand side
+/// with X as an ODE state (the reference the step quadrature is tested against).
+Result solve_force_driven(const Params& p, const ProgressFn& progress, bool velocity_in_rhs = false);
 
 /// Force-driven machinery with a FIXED actuation pressure q_cells[i] (inward positive, Pa)
 /// on every cell and no protocol: integrates from R = R0 at rest to t_end. Used for the

@@ -39,17 +39,34 @@ void induced_axial_velocity(const std::vector<double>& zc, const std::vector<dou
   u.assign(N, 0.0);
   const double c = 1.0 / (4.0 * pi);
   const double zL = faces.back(), z0 = faces.front();
+  // sum_j sigma_j (g_{j+1} - g_j) = sum_f g_f (sigma_{f-1} - sigma_f) over the faces f
+  // (sigma = 0 beyond both ends), g_f = 1 / sqrt((z - f)^2 + rho^2). The kernel row is
+  // formed in its own loop (vectorised: this file is compiled with -fno-math-errno) and
+  // then contracted with four partial sums.
+  thread_local std::vector<double> ds, g;
+  ds.resize(N + 1);
+  g.resize(N + 1);
+  ds[0] = -sigma[0];
+  for (int f = 1; f < N; ++f) ds[f] = sigma[f - 1] - sigma[f];
+  ds[N] = sigma[N - 1];
   for (int i = 0; i < N; ++i) {
     const double r2 = rho[i] * rho[i], z = zc[i];
-    // sum_j sigma_j (g_{j+1} - g_j), g_f = 1 / sqrt((z - f)^2 + rho^2), by parts over faces
-    double gprev = 1.0 / std::sqrt((z - faces[0]) * (z - faces[0]) + r2);
-    double s = 0;
-    for (int j = 0; j < N; ++j) {
-      const double dz = z - faces[j + 1];
-      const double g = 1.0 / std::sqrt(dz * dz + r2);
-      s += sigma[j] * (g - gprev);
-      gprev = g;
+    const double* F = faces.data();
+    double* G = g.data();
+    for (int f = 0; f <= N; ++f) {
+      const double dz = z - F[f];
+      G[f] = 1.0 / std::sqrt(dz * dz + r2);
     }
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    int f = 0;
+    for (; f + 3 <= N; f += 4) {
+      s0 += G[f] * ds[f];
+      s1 += G[f + 1] * ds[f + 1];
+      s2 += G[f + 2] * ds[f + 2];
+      s3 += G[f + 3] * ds[f + 3];
+    }
+    for (; f <= N; ++f) s0 += G[f] * ds[f];
+    const double s = (s0 + s1) + (s2 + s3);
     const double d0 = z - z0, dL = z - zL;
     const double q0 = d0 * d0 + r2, qL = dL * dL + r2;
     const double k0 = d0 / (q0 * std::sqrt(q0)), kL = dL / (qL * std::sqrt(qL));
@@ -86,6 +103,7 @@ ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, doubl
       k(npoints - 1),
       Q_in(npoints - 1, 0.0),
       dPi(npoints - 1, 0.0),
+      w(npoints - 1, 0.0),
       pts_(npoints),
       dpts_(npoints) {}
 
@@ -93,15 +111,52 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   for (int p = 0; p < np; ++p) {
     const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
     if (!(Ro < Rc * (1.0 - 1e-3)) || !(Ri > 0)) return false;
-    if (derivatives) {
+  }
+  if (!derivatives) {
+    // Two passes: the logarithms, then the arithmetic (independent per point, so the
+    // divisions pipeline instead of waiting behind each call). A point whose radius is
+    // bitwise the one of the previous call keeps its values (prescribed waves hold most of
+    // the tube at R0 or R_min exactly), so the result does not depend on the cache.
+    lambda_.resize(np);
+    last_Ro_.resize(np, -1.0);
+    changed_.clear();
+    for (int p = 0; p < np; ++p) {
+      const double Ro = Rpt[p] + a_out;
+      if (Ro == last_Ro_[p]) continue;
+      last_Ro_[p] = Ro;
+      changed_.push_back(p);
+      lambda_[p] = std::log(Rc / Ro);
+    }
+    const double Rc2 = Rc * Rc, Rc4 = Rc2 * Rc2, c8 = pi / (8.0 * mu);
+    for (int p : changed_) {
+      const double Ro = Rpt[p] + a_out, il = 1.0 / lambda_[p];
+      const double D2 = Rc2 - Ro * Ro;
+      const double Ga = c8 * (Rc4 - Ro * Ro * Ro * Ro - D2 * D2 * il);
+      const double S = (0.5 * pi) * D2 * il;
+      AnnulusPoint<double>& a = pts_[p];
+      a.rho = 1.0 / Ga;
+      a.kappa = (pi * Rc2 - S) * a.rho;
+      a.S = S;
+      a.e = (2.0 * pi * mu) * il;
+    }
+  }
+  if (derivatives) last_Ro_.assign(np, -1.0);  // the point values below come from another formula
+  for (int p = 0; p < np && derivatives; ++p) {
+    const double Ro = Rpt[p] + a_out;
+    {
       const AnnulusPointD a = annulus_point_d(Ro, Rc, mu);
       pts_[p] = a.f;
       dpts_[p] = a.df;
-    } else {
-      pts_[p] = annulus_point<double>(Ro, Rc, mu);
     }
   }
+  // Intervals whose two points kept their radii keep their coefficients (cache above).
+  const bool all = derivatives || changed_.size() == std::size_t(np) || !interval_valid_;
+  std::size_t next = 0;  // index into changed_ (ascending)
   for (int j = 0; j < ni; ++j) {
+    if (!all) {
+      while (next < changed_.size() && changed_[next] < j) ++next;
+      if (next == changed_.size() || changed_[next] > j + 1) continue;  // neither j nor j + 1 changed
+    }
     const double ai = Rpt[j] - a_in, bi = Rpt[j + 1] - a_in, ab = ai * bi;
     IntervalCoef<double>& c = k[j];
     c.rl = (8.0 * mu / pi) * d[j] * (ai * ai + ab + bi * bi) / (3.0 * ab * ab * ab);
@@ -110,7 +165,9 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
     c.c = 0.5 * d[j] * (pa.kappa + pb.kappa);
     c.S = 0.5 * (pa.S + pb.S);
     c.e = 0.5 * d[j] * (pa.e + pb.e);
+    w[j] = 1.0 / (c.rl + c.ra);
   }
+  interval_valid_ = !derivatives;
   return true;
 }
 
@@ -124,12 +181,12 @@ void ConfinedSystem::transmural(const double* Pi, double F_ext) {
   double m11 = r_free, m12 = 0, b1 = 0, m21 = 0, m22 = 0, b2 = F_ext;
   for (int j = 0; j < ni; ++j) {
     const auto& c = k[j];
-    const double w = 1.0 / (c.rl + c.ra);
-    const double alpha = c.ra * w, beta = (c.c - A_c * c.ra) * w, dpi = Pi[j + 1] - Pi[j];
+    const double wj = w[j];
+    const double alpha = c.ra * wj, beta = (c.c - A_c * c.ra) * wj, dpi = Pi[j + 1] - Pi[j];
     dPi[j] = dpi;
     m11 += c.rl * alpha;
     m12 += c.rl * beta;
-    b1 += c.rl * dpi * w;
+    b1 += c.rl * dpi * wj;
     m21 -= c.S * c.rl * alpha;
     m22 += c.e - c.S * c.rl * beta;
     b2 += c.S * alpha * dpi;
@@ -142,7 +199,7 @@ void ConfinedSystem::transmural(const double* Pi, double F_ext) {
   dp_tube = 0;
   for (int j = 0; j < ni; ++j) {
     const auto& c = k[j];
-    Q_in[j] = (c.ra * W + (c.c - A_c * c.ra) * U - dPi[j]) / (c.rl + c.ra);
+    Q_in[j] = (c.ra * W + (c.c - A_c * c.ra) * U - dPi[j]) * w[j];
     dp_tube -= c.rl * Q_in[j];
   }
 }

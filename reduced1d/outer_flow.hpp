@@ -45,14 +45,15 @@ template <class T>
 AnnulusPoint<T> annulus_point(T Ro, double Rc, double mu) {
   using std::log;
   const T lambda = log(Rc / Ro);
+  const T il = 1.0 / lambda;
   const T D2 = Rc * Rc - Ro * Ro;
-  const T Ga = (pi / (8.0 * mu)) * (Rc * Rc * Rc * Rc - Ro * Ro * Ro * Ro - D2 * D2 / lambda);
-  const T S = pi * D2 / (2.0 * lambda);
+  const T Ga = (pi / (8.0 * mu)) * (Rc * Rc * Rc * Rc - Ro * Ro * Ro * Ro - D2 * D2 * il);
+  const T S = (0.5 * pi) * D2 * il;
   AnnulusPoint<T> a;
   a.rho = 1.0 / Ga;
-  a.kappa = (pi * Rc * Rc - S) / Ga;
+  a.kappa = (pi * Rc * Rc - S) * a.rho;
   a.S = S;
-  a.e = 2.0 * pi * mu / lambda;
+  a.e = (2.0 * pi * mu) * il;
   return a;
 }
 
@@ -97,12 +98,16 @@ class ConfinedSystem {
   std::vector<IntervalCoef<double>> k;  ///< per interval
   std::vector<double> Q_in;             ///< lumen flux per face (swimmer frame) [m^3/s]
   std::vector<double> dPi;              ///< Pi_{j+1} - Pi_j used (transmural) [Pa]
+  std::vector<double> w;                ///< 1 / (rl + ra) per interval (valid after geometry())
   double U = 0, Q_tot = 0, dp_tube = 0;  ///< velocity, total swimmer-frame flux, pL - p0
   double W = 0;                          ///< Q_tot + U pi Rc^2: lab-frame flux through the free pipe
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
 
  private:
   std::vector<AnnulusPoint<double>> pts_, dpts_;
+  std::vector<double> lambda_, last_Ro_;  // geometry() workspace and the radii of pts_
+  std::vector<int> changed_;
+  bool interval_valid_ = false;  // k and w match last_Ro_ (set by a plain geometry() call)
 };
 
 /// The point functions and their derivatives d/dR_o (analytic), for the Newton matrix.
@@ -110,21 +115,21 @@ struct AnnulusPointD {
   AnnulusPoint<double> f, df;
 };
 inline AnnulusPointD annulus_point_d(double Ro, double Rc, double mu) {
-  const double lambda = std::log(Rc / Ro), dl = -1.0 / Ro;
+  const double lambda = std::log(Rc / Ro), il = 1.0 / lambda, dl = -1.0 / Ro;
   const double D2 = Rc * Rc - Ro * Ro, dD2 = -2.0 * Ro;
   const double c8 = pi / (8.0 * mu);
-  const double G = c8 * (Rc * Rc * Rc * Rc - Ro * Ro * Ro * Ro - D2 * D2 / lambda);
-  const double dG = c8 * (-4.0 * Ro * Ro * Ro - 2.0 * D2 * dD2 / lambda + D2 * D2 * dl / (lambda * lambda));
-  const double S = pi * D2 / (2.0 * lambda), dS = 0.5 * pi * (dD2 / lambda - D2 * dl / (lambda * lambda));
+  const double G = c8 * (Rc * Rc * Rc * Rc - Ro * Ro * Ro * Ro - D2 * D2 * il);
+  const double dG = c8 * (-4.0 * Ro * Ro * Ro - 2.0 * D2 * dD2 * il + D2 * D2 * dl * il * il);
+  const double S = (0.5 * pi) * D2 * il, dS = 0.5 * pi * (dD2 * il - D2 * dl * il * il);
   AnnulusPointD a;
   a.f.rho = 1.0 / G;
-  a.df.rho = -dG / (G * G);
+  a.df.rho = -dG * a.f.rho * a.f.rho;
   a.f.S = S;
   a.df.S = dS;
   a.f.kappa = (pi * Rc * Rc - S) * a.f.rho;
   a.df.kappa = -dS * a.f.rho + (pi * Rc * Rc - S) * a.df.rho;
-  a.f.e = 2.0 * pi * mu / lambda;
-  a.df.e = -2.0 * pi * mu * dl / (lambda * lambda);
+  a.f.e = (2.0 * pi * mu) * il;
+  a.df.e = -2.0 * pi * mu * dl * il * il;
   return a;
 }
 

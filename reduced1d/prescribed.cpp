@@ -10,6 +10,7 @@
 #include <cvode/cvode_ls.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <string>
 
@@ -167,11 +168,243 @@ struct PrescribedModel {
 
 void add_stat(std::map<std::string, long>& s, const char* k, long v) { s[k] += v; }
 
+// ---------------------------------------------------------------------------------------
+// Quadrature path (force-free model). The wall motion is prescribed and U, Q_rear, Q_front
+// are instantaneous functions of t, so X, V_rear, V_front and the lab-frame volumes are plain
+// integrals. They are evaluated on the output grid (whose samples need the evaluations
+// anyway): per interval the cubic through four neighbouring output times, checked against a
+// second cubic shifted by one node; an interval whose estimate exceeds the integrator's
+// tolerance (rtol |y| + atol_scale, on the scaled states) is integrated by adaptive Simpson.
+
+/// Integrands of the five quadrature states (scaled): X, V_rear, V_front, V_rear_lab,
+/// V_front_lab.
+constexpr int kQuad = 5;
+using QVec = std::array<double, kQuad>;
+
+QVec integrands(const PrescribedModel& m, const PrescribedModel::Eval& e) {
+  const double Rb0 = m.Rpt[0], RbL = m.Rpt[m.N + 1];
+  return {e.U / m.X_s, e.Q0 / m.V_s, e.QN / m.V_s, (e.Q0 + e.U * pi * Rb0 * Rb0) / m.V_s,
+          (e.QN + e.U * pi * RbL * RbL) / m.V_s};
+}
+
+/// Integral over [x[i1], x[i1 + 1]] of the cubic through the four nodes x[j0 .. j0 + 3]
+/// (weights by 3-point Gauss-Legendre on the Lagrange basis, exact for cubics).
+QVec cubic_piece(const std::vector<double>& x, const std::vector<QVec>& f, int j0, int i1) {
+  const double a = x[i1], b = x[i1 + 1], c = 0.5 * (a + b), r = 0.5 * (b - a);
+  const double g = std::sqrt(0.6);
+  const double node[3] = {c - g * r, c, c + g * r}, wt[3] = {5.0 / 9.0 * r, 8.0 / 9.0 * r, 5.0 / 9.0 * r};
+  QVec out{};
+  for (int m = 0; m < 4; ++m) {
+    double w = 0;
+    for (int q = 0; q < 3; ++q) {
+      double l = 1.0;
+      for (int n = 0; n < 4; ++n)
+        if (n != m) l *= (node[q] - x[j0 + n]) / (x[j0 + m] - x[j0 + n]);
+      w += wt[q] * l;
+    }
+    for (int k = 0; k < kQuad; ++k) out[k] += w * f[j0 + m][k];
+  }
+  return out;
+}
+
+struct QuadratureContext {
+  PrescribedModel& model;
+  double rtol, atol;
+  long evals = 0, pieces = 0;
+  long budget = 0;  // numerics.max_steps: evaluations allowed in the refinement
+  bool ok = true, exhausted = false;
+  double t_fail = 0;
+
+  bool eval(double t, QVec& f) {
+    if (++evals > budget) {
+      ok = false;
+      exhausted = true;
+      t_fail = t;
+      return false;
+    }
+    const auto e = model.evaluate(t);
+    if (!e.ok) {
+      ok = false;
+      t_fail = t;
+      return false;
+    }
+    f = integrands(model, e);
+    for (double v : f)
+      if (!std::isfinite(v)) {
+        ok = false;
+        t_fail = t;
+        return false;
+      }
+    return true;
+  }
+  static bool within(const QVec& err, const QVec& tol) {
+    for (int k = 0; k < kQuad; ++k)
+      if (!(std::abs(err[k]) <= tol[k])) return false;
+    return true;
+  }
+  /// Adaptive Simpson on [a, b] with f(a), f(b), f(m) known; tolerance per component.
+  QVec simpson(double a, double b, const QVec& fa, const QVec& fm, const QVec& fb, const QVec& whole,
+               const QVec& tol, int depth) {
+    const double m = 0.5 * (a + b), h = b - a;
+    QVec fl, fr;
+    if (!eval(0.5 * (a + m), fl) || !eval(0.5 * (m + b), fr)) return whole;
+    QVec left, right, sum, err;
+    for (int k = 0; k < kQuad; ++k) {
+      left[k] = h / 12.0 * (fa[k] + 4.0 * fl[k] + fm[k]);
+      right[k] = h / 12.0 * (fm[k] + 4.0 * fr[k] + fb[k]);
+      sum[k] = left[k] + right[k];
+      err[k] = (sum[k] - whole[k]) / 15.0;
+    }
+    ++pieces;
+    if (depth >= 40 || within(err, tol) || h <= 1e-14 * std::max(std::abs(a), std::abs(b))) {
+      for (int k = 0; k < kQuad; ++k) sum[k] += err[k];
+      return sum;
+    }
+    QVec half;
+    for (int k = 0; k < kQuad; ++k) half[k] = 0.5 * tol[k];
+    const QVec l = simpson(a, m, fa, fl, fm, left, half, depth + 1);
+    if (!ok) return whole;
+    const QVec r = simpson(m, b, fm, fr, fb, right, half, depth + 1);
+    QVec out;
+    for (int k = 0; k < kQuad; ++k) out[k] = l[k] + r[k];
+    return out;
+  }
+  QVec adaptive(double a, double b, const QVec& fa, const QVec& fb, const QVec& tol) {
+    QVec fm;
+    if (!eval(0.5 * (a + b), fm)) return QVec{};
+    QVec whole;
+    for (int k = 0; k < kQuad; ++k) whole[k] = (b - a) / 6.0 * (fa[k] + 4.0 * fm[k] + fb[k]);
+    return simpson(a, b, fa, fm, fb, whole, tol, 0);
+  }
+};
+
+Result solve_by_quadrature(const Params& p, PrescribedModel& model, const ProgressFn& progress) {
+  Result res;
+  const int N = model.N;
+  res.z.assign(model.zpt.begin() + 1, model.zpt.end() - 1);
+  for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
+                        "nonlin_iters", "nonlin_conv_fails", "root_evals", "reinits"})
+    res.stats[k] = 0;
+  const double t_end = end_time(p);
+  const double dt_out = p.numerics.output_interval;
+  QuadratureContext qc{model, p.numerics.rtol, p.numerics.atol_scale};
+  qc.budget = p.numerics.max_steps;
+
+  // 1. The samples at the output times (everything but the integrated states).
+  std::vector<double> tk;
+  std::vector<QVec> fk;
+  std::vector<Sample> samples;
+  const std::size_t expect = std::size_t(std::max(0.0, std::ceil(t_end / dt_out))) + 2;
+  tk.reserve(expect), fk.reserve(expect), samples.reserve(expect);
+  res.radius_times.reserve(expect);
+  res.radius.reserve(expect * std::size_t(N));
+  for (long k = 0;; ++k) {
+    double t = std::min(double(k) * dt_out, t_end);
+    if (t_end - t < 1e-9 * dt_out) t = t_end;
+    ++qc.evals;
+    const auto e = model.evaluate(t);
+    Sample s;
+    s.t = t;
+    s.W = e.U;
+    s.p_rear = e.p0, s.p_front = e.pL, s.Q_total = e.Qt;
+    const double Rb0 = model.Rpt[0], RbL = model.Rpt[N + 1];
+    s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
+    s.F_outer = -s.F_lumen;
+    const double* R = model.Rpt.data() + 1;
+    s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
+    s.R_min = *std::min_element(R, R + N);
+    s.R_max = *std::max_element(R, R + N);
+    s.Q_rear = e.Q0;
+    s.Q_front = e.QN;
+    double vol = 0;
+    for (int i = 0; i < N; ++i) vol += R[i] * R[i];
+    s.tube_volume = pi * vol * model.h;
+    const QVec f = integrands(model, e);
+    bool fin = e.ok && finite(s);
+    for (double v : f) fin = fin && std::isfinite(v);
+    if (!fin) {
+      res.failure = NumericalError(k == 0 ? "non-finite swimmer quantities at t = 0" : "non-finite swimmer quantities",
+                                   k == 0 ? "check the wave parameters (radius must stay positive)"
+                                          : "tighten numerics1d.rtol or check the wave parameters",
+                                   t);
+      break;
+    }
+    tk.push_back(t);
+    fk.push_back(f);
+    samples.push_back(s);
+    res.radius_times.push_back(t);
+    res.radius.insert(res.radius.end(), R, R + N);
+    if (t >= t_end) break;
+  }
+
+  // 2. The integrals per output interval, accumulated into the samples.
+  const int n = int(tk.size());
+  const double scale_tol = p.numerics.atol_scale;
+  QVec Y{};
+  if (n > 0) {
+    Sample& s0 = samples[0];
+    s0.X = 0, s0.V_rear = 0, s0.V_front = 0, s0.V_rear_lab = 0, s0.V_front_lab = 0;
+  }
+  for (int i = 0; i + 1 < n && qc.ok; ++i) {
+    // candidates: cubics through nodes j0 .. j0 + 3 with j0 in [i - 2, i]; the most central
+    // one is the value, the next one the error estimate
+    QVec I{}, err{};
+    bool have = false;
+    if (n >= 5) {
+      const int jc = std::clamp(i - 1, 0, n - 4);
+      const int ja = (jc - 1 >= std::max(0, i - 2)) ? jc - 1 : jc + 1;
+      if (ja >= 0 && ja + 3 < n && ja <= i && ja + 3 >= i + 1) {
+        I = cubic_piece(tk, fk, jc, i);
+        const QVec J = cubic_piece(tk, fk, ja, i);
+        for (int k = 0; k < kQuad; ++k) err[k] = I[k] - J[k];
+        have = true;
+      }
+    }
+    QVec tol;
+    for (int k = 0; k < kQuad; ++k) tol[k] = qc.rtol * std::abs(Y[k] + I[k]) + scale_tol;
+    ++res.stats["steps"];
+    if (!have || !QuadratureContext::within(err, tol)) {
+      I = qc.adaptive(tk[i], tk[i + 1], fk[i], fk[i + 1], tol);
+      if (!qc.ok) break;
+    }
+    for (int k = 0; k < kQuad; ++k) Y[k] += I[k];
+    Sample& s = samples[i + 1];
+    s.X = Y[0] * model.X_s;
+    s.V_rear = Y[1] * model.V_s;
+    s.V_front = Y[2] * model.V_s;
+    s.V_rear_lab = Y[3] * model.V_s;
+    s.V_front_lab = Y[4] * model.V_s;
+  }
+  int kept = n;
+  if (!qc.ok) {
+    // the failing evaluation lies inside an interval: keep the samples before it
+    kept = int(std::upper_bound(tk.begin(), tk.end(), qc.t_fail) - tk.begin()) - 1;
+    kept = std::max(kept, 1);
+    if (qc.exhausted)
+      res.failure = NumericalError("integrator step budget numerics1d.max_steps exhausted (" +
+                                       std::to_string(p.numerics.max_steps) + " closure evaluations in the quadrature)",
+                                   "raise numerics1d.max_steps or loosen numerics1d.rtol or numerics1d.atol_scale", qc.t_fail);
+    else
+      res.failure = NumericalError("the prescribed wave left the model's range during the quadrature (the wall reached the container or the lumen closed)",
+                                   "check the wave parameters or raise container.radius", qc.t_fail);
+  }
+  for (int i = 0; i < kept; ++i) {
+    res.series.push_back(samples[i]);
+    if (progress) progress(samples[i].t, t_end);
+  }
+  res.radius_times.resize(kept);
+  res.radius.resize(std::size_t(kept) * N);
+  res.stats["rhs_evals"] = qc.evals;
+  res.stats["steps"] += qc.pieces;
+  return res;
+}
+
 }  // namespace
 
-Result solve_prescribed(const Params& p, const ProgressFn& progress) {
-  Result res;
+Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedPath path) {
   PrescribedModel model(p);
+  if (model.force_free && path != PrescribedPath::Integrated) return solve_by_quadrature(p, model, progress);
+  Result res;
   const int N = model.N;
   res.z.assign(model.zpt.begin() + 1, model.zpt.end() - 1);
   for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",

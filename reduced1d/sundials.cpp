@@ -264,12 +264,14 @@ struct BandLU {
   int kl = 0, ku = 0, kv = 0, ldab = 0;
   std::vector<double> ab;
   std::vector<long> piv;
+  std::vector<double> dinv;  // 1 / U(j, j)
   double& at(long i, long j) { return ab[std::size_t(j) * ldab + kv + i - j]; }
   double at(long i, long j) const { return ab[std::size_t(j) * ldab + kv + i - j]; }
   void resize(long n_, int kl_, int ku_) {
     n = n_, kl = kl_, ku = ku_, kv = kl + ku, ldab = 2 * kl + ku + 1;
     ab.assign(std::size_t(n) * ldab, 0.0);
     piv.assign(n, 0);
+    dinv.assign(n, 0.0);
   }
   void load(SUNMatrix M) {
     std::fill(ab.begin(), ab.end(), 0.0);
@@ -293,6 +295,7 @@ struct BandLU {
       if (p != 0)
         for (long c = j; c <= ju; ++c) std::swap(at(j, c), at(j + p, c));
       const double inv = 1.0 / at(j, j);
+      dinv[j] = inv;
       for (long r = 1; r <= km; ++r) at(j + r, j) *= inv;
       for (long c = j + 1; c <= ju; ++c) {
         const double ajc = at(j, c);
@@ -309,10 +312,49 @@ struct BandLU {
       const double bj = b[j];
       for (long r = 1; r <= km; ++r) b[j + r] -= at(j + r, j) * bj;
     }
+    if (kv == 2 && n >= 2) {  // tridiagonal with pivoting: U has two superdiagonals
+      const double* a = ab.data();
+      b[n - 1] *= dinv[n - 1];
+      b[n - 2] = (b[n - 2] - a[std::size_t(n - 1) * ldab + 1] * b[n - 1]) * dinv[n - 2];
+      for (long j = n - 3; j >= 0; --j) {
+        const double* c1 = a + std::size_t(j + 1) * ldab;  // column j + 1, row j at offset kv - 1
+        const double* c2 = a + std::size_t(j + 2) * ldab;  // column j + 2, row j at offset kv - 2
+        b[j] = (b[j] - c1[1] * b[j + 1] - c2[0] * b[j + 2]) * dinv[j];
+      }
+      return;
+    }
     for (long j = n - 1; j >= 0; --j) {
-      b[j] /= at(j, j);
+      b[j] *= dinv[j];
       const double bj = b[j];
       for (long i = std::max(0L, j - kv); i < j; ++i) b[i] -= at(i, j) * bj;
+    }
+  }
+  /// Solve for r right-hand sides at once, stored row-major (row m: B[m * r .. m * r + r)):
+  /// the r substitution chains are independent, so they overlap instead of each waiting on
+  /// its own latency.
+  void solve_rows(double* B, int r) const {
+    for (long j = 0; j < n; ++j) {
+      const long km = std::min<long>(kl, n - 1 - j);
+      double* bj = B + std::size_t(j) * r;
+      if (piv[j] != j) {
+        double* bp = B + std::size_t(piv[j]) * r;
+        for (int k = 0; k < r; ++k) std::swap(bj[k], bp[k]);
+      }
+      for (long q = 1; q <= km; ++q) {
+        const double l = at(j + q, j);
+        double* bq = B + std::size_t(j + q) * r;
+        for (int k = 0; k < r; ++k) bq[k] -= l * bj[k];
+      }
+    }
+    for (long j = n - 1; j >= 0; --j) {
+      double* bj = B + std::size_t(j) * r;
+      const double d = dinv[j];
+      for (int k = 0; k < r; ++k) bj[k] *= d;
+      for (long i = std::max(0L, j - kv); i < j; ++i) {
+        const double u = at(i, j);
+        double* bi = B + std::size_t(i) * r;
+        for (int k = 0; k < r; ++k) bi[k] -= u * bj[k];
+      }
     }
   }
 };
@@ -323,8 +365,9 @@ struct LowRankContent {
   int rank = 0;     // rank used at the last setup
   double s = 1.0;   // scale at the last setup
   long n = 0;
-  std::vector<double> Z;   // M^{-1} Q, column-major n x rank (U = Q R, Q orthonormal)
-  std::vector<double> W;   // V R^T, column-major n x rank: U V^T = Q W^T
+  std::vector<double> Qc;  // Q, column-major n x rank (U = Q R, Q orthonormal); setup workspace
+  std::vector<double> Z;   // M^{-1} Q, row-major n x rank
+  std::vector<double> W;   // V R^T, row-major n x rank: U V^T = Q W^T
   std::vector<double> R;   // rank x rank, column-major
   std::vector<double> S;   // I + s W^T Z, LU-factored in place (rank x rank)
   std::vector<int> piv;
@@ -366,6 +409,20 @@ void small_solve(const std::vector<double>& a, const std::vector<int>& piv, int 
   }
 }
 
+// Dot product with four partial sums (the single-accumulator loop is latency bound).
+double dot4(const double* a, const double* b, long n) {
+  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+  long i = 0;
+  for (; i + 3 < n; i += 4) {
+    s0 += a[i] * b[i];
+    s1 += a[i + 1] * b[i + 1];
+    s2 += a[i + 2] * b[i + 2];
+    s3 += a[i + 3] * b[i + 3];
+  }
+  for (; i < n; ++i) s0 += a[i] * b[i];
+  return (s0 + s1) + (s2 + s3);
+}
+
 int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   LowRankContent* c = lr(S);
   c->lu.load(A);
@@ -380,44 +437,54 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   // Orthonormalise the columns of U (modified Gram-Schmidt, twice): U V^T = Q (V R^T)^T.
   // The terms may differ in scale by many decades and be nearly parallel; without this the
   // capacitance matrix I + s V^T M^{-1} U is numerically singular even when M + s U V^T is not.
-  c->Z.assign(t.U.begin(), t.U.begin() + n * r);
+  std::vector<double>& Q = c->Qc;
+  Q.assign(t.U.begin(), t.U.begin() + n * r);
   c->R.assign(std::size_t(r) * r, 0.0);
   for (int k = 0; k < r; ++k) {
-    double* qk = c->Z.data() + n * k;
+    double* qk = Q.data() + n * k;
     for (int pass = 0; pass < 2; ++pass)
       for (int j = 0; j < k; ++j) {
-        const double* qj = c->Z.data() + n * j;
-        double d = 0;
-        for (long i = 0; i < n; ++i) d += qj[i] * qk[i];
+        const double* qj = Q.data() + n * j;
+        const double d = dot4(qj, qk, n);
         c->R[std::size_t(k) * r + j] += d;
         for (long i = 0; i < n; ++i) qk[i] -= d * qj[i];
       }
-    double nrm = 0;
-    for (long i = 0; i < n; ++i) nrm += qk[i] * qk[i];
-    nrm = std::sqrt(nrm);
+    const double nrm = std::sqrt(dot4(qk, qk, n));
     c->R[std::size_t(k) * r + k] = nrm;
-    if (nrm > 0)
-      for (long i = 0; i < n; ++i) qk[i] /= nrm;
+    if (nrm > 0) {
+      const double inv = 1.0 / nrm;
+      for (long i = 0; i < n; ++i) qk[i] *= inv;
+    }
   }
+  // Z = M^{-1} Q and W = V R^T, both row-major (n x r, row m holds the r entries of cell m)
+  // for the fused loops of lr_solve; the r solves run together.
+  c->Z.assign(std::size_t(n) * r, 0.0);
   c->W.assign(std::size_t(n) * r, 0.0);
-  for (int i = 0; i < r; ++i)      // W(:, i) = sum_k V(:, k) R(i, k)
-    for (int k = i; k < r; ++k) {
-      const double rik = c->R[std::size_t(k) * r + i];
-      if (rik == 0.0) continue;
-      const double* Vk = t.V.data() + n * k;
-      double* Wi = c->W.data() + n * i;
-      for (long m = 0; m < n; ++m) Wi[m] += rik * Vk[m];
+  for (long m = 0; m < n; ++m) {
+    double* Wm = c->W.data() + std::size_t(m) * r;
+    double* Zm = c->Z.data() + std::size_t(m) * r;
+    for (int i = 0; i < r; ++i) {
+      Zm[i] = Q[std::size_t(i) * n + m];
+      double w = 0;  // W(m, i) = sum_{k >= i} V(m, k) R(i, k)
+      for (int k = i; k < r; ++k) w += t.V[std::size_t(k) * n + m] * c->R[std::size_t(k) * r + i];
+      Wm[i] = w;
     }
-  for (int k = 0; k < r; ++k) c->lu.solve(c->Z.data() + n * k);
+  }
+  c->lu.solve_rows(c->Z.data(), r);
+  // S = I + s W^T Z, accumulated row by row (r^2 independent sums).
   c->S.assign(std::size_t(r) * r, 0.0);
-  for (int i = 0; i < r; ++i)
+  for (long m = 0; m < n; ++m) {
+    const double* Wm = c->W.data() + std::size_t(m) * r;
+    const double* Zm = c->Z.data() + std::size_t(m) * r;
     for (int j = 0; j < r; ++j) {
-      double v = 0;
-      const double* Vi = c->W.data() + n * i;
-      const double* Zj = c->Z.data() + n * j;
-      for (long k = 0; k < n; ++k) v += Vi[k] * Zj[k];
-      c->S[j * r + i] = (i == j ? 1.0 : 0.0) + c->s * v;
+      const double z = Zm[j];
+      if (z == 0.0) continue;
+      double* Sj = c->S.data() + std::size_t(j) * r;
+      for (int i = 0; i < r; ++i) Sj[i] += Wm[i] * z;
     }
+  }
+  for (int i = 0; i < r * r; ++i) c->S[i] *= c->s;
+  for (int i = 0; i < r; ++i) c->S[std::size_t(i) * r + i] += 1.0;
   c->piv.assign(r, 0);
   c->w.assign(r, 0.0);
   if (!small_lu(c->S, c->piv, r)) return c->last = SUNLS_LUFACT_FAIL;
@@ -434,18 +501,22 @@ int lr_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   c->last = 0;
   if (c->rank == 0) return 0;
   const int r = c->rank;
-  // x <- x - Z (I + s W^T Z)^{-1} s W^T x
-  for (int i = 0; i < r; ++i) {
-    double v = 0;
-    const double* Vi = c->W.data() + n * i;
-    for (long k = 0; k < n; ++k) v += Vi[k] * xd[k];
-    c->w[i] = c->s * v;
+  // x <- x - Z (I + s W^T Z)^{-1} s W^T x, one pass for W^T x (r independent sums) and one
+  // for the update.
+  double* w = c->w.data();
+  std::fill(w, w + r, 0.0);
+  for (long m = 0; m < n; ++m) {
+    const double* Wm = c->W.data() + std::size_t(m) * r;
+    const double xm = xd[m];
+    for (int i = 0; i < r; ++i) w[i] += Wm[i] * xm;
   }
-  small_solve(c->S, c->piv, r, c->w.data());
-  for (int j = 0; j < r; ++j) {
-    const double* Zj = c->Z.data() + n * j;
-    const double wj = c->w[j];
-    for (long k = 0; k < n; ++k) xd[k] -= wj * Zj[k];
+  for (int i = 0; i < r; ++i) w[i] *= c->s;
+  small_solve(c->S, c->piv, r, w);
+  for (long m = 0; m < n; ++m) {
+    const double* Zm = c->Z.data() + std::size_t(m) * r;
+    double v = 0;
+    for (int j = 0; j < r; ++j) v += Zm[j] * w[j];
+    xd[m] -= v;
   }
   return 0;
 }
