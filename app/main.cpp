@@ -72,8 +72,8 @@ int main(int argc, char** argv) {
   cal->add_option("scene", cal_scene, "Scene file (JSON)")->required();
   cal->add_option("--out", cal_out, "Output directory (default out/<name>-calibration)");
   cal->add_option("--set", cal_sets, "Override a scene value: key.path=value");
-  bool cal_skip_wet = false;
-  cal->add_flag("--skip-wet", cal_skip_wet, "Skip the fluid-coupled confirmation of one load (the static fits only)");
+  bool cal_wet = false;
+  cal->add_flag("--wet", cal_wet, "Also confirm the largest fitted load with a fluid-coupled 3D run (up to 4 000 steps: minutes)");
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
   std::string val_suite, val_out;
   bool val_quick = false;
@@ -106,7 +106,7 @@ int main(int argc, char** argv) {
     if (*scr) return app::screen(sweep, out, jobs, progress);
     if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
     if (*sc) return app::scenes();
-    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, !cal_skip_wet);
+    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);
   } catch (const InputError& e) {
     std::fprintf(stderr, "swim: %s\n", e.what());

@@ -2,8 +2,11 @@
 
 #include <gsl/gsl_fit.h>
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cmath>
 
 #include "common/errors.hpp"
@@ -40,6 +43,72 @@ std::vector<double> ring_mode_stiffness(const full3d::CylinderMesh& mesh, const 
   }
   return k;
 }
+// Smallest eigenvalue of the Hessian of the loaded energy at X, without the two free rigid
+// motions (axial translation, rotation about the axis): Lanczos with full reorthogonalisation
+// on Hessian-vector products (central differences of the exact gradient), from a fixed
+// pseudo-random start. Ritz values bound the spectrum from inside, so a negative result proves
+// the equilibrium unstable; a positive one is the best estimate after `iterations` products.
+double lowest_hessian_eigenvalue(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p, double pressure,
+                                 const Eigen::Matrix3Xd& X, int iterations) {
+  const Eigen::Index n = X.size();
+  auto grad = [&](const Eigen::Matrix3Xd& Y) {
+    Eigen::Matrix3Xd g = -full3d::elastic_forces(mesh, Y, p);
+    const Eigen::Matrix3Xd e = full3d::radial_directions(mesh, Y);
+    for (Eigen::Index i = 0; i < Y.cols(); ++i) g.col(i) += pressure * mesh.node_area[i] * e.col(i);
+    return g;
+  };
+  const double s = 1e-4 * mesh.rest_length.minCoeff();
+  auto hess = [&](const Eigen::VectorXd& v) {
+    const Eigen::Map<const Eigen::Matrix3Xd> V(v.data(), 3, X.cols());
+    const Eigen::Matrix3Xd d = (grad(X + s * V) - grad(X - s * V)) / (2.0 * s);
+    return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(d.data(), n));
+  };
+  // rigid modes: translation along x, rotation about the axis
+  Eigen::MatrixXd rigid = Eigen::MatrixXd::Zero(n, 2);
+  for (Eigen::Index i = 0; i < X.cols(); ++i) {
+    rigid(3 * i, 0) = 1.0;
+    rigid(3 * i + 1, 1) = -(X(2, i) - mesh.axis_start.z());
+    rigid(3 * i + 2, 1) = X(1, i) - mesh.axis_start.y();
+  }
+  rigid.col(0).normalize();
+  rigid.col(1) -= rigid.col(0).dot(rigid.col(1)) * rigid.col(0);
+  rigid.col(1).normalize();
+  const int m = std::min<int>(iterations, int(n) - 2);
+  Eigen::MatrixXd Q(n, m + 1);
+  Eigen::VectorXd alpha(m), beta(m);
+  Eigen::VectorXd q(n);
+  std::uint64_t r = 0x2545F4914F6CDD1Dull;
+  for (Eigen::Index i = 0; i < n; ++i) {
+    r = r * 6364136223846793005ull + 1442695040888963407ull;
+    q[i] = double(r >> 11) / 9007199254740992.0 - 0.5;
+  }
+  q -= rigid * (rigid.transpose() * q);
+  q.normalize();
+  Q.col(0) = q;
+  int k = 0;
+  for (; k < m; ++k) {
+    Eigen::VectorXd w = hess(Q.col(k));
+    alpha[k] = Q.col(k).dot(w);
+    // full reorthogonalisation (twice) against the basis and the rigid modes
+    for (int pass = 0; pass < 2; ++pass) {
+      w -= Q.leftCols(k + 1) * (Q.leftCols(k + 1).transpose() * w);
+      w -= rigid * (rigid.transpose() * w);
+    }
+    beta[k] = w.norm();
+    if (beta[k] <= 1e-14 * std::abs(alpha[k])) {
+      ++k;
+      break;
+    }
+    Q.col(k + 1) = w / beta[k];
+  }
+  Eigen::MatrixXd T = Eigen::MatrixXd::Zero(k, k);
+  for (int i = 0; i < k; ++i) {
+    T(i, i) = alpha[i];
+    if (i + 1 < k) T(i, i + 1) = T(i + 1, i) = beta[i];
+  }
+  return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(T, Eigen::EigenvaluesOnly).eigenvalues()[0];
+}
+
 }  // namespace
 
 std::vector<double> default_loads(const full3d::Params3d& p) {
@@ -72,6 +141,7 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
     const auto soft = std::min_element(k.begin(), k.end());
     lp.softest_ring_mode = int(soft - k.begin()) + 2;
     lp.softest_ring_mode_stiffness_N_per_m = *soft;
+    lp.lowest_eigenvalue_N_per_m = lowest_hessian_eigenvalue(mesh, p.membrane, pr, r.X, 150);
     c.loads.push_back(lp);
   }
   // linear range: secant within 1 % of the smallest load's
@@ -178,6 +248,7 @@ scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const
                    {"ring_mode_stiffness_N_per_m", lp.ring_mode_stiffness_N_per_m},
                    {"softest_ring_mode", lp.softest_ring_mode},
                    {"softest_ring_mode_stiffness_N_per_m", lp.softest_ring_mode_stiffness_N_per_m},
+                   {"lowest_hessian_eigenvalue_N_per_m", lp.lowest_eigenvalue_N_per_m},
                    {"stable_to_ring_buckling", lp.stable()},
                    {"iterations", lp.iterations}});
   scene::json j = scene::json::object();

@@ -29,7 +29,10 @@ struct LoadPoint {
   std::vector<double> ring_mode_stiffness_N_per_m;
   int softest_ring_mode = 0;                     ///< n of the smallest entry
   double softest_ring_mode_stiffness_N_per_m = 0;
-  bool stable() const { return softest_ring_mode_stiffness_N_per_m > 0; }
+  /// Smallest eigenvalue of the loaded energy's Hessian without the rigid motions (Lanczos,
+  /// 150 Hessian-vector products), N/m: negative proves the symmetric equilibrium unstable.
+  double lowest_eigenvalue_N_per_m = 0;
+  bool stable() const { return softest_ring_mode_stiffness_N_per_m > 0 && lowest_eigenvalue_N_per_m > 0; }
 };
 
 struct C1Fit {
