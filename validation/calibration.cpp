@@ -18,18 +18,22 @@
 namespace swim::validation {
 
 namespace {
+// Gradient of the loaded energy E(Y) + P sum A_i r_i(Y): -F_el + P A_i e_r,i.
+Eigen::Matrix3Xd loaded_gradient(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p, double pressure,
+                                 const Eigen::Matrix3Xd& Y) {
+  Eigen::Matrix3Xd g = -full3d::elastic_forces(mesh, Y, p);
+  const Eigen::Matrix3Xd e = full3d::radial_directions(mesh, Y);
+  for (Eigen::Index i = 0; i < Y.cols(); ++i) g.col(i) += pressure * mesh.node_area[i] * e.col(i);
+  return g;
+}
+
 // d^2/ds^2 of E(X + sV) + P sum A_i r_i(X + sV) for the unit ring modes V_i ~ cos(n phi_i) e_r,i,
 // n = 2 .. n_theta/2 (see the scan below), by central differences of the exact gradient: V . (g(X + sV) - g(X - sV)) / (2 s).
 // (Modes with an axial variation cos(k pi x / L) are stiffer than k = 0 on the paper's tube.)
 std::vector<double> ring_mode_stiffness(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p,
                                         double pressure, const Eigen::Matrix3Xd& X) {
   const Eigen::Matrix3Xd er = full3d::radial_directions(mesh, X);
-  auto grad = [&](const Eigen::Matrix3Xd& Y) {
-    Eigen::Matrix3Xd g = -full3d::elastic_forces(mesh, Y, p);
-    const Eigen::Matrix3Xd e = full3d::radial_directions(mesh, Y);
-    for (Eigen::Index i = 0; i < Y.cols(); ++i) g.col(i) += pressure * mesh.node_area[i] * e.col(i);
-    return g;
-  };
+  auto grad = [&](const Eigen::Matrix3Xd& Y) { return loaded_gradient(mesh, p, pressure, Y); };
   const double s = 1e-4 * mesh.rest_length.minCoeff();
   // the stiffness grows as n^4 past its minimum: scan n = 2..32, and further only while the
   // softest mode is the last one scanned
@@ -51,12 +55,7 @@ std::vector<double> ring_mode_stiffness(const full3d::CylinderMesh& mesh, const 
 double lowest_hessian_eigenvalue(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& p, double pressure,
                                  const Eigen::Matrix3Xd& X, int iterations) {
   const Eigen::Index n = X.size();
-  auto grad = [&](const Eigen::Matrix3Xd& Y) {
-    Eigen::Matrix3Xd g = -full3d::elastic_forces(mesh, Y, p);
-    const Eigen::Matrix3Xd e = full3d::radial_directions(mesh, Y);
-    for (Eigen::Index i = 0; i < Y.cols(); ++i) g.col(i) += pressure * mesh.node_area[i] * e.col(i);
-    return g;
-  };
+  auto grad = [&](const Eigen::Matrix3Xd& Y) { return loaded_gradient(mesh, p, pressure, Y); };
   const double s = 1e-4 * mesh.rest_length.minCoeff();
   auto hess = [&](const Eigen::VectorXd& v) {
     const Eigen::Map<const Eigen::Matrix3Xd> V(v.data(), 3, X.cols());
