@@ -30,6 +30,17 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+/// Best wall time of `reps` solves of p; r receives the last result.
+double best_solve_time(const reduced1d::Params& p, int reps, reduced1d::Result& r) {
+  double best = 1e300;
+  for (int k = 0; k < reps; ++k) {
+    const auto t0 = std::chrono::steady_clock::now();
+    r = reduced1d::solve(p);
+    best = std::min(best, seconds_since(t0));
+  }
+  return best;
+}
+
 reduced1d::Params demo_params(const std::vector<std::string>& sets) {
   scene::json sc = scene::load_file(data_dir() + "/scenes/demo.json");
   for (const auto& s : sets) scene::apply_override(sc, s);
@@ -93,13 +104,8 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   scene::json cycles = scene::json::array();
   for (int n : {50, 200, 800}) {
     const auto p = demo_params({"numerics1d.cells=" + std::to_string(n), "protocol.cycles=1", "time.duration=\"auto\""});
-    double best = 1e300;
     reduced1d::Result r;
-    for (int k = 0; k < reps; ++k) {
-      const auto t0 = std::chrono::steady_clock::now();
-      r = reduced1d::solve(p);
-      best = std::min(best, seconds_since(t0));
-    }
+    const double best = best_solve_time(p, reps, r);
     const auto m = reduced1d::metrics(p, r);
     const long steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
     std::printf("  %6d %12.3f %10ld %10ld %10.4g%s\n", n, 1e3 * best, steps, r.switches, m.mean_cycle_time_s,
@@ -114,13 +120,8 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
     std::vector<std::string> sets = {"numerics1d.cells=200", "protocol.cycles=1", "time.duration=\"auto\"", v};
     if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
     const auto p = demo_params(sets);
-    double best = 1e300;
     reduced1d::Result r;
-    for (int k = 0; k < reps; ++k) {
-      const auto t0 = std::chrono::steady_clock::now();
-      r = reduced1d::solve(p);
-      best = std::min(best, seconds_since(t0));
-    }
+    const double best = best_solve_time(p, reps, r);
     const auto m = reduced1d::metrics(p, r);
     const long steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
     std::printf("  %6d %12.3f %10ld %10ld %10.4g  %s%s\n", 200, 1e3 * best, steps, r.switches, m.mean_cycle_time_s,

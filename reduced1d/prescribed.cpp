@@ -278,13 +278,40 @@ struct QuadratureContext {
   }
 };
 
-Result solve_by_quadrature(const Params& p, PrescribedModel& model, const ProgressFn& progress) {
+/// A Result with the cell centres and zeroed integrator statistics.
+Result prepared_result(const PrescribedModel& model) {
   Result res;
-  const int N = model.N;
   res.z.assign(model.zpt.begin() + 1, model.zpt.end() - 1);
   for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
                         "nonlin_iters", "nonlin_conv_fails", "root_evals", "reinits"})
     res.stats[k] = 0;
+  return res;
+}
+
+/// The wall quantities of a sample from an evaluation at the model's current radius: the
+/// force split (force-free model), energy, radius extremes, end fluxes and the tube volume.
+void fill_wall_sample(const PrescribedModel& model, const PrescribedModel::Eval& e, Sample& s) {
+  const int N = model.N;
+  if (model.force_free) {
+    s.p_rear = e.p0, s.p_front = e.pL, s.Q_total = e.Qt;
+    const double Rb0 = model.Rpt[0], RbL = model.Rpt[N + 1];
+    s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
+    s.F_outer = -s.F_lumen;
+  }
+  const double* R = model.Rpt.data() + 1;
+  s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
+  s.R_min = *std::min_element(R, R + N);
+  s.R_max = *std::max_element(R, R + N);
+  s.Q_rear = e.Q0;
+  s.Q_front = e.QN;
+  double vol = 0;
+  for (int i = 0; i < N; ++i) vol += R[i] * R[i];
+  s.tube_volume = pi * vol * model.h;
+}
+
+Result solve_by_quadrature(const Params& p, PrescribedModel& model, const ProgressFn& progress) {
+  Result res = prepared_result(model);
+  const int N = model.N;
   const double t_end = end_time(p);
   const double dt_out = p.numerics.output_interval;
   QuadratureContext qc{model, p.numerics.rtol, p.numerics.atol_scale};
@@ -306,19 +333,8 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
     Sample s;
     s.t = t;
     s.W = e.U;
-    s.p_rear = e.p0, s.p_front = e.pL, s.Q_total = e.Qt;
-    const double Rb0 = model.Rpt[0], RbL = model.Rpt[N + 1];
-    s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
-    s.F_outer = -s.F_lumen;
+    fill_wall_sample(model, e, s);
     const double* R = model.Rpt.data() + 1;
-    s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
-    s.R_min = *std::min_element(R, R + N);
-    s.R_max = *std::max_element(R, R + N);
-    s.Q_rear = e.Q0;
-    s.Q_front = e.QN;
-    double vol = 0;
-    for (int i = 0; i < N; ++i) vol += R[i] * R[i];
-    s.tube_volume = pi * vol * model.h;
     const QVec f = integrands(model, e);
     bool fin = e.ok && finite(s);
     for (double v : f) fin = fin && std::isfinite(v);
@@ -404,12 +420,8 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
 Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedPath path) {
   PrescribedModel model(p);
   if (model.force_free && path != PrescribedPath::Integrated) return solve_by_quadrature(p, model, progress);
-  Result res;
+  Result res = prepared_result(model);
   const int N = model.N;
-  res.z.assign(model.zpt.begin() + 1, model.zpt.end() - 1);
-  for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
-                        "nonlin_iters", "nonlin_conv_fails", "root_evals", "reinits"})
-    res.stats[k] = 0;
 
   const double t_end = end_time(p);
   const double dt_out = p.numerics.output_interval;
@@ -425,23 +437,10 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedP
     s.W = model.velocity(e, Y);
     s.V_rear_lab = Y[4] * model.V_s;
     s.V_front_lab = Y[5] * model.V_s;
-    if (model.force_free) {
-      s.p_rear = e.p0, s.p_front = e.pL, s.Q_total = e.Qt;
-      const double Rb0 = model.Rpt[0], RbL = model.Rpt[N + 1];
-      s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
-      s.F_outer = -s.F_lumen;
-    }
+    fill_wall_sample(model, e, s);
     const double* R = model.Rpt.data() + 1;
-    s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
-    s.R_min = *std::min_element(R, R + N);
-    s.R_max = *std::max_element(R, R + N);
-    s.Q_rear = e.Q0;
-    s.Q_front = e.QN;
     s.V_rear = Y[2] * model.V_s;
     s.V_front = Y[3] * model.V_s;
-    double vol = 0;
-    for (int i = 0; i < N; ++i) vol += R[i] * R[i];
-    s.tube_volume = pi * vol * model.h;
     s.phase = 0;
     if (!finite(s)) return false;
     res.series.push_back(s);
