@@ -182,7 +182,17 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       p.vtk = o.boolean("vtk", true);
       p.vtk_interval = o.quantity("vtk_interval", "s", fmt(p.output_interval, "s"), Range::positive());
       p.fluid_fields = o.boolean("fluid_fields", false);
-      p.fluid_interval = o.quantity("fluid_interval", "s", fmt(10.0 * p.output_interval, "s"), Range::positive());
+      // every fluid frame falls on a membrane frame: the default is the membrane's interval
+      // rounded up to a whole multiple of it that is at least 10 output intervals, and a given
+      // interval must be a whole multiple of vtk_interval
+      const double k_default = std::max(1.0, std::ceil(10.0 * p.output_interval / p.vtk_interval - 1e-9));
+      p.fluid_interval =
+          o.quantity("fluid_interval", "s", fmt(k_default * p.vtk_interval, "s"), Range::positive());
+      const double k = p.fluid_interval / p.vtk_interval;
+      if (!(k >= 1.0 - 1e-9) || std::abs(k - std::round(k)) > 1e-6 * k)
+        throw InputError(o.path("fluid_interval"), fmt(p.fluid_interval, "s"),
+                         "a whole multiple of full3d.output.vtk_interval (" + fmt(p.vtk_interval, "s") +
+                             "), so that every fluid frame has a membrane frame at the same time");
       o.finish();
     }
     p.checkpoint_interval =

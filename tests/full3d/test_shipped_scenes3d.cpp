@@ -7,6 +7,7 @@
 #include <cmath>
 #include <filesystem>
 
+#include "common/errors.hpp"
 #include "common/scene.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/run3d.hpp"
@@ -69,4 +70,27 @@ TEST(ShippedScenes3d, FirstStepsRunOnACoarseGrid) {
     EXPECT_TRUE(std::isfinite(r.summary["displacement_m"].get<double>()));
     EXPECT_TRUE(fs::exists(dir + "/summary.json"));
   }
+}
+
+// Every fluid frame falls on a membrane frame: the default fluid interval is a whole multiple
+// of the membrane's, and a given interval that is not is refused naming the key.
+TEST(ShippedScenes3d, FluidFramesFallOnMembraneFrames) {
+  for (const auto& e : std::filesystem::directory_iterator(SWIM_SOURCE_DIR "/data/scenes")) {
+    scene::json resolved;
+    const Params3d p = read_scene3d(scene::load_file(e.path().string()), resolved);
+    const double k = p.fluid_interval / p.vtk_interval;
+    EXPECT_NEAR(k, std::round(k), 1e-9 * k) << e.path();
+    EXPECT_GE(k, 1.0 - 1e-12) << e.path();
+  }
+  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json");
+  sc["full3d"]["output"]["fluid_interval"] = "15 ms";  // vtk_interval is 10 ms
+  scene::json resolved;
+  try {
+    read_scene3d(sc, resolved);
+    ADD_FAILURE() << "15 ms against 10 ms accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("full3d.output.fluid_interval"), std::string::npos) << err.what();
+  }
+  sc["full3d"]["output"]["fluid_interval"] = "30 ms";
+  EXPECT_NO_THROW(read_scene3d(sc, resolved));
 }
