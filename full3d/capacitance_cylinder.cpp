@@ -3,11 +3,9 @@
 // capacitance and its lift, the capacitance matrices and their factors, the sparse
 // axial-mean problem, and the mode solve.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "full3d/capacitance_impl.hpp"
-#include "full3d/parallel.hpp"
 
 namespace swim::full3d {
 
@@ -351,27 +349,6 @@ Eigen::MatrixXd CapacitanceStokes::Impl::capacitance_cyl(int kx, double alpha, S
   return Cs;
 }
 
-const CapacitanceStokes::Impl::Factors& CapacitanceStokes::Impl::factors_cyl(double alpha) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::array<PackedCholesky, 4>> chol(static_cast<std::size_t>(nxh));
-  parallel_blocks(nxh, threads, [&](long b, long e, int t) {
-    for (long kx = b; kx < e; ++kx) {
-      const Eigen::MatrixXd C = capacitance_cyl(int(kx), alpha, scratch[t]);
-      factor_blocks(C, chol[kx], kx, alpha, "cylinder");
-    }
-  });
-  auto u0llt = factor_mean_x(alpha);
-  Factors& f = free_slot();
-  f.alpha = alpha;
-  f.chol = std::move(chol);
-  f.u0llt = std::move(u0llt);
-  f.bytes = std::size_t(nxh) * factor_doubles * sizeof(double) +
-            std::size_t(f.u0llt->matrixL().nestedExpression().nonZeros()) * (sizeof(double) + sizeof(int));
-  factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  factorized_last = true;
-  return f;
-}
-
 // Mode solve for the cylinder: free-slip Y = M T b, ring values y_R (3 inverse transforms of a
 // copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam (3 forward transforms), then the inverses.
 void CapacitanceStokes::Impl::solve_mode_cyl(int kx, const Factors& fac, double alpha, Scratch& s) {
@@ -379,10 +356,7 @@ void CapacitanceStokes::Impl::solve_mode_cyl(int kx, const Factors& fac, double 
   const int np = two ? 2 : 1;
   double* F[2] = {plane(kx), two ? plane(nx - kx) : nullptr};
   double* fb = s.fb.data();
-  if (kx == 0) std::copy_n(F[0] + off[0], std::size_t(ny) * nz, s.y.data());  // b of the axial mean u
-  for (int q = 0; q < np; ++q)
-    for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(F[q] + yz_at[c], F[q] + yz_at[c]);
-  if (two) rotate(F[0], F[1], kx, +1);
+  mode_to_spectral(kx, F, np, s);
   const double gx = gx_of(kx);
   const double syz = 1.0 / (4.0 * ny * nz), inv_n = syz / nx;
   mode_tables(gx, alpha, s);
@@ -404,17 +378,7 @@ void CapacitanceStokes::Impl::solve_mode_cyl(int kx, const Factors& fac, double 
     for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
     apply_M(fb, F[q], gx, s, inv_n, true);
   }
-  if (two) rotate(F[0], F[1], kx, -1);
-  for (int q = 0; q < np; ++q) {
-    double* f = F[q];
-    for (int k = 0; k < nz; ++k) {
-      f[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
-      f[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
-    }
-    std::fill(f + off[2], f + off[2] + ny, 0.0);
-    std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
-    for (int c = 0; c < 4; ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
-  }
+  mode_from_spectral(kx, F, np);
   if (kx == 0) {  // exact axial mean of u on the free faces (masked ones 0), scaled by 1/nx like the planes
     double* u = F[0] + off[0];
     for (std::size_t i = 0; i < u0_id.size(); ++i)

@@ -3,11 +3,9 @@
 // wall lines, the capacitance matrices C(kx) = Dg^{-1} + U^T S_fs(kx)^{-1} U and their factors,
 // the exact axial mean of the x component, and the mode solve.
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 #include "full3d/capacitance_impl.hpp"
-#include "full3d/parallel.hpp"
 
 namespace swim::full3d {
 
@@ -257,10 +255,7 @@ void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alph
   const bool two = paired(kx);
   const int np = two ? 2 : 1;
   double* F[2] = {plane(kx), two ? plane(nx - kx) : nullptr};
-  if (kx == 0) std::copy_n(F[0] + off[0], std::size_t(ny) * nz, s.y.data());  // b of the axial mean u
-  for (int q = 0; q < np; ++q)
-    for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(F[q] + yz_at[c], F[q] + yz_at[c]);
-  if (two) rotate(F[0], F[1], kx, +1);
+  mode_to_spectral(kx, F, np, s);
   const double gx = gx_of(kx);
   const double syz = 1.0 / (4.0 * ny * nz), inv_n = syz / nx;
   mode_tables(gx, alpha, s);
@@ -279,39 +274,11 @@ void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alph
     wall_transform(s.w.col(q).data(), s.r.data(), s);
     apply_M(s.r.data(), F[q], gx, s, inv_n, true);
   }
-  if (two) rotate(F[0], F[1], kx, -1);
-  for (int q = 0; q < np; ++q) {
-    double* f = F[q];
-    for (int k = 0; k < nz; ++k) {  // wall faces (not transformed): zero
-      f[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
-      f[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
-    }
-    std::fill(f + off[2], f + off[2] + ny, 0.0);
-    std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
-    for (int c = 0; c < 4; ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
-  }
+  mode_from_spectral(kx, F, np);
   if (kx == 0) {
     std::copy_n(s.y.data(), std::size_t(ny) * nz, F[0] + off[0]);
     solve_mean_x(F[0] + off[0], alpha);
   }
-}
-
-const CapacitanceStokes::Impl::Factors& CapacitanceStokes::Impl::factors_duct(double alpha) {
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::array<PackedCholesky, 4>> chol(static_cast<std::size_t>(nxh));
-  parallel_blocks(nxh, threads, [&](long b, long e, int t) {
-    for (long kx = b; kx < e; ++kx) {
-      const Eigen::MatrixXd C = capacitance(int(kx), alpha, scratch[t]);
-      factor_blocks(C, chol[kx], kx, alpha, "duct");
-    }
-  });
-  Factors& f = free_slot();
-  f.alpha = alpha;
-  f.chol = std::move(chol);
-  f.bytes = std::size_t(nxh) * factor_doubles * sizeof(double);
-  factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  factorized_last = true;
-  return f;
 }
 
 }  // namespace swim::full3d

@@ -129,10 +129,15 @@ struct CapacitanceStokes::Impl {
   // B: u, v, w coefficients of a plane-shaped array; X: u, v, w, p coefficients; the tables
   // of mode_tables(gx, alpha). subtract: X = scale (X - M B), else X = scale M B (B may alias X).
   void apply_M(const double* B, double* X, double gx, const Scratch& s, double scale, bool subtract) const;
+  // Mode kx's np planes F to the yz spectral (rotated) frame and back (the common first and
+  // last stages of the duct's and the cylinder's mode solves).
+  void mode_to_spectral(int kx, double* const F[2], int np, Scratch& s);
+  void mode_from_spectral(int kx, double* const F[2], int np);
   // Rotation of the x component of a paired mode into the real frame, q = i e^{i theta/2} u^
   // (dir = +1), and back, u^ = -i e^{-i theta/2} q (dir = -1); re / im: the two planes.
   void rotate(double* re, double* im, int kx, int dir) const;
-  // The factors of this alpha: cached, else those of the duct or of the cylinder.
+  // The factors of this alpha: cached, else factorised (the duct's or the cylinder's
+  // capacitance per axial mode; the cylinder's sparse axial-mean factor).
   const Factors& factors(double alpha);
   // Cholesky factors of the symmetry blocks Q_c^T C Q_c of the capacitance C of mode kx.
   // Throws NumericalError (naming the solver `what`) when a block is not positive definite.
@@ -231,7 +236,6 @@ struct CapacitanceStokes::Impl {
   void wall_transform(const double* z, double* R, Scratch& s) const;
   // Capacitance matrix of mode kx: C = Dg^{-1} + U^T S_fs(kx)^{-1} U, one unit solve per column.
   Eigen::MatrixXd capacitance(int kx, double alpha, Scratch& s) const;
-  const Factors& factors_duct(double alpha);
   // Exact no-slip solve of the axial mean of the x component (plane 0, u part, real space,
   // x-unnormalised) in place: u = (alpha - mu L_ns)^{-1} b, scaled by 1/nx like the planes.
   void solve_mean_x(double* f, double alpha);
@@ -274,7 +278,6 @@ struct CapacitanceStokes::Impl {
   // inverse 2D transforms, gather on the ring). kx = 0: the ring x faces are decoupled
   // (g_x = 0, exact zeros) and solved separately; their block is replaced by I.
   Eigen::MatrixXd capacitance_cyl(int kx, double alpha, Scratch& s) const;
-  const Factors& factors_cyl(double alpha);
   // Mode solve for the cylinder: free-slip Y = M T b, ring values y_R (3 inverse transforms of a
   // copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam (3 forward transforms), then the inverses.
   void solve_mode_cyl(int kx, const Factors& fac, double alpha, Scratch& s);

@@ -179,7 +179,26 @@ const CapacitanceStokes::Impl::Factors& CapacitanceStokes::Impl::factors(double 
       factorized_last = false;
       return cache[k];
     }
-  return cyl ? factors_cyl(alpha) : factors_duct(alpha);
+  const auto t0 = std::chrono::steady_clock::now();
+  std::vector<std::array<PackedCholesky, 4>> chol(static_cast<std::size_t>(nxh));
+  parallel_blocks(nxh, threads, [&](long b, long e, int t) {
+    for (long kx = b; kx < e; ++kx) {
+      const Eigen::MatrixXd C =
+          cyl ? capacitance_cyl(int(kx), alpha, scratch[t]) : capacitance(int(kx), alpha, scratch[t]);
+      factor_blocks(C, chol[kx], kx, alpha, cyl ? "cylinder" : "duct");
+    }
+  });
+  auto u0llt = cyl ? factor_mean_x(alpha) : nullptr;
+  Factors& f = free_slot();  // taken only when every factorisation succeeded
+  f.alpha = alpha;
+  f.chol = std::move(chol);
+  f.u0llt = std::move(u0llt);
+  f.bytes = std::size_t(nxh) * factor_doubles * sizeof(double);
+  if (f.u0llt)
+    f.bytes += std::size_t(f.u0llt->matrixL().nestedExpression().nonZeros()) * (sizeof(double) + sizeof(int));
+  factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  factorized_last = true;
+  return f;
 }
 
 // Cholesky factors of the symmetry blocks Q_c^T C Q_c (LAPACK packed lower storage).
@@ -205,6 +224,31 @@ void CapacitanceStokes::Impl::factor_blocks(const Eigen::MatrixXd& C, std::array
                            "change the time step or the grid (full3d.grid.cells_across), or use "
                            "full3d.cylinder_wall = \"ghost_linear\" (iterative solver)");
     }
+  }
+}
+
+// Forward yz transforms of the np planes F of mode kx and, for a paired mode, the rotation
+// into the real frame; kx = 0: the axial-mean x part of b is kept in s.y first.
+void CapacitanceStokes::Impl::mode_to_spectral(int kx, double* const F[2], int np, Scratch& s) {
+  if (kx == 0) std::copy_n(F[0] + off[0], std::size_t(ny) * nz, s.y.data());  // b of the axial mean u
+  for (int q = 0; q < np; ++q)
+    for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(F[q] + yz_at[c], F[q] + yz_at[c]);
+  if (np == 2) rotate(F[0], F[1], kx, +1);
+}
+
+// The way back: rotation of a paired mode, the wall faces (not transformed) set to zero,
+// the inverse yz transforms of u, v, w, p.
+void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int np) {
+  if (np == 2) rotate(F[0], F[1], kx, -1);
+  for (int q = 0; q < np; ++q) {
+    double* f = F[q];
+    for (int k = 0; k < nz; ++k) {
+      f[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
+      f[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
+    }
+    std::fill(f + off[2], f + off[2] + ny, 0.0);
+    std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
+    for (int c = 0; c < 4; ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
   }
 }
 

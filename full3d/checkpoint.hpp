@@ -18,6 +18,7 @@
 // positions, sizes) are in run3d_checkpoint.hpp.
 #pragma once
 
+#include <concepts>
 #include <cstdint>
 #include <map>
 #include <string>
@@ -80,6 +81,36 @@ class CheckpointReader {
   std::string buf_, path_;
   std::map<std::string, Record> records_;
   const Record& find(const std::string& name, char kind) const;
+};
+
+/// A part of a run lists its records once, as calls f(name, member) (or f(name, data, n)
+/// for an array of fixed size), and runs that list with CheckpointOut to write and with
+/// CheckpointIn to read: the names of both directions cannot drift apart. Integers and
+/// flags are stored as 64-bit integers.
+class CheckpointOut {
+ public:
+  explicit CheckpointOut(CheckpointWriter& w) : w_(w) {}
+  void operator()(const std::string& name, double v) { w_.put(name, v); }
+  template <std::integral I>
+  void operator()(const std::string& name, I v) { w_.put(name, std::int64_t(v)); }
+  void operator()(const std::string& name, const std::vector<double>& v) { w_.put(name, v); }
+  void operator()(const std::string& name, const double* v, std::size_t n) { w_.put(name, v, n); }
+
+ private:
+  CheckpointWriter& w_;
+};
+
+class CheckpointIn {
+ public:
+  explicit CheckpointIn(const CheckpointReader& r) : r_(r) {}
+  void operator()(const std::string& name, double& v) { v = r_.get_double(name); }
+  template <std::integral I>
+  void operator()(const std::string& name, I& v) { v = static_cast<I>(r_.get_int(name)); }
+  void operator()(const std::string& name, std::vector<double>& v) { v = r_.get_vector(name); }
+  void operator()(const std::string& name, double* v, std::size_t n) { r_.get_into(name, v, n); }
+
+ private:
+  const CheckpointReader& r_;
 };
 
 }  // namespace swim::full3d

@@ -133,47 +133,38 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
 }
 
 // --- checkpoint records ------------------------------------------------------------
+template <class Self, class F>
+void Measurements::records(Self& self, F&& f) {
+  f("x_center0", self.x_center0_);
+  f("volume_rear", self.vol_rear_);
+  f("volume_front", self.vol_front_);
+  f("flux_rear", self.q_rear_);
+  f("flux_front", self.q_front_);
+  f("flux_rear_prev", self.q_rear_prev_);
+  f("flux_front_prev", self.q_front_prev_);
+  f("max_cfl", self.max_cfl_);
+  f("stokes_iterations_total", self.iterations_total_);
+  f("last_cfl", self.last_cfl_);
+  f("last_stokes_iterations", self.last_iterations_);
+  f("last_divergence", self.last_divergence_);
+  f("radius_times", self.radius_times_);
+  f("radius", self.radius_);
+  f("last_recorded", self.last_recorded_);
+}
+
 void Measurements::save(CheckpointWriter& w) const {
-  w.put("x_center0", x_center0_);
-  w.put("volume_rear", vol_rear_);
-  w.put("volume_front", vol_front_);
-  w.put("flux_rear", q_rear_);
-  w.put("flux_front", q_front_);
-  w.put("flux_rear_prev", q_rear_prev_);
-  w.put("flux_front_prev", q_front_prev_);
-  w.put("max_cfl", max_cfl_);
-  w.put("stokes_iterations_total", std::int64_t(iterations_total_));
-  w.put("last_cfl", last_cfl_);
-  w.put("last_stokes_iterations", std::int64_t(last_iterations_));
-  w.put("last_divergence", last_divergence_);
-  std::vector<double> flat;
+  records(*this, CheckpointOut(w));
+  std::vector<double> flat;  // the series, row by row
   for (const auto& row : series_) flat.insert(flat.end(), row.begin(), row.end());
   w.put("series", flat);
-  w.put("radius_times", radius_times_);
-  w.put("radius", radius_);
-  w.put("last_recorded", std::int64_t(last_recorded_));
 }
 
 void Measurements::load(const CheckpointReader& r) {
-  x_center0_ = r.get_double("x_center0");
-  vol_rear_ = r.get_double("volume_rear");
-  vol_front_ = r.get_double("volume_front");
-  q_rear_ = r.get_double("flux_rear");
-  q_front_ = r.get_double("flux_front");
-  q_rear_prev_ = r.get_double("flux_rear_prev");
-  q_front_prev_ = r.get_double("flux_front_prev");
-  max_cfl_ = r.get_double("max_cfl");
-  iterations_total_ = r.get_int("stokes_iterations_total");
-  last_cfl_ = r.get_double("last_cfl");
-  last_iterations_ = r.get_int("last_stokes_iterations");
-  last_divergence_ = r.get_double("last_divergence");
+  records(*this, CheckpointIn(r));
   const auto flat = r.get_vector("series");
   const size_t nc = kSeriesColumns.size();
   series_.clear();
   for (size_t k = 0; k + nc <= flat.size(); k += nc) series_.emplace_back(flat.begin() + k, flat.begin() + k + nc);
-  radius_times_ = r.get_vector("radius_times");
-  radius_ = r.get_vector("radius");
-  last_recorded_ = r.get_int("last_recorded");
 }
 
 }  // namespace swim::full3d

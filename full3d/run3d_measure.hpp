@@ -47,6 +47,9 @@ class Measurements {
   void load(const CheckpointReader& r);
 
  private:
+  /// The checkpoint records of the measurements, f(name, member) (checkpoint.hpp).
+  template <class Self, class F>
+  static void records(Self& self, F&& f);
   double kinetic_energy(const IbState& s) const;
   double disc_flux(int ring, const IbState& s, const MacGrid& grid) const;
 

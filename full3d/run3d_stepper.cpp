@@ -208,81 +208,57 @@ scene::json Stepper::time_step_summary() const {
 }
 
 // --- checkpoint records ------------------------------------------------------------
+template <class Self, class F>
+void Stepper::records(Self& self, F&& f) {
+  f("step", self.n_);
+  f("t", self.s_.t);
+  f("X", self.s_.X.data(), std::size_t(self.s_.X.size()));
+  f("V", self.s_.V.data(), std::size_t(self.s_.V.size()));
+  f("V_prev", self.s_.V_prev.data(), std::size_t(self.s_.V_prev.size()));
+  if (self.ib_)
+    for (int c = 0; c < 3; ++c) f(kVelocityRecords[c], self.s_.u.c[c].data(), self.s_.u.c[c].size());
+  auto& st = self.protocol_.state();
+  f("phase", st.phase);
+  f("active", st.active);
+  f("cycles_completed", st.cycles_completed);
+  f("switches", st.switches);
+  f("cycle_start", st.cycle_start);
+  f("cycle_end", st.cycle_end);
+  f("segment_reached", st.segment_reached);
+  f("step_marks", self.step_marks_);
+  f("dt_next", self.dt_next_);
+  f("dt_last", self.dt_last_);
+  f("dt_before_last", self.dt_before_last_);
+  f("dt_used_min", self.dt_used_min_);
+  f("dt_used_max", self.dt_used_max_);
+  f("last_speed", self.last_speed_);
+  f("last_dv", self.last_dv_);
+  f("lambda", self.lambda_);
+  f("lambda_max_seen", self.lambda_max_seen_);
+  f("lambda_step", self.lambda_step_);
+  f("estimates", self.estimates_);
+  f("rejected", self.rejected_);
+  f("after_event", self.after_event_);
+  for (auto& [k, v] : self.bound_count_) f("steps_by_bound." + k, v);
+}
+
 void Stepper::save(CheckpointWriter& w) const {
-  w.put("step", std::int64_t(n_));
-  w.put("t", s_.t);
-  w.put("X", s_.X.data(), s_.X.size());
-  w.put("V", s_.V.data(), s_.V.size());
-  w.put("V_prev", s_.V_prev.data(), s_.V_prev.size());
-  if (ib_) {
-    for (int c = 0; c < 3; ++c) w.put(kVelocityRecords[c], s_.u.c[c]);
-    w.put("p", ib_->stokes().pressure().v);
-  }
-  const auto& st = protocol_.state();
-  w.put("phase", std::int64_t(st.phase));
-  w.put("active", std::int64_t(st.active));
-  w.put("cycles_completed", std::int64_t(st.cycles_completed));
-  w.put("switches", std::int64_t(st.switches));
-  w.put("cycle_start", st.cycle_start);
-  w.put("cycle_end", st.cycle_end);
-  w.put("segment_reached", st.segment_reached);
-  w.put("step_marks", step_marks_);
-  w.put("dt_next", dt_next_);
-  w.put("dt_last", dt_last_);
-  w.put("dt_before_last", dt_before_last_);
-  w.put("dt_used_min", dt_used_min_);
-  w.put("dt_used_max", dt_used_max_);
-  w.put("last_speed", last_speed_);
-  w.put("last_dv", last_dv_);
-  w.put("lambda", lambda_);
-  w.put("lambda_max_seen", lambda_max_seen_);
-  w.put("lambda_step", std::int64_t(lambda_step_));
-  w.put("estimates", std::int64_t(estimates_));
-  w.put("rejected", std::int64_t(rejected_));
-  w.put("after_event", std::int64_t(after_event_ ? 1 : 0));
-  w.put("r_active_prev", std::isfinite(r_active_prev_) ? r_active_prev_ : -1.0);
-  for (const auto& [k, v] : bound_count_) w.put("steps_by_bound." + k, std::int64_t(v));
+  records(*this, CheckpointOut(w));
+  // The duct's PCG is warm-started from the previous pressure: with it, the resumed run
+  // repeats the uninterrupted one to round-off.
+  if (ib_) w.put("p", ib_->stokes().pressure().v);
+  w.put("r_active_prev", std::isfinite(r_active_prev_) ? r_active_prev_ : -1.0);  // NaN: none
 }
 
 void Stepper::load(const CheckpointReader& r) {
-  n_ = r.get_int("step");
-  s_.t = r.get_double("t");
-  r.get_into("X", s_.X.data(), s_.X.size());
-  r.get_into("V", s_.V.data(), s_.V.size());
-  r.get_into("V_prev", s_.V_prev.data(), s_.V_prev.size());
+  records(*this, CheckpointIn(r));
   if (ib_) {
-    for (int c = 0; c < 3; ++c) r.get_into(kVelocityRecords[c], s_.u.c[c].data(), s_.u.c[c].size());
-    // The duct's PCG is warm-started from the previous pressure: restore it so that the
-    // resumed run repeats the uninterrupted one to round-off.
     ScalarField pr = ib_->stokes().pressure();
     r.get_into("p", pr.v.data(), pr.v.size());
     ib_->stokes().set_pressure(pr);
   }
-  auto& st = protocol_.state();
-  st.phase = int(r.get_int("phase"));
-  st.active = int(r.get_int("active"));
-  st.cycles_completed = int(r.get_int("cycles_completed"));
-  st.switches = r.get_int("switches");
-  st.cycle_start = r.get_vector("cycle_start");
-  st.cycle_end = r.get_vector("cycle_end");
-  st.segment_reached = r.get_vector("segment_reached");
-  step_marks_ = r.get_vector("step_marks");
-  dt_next_ = r.get_double("dt_next");
-  dt_last_ = r.get_double("dt_last");
-  dt_before_last_ = r.get_double("dt_before_last");
-  dt_used_min_ = r.get_double("dt_used_min");
-  dt_used_max_ = r.get_double("dt_used_max");
-  last_speed_ = r.get_double("last_speed");
-  last_dv_ = r.get_double("last_dv");
-  lambda_ = r.get_double("lambda");
-  lambda_max_seen_ = r.get_double("lambda_max_seen");
-  lambda_step_ = r.get_int("lambda_step");
-  estimates_ = r.get_int("estimates");
-  rejected_ = r.get_int("rejected");
-  after_event_ = r.get_int("after_event") != 0;
   const double rp = r.get_double("r_active_prev");
   r_active_prev_ = rp >= 0.0 ? rp : std::numeric_limits<double>::quiet_NaN();
-  for (auto& [k, v] : bound_count_) v = r.get_int("steps_by_bound." + k);
   t_prev_ = s_.t;
 }
 

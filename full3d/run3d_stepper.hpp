@@ -60,6 +60,9 @@ class Stepper {
   void load(const CheckpointReader& r);
 
  private:
+  /// The checkpoint records of the stepping state, f(name, member) (checkpoint.hpp).
+  template <class Self, class F>
+  static void records(Self& self, F&& f);
   double ladder(double dt) const;
   void next_step(int switches);
 
