@@ -1,20 +1,11 @@
 #include "full3d/run3d.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <limits>
-#include <map>
-#include <memory>
 #include <optional>
 
 #include "common/errors.hpp"
-#include "common/output.hpp"
 #include "common/progress.hpp"
-#include "common/vtk.hpp"
 #include "full3d/run3d_checkpoint.hpp"
 #include "full3d/run3d_measure.hpp"
 #include "full3d/run3d_output.hpp"
