@@ -292,13 +292,11 @@ void CapacitanceStokes::Impl::clear_ring_unit(int a, double* R) const {
 // header): one unit solve per column (separable forward transform, spectral projection, three
 // inverse 2D transforms, gather on the ring). kx = 0: the ring x faces are decoupled
 // (g_x = 0, exact zeros) and solved separately; their block is replaced by I.
-Eigen::MatrixXd CapacitanceStokes::Impl::capacitance_cyl(int kx, double alpha, Scratch& s) const {
-  const double gx = gx_of(kx);
+Eigen::MatrixXd CapacitanceStokes::Impl::capacitance_cyl(int kx, double gx, Scratch& s) const {
   const double syz = 1.0 / (4.0 * ny * nz);
-  Eigen::MatrixXd C(m, m);
-  std::fill(s.r.begin(), s.r.end(), 0.0);
-  mode_tables(gx, alpha, s);
   double* fb = s.fb.data();
+  std::fill(s.r.begin(), s.r.end(), 0.0);
+  Eigen::MatrixXd C(m, m);
   for (int a : orbit_rep) {
     ring_unit_transform(a, s.r.data());
     apply_M(s.r.data(), fb, gx, s, syz, false);
@@ -349,19 +347,14 @@ Eigen::MatrixXd CapacitanceStokes::Impl::capacitance_cyl(int kx, double alpha, S
   return Cs;
 }
 
-// Mode solve for the cylinder: free-slip Y = M T b, ring values y_R (3 inverse transforms of a
-// copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam (3 forward transforms), then the inverses.
-void CapacitanceStokes::Impl::solve_mode_cyl(int kx, const Factors& fac, double alpha, Scratch& s) {
-  const bool two = paired(kx);
-  const int np = two ? 2 : 1;
-  double* F[2] = {plane(kx), two ? plane(nx - kx) : nullptr};
+// The ring correction of mode kx on its np planes F, which hold the free-slip solution
+// Y = M T b: ring values y_R (3 inverse transforms of a copy), lam = C^{-1} y_R,
+// X = Y - M T E_R^T lam (3 forward transforms).
+void CapacitanceStokes::Impl::correct_ring(int kx, double* const F[2], int np, double gx, const Factors& fac,
+                                           Scratch& s) const {
   double* fb = s.fb.data();
-  mode_to_spectral(kx, F, np, s);
-  const double gx = gx_of(kx);
   const double syz = 1.0 / (4.0 * ny * nz), inv_n = syz / nx;
-  mode_tables(gx, alpha, s);
   for (int q = 0; q < np; ++q) {
-    apply_M(F[q], F[q], gx, s, 1.0, false);
     std::copy_n(F[q], std::size_t(off[3]), fb);
     for (int c = 0; c < 3; ++c) yz_inv[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
     double* w = s.w.col(q).data();
@@ -378,14 +371,15 @@ void CapacitanceStokes::Impl::solve_mode_cyl(int kx, const Factors& fac, double 
     for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
     apply_M(fb, F[q], gx, s, inv_n, true);
   }
-  mode_from_spectral(kx, F, np);
-  if (kx == 0) {  // exact axial mean of u on the free faces (masked ones 0), scaled by 1/nx like the planes
-    double* u = F[0] + off[0];
-    for (std::size_t i = 0; i < u0_id.size(); ++i)
-      if (u0_id[i] >= 0) s.u0b[u0_id[i]] = s.y[i];
-    s.u0x = fac.u0llt->solve(s.u0b);
-    for (std::size_t i = 0; i < u0_id.size(); ++i) u[i] = u0_id[i] >= 0 ? s.u0x[u0_id[i]] / nx : 0.0;
-  }
+}
+
+// Exact axial mean of u on the free faces (masked ones 0) into u (plane 0, real space),
+// scaled by 1/nx like the planes; its right-hand side was kept in s.y.
+void CapacitanceStokes::Impl::mean_x_ring(double* u, const Factors& fac, Scratch& s) const {
+  for (std::size_t i = 0; i < u0_id.size(); ++i)
+    if (u0_id[i] >= 0) s.u0b[u0_id[i]] = s.y[i];
+  s.u0x = fac.u0llt->solve(s.u0b);
+  for (std::size_t i = 0; i < u0_id.size(); ++i) u[i] = u0_id[i] >= 0 ? s.u0x[u0_id[i]] / nx : 0.0;
 }
 
 bool CapacitanceStokes::supports_cylinder(const MacGrid& g, const CylinderOptions& cylinder) {

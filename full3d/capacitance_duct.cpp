@@ -215,12 +215,10 @@ void CapacitanceStokes::Impl::wall_transform(const double* z, double* R, Scratch
 }
 
 // Capacitance matrix of mode kx: C = Dg^{-1} + U^T S_fs(kx)^{-1} U, one unit solve per column.
-Eigen::MatrixXd CapacitanceStokes::Impl::capacitance(int kx, double alpha, Scratch& s) const {
-  const double gx = gx_of(kx);
+Eigen::MatrixXd CapacitanceStokes::Impl::capacitance(int kx, double gx, Scratch& s) const {
   const double syz = 1.0 / (4.0 * ny * nz);
   Eigen::MatrixXd C(m, m);
   std::fill(s.e.begin(), s.e.end(), 0.0);
-  mode_tables(gx, alpha, s);
   for (int a = 0; a < m; ++a) {
     s.e[a] = 1.0;
     wall_transform(s.e.data(), s.r.data(), s);
@@ -250,34 +248,20 @@ void CapacitanceStokes::Impl::solve_mean_x(double* f, double alpha) {
   std::copy_n(u0.data(), std::size_t(ny) * nz, f);
 }
 
-// The whole cross-section solve of axial mode kx on its one or two planes.
-void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alpha, Scratch& s) {
-  const bool two = paired(kx);
-  const int np = two ? 2 : 1;
-  double* F[2] = {plane(kx), two ? plane(nx - kx) : nullptr};
-  mode_to_spectral(kx, F, np, s);
-  const double gx = gx_of(kx);
+// The Woodbury correction of mode kx on its np planes F, which hold the free-slip solution
+// Y = M T b: wall values U^T y, z = C^{-1} U^T y, X = Y - M T (U z), normalised.
+void CapacitanceStokes::Impl::correct_walls(int kx, double* const F[2], int np, double gx, const Factors& fac,
+                                            Scratch& s) const {
   const double syz = 1.0 / (4.0 * ny * nz), inv_n = syz / nx;
-  mode_tables(gx, alpha, s);
-  // free-slip solution Y = M T b (in place), and its wall values U^T y
-  for (int q = 0; q < np; ++q) {
-    apply_M(F[q], F[q], gx, s, 1.0, false);
-    wall_values(F[q], s.w.col(q).data(), s);
-  }
-  // z = C^{-1} U^T y (syz: the normalisation of the inverse transform)
+  for (int q = 0; q < np; ++q) wall_values(F[q], s.w.col(q).data(), s);
+  // (syz: the normalisation of the inverse transform)
   for (int q = 0; q < np; ++q)
     for (int i = 0; i < m; ++i) s.w(i, q) *= syz;
   // to the symmetry-adapted basis (s.e: 2 columns of m), the four block solves, and back
   block_solve(fac.chol[kx], np, s);
-  // X = Y - M T (U z), normalised
   for (int q = 0; q < np; ++q) {
     wall_transform(s.w.col(q).data(), s.r.data(), s);
     apply_M(s.r.data(), F[q], gx, s, inv_n, true);
-  }
-  mode_from_spectral(kx, F, np);
-  if (kx == 0) {
-    std::copy_n(s.y.data(), std::size_t(ny) * nz, F[0] + off[0]);
-    solve_mean_x(F[0] + off[0], alpha);
   }
 }
 

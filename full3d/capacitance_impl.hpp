@@ -133,6 +133,8 @@ struct CapacitanceStokes::Impl {
   // last stages of the duct's and the cylinder's mode solves).
   void mode_to_spectral(int kx, double* const F[2], int np, Scratch& s);
   void mode_from_spectral(int kx, double* const F[2], int np);
+  // The whole cross-section solve of axial mode kx on its one or two planes.
+  void solve_mode(int kx, const Factors& fac, double alpha, Scratch& s);
   // Rotation of the x component of a paired mode into the real frame, q = i e^{i theta/2} u^
   // (dir = +1), and back, u^ = -i e^{-i theta/2} q (dir = -1); re / im: the two planes.
   void rotate(double* re, double* im, int kx, int dir) const;
@@ -235,12 +237,13 @@ struct CapacitanceStokes::Impl {
   // across it (the line's cross-direction basis values). Writes every coefficient of u, v, w.
   void wall_transform(const double* z, double* R, Scratch& s) const;
   // Capacitance matrix of mode kx: C = Dg^{-1} + U^T S_fs(kx)^{-1} U, one unit solve per column.
-  Eigen::MatrixXd capacitance(int kx, double alpha, Scratch& s) const;
+  // (x symbol gx; the tables of mode_tables(gx, alpha) in s)
+  Eigen::MatrixXd capacitance(int kx, double gx, Scratch& s) const;
   // Exact no-slip solve of the axial mean of the x component (plane 0, u part, real space,
   // x-unnormalised) in place: u = (alpha - mu L_ns)^{-1} b, scaled by 1/nx like the planes.
   void solve_mean_x(double* f, double alpha);
-  // The whole cross-section solve of axial mode kx on its one or two planes.
-  void solve_mode(int kx, const Factors& fac, double alpha, Scratch& s);
+  // Mode kx's Woodbury correction of the free-slip solution in F (see correct_ring).
+  void correct_walls(int kx, double* const F[2], int np, double gx, const Factors& fac, Scratch& s) const;
 
   // ==== staircase cylinder: constrained solve on the ring faces (capacitance_cylinder.cpp) ==
   bool cyl = false;
@@ -277,10 +280,13 @@ struct CapacitanceStokes::Impl {
   // header): one unit solve per column (separable forward transform, spectral projection, three
   // inverse 2D transforms, gather on the ring). kx = 0: the ring x faces are decoupled
   // (g_x = 0, exact zeros) and solved separately; their block is replaced by I.
-  Eigen::MatrixXd capacitance_cyl(int kx, double alpha, Scratch& s) const;
-  // Mode solve for the cylinder: free-slip Y = M T b, ring values y_R (3 inverse transforms of a
-  // copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam (3 forward transforms), then the inverses.
-  void solve_mode_cyl(int kx, const Factors& fac, double alpha, Scratch& s);
+  // (x symbol gx; the tables of mode_tables(gx, alpha) in s)
+  Eigen::MatrixXd capacitance_cyl(int kx, double gx, Scratch& s) const;
+  // Mode kx's ring correction of the free-slip solution Y = M T b in its np planes F: ring
+  // values y_R (3 inverse transforms of a copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam.
+  void correct_ring(int kx, double* const F[2], int np, double gx, const Factors& fac, Scratch& s) const;
+  // The cylinder's axial mean of u (kx = 0) from its sparse factor.
+  void mean_x_ring(double* u, const Factors& fac, Scratch& s) const;
 };
 
 }  // namespace swim::full3d

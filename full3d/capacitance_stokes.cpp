@@ -183,8 +183,9 @@ const CapacitanceStokes::Impl::Factors& CapacitanceStokes::Impl::factors(double 
   std::vector<std::array<PackedCholesky, 4>> chol(static_cast<std::size_t>(nxh));
   parallel_blocks(nxh, threads, [&](long b, long e, int t) {
     for (long kx = b; kx < e; ++kx) {
-      const Eigen::MatrixXd C =
-          cyl ? capacitance_cyl(int(kx), alpha, scratch[t]) : capacitance(int(kx), alpha, scratch[t]);
+      const double gx = gx_of(int(kx));
+      mode_tables(gx, alpha, scratch[t]);
+      const Eigen::MatrixXd C = cyl ? capacitance_cyl(int(kx), gx, scratch[t]) : capacitance(int(kx), gx, scratch[t]);
       factor_blocks(C, chol[kx], kx, alpha, cyl ? "cylinder" : "duct");
     }
   });
@@ -223,6 +224,31 @@ void CapacitanceStokes::Impl::factor_blocks(const Eigen::MatrixXd& C, std::array
                                " (rho/dt = " + std::to_string(alpha) + "; " + e.what() + ")",
                            "change the time step or the grid (full3d.grid.cells_across), or use "
                            "full3d.cylinder_wall = \"ghost_linear\" (iterative solver)");
+    }
+  }
+}
+
+// The whole cross-section solve of axial mode kx on its one or two planes: to the spectral
+// frame, the free-slip solution Y = M T b, the correction of the duct walls or of the
+// cylinder's ring, back to real space, and the exactly solved axial mean of u (kx = 0).
+void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alpha, Scratch& s) {
+  const int np = paired(kx) ? 2 : 1;
+  double* const F[2] = {plane(kx), np == 2 ? plane(nx - kx) : nullptr};
+  mode_to_spectral(kx, F, np, s);
+  const double gx = gx_of(kx);
+  mode_tables(gx, alpha, s);
+  for (int q = 0; q < np; ++q) apply_M(F[q], F[q], gx, s, 1.0, false);
+  if (cyl)
+    correct_ring(kx, F, np, gx, fac, s);
+  else
+    correct_walls(kx, F, np, gx, fac, s);
+  mode_from_spectral(kx, F, np);
+  if (kx == 0) {
+    if (cyl) {
+      mean_x_ring(F[0] + off[0], fac, s);
+    } else {
+      std::copy_n(s.y.data(), std::size_t(ny) * nz, F[0] + off[0]);
+      solve_mean_x(F[0] + off[0], alpha);
     }
   }
 }
@@ -335,12 +361,7 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
     xfwd[t].execute();
   });
   parallel_blocks(nxh, threads, [&](long kb, long ke, int t) {
-    for (long kx = kb; kx < ke; ++kx) {
-      if (cyl)
-        solve_mode_cyl(int(kx), fac, alpha, scratch[t]);
-      else
-        solve_mode(int(kx), fac, alpha, scratch[t]);
-    }
+    for (long kx = kb; kx < ke; ++kx) solve_mode(int(kx), fac, alpha, scratch[t]);
   });
   parallel_blocks(off[4], threads, [&](long rb, long re, int t) {
     xbwd[t].execute();
