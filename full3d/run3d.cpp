@@ -51,11 +51,7 @@ class Runner {
     RunOutcome res;
     const auto t0 = std::chrono::steady_clock::now();
     if (ctl_.resume) {
-      const CheckpointReader r = checkpoint_.open();
-      stepper_.load(r);
-      measured_.load(r);
-      output_.load(r);
-      wall_before_ = r.get_double("wall_time_s");
+      wall_before_ = checkpoint_.restore(stepper_, measured_, output_);
     } else {
       stepper_.start();
       measured_.start(stepper_.state());

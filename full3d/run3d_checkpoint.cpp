@@ -129,4 +129,12 @@ CheckpointReader RunCheckpoint::open() const {
   return r;
 }
 
+double RunCheckpoint::restore(Stepper& stepper, Measurements& measured, RunOutput& output) const {
+  const CheckpointReader r = open();
+  stepper.load(r);
+  measured.load(r);
+  output.load(r);
+  return r.get_double(kWallTime);
+}
+
 }  // namespace swim::full3d

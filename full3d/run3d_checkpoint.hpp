@@ -34,6 +34,8 @@ class RunCheckpoint {
   void save(const Stepper& stepper, const Measurements& measured, const RunOutput& output, double wall) const;
   /// Reads and validates checkpoint.bin (see above). Throws InputError.
   CheckpointReader open() const;
+  /// open(), then restores the parts; returns the wall time of the run so far, s.
+  double restore(Stepper& stepper, Measurements& measured, RunOutput& output) const;
 
   /// The hash of the scene as it must match on resume.
   static std::uint64_t scene_hash(const scene::json& resolved);
