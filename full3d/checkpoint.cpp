@@ -31,11 +31,11 @@ T load(const std::string& buf, std::size_t pos) {
 
 const char* kind_name(char k) {
   switch (k) {
-    case 'd': return "number";
-    case 'i': return "integer";
-    case 's': return "text";
-    case 'a': return "array";
-    default: return "unknown";
+    case 'd': return "a number";
+    case 'i': return "an integer";
+    case 's': return "a text";
+    case 'a': return "an array";
+    default: return "of unknown kind";
   }
 }
 
@@ -159,7 +159,7 @@ const CheckpointReader::Record& CheckpointReader::find(const std::string& name, 
   const auto it = records_.find(name);
   if (it == records_.end()) damaged("the checkpoint has no record '" + name + "'");
   if (it->second.kind != kind)
-    damaged(std::string("the checkpoint's record '") + name + "' is a " + kind_name(it->second.kind) + ", expected a " +
+    damaged(std::string("the checkpoint's record '") + name + "' is " + kind_name(it->second.kind) + ", expected " +
             kind_name(kind));
   return it->second;
 }

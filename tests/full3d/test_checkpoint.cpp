@@ -112,8 +112,7 @@ TEST(CheckpointFile, RecordsAreReadBackByName) {
   EXPECT_TRUE(r.get_vector("empty").empty());
   EXPECT_EQ(r.first_non_finite(), "");
   EXPECT_TRUE(has(refusal([&] { r.get_double("missing"); }), "no record 'missing'"));
-  EXPECT_TRUE(has(refusal([&] { r.get_int("t"); }), "is a number, expected a integer") ||
-              has(refusal([&] { r.get_int("t"); }), "expected"));
+  EXPECT_TRUE(has(refusal([&] { r.get_int("t"); }), "record 't' is a number, expected an integer"));
   double three[3];
   EXPECT_TRUE(has(refusal([&] { r.get_into("X", three, 3); }), "different grid or mesh"));
 }
