@@ -1,5 +1,3 @@
-#include <sys/statvfs.h>
-
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -67,21 +65,14 @@ void print_summary_1d(const std::string& name, const scene::json& s, double wall
 }
 
 // A failure after the folder was taken: the summary says so (exit 3 for a write failure).
-// Errors of the checkpoint writer (full3d/checkpoint.cpp) arrive as "cannot write ...".
 [[noreturn]] void fail_run(output::RunFolder& folder, const std::exception& e) {
-  const std::string m = e.what();
-  if (dynamic_cast<const OutputError*>(&e) || m.rfind("cannot write", 0) == 0) {
-    const bool marked = folder.mark_failed(m);
+  if (dynamic_cast<const OutputError*>(&e)) {
+    const bool marked = folder.mark_failed(e.what());
     std::fprintf(stderr, "swim: partial results in %s are %s\n", folder.dir().c_str(),
                  marked ? "marked failed in summary.json" : "incomplete (summary.json removed)");
-    if (dynamic_cast<const OutputError*>(&e)) throw;
-    // "cannot write checkpoint <path>": name the file and say whether the disk is full
-    struct statvfs fs_stat {};
-    const bool full = ::statvfs(folder.dir().c_str(), &fs_stat) == 0 && fs_stat.f_bavail == 0;
-    const std::string file = m.find("checkpoint") != std::string::npos ? "checkpoint.bin" : m.substr(13);
-    throw OutputError(file, full ? "disk full" : "write error");
+    throw;
   }
-  if (!dynamic_cast<const InputError*>(&e)) folder.mark_failed(m);
+  if (!dynamic_cast<const InputError*>(&e)) folder.mark_failed(e.what());
   throw;
 }
 
@@ -98,6 +89,12 @@ int run3d(const RunOptions& o, const scene::json& sc) {
   const std::string out = !o.resume.empty() ? o.resume : o.out.empty() ? "out/" + p.name + "-3d" : o.out;
   if (!o.resume.empty() && !fs::exists(full3d::checkpoint_path(out)))
     throw InputError("--resume", o.resume, "no checkpoint.bin in this folder");
+  // a damaged or foreign checkpoint is refused before the folder is touched (a folder of
+  // another tier is refused by the RunFolder below, naming its tier)
+  if (!o.resume.empty()) {
+    const std::string tier = output::RunFolder::tier_of(out);
+    if (tier.empty() || tier == "3d") full3d::check_resumable(p, resolved, out);
+  }
   output::RunFolder folder(out, {"3d", resolved, o.overwrite, !o.resume.empty(), o.resume.empty() ? "--out" : "--resume"});
   full3d::RunControl ctl;
   ctl.progress = o.progress;

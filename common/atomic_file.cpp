@@ -13,20 +13,13 @@
 #include <mutex>
 #include <streambuf>
 
+#include "common/checksum.hpp"
 #include "common/errors.hpp"
 
 namespace swim::output {
 namespace fs = std::filesystem;
 
 namespace {
-
-constexpr std::uint64_t kFnvOffset = 1469598103934665603ull, kFnvPrime = 1099511628211ull;
-
-std::string hex64(std::uint64_t v) {
-  char b[20];
-  std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(v));
-  return b;
-}
 
 std::string reason_of(int err) {
   if (err == ENOSPC) return "disk full";
@@ -99,7 +92,7 @@ class FdBuf : public std::streambuf {
     if (error_) return false;
     const char* p = pbase();
     std::size_t n = static_cast<std::size_t>(pptr() - pbase());
-    for (std::size_t k = 0; k < n; ++k) sum_ = (sum_ ^ static_cast<unsigned char>(p[k])) * kFnvPrime;
+    sum_ = fnv1a64(p, n, sum_);
     while (n > 0) {
       std::size_t chunk = n;
       if (fail_after_ >= 0) {
@@ -128,7 +121,7 @@ class FdBuf : public std::streambuf {
   long long fail_after_;
   int error_ = 0;
   std::uintmax_t bytes_ = 0;
-  std::uint64_t sum_ = kFnvOffset;
+  std::uint64_t sum_ = kFnv1a64Offset;
   char buf_[1 << 16];
 };
 
@@ -248,11 +241,11 @@ void reset_ledger(const std::string& dir) {
 std::string file_checksum(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";
-  std::uint64_t sum = kFnvOffset;
+  std::uint64_t sum = kFnv1a64Offset;
   char b[1 << 16];
   while (in) {
     in.read(b, sizeof b);
-    for (std::streamsize k = 0; k < in.gcount(); ++k) sum = (sum ^ static_cast<unsigned char>(b[k])) * kFnvPrime;
+    sum = fnv1a64(b, static_cast<std::size_t>(in.gcount()), sum);
   }
   return hex64(sum);
 }

@@ -15,6 +15,7 @@
 #include <set>
 
 #include "common/atomic_file.hpp"
+#include "common/checksum.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/strict_json.hpp"
@@ -55,15 +56,22 @@ std::string list(const std::vector<std::string>& v, std::size_t max = 5) {
   return s;
 }
 
+// The tier of a folder's run: its run record, else its summary; "" when neither says.
+std::string tier_in(const scene::json& owner, const scene::json& summary) {
+  for (const scene::json* j : {&owner, &summary})
+    if (j->is_object() && j->contains("tier") && (*j)["tier"].is_string()) return (*j)["tier"].get<std::string>();
+  return "";
+}
+
 }  // namespace
+
+std::string RunFolder::tier_of(const std::string& dir) {
+  return tier_in(read_json(fs::path(dir) / kOwner), read_json(fs::path(dir) / "summary.json"));
+}
 
 std::string json_hash(const scene::json& value) {
   const std::string s = value.dump(-1, ' ', false, scene::json::error_handler_t::replace);
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : s) h = (h ^ c) * 1099511628211ull;
-  char b[20];
-  std::snprintf(b, sizeof b, "%016llx", static_cast<unsigned long long>(h));
-  return b;
+  return hex64(fnv1a64(s));
 }
 
 bool RunFolder::is_result_name(const std::string& rel) {
@@ -123,11 +131,7 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
 
     const scene::json owner = read_json(fs::path(dir_) / kOwner);
     const std::string hash = json_hash(o.resolved);
-    const std::string old_tier = owner.is_object() && owner.contains("tier") && owner["tier"].is_string()
-                                     ? owner["tier"].get<std::string>()
-                                 : old_summary.is_object() && old_summary.contains("tier") && old_summary["tier"].is_string()
-                                     ? old_summary["tier"].get<std::string>()
-                                     : "";
+    const std::string old_tier = tier_in(owner, old_summary);
     const std::string old_status = old_summary.is_object() && old_summary.contains("status") &&
                                            old_summary["status"].is_string()
                                        ? old_summary["status"].get<std::string>()

@@ -46,6 +46,9 @@ class RunFolder {
 
   /// Names of the result files a swim run may write into its folder (for clearing).
   static bool is_result_name(const std::string& relative_path);
+  /// The tier ("1d", "3d") of the run whose results the folder holds, from its run record
+  /// or its summary.json; "" when unknown. Reads only.
+  static std::string tier_of(const std::string& dir);
 
  private:
   std::string dir_;

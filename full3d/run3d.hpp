@@ -17,6 +17,9 @@
 //
 // Failures (swim::NumericalError from the guards) end the run with the partial
 // results written ("status": "failed: ...") and the last checkpoint kept.
+//
+// The driver's parts (run3d_setup.hpp): Stepper (run3d_stepper.hpp), Measurements
+// (run3d_measure.hpp), RunOutput (run3d_output.hpp), RunCheckpoint (run3d_checkpoint.hpp).
 #pragma once
 
 #include <string>
@@ -42,7 +45,8 @@ struct RunOutcome {
 };
 
 /// Runs the scene into out_dir (created by the caller). Throws InputError for a resume
-/// that does not match the scene; numerical failures are reported in the outcome.
+/// from a checkpoint that is damaged or does not match the scene, OutputError for a result
+/// file or checkpoint that cannot be written; numerical failures are reported in the outcome.
 RunOutcome run3d(const Params3d& p, const scene::json& resolved, const std::string& out_dir,
                  const RunControl& ctl = {});
 
@@ -56,6 +60,11 @@ IbOptions ib_options(const Params3d& p);
 /// (remedy full3d.dt) on a non-finite state.
 void dry_step(const CylinderMesh& mesh, const MembraneParams& membrane, const Eigen::VectorXd& mass,
               const Eigen::VectorXd& damping, const ExternalForceFn& external, IbScheme scheme, IbState& s, double dt);
+
+/// Reads and validates the checkpoint of out_dir for a resume of this scene (format and
+/// checks: run3d_checkpoint.hpp) without touching the folder. Throws InputError (key
+/// "--resume") naming the file, what is wrong and what to do.
+void check_resumable(const Params3d& p, const scene::json& resolved, const std::string& out_dir);
 
 /// Name of the checkpoint file in an output folder.
 inline std::string checkpoint_path(const std::string& dir) { return dir + "/checkpoint.bin"; }

@@ -10,6 +10,7 @@
 #include "common/errors.hpp"
 #include "common/scene.hpp"
 #include "full3d/run3d.hpp"
+#include "run3d_scenes.hpp"
 
 using namespace swim;
 using namespace swim::full3d;
@@ -17,34 +18,16 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Scene {
-  scene::json resolved;
-  Params3d p;
-};
+using run3d_test::Scene;
 
-Scene cycle(const std::vector<std::string>& sets) {
-  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json");
-  for (const std::string& s : {std::string("full3d.output.vtk=false"), std::string("full3d.checkpoint_interval=\"50 ms\"")})
-    scene::apply_override(sc, s);
-  for (const auto& s : sets) scene::apply_override(sc, s);
-  Scene out;
-  out.p = read_scene3d(sc, out.resolved);
-  return out;
+Scene cycle(std::vector<std::string> sets) {
+  sets.insert(sets.begin(), {"full3d.output.vtk=false", "full3d.checkpoint_interval=\"50 ms\""});
+  return run3d_test::shipped_scene("tiny_3d_cycle.json", sets);
 }
 
-std::string fresh_dir(const std::string& name) {
-  const std::string d = std::string(SWIM_BINARY_DIR) + "/tests/out_adaptive3d/" + name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
+std::string fresh_dir(const std::string& name) { return run3d_test::fresh_dir("out_adaptive3d", name); }
 
-RunControl quiet() {
-  RunControl c;
-  c.progress = 0;
-  c.quiet_vtk = true;
-  return c;
-}
+RunControl quiet() { return run3d_test::quiet_control(); }
 
 }  // namespace
 

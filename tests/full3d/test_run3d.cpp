@@ -11,6 +11,7 @@
 #include "common/errors.hpp"
 #include "common/scene.hpp"
 #include "full3d/run3d.hpp"
+#include "run3d_scenes.hpp"
 
 using namespace swim;
 using namespace swim::full3d;
@@ -18,40 +19,12 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Scene {
-  scene::json resolved;
-  Params3d p;
-};
+using run3d_test::read_csv;
+using run3d_test::Scene;
 
-Scene tiny(const std::vector<std::string>& sets) {
-  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json");
-  for (const auto& s : sets) scene::apply_override(sc, s);
-  Scene s;
-  s.p = read_scene3d(sc, s.resolved);
-  return s;
-}
+Scene tiny(const std::vector<std::string>& sets) { return run3d_test::shipped_scene("tiny_3d.json", sets); }
 
-std::string fresh_dir(const std::string& name) {
-  const std::string d = std::string(SWIM_BINARY_DIR) + "/tests/out_run3d/" + name;
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::vector<std::vector<double>> read_csv(const std::string& path) {
-  std::ifstream in(path);
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::vector<double>> rows;
-  while (std::getline(in, line)) {
-    std::vector<double> r;
-    std::stringstream ss(line);
-    std::string cell;
-    while (std::getline(ss, cell, ',')) r.push_back(std::stod(cell));
-    rows.push_back(r);
-  }
-  return rows;
-}
+std::string fresh_dir(const std::string& name) { return run3d_test::fresh_dir("out_run3d", name); }
 
 // The strong, three-segment protocol that a 40 nm grid resolves (docs/full3d.md, "Run driver").
 const std::vector<std::string> kStrong = {"protocol.total_force=null", "protocol.load_factor=3",
@@ -327,13 +300,8 @@ TEST(Run3d, PaperRecoveryEndIsSelectable) {
 // as a run that had the larger cap from the start.
 TEST(Run3d, ResumeWithLargerTimeLimitFinishesTheCycle) {
   auto cycle_scene = [](const std::string& limit) {
-    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json");
-    for (const std::string& s : {"full3d.time_limit=\"" + limit + "\"", std::string("full3d.checkpoint_interval=\"50 ms\""),
-                                std::string("full3d.output.vtk=false")})
-      scene::apply_override(sc, s);
-    Scene out;
-    out.p = read_scene3d(sc, out.resolved);
-    return out;
+    return run3d_test::shipped_scene("tiny_3d_cycle.json", {"full3d.time_limit=\"" + limit + "\"",
+                                                         "full3d.checkpoint_interval=\"50 ms\"", "full3d.output.vtk=false"});
   };
   RunControl ctl;
   ctl.progress = 0;
@@ -385,11 +353,8 @@ TEST(Run3d, ShapeRecoveryCriterion) {
 // the second cycle is a transient towards a periodic regime. Measured (h = 40 nm): cycles of
 // 0.713 and 1.155 s moving 0.55 and 1.33 nm. The bounds check the order of magnitude only.
 TEST(Run3d, TwoFluidCoupledCyclesBothMoveForward) {
-  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json");
-  for (const char* s : {"protocol.cycles=2", "full3d.time_limit=\"3 s\"", "full3d.output.vtk=false"})
-    scene::apply_override(sc, s);
-  Scene s;
-  s.p = read_scene3d(sc, s.resolved);
+  const Scene s =
+      run3d_test::shipped_scene("tiny_3d_cycle.json", {"protocol.cycles=2", "full3d.time_limit=\"3 s\"", "full3d.output.vtk=false"});
   const std::string dir = fresh_dir("two_cycles");
   RunControl ctl;
   ctl.progress = 0;

@@ -1,0 +1,170 @@
+#include "full3d/run3d_measure.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/errors.hpp"
+#include "full3d/ib.hpp"
+
+namespace swim::full3d {
+
+const std::vector<std::string> kSeriesColumns = {
+    "t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m", "flux_rear_m3_per_s",
+    "flux_front_m3_per_s", "volume_rear_m3", "volume_front_m3", "tube_volume_m3", "phase", "elastic_energy_J",
+    "bending_energy_J", "kinetic_energy_J", "active_segment", "cycles_completed", "cfl", "stokes_iterations",
+    "max_divergence_per_s", "max_edge_m", "dt_s"};
+
+Measurements::Measurements(const RunSetup& run) : run_(run) {
+  const Params3d& p = run.p;
+  const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
+  e_cap_ = p.energy_growth * run.e_ref * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
+  // Mid-point rule on a polar grid of the unit disc: weights rho d rho d theta.
+  const int nr = 6, nth = 16;
+  for (int j = 0; j < nr; ++j)
+    for (int l = 0; l < nth; ++l) {
+      const double rho = (j + 0.5) / nr, th = 2.0 * M_PI * (l + 0.5 * (j % 2)) / nth;
+      disc_.push_back({rho * std::cos(th), rho * std::sin(th), rho * (1.0 / nr) * (2.0 * M_PI / nth)});
+    }
+}
+
+void Measurements::start(const IbState& s) { x_center0_ = s.X.row(0).mean(); }
+
+void Measurements::after_step(const IbStepStats& st, const IbState& s, double dt, const MacGrid* grid) {
+  last_cfl_ = st.cfl;
+  last_iterations_ = st.stokes_iterations;
+  last_divergence_ = st.max_divergence;
+  if (!grid) return;  // the dry swimmer: no fluid
+  max_cfl_ = std::max(max_cfl_, st.cfl);
+  iterations_total_ += st.stokes_iterations;
+  q_rear_ = disc_flux(0, s, *grid);
+  q_front_ = disc_flux(run_.mesh.n_rings - 1, s, *grid);
+  vol_rear_ += 0.5 * dt * (q_rear_prev_ + q_rear_);
+  vol_front_ += 0.5 * dt * (q_front_prev_ + q_front_);
+  q_rear_prev_ = q_rear_;
+  q_front_prev_ = q_front_;
+}
+
+double Measurements::kinetic_energy(const IbState& s) const {
+  double k = 0;
+  for (Eigen::Index i = 0; i < s.V.cols(); ++i) k += 0.5 * run_.mass[i] * s.V.col(i).squaredNorm();
+  return k;
+}
+
+double Measurements::wall_energy(const IbState& s) const {
+  return elastic_energy(run_.mesh, s.X, run_.p.membrane) + kinetic_energy(s);
+}
+
+void Measurements::guards(double e, const IbState& s) {
+  const Params3d& p = run_.p;
+  const std::string& dt_key = run_.dt_key;
+  if (!std::isfinite(e)) throw NumericalError("non-finite wall energy", "reduce the time step " + dt_key, s.t);
+  const double rmin = node_radii(run_.mesh, s.X).minCoeff();
+  if (e > e_cap_) {
+    // Below about 0.55 R0 of hoop contraction the linear spring lattice has a negative
+    // stiffness in the alternate-ring twist mode (docs/full3d.md, "Compressed-lattice
+    // instability"): no time step cures that, so say so when the run went that far.
+    const double r_lowest = std::min(rmin_seen_, rmin) / p.R0;
+    const bool lattice = r_lowest < 0.56;
+    throw NumericalError(
+        "wall energy " + short_number(e) + " J grew beyond " + short_number(p.energy_growth) +
+            " times the reference energy (" + short_number(e_cap_) + " J)" +
+            (lattice ? ": nodes had contracted to " + short_number(r_lowest) +
+                           " R0, where the compressed spring lattice loses its in-plane stability (alternate-ring "
+                           "twist mode, docs/full3d.md); a smaller time step does not help"
+                     : ": the explicit coupling is unstable"),
+        lattice ? "raise wave.contracted_ratio (>= 0.6), lower the actuation overshoot (protocol.load_factor), or run "
+                  "with fluid (full3d.dry = false)"
+                : "reduce the time step " + dt_key + " (or raise full3d.energy_growth_limit if the growth is physical)",
+        s.t);
+  }
+  rmin_seen_ = std::min(rmin_seen_, rmin);
+  if (rmin < 0.02 * p.R0)
+    throw NumericalError("the tube collapsed: a node came within " + short_number(rmin) + " m of the axis",
+                         "lower the actuation (protocol.total_force / pressure / load_factor) or reduce " + dt_key, s.t);
+}
+
+/// Volume flux through the disc spanned by ring r, relative to the ring's axial
+/// motion, positive towards +x (m^3/s).
+double Measurements::disc_flux(int ring, const IbState& s, const MacGrid& grid) const {
+  const CylinderMesh& mesh = run_.mesh;
+  const int nt = mesh.n_theta;
+  double xc = 0, vx = 0;
+  for (int i = 0; i < nt; ++i) {
+    xc += s.X(0, mesh.node(ring, i));
+    vx += s.V(0, mesh.node(ring, i));
+  }
+  xc /= nt;
+  vx /= nt;
+  const double R = ring_radii(mesh, s.X)[ring];
+  const Eigen::Vector3d a = mesh.axis_start;
+  Eigen::Matrix3Xd P(3, disc_.size());
+  for (size_t k = 0; k < disc_.size(); ++k) P.col(k) = Eigen::Vector3d(xc, a[1] + R * disc_[k][0], a[2] + R * disc_[k][1]);
+  Eigen::Matrix3Xd U;
+  interpolate(grid, s.u, P, U);
+  double q = 0;
+  for (size_t k = 0; k < disc_.size(); ++k) q += (U(0, k) - vx) * disc_[k][2] * R * R;
+  return q;
+}
+
+void Measurements::record(const IbState& s, const ProtocolState& st, long n, double dt_last) {
+  const CylinderMesh& mesh = run_.mesh;
+  const MembraneParams& membrane = run_.p.membrane;
+  const Eigen::VectorXd rr = ring_radii(mesh, s.X);
+  const Eigen::VectorXd rn = node_radii(mesh, s.X);
+  const double es = stretching_energy(mesh, s.X, membrane.ks);
+  const double eb = bending_energy(mesh, s.X, membrane.kb, membrane.bending);
+  const double ek = kinetic_energy(s);
+  double vol = 0;
+  const int nt = mesh.n_theta;
+  std::vector<double> xr(mesh.n_rings, 0.0);
+  for (int r = 0; r < mesh.n_rings; ++r) {
+    for (int i = 0; i < nt; ++i) xr[r] += s.X(0, mesh.node(r, i));
+    xr[r] /= nt;
+  }
+  for (int r = 0; r + 1 < mesh.n_rings; ++r)
+    vol += 0.5 * M_PI * (rr[r] * rr[r] + rr[r + 1] * rr[r + 1]) * (xr[r + 1] - xr[r]);
+  series_.push_back({s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
+                     rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
+                     double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
+                     last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0});
+  radius_times_.push_back(s.t);
+  radius_.insert(radius_.end(), rr.data(), rr.data() + rr.size());
+  last_recorded_ = n;
+}
+
+// --- checkpoint records ------------------------------------------------------------
+template <class Self, class F>
+void Measurements::records(Self& self, F&& f) {
+  f("x_center0", self.x_center0_);
+  f("volume_rear", self.vol_rear_);
+  f("volume_front", self.vol_front_);
+  f("flux_rear", self.q_rear_);
+  f("flux_front", self.q_front_);
+  f("flux_rear_prev", self.q_rear_prev_);
+  f("flux_front_prev", self.q_front_prev_);
+  f("max_cfl", self.max_cfl_);
+  f("stokes_iterations_total", self.iterations_total_);
+  f("last_cfl", self.last_cfl_);
+  f("last_stokes_iterations", self.last_iterations_);
+  f("last_divergence", self.last_divergence_);
+  f("radius_times", self.radius_times_);
+  f("radius", self.radius_);
+  f("last_recorded", self.last_recorded_);
+}
+
+void Measurements::save(CheckpointWriter& w) const {
+  records(*this, CheckpointOut(w));
+  std::vector<double> flat;  // the series, row by row
+  for (const auto& row : series_) flat.insert(flat.end(), row.begin(), row.end());
+  w.put("series", flat);
+}
+
+void Measurements::load(const CheckpointReader& r) {
+  records(*this, CheckpointIn(r));
+  const auto flat = r.get_vector("series");
+  const size_t nc = kSeriesColumns.size();
+  series_.clear();
+  for (size_t k = 0; k + nc <= flat.size(); k += nc) series_.emplace_back(flat.begin() + k, flat.begin() + k + nc);
+}
+
+}  // namespace swim::full3d

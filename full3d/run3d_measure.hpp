@@ -1,0 +1,68 @@
+// The measuring part of a 3D run. Every step: the volume fluxes through the two end discs
+// (integrated in time to the pumped volumes), the solver statistics, the wall energy and
+// the guards (non-finite or runaway energy, collapsed tube: NumericalError naming the
+// parameter to change). Every output step: a row of series.csv (centre position and
+// velocity, radii, energies, fluxes, volumes, protocol phase, step statistics) and the
+// ring radii of radius.csv.
+#pragma once
+
+#include <array>
+#include <string>
+#include <vector>
+
+#include "full3d/checkpoint.hpp"
+#include "full3d/grid.hpp"
+#include "full3d/ib_solver.hpp"
+#include "full3d/protocol3d.hpp"
+#include "full3d/run3d_setup.hpp"
+
+namespace swim::full3d {
+
+/// The columns of series.csv.
+extern const std::vector<std::string> kSeriesColumns;
+
+class Measurements {
+ public:
+  explicit Measurements(const RunSetup& run);
+
+  /// A fresh run: the reference of the centre displacement.
+  void start(const IbState& s);
+  /// After a step: solver statistics, end-disc fluxes and volumes (fluid-coupled runs).
+  void after_step(const IbStepStats& st, const IbState& s, double dt, const MacGrid* grid);
+  double wall_energy(const IbState& s) const;
+  /// Throws NumericalError when the wall energy e is not finite or ran away, or the tube collapsed.
+  void guards(double e, const IbState& s);
+  /// One output row at step n (dt_last: the step that led to it).
+  void record(const IbState& s, const ProtocolState& st, long n, double dt_last);
+
+  long last_recorded() const { return last_recorded_; }
+  const std::vector<std::vector<double>>& series() const { return series_; }
+  const std::vector<double>& radius_times() const { return radius_times_; }
+  const std::vector<double>& radius() const { return radius_; }
+  double pumped_volume() const { return -vol_rear_; }
+  double max_cfl() const { return max_cfl_; }
+  long stokes_iterations() const { return iterations_total_; }
+
+  void save(CheckpointWriter& w) const;
+  void load(const CheckpointReader& r);
+
+ private:
+  /// The checkpoint records of the measurements, f(name, member) (checkpoint.hpp).
+  template <class Self, class F>
+  static void records(Self& self, F&& f);
+  double kinetic_energy(const IbState& s) const;
+  double disc_flux(int ring, const IbState& s, const MacGrid& grid) const;
+
+  const RunSetup& run_;
+  double e_cap_;
+  std::vector<std::array<double, 3>> disc_;  ///< unit-disc quadrature: y, z, weight
+  double x_center0_ = 0, vol_rear_ = 0, vol_front_ = 0, q_rear_ = 0, q_front_ = 0, q_rear_prev_ = 0, q_front_prev_ = 0;
+  double rmin_seen_ = 1e300;
+  double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0;
+  long iterations_total_ = 0, last_iterations_ = 0;
+  long last_recorded_ = -1;
+  std::vector<std::vector<double>> series_;
+  std::vector<double> radius_times_, radius_;
+};
+
+}  // namespace swim::full3d

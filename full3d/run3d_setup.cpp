@@ -1,0 +1,29 @@
+#include "full3d/run3d_setup.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+namespace swim::full3d {
+
+namespace {
+long steps_for(double interval, double dt) { return std::max(1L, std::lround(interval / dt)); }
+}  // namespace
+
+RunSetup::RunSetup(const Params3d& params)
+    : p(params), mesh(make_mesh(params)), mass(node_masses(mesh, params.mass_per_area)),
+      e_ref(uniform_contraction_energy(mesh, params.membrane, params.protocol.R_f)),
+      adaptive(params.adaptive.enabled && !params.dry), dt_key(adaptive ? "full3d.adaptive.dt_max" : "full3d.dt"),
+      n_end(params.duration > 0 ? std::max(1L, std::lround(params.duration / params.dt)) : -1),
+      n_limit(std::max(1L, std::lround(params.time_limit / params.dt))),
+      out_every(steps_for(params.output_interval, params.dt)), vtk_every(steps_for(params.vtk_interval, params.dt)),
+      fluid_every(steps_for(params.fluid_interval, params.dt)),
+      ckpt_every(steps_for(params.checkpoint_interval, params.dt)) {}
+
+std::string short_number(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+}  // namespace swim::full3d
