@@ -51,7 +51,8 @@ std::string find_scene(const std::string& name, const std::string& suite_dir, co
                    "a scene file (tried as given, beside the suite file and in the shipped data/scenes/)");
 }
 
-/// Sets a dotted key of a scene to a JSON value, creating the objects on the way.
+/// Sets a dotted key of a scene to a JSON value, creating the objects on the way; null removes
+/// the key (as `--set key=null` does).
 void set_key(json& sc, const std::string& dotted, const json& value) {
   json* node = &sc;
   std::stringstream ss(dotted);
@@ -62,7 +63,8 @@ void set_key(json& sc, const std::string& dotted, const json& value) {
     if (!node->contains(parts[i]) || !(*node)[parts[i]].is_object()) (*node)[parts[i]] = json::object();
     node = &(*node)[parts[i]];
   }
-  (*node)[parts.back()] = value;
+  if (value.is_null()) node->erase(parts.back());
+  else (*node)[parts.back()] = value;
 }
 
 void apply_sets(json& sc, const json& sets) {
@@ -160,24 +162,53 @@ struct Run3d {
   bool ok = false;
 };
 
+/// The part of a resolved 3D scene that determines its results: without the output settings
+/// (frames, intervals), the checkpoint interval and the thread count.
+json physics_of(json resolved) {
+  if (resolved.contains("full3d") && resolved["full3d"].is_object()) {
+    resolved["full3d"].erase("output");
+    resolved["full3d"].erase("checkpoint_interval");
+    resolved["full3d"].erase("threads");
+  }
+  return resolved;
+}
+
+/// A finished run (summary status not "running") in `dir`, or null.
+json finished_summary(const std::string& dir) {
+  std::ifstream in(dir + "/summary.json");
+  if (!in) return nullptr;
+  json s = json::parse(in, nullptr, false);
+  if (s.is_discarded() || !s.contains("status") || s["status"] == "running") return nullptr;
+  return s;
+}
+
 Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached) {
   json s = sc;
   set_key(s, "full3d.threads", threads);
   set_key(s, "full3d.output.vtk", false);
   json resolved;
   const full3d::Params3d p = full3d::read_scene3d(s, resolved);
-  const std::string dir = runs_dir + "/" + p.name + "-3d-" + output::json_hash(resolved);
+  // the cache is keyed by the physics of the resolved scene; a folder under another name
+  // (written with other output settings) is found by its own scene.resolved.json
+  const std::string key = output::json_hash(physics_of(resolved));
+  std::string dir = runs_dir + "/" + p.name + "-3d-" + key;
   Run3d r;
   r.h = p.h;
   r.length = p.L;
-  json summary;
-  *cached = false;
-  if (fs::exists(dir + "/summary.json")) {
-    std::ifstream in(dir + "/summary.json");
-    summary = json::parse(in, nullptr, false);
-    if (summary.is_discarded() || !summary.contains("status") || summary["status"] == "running") summary = json();
-    else *cached = true;
-  }
+  json summary = finished_summary(dir);
+  if (summary.is_null())
+    for (const auto& e : fs::directory_iterator(runs_dir)) {
+      std::ifstream in(e.path() / "scene.resolved.json");
+      if (!in) continue;
+      const json other = json::parse(in, nullptr, false);
+      if (other.is_discarded() || output::json_hash(physics_of(other)) != key) continue;
+      summary = finished_summary(e.path().string());
+      if (!summary.is_null()) {
+        dir = e.path().string();
+        break;
+      }
+    }
+  *cached = !summary.is_null();
   if (!*cached) {
     fs::remove_all(dir);
     fs::create_directories(dir);
