@@ -49,14 +49,18 @@ def main(d):
     ax[1].axhspan(sec[0] * 0.99, sec[0] * 1.01, color="0.9", label="\u00b11 % of the smallest load's")
     ax[1].axhline(c["C1_spring_network_Pa_per_m"] / 1e6, color="k", ls=":", lw=1, label="spring-network value")
     ax[1].set(xlabel="pressure [mPa] (log scale)", ylabel="secant C1 [MPa/m]", title="stiffness against load")
-    ax[1].legend(loc="lower left", fontsize="small", frameon=False)
+    ax[1].legend(loc="upper right", fontsize="small")
 
     for n in (2, 3):
         ax[2].semilogx(P, [p["ring_mode_stiffness_N_per_m"][n - 2] * 1e12 for p in pts], "o-", label=f"mode n = {n}")
     ax[2].semilogx(P, [p["softest_ring_mode_stiffness_N_per_m"] * 1e12 for p in pts], "ks--", label="softest mode")
-    for p in pts:
-        ax[2].annotate(f"n={p['softest_ring_mode']}", (p["pressure_Pa"] * 1e3, p["softest_ring_mode_stiffness_N_per_m"] * 1e12),
-                       fontsize=7, xytext=(-3, -11), textcoords="offset points", ha="right")
+    prev = None
+    for p in pts:  # the softest mode's n, where it changes
+        if p["softest_ring_mode"] != prev:
+            ax[2].annotate(f"n = {p['softest_ring_mode']}",
+                           (p["pressure_Pa"] * 1e3, p["softest_ring_mode_stiffness_N_per_m"] * 1e12),
+                           fontsize=7, xytext=(-4, -12), textcoords="offset points", ha="right")
+        prev = p["softest_ring_mode"]
     ax[2].axhline(0, color="k", lw=1)
     ax[2].set(xlabel="pressure [mPa] (log scale)", ylabel="ring-mode stiffness [pN/m]",
               title="ring buckling: unstable below zero")

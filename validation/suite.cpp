@@ -480,7 +480,10 @@ json run_suite(const SuiteOptions& o) {
     const std::string name = base.value("name", fs::path(scene_path).stem().string());
     const std::string grid_key = cs.value("grid_key", std::string("full3d.grid.cells_across"));
     const std::string tag = "case " + std::to_string(ci + 1) + "/" + std::to_string(cases.size()) + " (" + name + ")";
-    json cr = {{"name", name}, {"scene", scene_path}, {"group", cs.value("group", json())},
+    // shipped scenes are named relative to the source tree, so that reports compare across machines
+    const fs::path rel = fs::path(scene_path).lexically_relative(fs::path(o.data_dir).parent_path());
+    const std::string scene_name = !rel.empty() && *rel.begin() != ".." ? rel.string() : scene_path;
+    json cr = {{"name", name}, {"scene", scene_name}, {"group", cs.value("group", json())},
                {"grid_key", grid_key}, {"paper", cs.value("paper", json())}};
     cr["description"] = base.value("description", std::string());
     cr["sweep_value"] = cs.value("sweep_value", json());
