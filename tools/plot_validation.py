@@ -87,7 +87,7 @@ def convergence_figure(case, path):
     runs = [r for r in case["runs3d"] if r.get("has_cycle")]
     if not runs:
         return False
-    fig, ax = plt.subplots(figsize=(6.5, 4.4))
+    fig, ax = plt.subplots(figsize=(9.5, 4.6))
     h = [r["cell_size_m"] * 1e9 for r in runs]
     d = [r["displacement_per_cycle_m"] * 1e9 for r in runs]
     ax.plot(h, d, "ko-", label="3D runs")
@@ -99,6 +99,9 @@ def convergence_figure(case, path):
     for k, m in enumerate(case["models1d"]):
         if m.get("has_cycle") and ref and abs(m["displacement_per_cycle_m"]) < 20 * abs(ref["value"]):
             ax.axhline(m["displacement_per_cycle_m"] * 1e9, color=f"C{k + 1}", ls="--", lw=1, label=f"1D: {m['label']}")
+    paper = (case.get("paper") or {}).get("max_displacement_m")
+    if paper:
+        ax.axhline(paper * 1e9, color="0.4", ls=":", lw=1.2, label="paper: maximum displacement over the cycle")
     ax.set(xlabel="cell size h [nm]", ylabel="displacement per cycle [nm]",
            title=f"{case['name']}: 3D grid convergence")
     ax.set_xlim(left=-0.05 * max(h))
