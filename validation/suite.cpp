@@ -547,8 +547,8 @@ json run_suite(const SuiteOptions& o) {
       set_key(s, grid_key, grids[cg]);
       json resolved;
       const full3d::Params3d p = full3d::read_scene3d(s, resolved);
-      // the calibration file's format version is part of its cache key
-      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({resolved, kCalibrationFormat});
+      // keyed by the physics of the resolved scene and the calibration file's format version
+      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
       cal_file = dir + "/calibration.json";
       if (fs::exists(cal_file)) {
         std::ifstream in(cal_file);

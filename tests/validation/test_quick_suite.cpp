@@ -4,6 +4,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
+
+#include "common/scene.hpp"
 
 #include "validation/suite.hpp"
 
@@ -64,4 +67,14 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   }
   EXPECT_EQ(c2["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
   EXPECT_EQ(c2["models1d"][0]["displacement_per_cycle_m"], c["models1d"][0]["displacement_per_cycle_m"]);
+
+  // other output settings do not change the physics: the cached 3D runs are found again
+  scene::json suite = scene::load_file(o.suite);
+  suite["cases"][0]["set"]["full3d.output.vtk_interval"] = "5 ms";
+  suite["cases"][0]["scene"] = SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json";
+  const std::string edited = out + "/suite_other_output.json";
+  std::ofstream(edited) << suite.dump(2);
+  o.suite = edited;
+  const scene::json r3 = validation::run_suite(o);
+  for (std::size_t g = 0; g < 3; ++g) EXPECT_TRUE(r3["cases"][0]["runs3d"][g]["cached"].get<bool>()) << g;
 }
