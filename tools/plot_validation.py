@@ -36,6 +36,11 @@ def si(v, unit, digits=3):
     return f"{v / scale:.{digits}g} {p}{unit}"
 
 
+def legend_right(ax):
+    """Legend beside the axes, off the data."""
+    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+
+
 def pct(v):
     return "—" if v is None else f"{100 * v:+.1f} %"
 
@@ -105,7 +110,7 @@ def convergence_figure(case, path):
     ax.set(xlabel="cell size h [nm]", ylabel="displacement per cycle [nm]",
            title=f"{case['name']}: 3D grid convergence")
     ax.set_xlim(left=-0.05 * max(h))
-    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    legend_right(ax)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -132,7 +137,7 @@ def pareto_figure(report, path):
         return False
     ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)",
            title=f"Speed against accuracy: {report['suite']} suite\n(error against the extrapolated 3D reference)")
-    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    legend_right(ax)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -162,7 +167,7 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title):
             continue
         ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
     ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
-    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    legend_right(ax)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)
@@ -182,7 +187,7 @@ def multicycle_figure(report, path):
                 ax.plot(m["series"]["t_s"], [v * 1e9 for v in m["series"]["x_m"]], MODEL_STYLES[k % 6],
                         label=f"1D: {m['label']}")
     ax.set(xlabel="time [s]", ylabel="centre displacement [nm]", title="Multi-cycle centre histories")
-    ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+    legend_right(ax)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     plt.close(fig)

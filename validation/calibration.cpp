@@ -218,9 +218,8 @@ WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double s
     d_hist.push_back(delta(s));
     if (steps >= 100) {
       // the displacement a tenth of the elapsed time ago
-      const double t_back = 0.9 * s.t;
-      std::size_t k = 0;
-      while (k + 1 < t_hist.size() && t_hist[k + 1] <= t_back) ++k;
+      const auto it = std::upper_bound(t_hist.begin(), t_hist.end(), 0.9 * s.t);
+      const std::size_t k = std::size_t(std::max<std::ptrdiff_t>(0, (it - t_hist.begin()) - 1));
       if (std::abs(d_hist.back() - d_hist[k]) < 1e-3 * std::abs(d_hist.back())) {
         w.steady = true;
         ++steps;

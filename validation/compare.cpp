@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <gsl/gsl_statistics_double.h>
+
 #include "common/errors.hpp"
 
 namespace swim::validation {
@@ -38,24 +40,17 @@ SeriesComparison compare_series(const std::vector<double>& t_a, const std::vecto
     a[std::size_t(k)] = interpolate_linear(t_a, u_a, phase ? s * T_a : s * T);
     b[std::size_t(k)] = interpolate_linear(t_b, u_b, phase ? s * T_b : s * T);
   }
-  double ma = 0, mb = 0;
-  for (int k = 0; k < n; ++k) {
-    ma += a[std::size_t(k)] / n;
-    mb += b[std::size_t(k)] / n;
-  }
-  double num = 0, den = 0, saa = 0, sbb = 0, sab = 0;
+  double num = 0, den = 0;
   for (int k = 0; k < n; ++k) {
     const double x = a[std::size_t(k)], y = b[std::size_t(k)];
     num += (x - y) * (x - y);
     den += y * y;
-    saa += (x - ma) * (x - ma);
-    sbb += (y - mb) * (y - mb);
-    sab += (x - ma) * (y - mb);
   }
+  const bool flat = gsl_stats_sd(a.data(), 1, a.size()) == 0.0 || gsl_stats_sd(b.data(), 1, b.size()) == 0.0;
   SeriesComparison c;
   c.points = n;
   c.l2_relative = den > 0 ? std::sqrt(num / den) : 0.0;
-  c.correlation = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+  c.correlation = flat ? 0.0 : gsl_stats_correlation(a.data(), 1, b.data(), 1, a.size());
   return c;
 }
 

@@ -2,6 +2,7 @@
 
 #include <gsl/gsl_fit.h>
 #include <gsl/gsl_multifit.h>
+#include <gsl/gsl_statistics_double.h>
 
 #include <algorithm>
 #include <chrono>
@@ -17,6 +18,7 @@
 #include "full3d/membrane.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/stokes.hpp"
+#include "validation/richardson.hpp"
 
 namespace swim::validation {
 
@@ -89,12 +91,8 @@ std::pair<RootFit, RootFit> annulus_fit(const std::vector<Sample>& pts, double R
     if (!(u(lo) * u(hi) < 0))
       throw NumericalError(std::string("the annulus velocity fit has no zero near the ") + what,
                            "refine full3d.grid.cells_across or widen container.radius");
-    for (int it = 0; it < 200; ++it) {
-      const double m = 0.5 * (lo + hi);
-      (u(lo) * u(m) <= 0 ? hi : lo) = m;
-    }
     RootFit f;
-    f.root = 0.5 * (lo + hi);
+    f.root = bracketed_root(u, lo, hi);
     const double rr = f.root / R0;
     const double phi[3] = {1.0, rr * rr, std::log(rr)};
     double var = 0;
@@ -106,18 +104,8 @@ std::pair<RootFit, RootFit> annulus_fit(const std::vector<Sample>& pts, double R
   return {root_in(R0 - 3.0 * h, R0 + 2.0 * h, "tube wall"), root_in(Rc - 3.0 * h, Rc + 2.0 * h, "container wall")};
 }
 
-double mean(const std::vector<double>& v) {
-  double s = 0;
-  for (double x : v) s += x;
-  return s / double(v.size());
-}
-double sample_std(const std::vector<double>& v) {
-  if (v.size() < 2) return 0.0;
-  const double m = mean(v);
-  double s = 0;
-  for (double x : v) s += (x - m) * (x - m);
-  return std::sqrt(s / double(v.size() - 1));
-}
+double mean(const std::vector<double>& v) { return gsl_stats_mean(v.data(), 1, v.size()); }
+double sample_std(const std::vector<double>& v) { return v.size() < 2 ? 0.0 : gsl_stats_sd(v.data(), 1, v.size()); }
 
 }  // namespace
 

@@ -2,11 +2,34 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <numeric>
+
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_roots.h>
 
 #include "common/errors.hpp"
 
 namespace swim::validation {
+
+double bracketed_root(const std::function<double(double)>& f, double lo, double hi) {
+  if (f(lo) == 0.0) return lo;
+  if (f(hi) == 0.0) return hi;
+  gsl_function F;
+  F.function = [](double x, void* p) { return (*static_cast<const std::function<double(double)>*>(p))(x); };
+  F.params = const_cast<std::function<double(double)>*>(&f);
+  std::unique_ptr<gsl_root_fsolver, decltype(&gsl_root_fsolver_free)> s(gsl_root_fsolver_alloc(gsl_root_fsolver_brent),
+                                                                        gsl_root_fsolver_free);
+  if (gsl_root_fsolver_set(s.get(), &F, lo, hi) != GSL_SUCCESS)
+    throw NumericalError("no sign change of the function on [" + std::to_string(lo) + ", " + std::to_string(hi) + "]",
+                         "widen the bracket");
+  for (int it = 0; it < 200; ++it) {
+    gsl_root_fsolver_iterate(s.get());
+    const double a = gsl_root_fsolver_x_lower(s.get()), b = gsl_root_fsolver_x_upper(s.get());
+    if (gsl_root_test_interval(a, b, 0.0, 1e-14) == GSL_SUCCESS) break;
+  }
+  return gsl_root_fsolver_root(s.get());
+}
 
 Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order) {
   if (h.size() != f.size() || h.size() < 2)
@@ -55,13 +78,8 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
   auto g = [&](double p) {
     return (std::pow(h1, p) - std::pow(h2, p)) / (std::pow(h2, p) - std::pow(h3, p)) - ratio;
   };
-  double lo = 0.25, hi = 8.0;
-  if (g(lo) * g(hi) > 0) return not_asymptotic("observed order outside [0.25, 8]");
-  for (int it = 0; it < 200; ++it) {
-    const double m = 0.5 * (lo + hi);
-    (g(lo) * g(m) <= 0 ? hi : lo) = m;
-  }
-  e.order = 0.5 * (lo + hi);
+  if (g(0.25) * g(8.0) > 0) return not_asymptotic("observed order outside [0.25, 8]");
+  e.order = bracketed_root(g, 0.25, 8.0);
   e.value = extrapolate(e.order);
   e.error = std::abs(e.value - f3);
   e.asymptotic = true;

@@ -9,6 +9,7 @@
 // error, and `asymptotic` is false. With two grids the order must be given (`assumed_order`).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,6 +22,10 @@ struct Extrapolation {
   bool asymptotic = false;
   std::string note;      ///< how the value was obtained
 };
+
+/// Root of f in [lo, hi], where f(lo) and f(hi) differ in sign (GSL Brent, to 1e-14 relative).
+/// Throws NumericalError when the solver fails.
+double bracketed_root(const std::function<double(double)>& f, double lo, double hi);
 
 /// h: grid spacings (any order), f: the figure on each. Throws InputError for fewer than two
 /// grids, repeated spacings, or mismatched sizes.
