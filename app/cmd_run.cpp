@@ -9,6 +9,7 @@
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/run_folder.hpp"
+#include "common/run_record.hpp"
 #include "common/progress.hpp"
 #include "common/scene.hpp"
 #include "common/si_format.hpp"
@@ -56,7 +57,7 @@ void print_summary_1d(const std::string& name, const scene::json& s, double wall
   }
   std::printf("%s (1d, %s): displacement %s; %s; %d cycle(s); pumped %s; thermal rms %s per cycle "
               "(directed/diffusive %.3g); wall time %s\n  -> %s/summary.json\n",
-              name.c_str(), s["model1d"].get<std::string>().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(),
+              name.c_str(), s["model"].get<std::string>().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(),
               per_cycle.c_str(), s["cycles_completed"].get<int>(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(),
               si(s["brownian"]["thermal_rms_displacement_per_cycle_m"].get<double>(), "m").c_str(),
               s["brownian"]["directed_to_diffusive_ratio"].get<double>(), si(wall, "s").c_str(), out.c_str());
@@ -144,21 +145,29 @@ int run(const RunOptions& o) {
   check_output_size(estimate_output(p), sc);
   const std::string out = o.out.empty() ? "out/" + p.name + "-1d" : o.out;
 
-  // 2. Take the folder, run.
+  // 2. Take the folder, run: the series and radius samples stream to disk as they are
+  // produced (nothing is buffered in memory).
   output::RunFolder folder(out, {"1d", resolved, o.overwrite, false, "--out"});
   const auto t0 = std::chrono::steady_clock::now();
   Progress progress("1d " + p.name, reduced1d::end_time(p), o.progress);
-  const reduced1d::Result r = reduced1d::solve(p, [&](double t, double) { progress.update(t); });
-  progress.done();
-  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-
-  // 3. Write (partial results too; summary.json last), report.
+  std::unique_ptr<record::RunStream> stream;
+  reduced1d::Result r;
   scene::json summary;
   try {
+    stream = std::make_unique<record::RunStream>(out, reduced1d::series_columns());
+    reduced1d::SolveOptions so;
+    so.progress = [&](double t, double) { progress.update(t); };
+    so.keep_samples = false;
+    so.stream = stream.get();
+    r = reduced1d::solve(p, so);
+    progress.done();
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    // 3. Write (partial results too; summary.json last), report.
     summary = reduced1d::write_run(out, p, resolved, r, wall);
   } catch (const std::exception& e) {
     fail_run(folder, e);
   }
+  const double wall = summary["wall_time_s"].get<double>();
   if (o.plot) plot("plot_run.py", {out});
   print_summary_1d(p.name, summary, wall, out);
   if (r.failure) {

@@ -48,7 +48,8 @@ Ledger& ledger() {
   return l;
 }
 
-void record(const std::string& path, std::uintmax_t bytes, std::uint64_t sum) {
+/// Forget the ledger record of `path` (none: nothing happens).
+void unrecord(const std::string& path) {
   const fs::path p(path);
   Ledger& l = ledger();
   std::lock_guard lock(l.mutex);
@@ -59,7 +60,14 @@ void record(const std::string& path, std::uintmax_t bytes, std::uint64_t sum) {
       v.erase(it);
       break;
     }
-  v.push_back({name, bytes, hex64(sum)});
+}
+
+void record(const std::string& path, std::uintmax_t bytes, std::uint64_t sum) {
+  unrecord(path);
+  const fs::path p(path);
+  Ledger& l = ledger();
+  std::lock_guard lock(l.mutex);
+  l.files[key_of(p.parent_path().string())].push_back({p.filename().string(), bytes, hex64(sum)});
 }
 
 bool inside(const std::string& folder, const std::string& dir) {
@@ -71,7 +79,11 @@ bool inside(const std::string& folder, const std::string& dir) {
 // counts bytes and checksums them; optionally fails after a byte budget (test hook).
 class FdBuf : public std::streambuf {
  public:
-  FdBuf(int fd, long long fail_after) : fd_(fd), fail_after_(fail_after) { setp(buf_, buf_ + sizeof buf_); }
+  /// bytes, sum: what the file already holds (a continued part file).
+  FdBuf(int fd, long long fail_after, std::uintmax_t bytes = 0, std::uint64_t sum = kFnv1a64Offset)
+      : fd_(fd), fail_after_(fail_after), bytes_(bytes), sum_(sum) {
+    setp(buf_, buf_ + sizeof buf_);
+  }
   int error() const { return error_; }
   std::uintmax_t bytes() const { return bytes_; }
   std::uint64_t checksum() const { return sum_; }
@@ -120,8 +132,8 @@ class FdBuf : public std::streambuf {
   int fd_;
   long long fail_after_;
   int error_ = 0;
-  std::uintmax_t bytes_ = 0;
-  std::uint64_t sum_ = kFnv1a64Offset;
+  std::uintmax_t bytes_;
+  std::uint64_t sum_;
   char buf_[1 << 16];
 };
 
@@ -136,6 +148,27 @@ long long injected_budget(const std::string& name) {
     spec = spec.substr(0, c);
   }
   return spec == name ? budget : -1;
+}
+
+/// Flush and check the stream, close the file and rename `from` to `to`. Any failure is
+/// noted in the ledger and thrown as the OutputError naming `to`; `from` is removed then
+/// when `discard` (a temporary file), kept otherwise (a part file: partial results).
+void publish(int& fd, FdBuf& buf, std::ostream& stream, const std::string& from, const std::string& to,
+             bool discard) {
+  const auto fail = [&](int err) {
+    if (fd >= 0) ::close(fd);
+    fd = -1;
+    if (discard) ::unlink(from.c_str());
+    note_failure(to, reason_of(err));
+    throw OutputError(fs::path(to).filename().string(), reason_of(err));
+  };
+  stream.flush();
+  if (buf.error()) fail(buf.error());
+  if (!stream) fail(EIO);
+  const int f = fd;
+  fd = -1;
+  if (::close(f) != 0) fail(errno);
+  if (::rename(from.c_str(), to.c_str()) != 0) fail(errno);
 }
 
 }  // namespace
@@ -171,32 +204,112 @@ std::ostream& AtomicFile::stream() { return *impl_->stream; }
 
 void AtomicFile::commit() {
   if (committed_) return;
-  const std::string name = fs::path(path_).filename().string();
-  const auto fail = [&](int err) {
+  publish(impl_->fd, *impl_->buf, *impl_->stream, impl_->tmp, path_, true);
+  committed_ = true;
+  record(path_, impl_->buf->bytes(), impl_->buf->checksum());
+}
+
+// ---- PartFile -------------------------------------------------------------------------
+
+struct PartFile::Impl {
+  int fd = -1;
+  std::unique_ptr<FdBuf> buf;
+  std::unique_ptr<std::ostream> stream;
+};
+
+namespace {
+/// Checksum of the first `bytes` bytes of a file; false when it is shorter or unreadable.
+bool prefix_checksum(const std::string& path, std::uintmax_t bytes, std::uint64_t& sum) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  sum = kFnv1a64Offset;
+  char b[1 << 16];
+  std::uintmax_t left = bytes;
+  while (left > 0) {
+    in.read(b, static_cast<std::streamsize>(std::min<std::uintmax_t>(left, sizeof b)));
+    const auto got = static_cast<std::uintmax_t>(in.gcount());
+    if (got == 0) return false;
+    sum = fnv1a64(b, static_cast<std::size_t>(got), sum);
+    left -= got;
+  }
+  return true;
+}
+}  // namespace
+
+PartFile::PartFile(std::string path) : path_(std::move(path)), impl_(std::make_unique<Impl>()) {
+  open(O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, Mark{});
+}
+
+PartFile::PartFile(std::string path, Mark from) : path_(std::move(path)), impl_(std::make_unique<Impl>()) {
+  if (!matches(path_, from))
+    throw InputError("--resume", "\"" + part_path() + "\"",
+                     "the partial results do not match the checkpoint (missing, shorter or changed); run the scene "
+                     "again without --resume, with --overwrite to replace this folder's interrupted results");
+  // a run that ended (failed, e.g. at its time limit) published its part file: continue it
+  if (!fs::exists(part_path()) && ::rename(path_.c_str(), part_path().c_str()) != 0) {
+    const int err = errno;
+    note_failure(path_, reason_of(err));
+    throw OutputError(fs::path(path_).filename().string(), reason_of(err));
+  }
+  open(O_WRONLY | O_CLOEXEC, from);
+  if (::ftruncate(impl_->fd, static_cast<off_t>(from.bytes)) != 0 ||
+      ::lseek(impl_->fd, static_cast<off_t>(from.bytes), SEEK_SET) < 0) {
+    const int err = errno;
     ::close(impl_->fd);
     impl_->fd = -1;
-    ::unlink(impl_->tmp.c_str());
+    note_failure(path_, reason_of(err));
+    throw OutputError(fs::path(part_path()).filename().string(), reason_of(err));
+  }
+}
+
+void PartFile::open(int flags, Mark from) {
+  const std::string part = part_path();
+  const std::string name = fs::path(part).filename().string();
+  impl_->fd = ::open(part.c_str(), flags, 0644);
+  if (impl_->fd < 0) {
+    const int err = errno;
     note_failure(path_, reason_of(err));
     throw OutputError(name, reason_of(err));
-  };
+  }
+  long long budget = injected_budget(fs::path(path_).filename().string());
+  if (budget >= 0) budget += static_cast<long long>(from.bytes);
+  impl_->buf = std::make_unique<FdBuf>(impl_->fd, budget, from.bytes, from.checksum);
+  impl_->stream = std::make_unique<std::ostream>(impl_->buf.get());
+}
+
+PartFile::~PartFile() {
+  if (committed_ || impl_->fd < 0) return;
+  impl_->stream->flush();  // best effort: the rows so far are partial results
+  ::close(impl_->fd);
+}
+
+std::ostream& PartFile::stream() { return *impl_->stream; }
+
+bool PartFile::matches(const std::string& path, Mark from) {
+  std::uint64_t sum = 0;
+  const std::string part = path + ".part";
+  return prefix_checksum(fs::exists(part) ? part : path, from.bytes, sum) && sum == from.checksum;
+}
+
+PartFile::Mark PartFile::sync() {
+  const std::string name = fs::path(path_).filename().string();
   impl_->stream->flush();
-  if (impl_->buf->error()) fail(impl_->buf->error());
-  if (!*impl_->stream) fail(EIO);
-  const int fd = impl_->fd;
-  impl_->fd = -1;
-  if (::close(fd) != 0) {
-    const int err = errno;
-    ::unlink(impl_->tmp.c_str());
+  int err = impl_->buf->error();
+  if (!err && !*impl_->stream) err = EIO;
+  if (err) {
     note_failure(path_, reason_of(err));
     throw OutputError(name, reason_of(err));
   }
-  if (::rename(impl_->tmp.c_str(), path_.c_str()) != 0) {
-    const int err = errno;
-    ::unlink(impl_->tmp.c_str());
-    note_failure(path_, reason_of(err));
-    throw OutputError(name, reason_of(err));
-  }
+  const Mark m{impl_->buf->bytes(), impl_->buf->checksum()};
+  record(part_path(), m.bytes, m.checksum);
+  return m;
+}
+
+void PartFile::commit() {
+  if (committed_) return;
+  publish(impl_->fd, *impl_->buf, *impl_->stream, part_path(), path_, false);
   committed_ = true;
+  unrecord(part_path());
   record(path_, impl_->buf->bytes(), impl_->buf->checksum());
 }
 

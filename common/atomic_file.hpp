@@ -21,6 +21,8 @@
 #include <string>
 #include <vector>
 
+#include "common/checksum.hpp"
+
 namespace swim::output {
 
 class AtomicFile {
@@ -41,6 +43,54 @@ class AtomicFile {
  private:
   struct Impl;
   std::string path_;
+  std::unique_ptr<Impl> impl_;
+  bool committed_ = false;
+};
+
+/// A streamed result file (series.csv, radius.csv): written under the visible partial name
+/// "<name>.part" while the run produces it, and renamed to its name by commit(), after the
+/// stream state and the close are checked. While the run goes on, sync() flushes and checks
+/// the file and records the part file, with its size and checksum so far, in the folder's
+/// ledger (a summary.json written then lists it: the rows up to that size are valid). An
+/// abandoned part file is kept: its rows are partial results.
+///
+/// A resumed run continues a part file from a mark (the size and checksum recorded by a
+/// checkpoint): the bytes up to the mark must match, and what follows them (written after the
+/// checkpoint by the interrupted process) is cut off. A run that ended in failure (at its time
+/// limit, say) published its part file under the final name; that file is continued then.
+class PartFile {
+ public:
+  struct Mark {
+    std::uintmax_t bytes = 0;
+    std::uint64_t checksum = kFnv1a64Offset;
+  };
+  /// A fresh part file (an old one is truncated). Throws OutputError.
+  explicit PartFile(std::string path);
+  /// Continue from `from`. Throws InputError (key "--resume") when the part file is missing
+  /// or its first from.bytes bytes do not have the checksum; OutputError when it cannot be
+  /// opened for writing.
+  PartFile(std::string path, Mark from);
+  ~PartFile();
+  PartFile(const PartFile&) = delete;
+  PartFile& operator=(const PartFile&) = delete;
+
+  std::ostream& stream();
+  /// Flush and check; record the part file in the ledger. Returns the mark of the bytes on
+  /// disk. Throws OutputError.
+  Mark sync();
+  /// Flush, check, close, rename "<name>.part" to "<name>", record it. Throws OutputError.
+  void commit();
+  bool committed() const { return committed_; }
+  const std::string& path() const { return path_; }
+  std::string part_path() const { return path_ + ".part"; }
+  /// True when the part file of `path` (or, without one, `path` itself) exists and its first
+  /// from.bytes bytes have the checksum.
+  static bool matches(const std::string& path, Mark from);
+
+ private:
+  void open(int flags, Mark from);
+  std::string path_;
+  struct Impl;
   std::unique_ptr<Impl> impl_;
   bool committed_ = false;
 };

@@ -75,7 +75,8 @@ std::string json_hash(const scene::json& value) {
 }
 
 bool RunFolder::is_result_name(const std::string& rel) {
-  static const std::set<std::string> fixed = {"summary.json",  "series.csv",     "radius.csv",  "solver_stats.json",
+  static const std::set<std::string> fixed = {"summary.json",  "series.csv",     "radius.csv",  "series.csv.part",
+                                              "radius.csv.part", "solver_stats.json",
                                               "scene.resolved.json", "checkpoint.bin", "membrane.pvd", "fluid.pvd",
                                               "run.png",       "vtk",            kOwner};
   if (fixed.count(rel)) return true;

@@ -120,4 +120,6 @@ ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double 
   return p;
 }
 
+double c1_from_spring_constant(double k_s, double R0) { return 2.0 * k_s / (std::sqrt(3.0) * R0 * R0); }
+
 }  // namespace swim::scene

@@ -43,6 +43,11 @@ struct WallSpec {
 /// Reads (and finishes) the wall section.
 WallSpec read_wall(Reader& top, double R0);
 
+/// The spring network's small-strain wall stiffness C1 = 2 k_s / (sqrt(3) R0^2) [Pa/m] of a
+/// tube of radius R0 [m] with spring constant k_s [N/m] (plane stress of the triangulated
+/// network; docs/source-equations.md). The one formula of both tiers and the calibration.
+double c1_from_spring_constant(double k_s, double R0);
+
 /// wave.contracted_ratio | wave.contracted_radius -> R_f [m]; the caller reads the other
 /// wave keys and finishes `wave`.
 double read_contracted_radius(Reader& wave, double R0);

@@ -43,9 +43,11 @@ namespace {
 class Runner {
  public:
   Runner(const Params3d& p, const json& resolved, const std::string& out, const RunControl& ctl)
-      : p_(p), out_(out), ctl_(ctl), run_(p), stepper_(run_), measured_(run_),
-        output_(run_, resolved, out, p.vtk && !ctl.quiet_vtk, p.fluid_fields && !p.dry && !ctl.quiet_vtk),
-        checkpoint_(run_, resolved, out) {}
+      : p_(p), out_(out), ctl_(ctl), run_(p), rec_(new_record(run_)), stepper_(run_), measured_(run_, rec_),
+        output_(run_, resolved, out, p.vtk && !ctl.quiet_vtk, p.fluid_fields && !p.dry && !ctl.quiet_vtk, rec_),
+        checkpoint_(run_, resolved, out) {
+    rec_.keep(ctl.keep_rows);
+  }
 
   RunOutcome run() {
     RunOutcome res;
@@ -55,6 +57,8 @@ class Runner {
     } else {
       stepper_.start();
       measured_.start(stepper_.state());
+      output_.start();
+      measured_.events(stepper_.protocol().state());
       record();
       if (output_.vtk()) output_.write_membrane_frame(stepper_);
       if (output_.fluid()) output_.write_fluid_frame(stepper_);
@@ -96,9 +100,12 @@ class Runner {
     const double wall = wall_before_ + seconds_since(t0);
     res.failed = failure.has_value();
     res.message = failure ? failure->what() : "";
+    measured_.events(stepper_.protocol().state());
     res.summary = output_.write_results(failure ? "failed: " + std::string(failure->what()) : "ok", wall, stepper_,
                                         measured_);
     res.steps = stepper_.steps();
+    rec_.attach(nullptr);
+    res.record = std::move(rec_);
     return res;
   }
 
@@ -114,6 +121,7 @@ class Runner {
     const double e = measured_.wall_energy(stepper_.state());
     measured_.guards(e, stepper_.state());
     stepper_.finish_step(e);
+    measured_.events(stepper_.protocol().state());
   }
 
   void record() {
@@ -121,17 +129,20 @@ class Runner {
   }
 
   void save_checkpoint(double wall) {
-    checkpoint_.save(stepper_, measured_, output_, wall);
-    // partial results next to the checkpoint, so that a killed run still has them
-    output_.write_results("running: last checkpoint at t = " + short_number(stepper_.state().t) +
-                              " s (resume with --resume " + out_ + ")",
-                          wall, stepper_, measured_);
+    // partial results first (the streams flushed, summary.json "running"), so that a killed
+    // run still has them; the checkpoint then records the streams' marks to continue from
+    const std::vector<double> marks =
+        output_.write_snapshot("running: last checkpoint at t = " + short_number(stepper_.state().t) +
+                                   " s (resume with --resume " + out_ + ")",
+                               wall, stepper_, measured_);
+    checkpoint_.save(stepper_, measured_, output_, marks, wall);
   }
 
   const Params3d& p_;
   std::string out_;
   RunControl ctl_;
   RunSetup run_;
+  record::RunRecord rec_;
   Stepper stepper_;
   Measurements measured_;
   RunOutput output_;

@@ -24,6 +24,7 @@
 
 #include <string>
 
+#include "common/run_record.hpp"
 #include "common/scene.hpp"
 #include "full3d/scene3d.hpp"
 
@@ -34,10 +35,14 @@ struct RunControl {
   bool resume = false;          ///< continue from out_dir/checkpoint.bin
   long stop_after_steps = -1;   ///< testing: stop after this many steps of this process, as if killed
   bool quiet_vtk = false;       ///< testing: suppress VTK output regardless of the scene
+  bool keep_rows = false;       ///< keep the record's rows and ring radii in memory (RunOutcome::record)
 };
 
 struct RunOutcome {
   scene::json summary;
+  /// The run record (common/run_record.hpp); its rows only with RunControl::keep_rows, and
+  /// then those produced by this process (a resumed run's earlier rows are in series.csv).
+  record::RunRecord record;
   bool failed = false;          ///< a NumericalError ended the run (exit 3)
   bool interrupted = false;     ///< stop_after_steps reached (nothing final written)
   std::string message;

@@ -7,6 +7,7 @@
 #include "full3d/run3d_measure.hpp"
 #include "full3d/run3d_output.hpp"
 #include "full3d/run3d_stepper.hpp"
+#include "common/run_record.hpp"
 
 namespace swim::full3d {
 
@@ -84,9 +85,16 @@ void validate(const CheckpointReader& r, const RunSetup& run) {
     for (int c = 0; c < 3; ++c) expect_size(r, u[c], grid.size(c), "fluid grid");
     expect_size(r, "p", grid.cells(), "fluid grid");
   }
-  const std::size_t rows = r.size_of("radius_times");
-  expect_size(r, "series", rows * kSeriesColumns.size(), "series (one row per output time)");
-  expect_size(r, "radius", rows * std::size_t(run.mesh.n_rings), "ring radii (one set per output time)");
+  // the record's running figures: one value per series column (none before the first row)
+  const std::size_t width = kSeriesColumns.size();
+  const std::int64_t rows = r.size_of("series_count") == 1 ? std::int64_t(r.get_vector("series_count")[0]) : -1;
+  if (rows < 0 || rows > n + 1) r.damaged("the checkpoint's series row count is missing or out of range");
+  for (const char* name : {"series_min", "series_max", "series_first", "series_last"})
+    expect_size(r, name, rows > 0 ? width : 0, "series (one value per column)");
+  expect_size(r, "series_previous", rows > 1 ? width : 0, "series (one value per column)");
+  if (r.size_of("series_rows") % width != 0 || r.size_of("radius") != r.size_of("radius_times") * std::size_t(run.mesh.n_rings))
+    r.damaged("the checkpoint's kept rows do not match this scene's series columns and rings");
+  expect_size(r, kOutputMarks, 6, "output streams (size and checksum of series.csv.part and radius.csv.part)");
   // every number finite
   if (const std::string bad = r.first_non_finite(); !bad.empty())
     r.damaged("the checkpoint's record '" + bad + "' holds a NaN or infinite value");
@@ -111,14 +119,14 @@ void validate(const CheckpointReader& r, const RunSetup& run) {
 std::uint64_t RunCheckpoint::scene_hash(const scene::json& resolved) { return fnv1a64(resume_key(resolved)); }
 
 RunCheckpoint::RunCheckpoint(const RunSetup& run, const scene::json& resolved, const std::string& dir)
-    : run_(run), hash_(scene_hash(resolved)), path_(dir + "/checkpoint.bin") {}
+    : run_(run), hash_(scene_hash(resolved)), dir_(dir), path_(dir + "/checkpoint.bin") {}
 
 void RunCheckpoint::save(const Stepper& stepper, const Measurements& measured, const RunOutput& output,
-                         double wall) const {
+                         const std::vector<double>& output_marks, double wall) const {
   CheckpointWriter w(hash_);
   stepper.save(w);
   measured.save(w);
-  output.save(w);
+  output.save(w, output_marks);
   w.put(kWallTime, wall);
   w.save(path_);
 }
@@ -126,6 +134,9 @@ void RunCheckpoint::save(const Stepper& stepper, const Measurements& measured, c
 CheckpointReader RunCheckpoint::open() const {
   CheckpointReader r(path_, hash_);
   validate(r, run_);
+  if (!record::RunStream::matches(dir_, r.get_vector(kOutputMarks)))
+    r.damaged("the partial results series.csv.part and radius.csv.part next to it are missing or do not match it "
+              "(changed, or shorter than at the checkpoint)");
   return r;
 }
 

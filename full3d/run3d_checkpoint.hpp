@@ -31,8 +31,10 @@ class RunCheckpoint {
 
   const std::string& path() const { return path_; }
   /// Writes checkpoint.bin atomically. Throws OutputError naming checkpoint.bin.
-  void save(const Stepper& stepper, const Measurements& measured, const RunOutput& output, double wall) const;
-  /// Reads and validates checkpoint.bin (see above). Throws InputError.
+  void save(const Stepper& stepper, const Measurements& measured, const RunOutput& output,
+            const std::vector<double>& output_marks, double wall) const;
+  /// Reads and validates checkpoint.bin (see above) and the partial results it continues
+  /// (series.csv.part and radius.csv.part must match its marks). Throws InputError.
   CheckpointReader open() const;
   /// open(), then restores the parts; returns the wall time of the run so far, s.
   double restore(Stepper& stepper, Measurements& measured, RunOutput& output) const;
@@ -43,7 +45,7 @@ class RunCheckpoint {
  private:
   const RunSetup& run_;
   std::uint64_t hash_;
-  std::string path_;
+  std::string dir_, path_;
 };
 
 }  // namespace swim::full3d

@@ -8,13 +8,22 @@
 
 namespace swim::full3d {
 
-const std::vector<std::string> kSeriesColumns = {
-    "t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m", "flux_rear_m3_per_s",
-    "flux_front_m3_per_s", "volume_rear_m3", "volume_front_m3", "tube_volume_m3", "phase", "elastic_energy_J",
-    "bending_energy_J", "kinetic_energy_J", "active_segment", "cycles_completed", "cfl", "stokes_iterations",
-    "max_divergence_per_s", "max_edge_m", "dt_s"};
+const std::vector<std::string> kSeriesColumns = [] {
+  std::vector<std::string> c = record::common_series_columns();
+  for (const char* k : {"elastic_energy_J", "bending_energy_J", "kinetic_energy_J", "active_segment",
+                        "cycles_completed", "cfl", "stokes_iterations", "max_divergence_per_s", "max_edge_m", "dt_s"})
+    c.push_back(k);
+  return c;
+}();
 
-Measurements::Measurements(const RunSetup& run) : run_(run) {
+record::RunRecord new_record(const RunSetup& run) {
+  std::vector<double> z(run.mesh.n_rings);
+  for (int r = 0; r < run.mesh.n_rings; ++r) z[r] = r * run.mesh.ring_spacing;
+  return record::RunRecord("3d", run.p.dry ? "immersed_boundary_dry" : "immersed_boundary", run.p.L, kSeriesColumns,
+                           std::move(z));
+}
+
+Measurements::Measurements(const RunSetup& run, record::RunRecord& rec) : run_(run), rec_(rec) {
   const Params3d& p = run.p;
   const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
   e_cap_ = p.energy_growth * run.e_ref * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
@@ -123,13 +132,21 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
   }
   for (int r = 0; r + 1 < mesh.n_rings; ++r)
     vol += 0.5 * M_PI * (rr[r] * rr[r] + rr[r + 1] * rr[r + 1]) * (xr[r + 1] - xr[r]);
-  series_.push_back({s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
-                     rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
-                     double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
-                     last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0});
-  radius_times_.push_back(s.t);
-  radius_.insert(radius_.end(), rr.data(), rr.data() + rr.size());
+  const double row[] = {s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
+                        rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
+                        double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
+                        last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0};
+  rec_.add_row(row);
+  rec_.add_radius(s.t, {rr.data(), std::size_t(rr.size())});
   last_recorded_ = n;
+}
+
+void Measurements::events(const ProtocolState& st) {
+  auto& e = rec_.events;
+  while (e.cycle_start_s.size() < st.cycle_start.size()) rec_.cycle_started(st.cycle_start[e.cycle_start_s.size()]);
+  while (e.cycle_end_s.size() < st.cycle_end.size()) rec_.cycle_ended(st.cycle_end[e.cycle_end_s.size()]);
+  e.switches = st.switches;
+  e.segment_reached_s = st.segment_reached;
 }
 
 // --- checkpoint records ------------------------------------------------------------
@@ -147,24 +164,17 @@ void Measurements::records(Self& self, F&& f) {
   f("last_cfl", self.last_cfl_);
   f("last_stokes_iterations", self.last_iterations_);
   f("last_divergence", self.last_divergence_);
-  f("radius_times", self.radius_times_);
-  f("radius", self.radius_);
   f("last_recorded", self.last_recorded_);
 }
 
 void Measurements::save(CheckpointWriter& w) const {
   records(*this, CheckpointOut(w));
-  std::vector<double> flat;  // the series, row by row
-  for (const auto& row : series_) flat.insert(flat.end(), row.begin(), row.end());
-  w.put("series", flat);
+  rec_.save([&](const std::string& name, const std::vector<double>& v) { w.put(name, v); });
 }
 
 void Measurements::load(const CheckpointReader& r) {
   records(*this, CheckpointIn(r));
-  const auto flat = r.get_vector("series");
-  const size_t nc = kSeriesColumns.size();
-  series_.clear();
-  for (size_t k = 0; k + nc <= flat.size(); k += nc) series_.emplace_back(flat.begin() + k, flat.begin() + k + nc);
+  rec_.load([&](const std::string& name) { return r.get_vector(name); });
 }
 
 }  // namespace swim::full3d

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "common/run_record.hpp"
 #include "full3d/checkpoint.hpp"
 #include "full3d/grid.hpp"
 #include "full3d/ib_solver.hpp"
@@ -18,12 +19,17 @@
 
 namespace swim::full3d {
 
-/// The columns of series.csv.
+/// The columns of a 3D run's series.csv: the common ones (record::common_series_columns()),
+/// then the energy split, protocol state and step statistics.
 extern const std::vector<std::string> kSeriesColumns;
+
+/// An empty record of a 3D run (tier, model, length, columns, reference ring positions).
+record::RunRecord new_record(const RunSetup& run);
 
 class Measurements {
  public:
-  explicit Measurements(const RunSetup& run);
+  /// Rows and ring radii go into `rec`.
+  Measurements(const RunSetup& run, record::RunRecord& rec);
 
   /// A fresh run: the reference of the centre displacement.
   void start(const IbState& s);
@@ -32,13 +38,12 @@ class Measurements {
   double wall_energy(const IbState& s) const;
   /// Throws NumericalError when the wall energy e is not finite or ran away, or the tube collapsed.
   void guards(double e, const IbState& s);
+  /// The protocol's cycle events since the last call, into the record.
+  void events(const ProtocolState& st);
   /// One output row at step n (dt_last: the step that led to it).
   void record(const IbState& s, const ProtocolState& st, long n, double dt_last);
 
   long last_recorded() const { return last_recorded_; }
-  const std::vector<std::vector<double>>& series() const { return series_; }
-  const std::vector<double>& radius_times() const { return radius_times_; }
-  const std::vector<double>& radius() const { return radius_; }
   double pumped_volume() const { return -vol_rear_; }
   double max_cfl() const { return max_cfl_; }
   long stokes_iterations() const { return iterations_total_; }
@@ -54,6 +59,7 @@ class Measurements {
   double disc_flux(int ring, const IbState& s, const MacGrid& grid) const;
 
   const RunSetup& run_;
+  record::RunRecord& rec_;
   double e_cap_;
   std::vector<std::array<double, 3>> disc_;  ///< unit-disc quadrature: y, z, weight
   double x_center0_ = 0, vol_rear_ = 0, vol_front_ = 0, q_rear_ = 0, q_front_ = 0, q_rear_prev_ = 0, q_front_prev_ = 0;
@@ -61,8 +67,6 @@ class Measurements {
   double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0;
   long iterations_total_ = 0, last_iterations_ = 0;
   long last_recorded_ = -1;
-  std::vector<std::vector<double>> series_;
-  std::vector<double> radius_times_, radius_;
 };
 
 }  // namespace swim::full3d

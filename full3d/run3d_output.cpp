@@ -19,9 +19,17 @@ std::string frame_name(const char* kind, const char* ext, std::size_t index) {
 }
 }  // namespace
 
-RunOutput::RunOutput(const RunSetup& run, const json& resolved, std::string dir, bool vtk, bool fluid)
+RunOutput::RunOutput(const RunSetup& run, const json& resolved, std::string dir, bool vtk, bool fluid,
+                     record::RunRecord& rec)
     : run_(run), resolved_(resolved), dir_(std::move(dir)), vtk_(vtk), fluid_(fluid), pvd_(dir_ + "/membrane.pvd"),
-      fluid_pvd_(dir_ + "/fluid.pvd") {}
+      fluid_pvd_(dir_ + "/fluid.pvd"), rec_(rec) {}
+
+RunOutput::~RunOutput() { rec_.attach(nullptr); }
+
+void RunOutput::start() {
+  stream_ = std::make_unique<record::RunStream>(dir_, rec_.series.columns());
+  rec_.attach(stream_.get());
+}
 
 void RunOutput::write_membrane_frame(const Stepper& stepper) {
   std::filesystem::create_directories(dir_ + "/vtk");
@@ -68,50 +76,14 @@ void RunOutput::write_fluid_frame(const Stepper& stepper) {
   fluid_pvd_.write();
 }
 
-json RunOutput::write_results(const std::string& status, double wall, const Stepper& stepper,
-                              const Measurements& measured) const {
+void RunOutput::fill(const std::string& status, double wall, const Stepper& stepper, const Measurements& measured) {
   const Params3d& p = run_.p;
   const CylinderMesh& mesh = run_.mesh;
   const Protocol3d& protocol = stepper.protocol();
-  const auto& st = protocol.state();
-  const auto& series = measured.series();
   const long n = stepper.steps();
-  json s = json::object();
-  s["tier"] = "3d";
-  s["scene"] = resolved_;
-  s["status"] = status;
-  const auto& last = series.back();
-  const double t_end = last[0];
-  s["t_end_s"] = t_end;
-  s["displacement_m"] = last[1];
-  s["cycles_completed"] = st.cycles_completed;
-  std::vector<double> ct;
-  for (size_t k = 0; k < st.cycle_end.size() && k < st.cycle_start.size(); ++k)
-    ct.push_back(st.cycle_end[k] - st.cycle_start[k]);
-  s["cycle_times_s"] = ct;
-  s["cycle_start_times_s"] = st.cycle_start;
-  s["cycle_end_times_s"] = st.cycle_end;
-  const double vmean = t_end > 0 ? last[1] / t_end : 0.0;
-  s["mean_velocity_m_per_s"] = vmean;
-  s["body_lengths_per_s"] = vmean / p.L;
-  s["final_velocity_m_per_s"] = last[2];
-  double vmax = -1e300, rmin = 1e300, emax = 0, xmax = 0;
-  for (const auto& row : series) {
-    vmax = std::max(vmax, row[2]);
-    xmax = std::max(xmax, row[1]);
-    rmin = std::min(rmin, row[4]);
-    emax = std::max(emax, row[20]);
-  }
-  s["max_edge_over_h"] = emax / p.h;  // at the output steps; the no-leak guard needs < 0.5
-  s["max_velocity_m_per_s"] = vmax;
-  s["max_displacement_m"] = xmax;  // largest centre displacement at the output steps
-  s["pumped_volume_m3"] = measured.pumped_volume();
-  s["min_radius_m"] = rmin;
-  s["protocol_switches"] = st.switches;
-  s["segment_reached_s"] = st.segment_reached;
-  s["steps"] = n;
-  s["steps_per_cycle"] = stepper.steps_per_cycle();
-  s["derived"] = {{"C1_estimate_Pa_per_m", p.c1_estimate()},
+  rec_.status = status;
+  rec_.wall_time_s = wall;
+  rec_.derived = {{"C1_Pa_per_m", p.c1_estimate()},
                   {"mass_per_area_kg_per_m2", p.mass_per_area},
                   {"mass_per_length_kg_per_m", p.mass_per_area * 2.0 * M_PI * p.R0},
                   {"aspect_ratio_R0_over_L", p.R0 / p.L},
@@ -128,39 +100,43 @@ json RunOutput::write_results(const std::string& status, double wall, const Step
                   {"ring_spacing_m", mesh.ring_spacing},
                   {"max_edge_m", max_edge_length(mesh, mesh.X0)},
                   {"segment_boundaries_m", protocol.boundaries()}};
-  s["wall_time_s"] = wall;
-  {
-    output::CsvWriter csv(dir_ + "/series.csv", kSeriesColumns);
-    for (const auto& row : series) csv.row(row);
-  }
-  {
-    output::CsvWriter csv(dir_ + "/radius.csv", {"t_s", "z_m", "radius_m"});
-    const int nr = mesh.n_rings;
-    const auto& times = measured.radius_times();
-    const auto& radius = measured.radius();
-    for (size_t k = 0; k < times.size(); ++k)
-      for (int r = 0; r < nr; ++r) csv.row({times[k], r * mesh.ring_spacing, radius[k * nr + r]});
-  }
+  // the largest edge at the output steps; the no-leak guard needs < 0.5 h
+  const double emax = rec_.series.count() ? rec_.series.max("max_edge_m") : 0.0;
+  rec_.extras = {{"max_edge_over_h", emax / p.h}, {"steps", n}, {"steps_per_cycle", stepper.steps_per_cycle()}};
+  // Stokes flow: a swimmer cannot outrun its wave; per cycle the wave crosses the tube once
+  rec_.implausible.clear();
+  const record::CycleFigures c = record::cycle_figures(rec_);
+  if (c.has_cycle && std::abs(c.displacement_per_cycle_m) > p.L)
+    rec_.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
   const double t = stepper.state().t;
-  json stats = {{"steps", n},
+  rec_.stats = {{"steps", n},
                 {"steps_per_cycle", stepper.steps_per_cycle()},
                 {"time_step", stepper.time_step_summary()},
                 {"dt_s", run_.adaptive ? (n > 0 ? t / double(n) : 0.0) : p.dt},
                 {"mode", p.dry ? "dry" : "fluid"},
                 {"stokes_iterations_total", measured.stokes_iterations()},
                 {"max_cfl", measured.max_cfl()},
-                {"protocol_switches", st.switches},
+                {"protocol_switches", protocol.state().switches},
                 {"wall_time_s", wall},
                 {"steps_per_s", wall > 0 ? n / wall : 0.0},
                 {"output_every_steps", run_.out_every},
                 {"checkpoint_every_steps", run_.ckpt_every}};
-  output::write_json(dir_ + "/solver_stats.json", stats);
-  output::write_json(dir_ + "/scene.resolved.json", resolved_);
-  output::write_json(dir_ + "/summary.json", s);
-  return s;
 }
 
-void RunOutput::save(CheckpointWriter& w) const {
+json RunOutput::write_results(const std::string& status, double wall, const Stepper& stepper,
+                              const Measurements& measured) {
+  fill(status, wall, stepper, measured);
+  return record::write_run(dir_, rec_, resolved_);
+}
+
+std::vector<double> RunOutput::write_snapshot(const std::string& status, double wall, const Stepper& stepper,
+                                              const Measurements& measured) {
+  fill(status, wall, stepper, measured);
+  return record::write_snapshot(dir_, rec_, resolved_);
+}
+
+void RunOutput::save(CheckpointWriter& w, const std::vector<double>& marks) const {
+  w.put(kOutputMarks, marks);
   std::vector<double> ft;
   for (const auto& f : pvd_.frames()) ft.push_back(f.first);
   w.put("vtk_frames", ft);
@@ -174,6 +150,8 @@ void RunOutput::load(const CheckpointReader& r) {
   for (double t : r.get_vector("fluid_frames")) fluid_pvd_.add(t, frame_name("fluid", "vti", fluid_pvd_.frames().size()));
   if (vtk_) pvd_.write();
   if (fluid_) fluid_pvd_.write();
+  stream_ = std::make_unique<record::RunStream>(dir_, r.get_vector(kOutputMarks));
+  rec_.attach(stream_.get());
 }
 
 }  // namespace swim::full3d

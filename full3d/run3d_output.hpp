@@ -6,6 +6,7 @@
 
 #include <string>
 
+#include "common/run_record.hpp"
 #include "common/scene.hpp"
 #include "common/vtk.hpp"
 #include "full3d/checkpoint.hpp"
@@ -17,27 +18,47 @@ namespace swim::full3d {
 
 class RunOutput {
  public:
-  /// vtk: membrane frames; fluid: fluid frames.
-  RunOutput(const RunSetup& run, const scene::json& resolved, std::string dir, bool vtk, bool fluid);
+  /// vtk: membrane frames; fluid: fluid frames. The record's rows and ring radii stream into
+  /// the folder (record::RunStream) from start() or load() on.
+  RunOutput(const RunSetup& run, const scene::json& resolved, std::string dir, bool vtk, bool fluid,
+            record::RunRecord& rec);
+  ~RunOutput();
+
+  /// A fresh run: open the streams.
+  void start();
 
   bool vtk() const { return vtk_; }
   bool fluid() const { return fluid_; }
   void write_membrane_frame(const Stepper& stepper);
   void write_fluid_frame(const Stepper& stepper);
-  /// Writes the result files (summary.json last) and returns the summary.
+  /// The final result files (series.csv and radius.csv published, summary.json last); returns
+  /// the summary. `status`: "ok" or "failed: ...".
   scene::json write_results(const std::string& status, double wall, const Stepper& stepper,
-                            const Measurements& measured) const;
+                            const Measurements& measured);
+  /// A running run's snapshot before a checkpoint (the streams flushed, summary.json with
+  /// this status listing the part files so far). Returns the streams' marks for the checkpoint.
+  std::vector<double> write_snapshot(const std::string& status, double wall, const Stepper& stepper,
+                                     const Measurements& measured);
 
-  /// The frame times; load() also rewrites the collections of the enabled frame kinds.
-  void save(CheckpointWriter& w) const;
+  /// The frame times and the streams' marks; load() also rewrites the collections of the
+  /// enabled frame kinds and continues the streams from the marks.
+  void save(CheckpointWriter& w, const std::vector<double>& marks) const;
   void load(const CheckpointReader& r);
 
  private:
+  /// The record's summary keys of a 3D run (derived values, extras, statistics, status).
+  void fill(const std::string& status, double wall, const Stepper& stepper, const Measurements& measured);
+
   const RunSetup& run_;
   const scene::json& resolved_;
   std::string dir_;
   bool vtk_, fluid_;
   vtk::Collection pvd_, fluid_pvd_;
+  record::RunRecord& rec_;
+  std::unique_ptr<record::RunStream> stream_;
 };
+
+/// The checkpoint record of the streams' marks.
+inline constexpr const char* kOutputMarks = "output_marks";
 
 }  // namespace swim::full3d

@@ -23,7 +23,7 @@ bool multiple_of(double a, double h) {
 
 }  // namespace
 
-double Params3d::c1_estimate() const { return 2.0 * membrane.ks / (std::sqrt(3.0) * R0 * R0); }
+double Params3d::c1_estimate() const { return scene::c1_from_spring_constant(membrane.ks, R0); }
 
 ContainerKind Params3d::container_kind() const {
   return container == "box" ? ContainerKind::PeriodicBox : ContainerKind::SquareDuct;  // cylinder: inside a duct

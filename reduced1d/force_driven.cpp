@@ -1136,7 +1136,7 @@ class IdaBackend final : public Backend {
 
 // ---------------------------------------------------------------------------------------
 // Event loop shared by the protocol run and the fixed-actuation run.
-Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, const ProgressFn& progress,
+Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, const Output& out,
            bool velocity_in_rhs = false) {
   Result res;
   for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
@@ -1199,10 +1199,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     s.phase = machine.phase();
     if (!ok) return false;
     if (!finite(s)) return false;
-    res.series.push_back(s);
-    res.radius_times.push_back(tt);
-    res.radius.insert(res.radius.end(), M.R.begin(), M.R.end());
-    if (progress) progress(tt, t_stop);
+    emit(res, out, s, M.R.data(), N, t_stop);
     return true;
   };
   auto cells = [&](const double* y) {
@@ -1232,6 +1229,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     if (!fixed) {
       machine.start_cycle(0.0, Rcells.data());
       res.cycle_start.push_back(0.0);
+      if (out.record) out.record->cycle_started(0.0);
     }
     machine.laws(lawbuf, seglawbuf);
     M.set_actuation(machine, lawbuf, seglawbuf);
@@ -1293,6 +1291,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
         }
         if (machine.cycle_completed()) {
           res.cycle_end.push_back(t);
+          if (out.record) out.record->cycle_ended(t);
           ++cycles_done;
           if (fixed || (P.duration <= 0 && cycles_done >= P.protocol.cycles)) {
             machine.finish();
@@ -1301,6 +1300,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
           }
           machine.start_cycle(t, R);
           res.cycle_start.push_back(t);
+          if (out.record) out.record->cycle_started(t);
         }
         apply_actuation(t);
         if (M.velocity_quadrature) vq.restart(t, vq.integrand(M, be->y()));  // right-hand value
@@ -1463,16 +1463,16 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
   return out;
 }
 
-Result solve_force_driven(const Params& p, const ProgressFn& progress, bool velocity_in_rhs) {
-  return run(p, {}, 0.0, progress, velocity_in_rhs);
+Result solve_force_driven(const Params& p, const Output& out, bool velocity_in_rhs) {
+  return run(p, {}, 0.0, out, velocity_in_rhs);
 }
 
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
-                             const ProgressFn& progress) {
+                             const Output& out) {
   validate(p);
   if (static_cast<int>(q_cells.size()) != p.numerics.cells)
     throw InputError("q_cells", std::to_string(q_cells.size()), "one actuation value per cell");
-  return run(p, q_cells, t_end, progress);
+  return run(p, q_cells, t_end, out);
 }
 
 }  // namespace swim::reduced1d::detail

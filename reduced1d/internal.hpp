@@ -23,19 +23,23 @@ double relaxation_time(const Params& p);
 enum class PrescribedPath { Auto, Integrated };
 
 /// Prescribed Step/Sine wave: swimmer balance and end volumes as time integrals.
-Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedPath path = PrescribedPath::Auto);
+Result solve_prescribed(const Params& p, const Output& out, PrescribedPath path = PrescribedPath::Auto);
 
 /// Force-driven wave under the Section-3 protocol (CVODE or IDA, root-located switches).
 /// Unbounded outer flow without wall inertia: U is evaluated once per accepted step and X
 /// integrated along the steps; `velocity_in_rhs` puts U back into every right-hand side
 /// with X as an ODE state (the reference the step quadrature is tested against).
-Result solve_force_driven(const Params& p, const ProgressFn& progress, bool velocity_in_rhs = false);
+Result solve_force_driven(const Params& p, const Output& out, bool velocity_in_rhs = false);
 
 /// Force-driven machinery with a FIXED actuation pressure q_cells[i] (inward positive, Pa)
 /// on every cell and no protocol: integrates from R = R0 at rest to t_end. Used for the
 /// uniform-load (static calibration) check; the result has phase 0 throughout.
 Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells, double t_end,
-                             const ProgressFn& progress = {});
+                             const Output& out = {});
+
+/// A sample produced: into the record of `out` (and its stream), into the Result's typed
+/// samples when kept, then the progress report. R: the N cell radii.
+void emit(Result& res, const Output& out, const Sample& s, const double* R, int N, double t_end);
 
 /// Test of the analytic Newton-matrix Jacobians against central finite differences of the
 /// right-hand side (CVODE) or residual (IDA) at a random state: radii drawn in

@@ -309,7 +309,7 @@ void fill_wall_sample(const PrescribedModel& model, const PrescribedModel::Eval&
   s.tube_volume = pi * vol * model.h;
 }
 
-Result solve_by_quadrature(const Params& p, PrescribedModel& model, const ProgressFn& progress) {
+Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Output& out) {
   Result res = prepared_result(model);
   const int N = model.N;
   const double t_end = end_time(p);
@@ -321,10 +321,10 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
   std::vector<double> tk;
   std::vector<QVec> fk;
   std::vector<Sample> samples;
+  std::vector<double> radius;  // the snapshots, until the integrals are known
   const std::size_t expect = std::size_t(std::max(0.0, std::ceil(t_end / dt_out))) + 2;
   tk.reserve(expect), fk.reserve(expect), samples.reserve(expect);
-  res.radius_times.reserve(expect);
-  res.radius.reserve(expect * std::size_t(N));
+  radius.reserve(expect * std::size_t(N));
   for (long k = 0;; ++k) {
     double t = std::min(double(k) * dt_out, t_end);
     if (t_end - t < 1e-9 * dt_out) t = t_end;
@@ -348,8 +348,7 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
     tk.push_back(t);
     fk.push_back(f);
     samples.push_back(s);
-    res.radius_times.push_back(t);
-    res.radius.insert(res.radius.end(), R, R + N);
+    radius.insert(radius.end(), R, R + N);
     if (t >= t_end) break;
   }
 
@@ -404,12 +403,7 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
       res.failure = NumericalError("the prescribed wave left the model's range during the quadrature (the wall reached the container or the lumen closed)",
                                    "check the wave parameters or raise container.radius", qc.t_fail);
   }
-  for (int i = 0; i < kept; ++i) {
-    res.series.push_back(samples[i]);
-    if (progress) progress(samples[i].t, t_end);
-  }
-  res.radius_times.resize(kept);
-  res.radius.resize(std::size_t(kept) * N);
+  for (int i = 0; i < kept; ++i) emit(res, out, samples[i], radius.data() + std::size_t(i) * N, N, t_end);
   res.stats["rhs_evals"] = qc.evals;
   res.stats["steps"] += qc.pieces;
   return res;
@@ -417,9 +411,9 @@ Result solve_by_quadrature(const Params& p, PrescribedModel& model, const Progre
 
 }  // namespace
 
-Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedPath path) {
+Result solve_prescribed(const Params& p, const Output& out, PrescribedPath path) {
   PrescribedModel model(p);
-  if (model.force_free && path != PrescribedPath::Integrated) return solve_by_quadrature(p, model, progress);
+  if (model.force_free && path != PrescribedPath::Integrated) return solve_by_quadrature(p, model, out);
   Result res = prepared_result(model);
   const int N = model.N;
 
@@ -443,10 +437,7 @@ Result solve_prescribed(const Params& p, const ProgressFn& progress, PrescribedP
     s.V_front = Y[3] * model.V_s;
     s.phase = 0;
     if (!finite(s)) return false;
-    res.series.push_back(s);
-    res.radius_times.push_back(t);
-    res.radius.insert(res.radius.end(), R, R + N);
-    if (progress) progress(t, t_end);
+    emit(res, out, s, R, N, t_end);
     return true;
   };
 

@@ -41,9 +41,11 @@ struct Metrics {
 
 Metrics metrics(const Params& p, const Result& r);
 
-/// Write summary.json, series.csv, radius.csv and solver_stats.json into `dir` (which must
-/// exist). Returns the summary. `status` is "ok" or "failed: <message>".
-scene::json write_run(const std::string& dir, const Params& p, const scene::json& resolved, const Result& r,
+/// Write the run folder (record::write_run: series.csv, radius.csv, solver_stats.json,
+/// scene.resolved.json, summary.json last) into `dir` (which must exist), from r.record (its
+/// stream, when solve() had one) or from the kept samples. Returns the summary; its `status`
+/// is "ok" or "failed: <message>".
+scene::json write_run(const std::string& dir, const Params& p, const scene::json& resolved, Result& r,
                       double wall_time_s);
 
 }  // namespace swim::reduced1d

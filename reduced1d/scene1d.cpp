@@ -21,7 +21,6 @@ namespace {
 std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
 }  // namespace
 
-double c1_from_spring_constant(double k_s, double R0) { return 2.0 * k_s / (std::sqrt(3.0) * R0 * R0); }
 
 namespace {
 json load_calibration(const std::string& key, const std::string& path, const std::string& scene_dir) {
@@ -94,7 +93,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     if (w.stiffness == "C1")
       p.wall.C1 = w.value;
     else if (w.stiffness == "spring_constant")
-      p.wall.C1 = c1_from_spring_constant(w.value, R0);
+      p.wall.C1 = scene::c1_from_spring_constant(w.value, R0);
     else
       p.wall.C1 = c1_from_calibration("wall.calibration", w.calibration, scene_dir);
     p.wall.m = w.mass_per_area;

@@ -20,7 +20,9 @@ std::vector<DesignOutcome> run_designs(const std::vector<Params>& designs, int j
       const auto t0 = std::chrono::steady_clock::now();
       DesignOutcome& o = out[k];
       try {
-        const Result r = solve(designs[k]);
+        SolveOptions so;
+        so.keep_samples = false;  // the metrics come from the record's running figures
+        const Result r = solve(designs[k], so);
         o.metrics = metrics(designs[k], r);
         o.ok = !r.failure;
         if (r.failure) o.message = r.failure->what();

@@ -169,12 +169,106 @@ double straight_tube_drag(const Params& p) {
                                           p.container.period, mu);
 }
 
-Result solve(const Params& params, const ProgressFn& progress) {
+namespace detail {
+void emit(Result& res, const Output& out, const Sample& s, const double* R, int N, double t_end) {
+  if (out.record) {
+    out.record->add_row(series_row(s));
+    out.record->add_radius(s.t, {R, std::size_t(N)});
+  }
+  if (out.keep_samples) {
+    res.series.push_back(s);
+    res.radius_times.push_back(s.t);
+    res.radius.insert(res.radius.end(), R, R + N);
+  }
+  if (out.progress) out.progress(s.t, t_end);
+}
+}  // namespace detail
+
+const std::vector<std::string>& series_columns() {
+  static const std::vector<std::string> c = [] {
+    std::vector<std::string> v = record::common_series_columns();
+    for (const char* k : {"pressure_rear_Pa", "pressure_front_Pa", "flux_total_m3_per_s", "force_lumen_N",
+                          "force_outer_N", "volume_rear_lab_m3", "volume_front_lab_m3"})
+      v.push_back(k);
+    return v;
+  }();
+  return c;
+}
+
+std::vector<double> series_row(const Sample& s) {
+  return {s.t,       s.X,       s.W,         s.energy,  s.R_min,   s.R_max,      s.Q_rear,      s.Q_front,
+          s.V_rear,  s.V_front, s.tube_volume, double(s.phase), s.p_rear, s.p_front, s.Q_total, s.F_lumen,
+          s.F_outer, s.V_rear_lab, s.V_front_lab};
+}
+
+namespace {
+std::string model_name(const Params& p) {
+  if (p.swimmer.model == SwimmerModel::Paper) return "paper";
+  return p.swimmer.outer == OuterFlow::Confined ? "force_free_confined" : "force_free_unbounded";
+}
+std::vector<double> cell_centres(const Params& p) {
+  const int N = p.numerics.cells;
+  std::vector<double> z(N);
+  for (int i = 0; i < N; ++i) z[i] = (i + 0.5) * p.geometry.L / N;
+  return z;
+}
+
+/// What the solver leaves in the Result and not in the record: events, status, plausibility.
+void finish_record(const Params& p, const Result& r, record::RunRecord& rec) {
+  rec.events.segment_reached_s = r.segment_reached;
+  rec.events.switches = r.switches;
+  rec.status = r.failure ? "failed: " + std::string(r.failure->what()) : "ok";
+  rec.transit_is_cycle = p.wave != WaveKind::ForceDriven && !r.failure && rec.series.count() > 0 &&
+                         rec.t_end() >= end_time(p) * (1 - 1e-9);
+  // A peristaltic swimmer cannot outrun its wave: per cycle the wave crosses the tube once
+  // (length L), so |displacement per cycle| <= L (the paper's inertial model is exempt).
+  const record::CycleFigures c = record::cycle_figures(rec);
+  rec.implausible.clear();
+  if (p.swimmer.model == SwimmerModel::ForceFree && c.has_cycle && std::abs(c.displacement_per_cycle_m) > p.geometry.L)
+    rec.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
+  for (const auto& [k, v] : r.stats) rec.stats[k] = v;
+  rec.stats["protocol_switches"] = r.switches;
+}
+}  // namespace
+
+record::RunRecord new_record(const Params& p) {
+  return record::RunRecord("1d", model_name(p), p.geometry.L, series_columns(), cell_centres(p));
+}
+
+record::RunRecord record_of(const Params& p, const Result& r) {
+  record::RunRecord rec = new_record(p);
+  const std::size_t n = rec.radius.z().size();
+  record::replay(
+      rec, r.series.size(), [&](std::size_t k) { return r.series[k].t; },
+      [&](std::size_t k) {
+        rec.add_row(series_row(r.series[k]));
+        if (k < r.radius_times.size()) rec.add_radius(r.radius_times[k], {r.radius.data() + k * n, n});
+      },
+      r.cycle_start, r.cycle_end);
+  finish_record(p, r, rec);
+  return rec;
+}
+
+Result solve(const Params& params, const SolveOptions& o) {
   detail::validate(params);
-  Result r = params.wave == WaveKind::ForceDriven ? detail::solve_force_driven(params, progress)
-                                                  : detail::solve_prescribed(params, progress);
+  record::RunRecord rec = new_record(params);
+  rec.keep(o.keep_record_rows);
+  rec.attach(o.stream);
+  Output out(o.progress);
+  out.keep_samples = o.keep_samples;
+  out.record = &rec;
+  Result r = params.wave == WaveKind::ForceDriven ? detail::solve_force_driven(params, out)
+                                                  : detail::solve_prescribed(params, out);
   r.drag_coefficient = straight_tube_drag(params);
+  finish_record(params, r, rec);
+  r.record = std::move(rec);  // still attached to the caller's stream, which write_run commits
   return r;
+}
+
+Result solve(const Params& params, const ProgressFn& progress) {
+  SolveOptions o;
+  o.progress = progress;
+  return solve(params, o);
 }
 
 }  // namespace swim::reduced1d

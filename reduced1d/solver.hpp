@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "common/errors.hpp"
+#include "common/run_record.hpp"
 #include "reduced1d/params.hpp"
 
 namespace swim::reduced1d {
@@ -64,12 +65,49 @@ struct Result {
   double drag_coefficient = 0;
   std::map<std::string, long> stats; ///< integrator statistics (steps, rhs evals, ...)
   std::optional<NumericalError> failure;  ///< set when the run stopped on a numerical failure
+  /// The run record (common/run_record.hpp) of solve(): every sample went through it (its
+  /// running figures, events and status are complete; its rows are kept on request).
+  record::RunRecord record;
 };
 
 /// Called after every output sample with the current and final simulated times.
 using ProgressFn = std::function<void(double t, double t_end)>;
 
+/// Where a run's samples go as they are produced.
+struct Output {
+  Output() = default;
+  Output(ProgressFn p) : progress(std::move(p)) {}  // NOLINT: a progress function alone
+  ProgressFn progress;
+  /// Keep the typed samples (Result::series, radius snapshots) in memory.
+  bool keep_samples = true;
+  /// Also into this record (running figures, events; its stream writes them to disk).
+  record::RunRecord* record = nullptr;
+};
+
+/// How solve() keeps and writes what it produces.
+struct SolveOptions {
+  ProgressFn progress;
+  /// Keep Result::series and the radius snapshots (typed samples) in memory.
+  bool keep_samples = true;
+  /// Keep the rows of Result::record in memory (named columns).
+  bool keep_record_rows = false;
+  /// Stream every row and snapshot to disk as produced (memory then stays bounded). The
+  /// Result's record stays attached to it (write_run commits it).
+  record::RunStream* stream = nullptr;
+};
+
+Result solve(const Params& params, const SolveOptions& options);
 Result solve(const Params& params, const ProgressFn& progress = {});
+
+/// The columns of a 1D run's series.csv: the common ones (record::common_series_columns()),
+/// then the force-free model's lumen pressures, total flux, force split and lab-frame volumes.
+const std::vector<std::string>& series_columns();
+/// A sample as a series row (series_columns() order).
+std::vector<double> series_row(const Sample& s);
+/// An empty record of a run of these parameters (tier, model, length, columns, cell centres).
+record::RunRecord new_record(const Params& params);
+/// The record of a finished Result whose record is empty (built from its kept samples).
+record::RunRecord record_of(const Params& params, const Result& r);
 
 /// Drag coefficient zeta [N s/m] of the straight tube (R = R0) towed through the model's outer
 /// flow (confined: lumen, annulus and free pipe; unbounded: resistive force); 0 in paper mode.

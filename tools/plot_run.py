@@ -39,7 +39,7 @@ def main(run_dir):
         with open(f"{run_dir}/summary.json") as f:
             summary = json.load(f)
         name = summary.get("scene", {}).get("name", run_dir)
-        label = f"{name} ({summary.get('tier', '')}{', ' + summary['model1d'] if 'model1d' in summary else ''})"
+        label = f"{name} ({summary.get('tier', '')}{', ' + summary['model'] if 'model' in summary else ''})"
     except (OSError, ValueError):
         label = run_dir
     fig, ax = plt.subplots(2, 2, figsize=(11, 7.5))

@@ -9,6 +9,7 @@
 
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/run_record.hpp"
 #include "common/run_folder.hpp"
 #include "common/units.hpp"
 #include "full3d/run3d.hpp"
@@ -78,35 +79,17 @@ struct Series {
   std::vector<double> t, x, u;
 };
 
-/// The 3D run's own series.csv in its cache folder (t_s, x_center_m, velocity_m_per_s).
-Series read_series_csv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw NumericalError("the cached 3D run has no series.csv (" + path + ")", "remove the run's cache folder");
-  std::string line;
-  std::getline(in, line);
-  std::vector<std::string> cols;
-  {
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) cols.push_back(c);
-  }
-  auto col = [&](const std::string& name) {
-    for (std::size_t i = 0; i < cols.size(); ++i)
-      if (cols[i] == name) return i;
-    throw NumericalError("series.csv has no column " + name, "remove the run's cache folder");
-  };
-  const std::size_t it = col("t_s"), ix = col("x_center_m"), iu = col("velocity_m_per_s");
+/// The centre history of a record's kept rows (times strictly increasing).
+Series series_of(const record::RunRecord& rec) {
   Series s;
-  while (std::getline(in, line)) {
-    std::vector<double> v;
-    std::stringstream ss(line);
-    std::string c;
-    while (std::getline(ss, c, ',')) v.push_back(std::strtod(c.c_str(), nullptr));
-    if (v.size() < cols.size()) continue;
-    if (!s.t.empty() && !(v[it] > s.t.back())) continue;
-    s.t.push_back(v[it]);
-    s.x.push_back(v[ix]);
-    s.u.push_back(v[iu]);
+  const record::Series& se = rec.series;
+  const std::size_t it = se.index("t_s"), ix = se.index("x_center_m"), iu = se.index("velocity_m_per_s");
+  for (std::size_t k = 0; k < se.rows(); ++k) {
+    const auto row = se.row(k);
+    if (!s.t.empty() && !(row[it] > s.t.back())) continue;
+    s.t.push_back(row[it]);
+    s.x.push_back(row[ix]);
+    s.u.push_back(row[iu]);
   }
   return s;
 }
@@ -123,34 +106,8 @@ json downsample(const Series& s, double t_end, int n = 400) {
   return {{"t_s", t}, {"velocity_m_per_s", u}, {"x_m", x}};
 }
 
-/// Per-cycle figures from the cycle start/end times and the centre history.
-struct CycleFigures {
-  bool has_cycle = false;
-  double displacement_per_cycle_m = 0, cycle_time_s = 0, mean_velocity_per_cycle_m_per_s = 0;
-};
+using record::CycleFigures;
 
-CycleFigures cycle_figures(const Series& s, const std::vector<double>& starts, const std::vector<double>& ends) {
-  CycleFigures c;
-  const std::size_t n = std::min(starts.size(), ends.size());
-  if (n == 0 || s.t.size() < 2) return c;
-  double d = 0, T = 0;
-  for (std::size_t k = 0; k < n; ++k) {
-    d += interpolate_linear(s.t, s.x, ends[k]) - interpolate_linear(s.t, s.x, starts[k]);
-    T += ends[k] - starts[k];
-  }
-  c.has_cycle = true;
-  c.displacement_per_cycle_m = d / double(n);
-  c.cycle_time_s = T / double(n);
-  c.mean_velocity_per_cycle_m_per_s = d / T;
-  return c;
-}
-
-std::vector<double> doubles(const json& j, const std::string& key) {
-  std::vector<double> v;
-  if (j.contains(key) && j[key].is_array())
-    for (const auto& x : j[key]) v.push_back(x.get<double>());
-  return v;
-}
 
 // ---- one 3D run (cached) --------------------------------------------------------------
 
@@ -212,17 +169,25 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   if (!*cached) {
     fs::remove_all(dir);
     fs::create_directories(dir);
+  }
+  // a fresh run's record comes from the tier; a cached one is read back from its folder
+  record::RunRecord rec;
+  if (!*cached) {
     full3d::RunControl ctl;
     ctl.progress = 0;
     ctl.quiet_vtk = true;
-    const full3d::RunOutcome out = full3d::run3d(p, resolved, dir, ctl);
+    ctl.keep_rows = true;
+    full3d::RunOutcome out = full3d::run3d(p, resolved, dir, ctl);
     summary = out.summary;
+    rec = std::move(out.record);
+  } else {
+    rec = record::read_run(dir);
   }
   const std::string status = summary.value("status", std::string("unknown"));
   r.ok = status == "ok";
   r.wall = summary.value("wall_time_s", 0.0);
-  r.series = read_series_csv(dir + "/series.csv");
-  r.cyc = cycle_figures(r.series, doubles(summary, "cycle_start_times_s"), doubles(summary, "cycle_end_times_s"));
+  r.series = series_of(rec);
+  r.cyc = record::cycle_figures(rec);
   r.record = {{"cell_size_m", p.h},
               {"grid", {p.nx, p.ny, p.nz}},
               {"status", status},
@@ -260,15 +225,13 @@ Run1d run_1d(const json& sc, const std::string& label, const std::string& scene_
   try {
     const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir);
     const auto t0 = std::chrono::steady_clock::now();
-    const reduced1d::Result res = reduced1d::solve(p);
+    reduced1d::SolveOptions so;
+    so.keep_samples = false;
+    so.keep_record_rows = true;
+    const reduced1d::Result res = reduced1d::solve(p, so);
     r.wall = seconds_since(t0);
     const reduced1d::Metrics m = reduced1d::metrics(p, res);
-    for (const auto& smp : res.series) {
-      if (!r.series.t.empty() && !(smp.t > r.series.t.back())) continue;
-      r.series.t.push_back(smp.t);
-      r.series.x.push_back(smp.X);
-      r.series.u.push_back(smp.W);
-    }
+    r.series = series_of(res.record);
     r.ok = !res.failure.has_value();
     r.cyc.has_cycle = m.has_cycle;
     if (m.has_cycle) {

@@ -12,6 +12,7 @@
 #include <iterator>
 #include <regex>
 #include <set>
+#include <sstream>
 #include <string>
 
 #include "common/atomic_file.hpp"
@@ -333,4 +334,59 @@ TEST(RunFolderCli, ARealFullFilesystemIsExitThreeAndNothingClaimsSuccess) {
   EXPECT_FALSE(fs::exists(out / "radius.csv"));
   for (const auto& e : fs::directory_iterator(out))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
+}
+
+// Both tiers write their folders with one writer (common/run_record.hpp): the same summary
+// keys, the same leading series columns in the same order, the same radius.csv columns.
+TEST(RunFolderCli, BothTiersWriteTheSameKeysAndColumns) {
+  const fs::path d = tmpdir("same_keys");
+  ASSERT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "a").string() + "\"", d).code, 0);
+  ASSERT_EQ(swim_cli("run \"" + kTiny3d + "\" --tier 3d" + kTiny3dFast + " --out \"" + (d / "b").string() + "\"", d).code,
+            0);
+  const json a = summary_of(d / "a"), b = summary_of(d / "b");
+  // the tier-specific summary keys, documented in docs/outputs.md
+  const std::set<std::string> only1d = {"pumped_volume_lab_m3", "brownian"};
+  const std::set<std::string> only3d = {"steps", "steps_per_cycle", "max_edge_over_h"};
+  std::set<std::string> ka, kb;
+  for (const auto& [k, v] : a.items())
+    if (!only1d.count(k)) ka.insert(k);
+  for (const auto& [k, v] : b.items())
+    if (!only3d.count(k)) kb.insert(k);
+  EXPECT_EQ(ka, kb);
+  for (const char* k : {"tier", "model", "status", "displacement_m", "cycle_start_times_s", "cycle_end_times_s",
+                        "displacement_per_cycle_m", "pumped_volume_m3", "plausible", "series_rows", "files"})
+    EXPECT_TRUE(a.contains(k) && b.contains(k)) << k;
+  for (const char* k : {"C1_Pa_per_m", "mass_per_area_kg_per_m2", "aspect_ratio_R0_over_L", "contracted_ratio",
+                        "actuation_pressure_Pa"})
+    EXPECT_TRUE(a["derived"].contains(k) && b["derived"].contains(k)) << k;
+  // series.csv: the 12 common columns lead in both
+  const auto header = [](const fs::path& p) {
+    std::ifstream in(p);
+    std::string line;
+    std::getline(in, line);
+    std::vector<std::string> c;
+    std::stringstream ss(line);
+    for (std::string x; std::getline(ss, x, ',');) c.push_back(x);
+    return c;
+  };
+  const auto ha = header(d / "a" / "series.csv"), hb = header(d / "b" / "series.csv");
+  const std::vector<std::string> common = {"t_s",           "x_center_m",         "velocity_m_per_s",    "energy_J",
+                                           "min_radius_m",  "max_radius_m",       "flux_rear_m3_per_s",  "flux_front_m3_per_s",
+                                           "volume_rear_m3", "volume_front_m3",   "tube_volume_m3",      "phase"};
+  ASSERT_GE(ha.size(), common.size());
+  ASSERT_GE(hb.size(), common.size());
+  EXPECT_TRUE(std::equal(common.begin(), common.end(), ha.begin()));
+  EXPECT_TRUE(std::equal(common.begin(), common.end(), hb.begin()));
+  EXPECT_EQ(header(d / "a" / "radius.csv"), header(d / "b" / "radius.csv"));
+  // the rows written are those the summary counts
+  const auto rows = [](const fs::path& p) {
+    std::ifstream in(p);
+    long n = -1;
+    for (std::string l; std::getline(in, l);) ++n;
+    return n;
+  };
+  EXPECT_EQ(rows(d / "a" / "series.csv"), a["series_rows"].get<long>());
+  EXPECT_EQ(rows(d / "b" / "series.csv"), b["series_rows"].get<long>());
+  expect_consistent_folder(d / "a");
+  expect_consistent_folder(d / "b");
 }

@@ -86,11 +86,33 @@ TEST(Run3d, ResumeEqualsUninterruptedRun) {
   stop.stop_after_steps = 17;  // "killed" at step 17; the last checkpoint is at step 10
   const RunOutcome rb = run3d(s.p, s.resolved, b, stop);
   ASSERT_TRUE(rb.interrupted);
+  // the killed run: its rows streamed to the part files, and its summary (written at the
+  // checkpoint of step 10) says running and lists the part files as they were then
+  {
+    std::ifstream in(b + "/summary.json");
+    const scene::json sb = scene::json::parse(in);
+    EXPECT_EQ(sb["status"].get<std::string>().rfind("running", 0), 0u) << sb["status"];
+    EXPECT_FALSE(std::filesystem::exists(b + "/series.csv"));
+    bool listed = false;
+    for (const auto& f : sb["files"])
+      if (f["name"] == "series.csv.part") {
+        listed = true;
+        EXPECT_LT(f["bytes"].get<std::uintmax_t>(), std::filesystem::file_size(b + "/series.csv.part"));
+      }
+    EXPECT_TRUE(listed);
+  }
   RunControl res = ctl;
   res.resume = true;
   const RunOutcome rc = run3d(s.p, s.resolved, b, res);
   ASSERT_FALSE(rc.failed) << rc.message;
   EXPECT_EQ(rc.steps, ra.steps);
+  // the rows after the checkpoint are recomputed to the bit: the files are byte-identical
+  for (const char* f : {"/series.csv", "/radius.csv"}) {
+    std::ifstream fa(a + f, std::ios::binary), fc(b + f, std::ios::binary);
+    const std::string A((std::istreambuf_iterator<char>(fa)), {}), C((std::istreambuf_iterator<char>(fc)), {});
+    EXPECT_EQ(A, C) << f;
+  }
+  EXPECT_FALSE(std::filesystem::exists(b + "/series.csv.part"));
   const auto A = read_csv(a + "/series.csv"), C = read_csv(b + "/series.csv");
   ASSERT_EQ(A.size(), C.size());
   double worst = 0;

@@ -1,0 +1,265 @@
+// The run record of both tiers and its one writer (common/run_record.hpp): running figures
+// without kept rows, events, the streamed files and their resume, reading a folder back.
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "common/checksum.hpp"
+#include "common/errors.hpp"
+#include "common/run_record.hpp"
+
+namespace fs = std::filesystem;
+using namespace swim;
+using namespace swim::record;
+
+namespace {
+
+std::string fresh_dir(const std::string& name) {
+  const fs::path d = fs::temp_directory_path() / ("swim_record_" + name + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d.string();
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::string> columns() {
+  std::vector<std::string> c = common_series_columns();
+  c.push_back("extra_J");
+  return c;
+}
+
+/// A row at time t of a swimmer moving at v: x = v t, radius dipping at t = 0.3 s.
+std::vector<double> row_at(double t, double v = 2e-9) {
+  std::vector<double> r(columns().size(), 0.0);
+  r[0] = t;
+  r[1] = v * t;
+  r[2] = v;
+  r[3] = 1e-18 * (1 + t);
+  r[4] = 1e-7 - 1e-8 * std::exp(-100 * (t - 0.3) * (t - 0.3));
+  r[5] = 1.25e-7;
+  r[8] = -1e-21 * t;  // volume_rear_m3
+  r[11] = t < 0.5 ? 0 : 1;
+  r[12] = std::sin(7 * t);
+  return r;
+}
+
+RunRecord filled(bool keep, int rows = 101) {
+  RunRecord r("1d", "test_model", 4e-7, columns(), {1e-7, 2e-7, 3e-7});
+  r.keep(keep);
+  for (int k = 0; k < rows; ++k) {
+    const double t = 0.01 * k;
+    if (k == 0) r.cycle_started(0.0);
+    if (std::abs(t - 0.55) < 1e-12) {
+      r.cycle_ended(0.545);  // between two rows: interpolated
+      r.cycle_started(0.545);
+    }
+    r.add_row(row_at(t));
+    const double R[3] = {1e-7, 1.1e-7 + t * 1e-9, 1.2e-7};
+    r.add_radius(t, R);
+  }
+  return r;
+}
+
+}  // namespace
+
+TEST(RunRecord, RunningFiguresDoNotNeedTheRows) {
+  const RunRecord kept = filled(true), lean = filled(false);
+  EXPECT_EQ(kept.series.rows(), 101u);
+  EXPECT_EQ(lean.series.rows(), 0u);  // bounded memory: nothing kept
+  EXPECT_EQ(lean.series.count(), 101u);
+  EXPECT_EQ(lean.radius.count(), 101u);
+  EXPECT_TRUE(lean.radius.values().empty());
+  for (const auto& c : columns()) {
+    const std::vector<double> v = kept.series.column(c);
+    EXPECT_EQ(lean.series.min(c), *std::min_element(v.begin(), v.end())) << c;
+    EXPECT_EQ(lean.series.max(c), *std::max_element(v.begin(), v.end())) << c;
+  }
+  EXPECT_EQ(std::vector<double>(lean.series.last().begin(), lean.series.last().end()), row_at(1.0));
+  // the summaries of both are the same: the summary never reads the kept rows
+  const json a = summary(kept, json::object()), b = summary(lean, json::object());
+  EXPECT_EQ(a.dump(), b.dump());
+}
+
+TEST(RunRecord, EventsTakeTheDisplacementInterpolatedBetweenTheRowsAroundThem) {
+  const RunRecord r = filled(false);
+  ASSERT_EQ(r.events.x_at_cycle_start_m.size(), 2u);
+  ASSERT_EQ(r.events.x_at_cycle_end_m.size(), 1u);
+  // x = v t is linear, so the interpolation between rows is exact
+  EXPECT_DOUBLE_EQ(r.events.x_at_cycle_start_m[0], 0.0);
+  EXPECT_NEAR(r.events.x_at_cycle_end_m[0], 2e-9 * 0.545, 1e-24);
+  EXPECT_NEAR(r.events.x_at_cycle_start_m[1], 2e-9 * 0.545, 1e-24);
+  const CycleFigures c = cycle_figures(r);
+  ASSERT_TRUE(c.has_cycle);
+  EXPECT_EQ(c.cycles_completed, 1);
+  EXPECT_NEAR(c.cycle_time_s, 0.545, 1e-15);
+  EXPECT_NEAR(c.displacement_per_cycle_m, 2e-9 * 0.545, 1e-24);
+  EXPECT_NEAR(c.mean_velocity_per_cycle_m_per_s, 2e-9, 1e-22);
+  const json s = summary(r, json::object());
+  EXPECT_NEAR(s["displacement_per_cycle_m"].get<double>(), 1.09e-9, 1e-24);
+  EXPECT_NEAR(s["body_lengths_per_cycle_per_s"].get<double>(), 2e-9 / 4e-7, 1e-18);
+  EXPECT_NEAR(s["pumped_volume_m3"].get<double>(), 1e-21, 1e-36);
+  EXPECT_NEAR(s["min_radius_m"].get<double>(), 9e-8, 1e-22);
+}
+
+TEST(RunRecord, NoCompletedCycleGivesNullPerCycleFiguresWithTheReason) {
+  RunRecord r("3d", "m", 1e-7, columns(), {0.0});
+  r.cycle_started(0.0);
+  r.add_row(row_at(0.0));
+  r.add_row(row_at(0.1));
+  const json s = summary(r, json::object());
+  EXPECT_TRUE(s["displacement_per_cycle_m"].is_null());
+  EXPECT_EQ(s["per_cycle_absent_because"], "no cycle completed within the run's duration");
+  r.status = "failed: test";
+  EXPECT_EQ(summary(r, json::object())["per_cycle_absent_because"], "the run stopped before completing a cycle");
+  r.transit_is_cycle = true;  // a prescribed wave's transit
+  r.status = "ok";
+  EXPECT_NEAR(summary(r, json::object())["displacement_per_cycle_m"].get<double>(), 2e-10, 1e-25);
+}
+
+TEST(RunRecord, ANonFiniteValueIsRefusedNamingTheColumnAndNothingIsAppended) {
+  RunRecord r("1d", "m", 1e-7, columns(), {0.0});
+  r.add_row(row_at(0.0));
+  std::vector<double> bad = row_at(0.1);
+  bad[4] = std::nan("");
+  try {
+    r.add_row(bad);
+    FAIL() << "accepted a NaN";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("min_radius_m"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(r.series.count(), 1u);
+  EXPECT_THROW(Series({"t_s", "x_m"}), std::logic_error);  // the common columns come first
+}
+
+TEST(RunRecord, AStreamedFolderReadsBackToTheSameRecord) {
+  const std::string d = fresh_dir("roundtrip");
+  RunRecord r = filled(false);
+  {
+    RunStream stream(d, r.series.columns());
+    RunRecord live("1d", "test_model", 4e-7, columns(), {1e-7, 2e-7, 3e-7});
+    live.keep(false);
+    live.attach(&stream);
+    RunRecord src = filled(true);
+    // replay the kept rows through the streaming record, with the same events
+    replay(
+        live, src.series.rows(), [&](std::size_t k) { return src.series.row(k)[0]; },
+        [&](std::size_t k) {
+          live.add_row(src.series.row(k));
+          live.add_radius(src.radius.times()[k], {src.radius.values().data() + 3 * k, 3});
+        },
+        src.events.cycle_start_s, src.events.cycle_end_s);
+    EXPECT_TRUE(fs::exists(d + "/series.csv.part"));
+    EXPECT_FALSE(fs::exists(d + "/series.csv"));
+    const json written = write_run(d, live, json{{"name", "x"}});
+    EXPECT_EQ(written["series_rows"], 101);
+    r = std::move(live);
+  }
+  EXPECT_FALSE(fs::exists(d + "/series.csv.part"));
+  EXPECT_FALSE(fs::exists(d + "/radius.csv.part"));
+  const RunRecord back = read_run(d);
+  EXPECT_EQ(back.tier, "1d");
+  EXPECT_EQ(back.model, "test_model");
+  EXPECT_EQ(back.series.rows(), 101u);
+  EXPECT_EQ(back.series.columns(), columns());
+  const CycleFigures a = cycle_figures(r), b = cycle_figures(back);
+  EXPECT_EQ(a.cycles_completed, b.cycles_completed);
+  EXPECT_NEAR(a.displacement_per_cycle_m, b.displacement_per_cycle_m, 1e-9 * std::abs(a.displacement_per_cycle_m));
+  // radius.csv: 3 lines per snapshot plus the header
+  std::ifstream rad(d + "/radius.csv");
+  int lines = 0;
+  for (std::string l; std::getline(rad, l);) ++lines;
+  EXPECT_EQ(lines, 1 + 101 * 3);
+  // summary.json lists the two published files with their sizes and checksums
+  const json s = json::parse(slurp(d + "/summary.json"));
+  int listed = 0;
+  for (const auto& f : s["files"]) {
+    const std::string name = f["name"];
+    if (name == "series.csv" || name == "radius.csv") {
+      ++listed;
+      EXPECT_EQ(f["bytes"].get<std::uintmax_t>(), fs::file_size(d + "/" + name));
+      EXPECT_EQ(f["fnv1a64"], hex64(fnv1a64(slurp(d + "/" + name))));
+    }
+    EXPECT_EQ(name.find(".part"), std::string::npos) << name;
+  }
+  EXPECT_EQ(listed, 2);
+}
+
+TEST(RunRecord, AResumedStreamCutsWhatFollowedTheMarkAndRefusesAChangedFile) {
+  const std::string d = fresh_dir("resume");
+  std::vector<double> marks;
+  std::string at_mark;
+  {
+    RunStream s(d, columns());
+    for (int k = 0; k < 10; ++k) s.row(row_at(0.01 * k));
+    marks = s.mark();
+    at_mark = slurp(d + "/series.csv.part");
+    for (int k = 10; k < 15; ++k) s.row(row_at(0.01 * k));  // written after the checkpoint, then "killed"
+    s.mark();
+  }
+  ASSERT_GT(slurp(d + "/series.csv.part").size(), at_mark.size());
+  EXPECT_TRUE(RunStream::matches(d, marks));
+  {
+    RunStream s(d, marks);
+    EXPECT_EQ(slurp(d + "/series.csv.part"), at_mark);  // cut back to the mark
+    for (int k = 10; k < 12; ++k) s.row(row_at(0.01 * k));
+    s.commit();
+  }
+  // the same bytes as a stream that was never interrupted
+  const std::string e = fresh_dir("resume_ref");
+  {
+    RunStream s(e, columns());
+    for (int k = 0; k < 12; ++k) s.row(row_at(0.01 * k));
+    s.commit();
+  }
+  EXPECT_EQ(slurp(d + "/series.csv"), slurp(e + "/series.csv"));
+
+  // a changed byte before the mark, or a part file shorter than the mark: refused
+  const std::string f = fresh_dir("resume_bad");
+  std::vector<double> m2;
+  {
+    RunStream s(f, columns());
+    for (int k = 0; k < 5; ++k) s.row(row_at(0.01 * k));
+    m2 = s.mark();
+  }
+  std::string text = slurp(f + "/series.csv.part");
+  text[text.size() / 2] ^= 1;
+  std::ofstream(f + "/series.csv.part", std::ios::binary) << text;
+  EXPECT_FALSE(RunStream::matches(f, m2));
+  EXPECT_THROW(RunStream(f, m2), InputError);
+  text[text.size() / 2] ^= 1;
+  std::ofstream(f + "/series.csv.part", std::ios::binary) << text.substr(0, text.size() - 3);
+  EXPECT_FALSE(RunStream::matches(f, m2));
+  fs::remove(f + "/series.csv.part");
+  EXPECT_THROW(RunStream(f, m2), InputError);
+}
+
+TEST(RunRecord, AFullDiskEndsTheStreamAtOnceNamingTheFile) {
+  const std::string d = fresh_dir("full");
+  ::setenv("SWIM_TEST_FAIL_WRITE", "series.csv:70000", 1);
+  RunStream s(d, columns());
+  RunRecord r("1d", "m", 1e-7, columns(), {0.0});
+  r.keep(false);
+  r.attach(&s);
+  int written = 0;
+  try {
+    for (; written < 100000; ++written) {
+      r.add_row(row_at(1e-3 * written));
+    }
+    FAIL() << "no error on a full disk";
+  } catch (const OutputError& e) {
+    EXPECT_NE(std::string(e.what()).find("disk full while writing series.csv"), std::string::npos) << e.what();
+  }
+  ::unsetenv("SWIM_TEST_FAIL_WRITE");
+  // the failure surfaces within a buffer (64 KiB) of the limit, not at the end of the run
+  EXPECT_LT(written, 2000);
+  r.attach(nullptr);
+}
