@@ -99,6 +99,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
   output::RunFolder folder(out, {"3d", resolved, o.overwrite, !o.resume.empty(), o.resume.empty() ? "--out" : "--resume"});
   full3d::RunControl ctl;
   ctl.progress = o.progress;
+  ctl.max_output_bytes = static_cast<std::uintmax_t>(scene::output_limits(sc).max_bytes);
   ctl.resume = !o.resume.empty();
   full3d::RunOutcome r;
   try {
@@ -155,6 +156,7 @@ int run(const RunOptions& o) {
   scene::json summary;
   try {
     stream = std::make_unique<record::RunStream>(out, reduced1d::series_columns());
+    stream->limit(static_cast<std::uintmax_t>(scene::output_limits(sc).max_bytes));
     reduced1d::SolveOptions so;
     so.progress = [&](double t, double) { progress.update(t); };
     so.keep_samples = false;

@@ -86,6 +86,8 @@ class FdBuf : public std::streambuf {
   }
   int error() const { return error_; }
   std::uintmax_t bytes() const { return bytes_; }
+  /// Bytes written to the buffer and not yet to the file.
+  std::uintmax_t pending() const { return static_cast<std::uintmax_t>(pptr() - pbase()); }
   std::uint64_t checksum() const { return sum_; }
 
  protected:
@@ -284,6 +286,8 @@ PartFile::~PartFile() {
 }
 
 std::ostream& PartFile::stream() { return *impl_->stream; }
+
+std::uintmax_t PartFile::bytes() const { return impl_->buf->bytes() + impl_->buf->pending(); }
 
 bool PartFile::matches(const std::string& path, Mark from) {
   std::uint64_t sum = 0;

@@ -75,6 +75,8 @@ class PartFile {
   PartFile& operator=(const PartFile&) = delete;
 
   std::ostream& stream();
+  /// The file's size so far (written and buffered).
+  std::uintmax_t bytes() const;
   /// Flush and check; record the part file in the ledger. Returns the mark of the bytes on
   /// disk. Throws OutputError.
   Mark sync();

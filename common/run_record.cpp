@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -363,6 +364,14 @@ void RunStream::row(std::span<const double> values) {
   for (std::size_t i = 0; i < values.size(); ++i) write_number(o, values[i], i == 0);
   o << '\n';
   if (!o) series_->sync();  // a failed write (disk full) ends the run now: OutputError naming the file
+  check_limit(values[0]);
+}
+
+void RunStream::check_limit(double t) const {
+  if (limit_ == 0 || series_->bytes() + radius_->bytes() <= limit_) return;
+  throw NumericalError("the run's output (series.csv and radius.csv) reached output.max_bytes = " +
+                           std::to_string(limit_) + " bytes before the run ended",
+                       "raise time.output_interval or output.max_bytes", t);
 }
 
 void RunStream::radius(double t, std::span<const double> z, std::span<const double> r) {
@@ -374,6 +383,7 @@ void RunStream::radius(double t, std::span<const double> z, std::span<const doub
     o << '\n';
   }
   if (!o) radius_->sync();
+  check_limit(t);
 }
 
 std::vector<double> RunStream::mark() {

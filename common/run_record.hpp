@@ -214,6 +214,12 @@ class RunStream {
   RunStream(const std::string& dir, const std::vector<double>& marks);
   ~RunStream();
 
+  /// A bound on the two files' total size (output.max_bytes): the row or snapshot that passes
+  /// it ends the run like a numerical failure (NumericalError naming the key: exit 3, the
+  /// results so far written and marked failed). Runs with a known duration are refused
+  /// before they start when their estimate exceeds it; this catches the others (a
+  /// force-driven run that lasts until its cycles complete).
+  void limit(std::uintmax_t max_bytes) { limit_ = max_bytes; }
   void row(std::span<const double> values);
   void radius(double t, std::span<const double> z, std::span<const double> radius);
   /// Flush and check both files, record them in the folder's ledger; their marks (size and
@@ -225,7 +231,9 @@ class RunStream {
   static bool matches(const std::string& dir, const std::vector<double>& marks);
 
  private:
+  void check_limit(double t) const;
   std::unique_ptr<output::PartFile> series_, radius_;
+  std::uintmax_t limit_ = 0;  ///< 0: none
 };
 
 /// Write the run folder of a record: series.csv and radius.csv (committed from the attached

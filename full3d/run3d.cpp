@@ -53,11 +53,11 @@ class Runner {
     RunOutcome res;
     const auto t0 = std::chrono::steady_clock::now();
     if (ctl_.resume) {
-      wall_before_ = checkpoint_.restore(stepper_, measured_, output_);
+      wall_before_ = checkpoint_.restore(stepper_, measured_, output_, ctl_.max_output_bytes);
     } else {
       stepper_.start();
       measured_.start(stepper_.state());
-      output_.start();
+      output_.start(ctl_.max_output_bytes);
       measured_.events(stepper_.protocol().state());
       record();
       if (output_.vtk()) output_.write_membrane_frame(stepper_);

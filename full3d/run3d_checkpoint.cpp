@@ -140,11 +140,12 @@ CheckpointReader RunCheckpoint::open() const {
   return r;
 }
 
-double RunCheckpoint::restore(Stepper& stepper, Measurements& measured, RunOutput& output) const {
+double RunCheckpoint::restore(Stepper& stepper, Measurements& measured, RunOutput& output,
+                              std::uintmax_t max_bytes) const {
   const CheckpointReader r = open();
   stepper.load(r);
   measured.load(r);
-  output.load(r);
+  output.load(r, max_bytes);
   return r.get_double(kWallTime);
 }
 

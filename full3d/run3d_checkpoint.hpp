@@ -37,7 +37,7 @@ class RunCheckpoint {
   /// (series.csv.part and radius.csv.part must match its marks). Throws InputError.
   CheckpointReader open() const;
   /// open(), then restores the parts; returns the wall time of the run so far, s.
-  double restore(Stepper& stepper, Measurements& measured, RunOutput& output) const;
+  double restore(Stepper& stepper, Measurements& measured, RunOutput& output, std::uintmax_t max_bytes = 0) const;
 
   /// The hash of the scene as it must match on resume.
   static std::uint64_t scene_hash(const scene::json& resolved);

@@ -26,8 +26,9 @@ RunOutput::RunOutput(const RunSetup& run, const json& resolved, std::string dir,
 
 RunOutput::~RunOutput() { rec_.attach(nullptr); }
 
-void RunOutput::start() {
+void RunOutput::start(std::uintmax_t max_bytes) {
   stream_ = std::make_unique<record::RunStream>(dir_, rec_.series.columns());
+  stream_->limit(max_bytes);
   rec_.attach(stream_.get());
 }
 
@@ -145,12 +146,13 @@ void RunOutput::save(CheckpointWriter& w, const std::vector<double>& marks) cons
   w.put("fluid_frames", ft);
 }
 
-void RunOutput::load(const CheckpointReader& r) {
+void RunOutput::load(const CheckpointReader& r, std::uintmax_t max_bytes) {
   for (double t : r.get_vector("vtk_frames")) pvd_.add(t, frame_name("membrane", "vtp", pvd_.frames().size()));
   for (double t : r.get_vector("fluid_frames")) fluid_pvd_.add(t, frame_name("fluid", "vti", fluid_pvd_.frames().size()));
   if (vtk_) pvd_.write();
   if (fluid_) fluid_pvd_.write();
   stream_ = std::make_unique<record::RunStream>(dir_, r.get_vector(kOutputMarks));
+  stream_->limit(max_bytes);
   rec_.attach(stream_.get());
 }
 

@@ -24,8 +24,8 @@ class RunOutput {
             record::RunRecord& rec);
   ~RunOutput();
 
-  /// A fresh run: open the streams.
-  void start();
+  /// A fresh run: open the streams; max_bytes bounds them (record::RunStream::limit).
+  void start(std::uintmax_t max_bytes = 0);
 
   bool vtk() const { return vtk_; }
   bool fluid() const { return fluid_; }
@@ -43,7 +43,7 @@ class RunOutput {
   /// The frame times and the streams' marks; load() also rewrites the collections of the
   /// enabled frame kinds and continues the streams from the marks.
   void save(CheckpointWriter& w, const std::vector<double>& marks) const;
-  void load(const CheckpointReader& r);
+  void load(const CheckpointReader& r, std::uintmax_t max_bytes = 0);
 
  private:
   /// The record's summary keys of a 3D run (derived values, extras, statistics, status).

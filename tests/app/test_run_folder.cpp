@@ -390,3 +390,24 @@ TEST(RunFolderCli, BothTiersWriteTheSameKeysAndColumns) {
   expect_consistent_folder(d / "a");
   expect_consistent_folder(d / "b");
 }
+
+// A run without a size estimate (a force-driven run until its cycles complete) is bounded
+// while it runs: the row that passes output.max_bytes ends it with exit 3, its results so far
+// written and marked failed.
+TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
+  const fs::path d = tmpdir("runtime_limit");
+  const fs::path out = d / "run";
+  const Cli c = swim_cli("run \"" + kDemo + "\" --set output.max_bytes=20000 --out \"" + out.string() + "\"", d);
+  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_NE(c.err.find("output.max_bytes = 20000"), std::string::npos) << c.err;
+  const json s = summary_of(out);
+  ASSERT_TRUE(s.is_object());
+  EXPECT_EQ(s["status"].get<std::string>().rfind("failed", 0), 0u) << s["status"];
+  // within one row and one radius snapshot (a few kB) of the limit
+  const auto written = fs::file_size(out / "series.csv") + fs::file_size(out / "radius.csv");
+  EXPECT_GT(written, 20000u);
+  EXPECT_LT(written, 30000u);
+  expect_consistent_folder(out);
+  // the same run with the default limit completes
+  EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "full").string() + "\"", d).code, 0);
+}
