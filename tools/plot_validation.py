@@ -121,14 +121,18 @@ def pareto_figure(report, path):
     fig, ax = plt.subplots(figsize=(8, 4.8))
     any_pt = False
     for c in report["cases"]:
-        pts = c.get("speed_accuracy", [])
-        for tier, mk in (("1d", "o"), ("3d", "s")):
-            p = [q for q in pts if q["tier"] == tier and q["displacement_per_cycle_error"] > 0]
-            if not p:
-                continue
+        pts = [q for q in c.get("speed_accuracy", []) if q.get("displacement_per_cycle_error", 0) > 0]
+        axes = []
+        for q in pts:
+            if (q["tier"], q.get("axis", "")) not in axes:
+                axes.append((q["tier"], q.get("axis", "")))
+        markers = {"cells": "o-", "rtol": "^--", "h": "s-", "time step": "D--"}
+        for tier, axis in axes:
+            p = [q for q in pts if q["tier"] == tier and q.get("axis", "") == axis]
+            p.sort(key=lambda q: q["wall_time_s"])
             any_pt = True
-            ax.loglog([q["wall_time_s"] for q in p], [100 * q["displacement_per_cycle_error"] for q in p], mk + "-",
-                      label=f"{c['name']}, {tier.upper()}")
+            ax.loglog([q["wall_time_s"] for q in p], [100 * q["displacement_per_cycle_error"] for q in p],
+                      markers.get(axis, "x-"), label=f"{c['name']}, {tier.upper()}, varying {axis}")
             for q in p:
                 ax.annotate(q["resolution"], (q["wall_time_s"], 100 * q["displacement_per_cycle_error"]),
                             fontsize=7, xytext=(-4, 4), textcoords="offset points", ha="right")

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "common/errors.hpp"
@@ -395,6 +396,15 @@ json load_suite(const std::string& path) {
         throw InputError(at + ".calibration_grid", scene::show(c),
                          "an index into grids, 0 to " + std::to_string(g.size() - 1));
     }
+    if (cases[i].contains("time_variants3d")) {
+      const json& v = cases[i]["time_variants3d"];
+      bool ok = v.is_array();
+      for (const auto& e : ok ? v : json::array()) ok = ok && e.is_object() && e.contains("label") && e["label"].is_string() &&
+                                                        e.contains("set") && e["set"].is_object();
+      if (!ok)
+        throw InputError(at + ".time_variants3d", scene::show(v),
+                         "an array of {\"label\": text, \"set\": {\"dotted.key\": value}} (3D time-step variants)");
+    }
   }
   const json& models = member(s, "models1d", "suite");
   if (!models.is_array() || models.empty()) throw InputError("suite.models1d", scene::show(models), "a non-empty array");
@@ -607,33 +617,58 @@ json run_suite(const SuiteOptions& o) {
     }
     cr["models1d"] = models_j;
 
-    // 5. speed/accuracy of the first 1D model: cell counts
+    // 5. speed/accuracy: the first 1D model over cell counts and integrator tolerances, 3D
+    // over the grids and the case's time-step variants (at the calibration grid)
     json trade = json::array();
     if (have_ref) {
       const json& m0 = suite["models1d"][0];
-      for (long cells : suite.value("cells1d", std::vector<long>{50, 100, 200, 400})) {
+      auto point = [&](const char* tier, const std::string& axis, const std::string& resolution, double wall,
+                       double d) {
+        trade.push_back({{"tier", tier},
+                         {"axis", axis},
+                         {"resolution", resolution},
+                         {"wall_time_s", wall},
+                         {"displacement_per_cycle_error", std::abs(d - ed.value) / std::abs(ed.value)}});
+      };
+      auto model0 = [&](const std::string& key, const json& value) -> std::optional<Run1d> {
         json s = base;
         apply_sets(s, m0.value("set", json()));
         if (m0.value("calibrated", false)) {
-          if (cal_file.empty()) break;
+          if (cal_file.empty()) return std::nullopt;
           if (s.contains("wall")) s["wall"].erase("spring_constant");
           set_key(s, "wall.calibration", fs::absolute(cal_file).string());
         }
-        set_key(s, "numerics1d.cells", cells);
-        const Run1d r = run_1d(s, m0["label"], scene_dir);
-        if (!r.cyc.has_cycle) continue;
-        trade.push_back({{"tier", "1d"},
-                         {"resolution", "N = " + std::to_string(cells)},
-                         {"wall_time_s", r.wall},
-                         {"displacement_per_cycle_error", std::abs(r.cyc.displacement_per_cycle_m - ed.value) / std::abs(ed.value)}});
+        set_key(s, key, value);
+        return run_1d(s, m0["label"], scene_dir);
+      };
+      for (long cells : suite.value("cells1d", std::vector<long>{50, 100, 200, 400}))
+        if (const auto r = model0("numerics1d.cells", cells); r && r->cyc.has_cycle)
+          point("1d", "cells", "N = " + std::to_string(cells), r->wall, r->cyc.displacement_per_cycle_m);
+      for (double rtol : suite.value("rtol1d", std::vector<double>{1e-4, 1e-6, 1e-8})) {
+        char label[40];
+        std::snprintf(label, sizeof label, "rtol = %.0e", rtol);
+        if (const auto r = model0("numerics1d.rtol", rtol); r && r->cyc.has_cycle)
+          point("1d", "rtol", label, r->wall, r->cyc.displacement_per_cycle_m);
       }
       for (const auto& r : runs)
         if (r.cyc.has_cycle)
-          trade.push_back({{"tier", "3d"},
-                           {"resolution", "h = " + std::to_string(r.h * 1e9).substr(0, 5) + " nm"},
-                           {"wall_time_s", r.wall},
-                           {"displacement_per_cycle_error",
-                            std::abs(r.cyc.displacement_per_cycle_m - ed.value) / std::abs(ed.value)}});
+          point("3d", "h", "h = " + std::to_string(r.h * 1e9).substr(0, 5) + " nm", r.wall,
+                r.cyc.displacement_per_cycle_m);
+      const json& variants = cs.contains("time_variants3d") ? cs["time_variants3d"] : json::array();
+      for (std::size_t v = 0; v < variants.size(); ++v) {
+        json s = base;
+        set_key(s, grid_key, grids[cg]);
+        apply_sets(s, variants[v].value("set", json()));
+        const std::string label = variants[v].value("label", "variant " + std::to_string(v + 1));
+        say(tag + ": 3D time-step variant " + std::to_string(v + 1) + "/" + std::to_string(variants.size()) + " (" +
+            label + ")");
+        bool cached = false;
+        const Run3d r = run_3d(s, runs_dir, o.threads, &cached);
+        if (r.cyc.has_cycle) point("3d", "time step", label, r.wall, r.cyc.displacement_per_cycle_m);
+        else  // a step beyond the stability limit: the outcome is reported, not a point
+          trade.push_back({{"tier", "3d"}, {"axis", "time step"}, {"resolution", label}, {"wall_time_s", r.wall},
+                           {"status", r.record.value("status", std::string("unknown"))}});
+      }
     }
     cr["speed_accuracy"] = trade;
     double w3 = 0, w1 = 0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
 #include "common/scene.hpp"
 
@@ -53,8 +54,21 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   EXPECT_GT(c["models1d"][0]["displacement_per_cycle_m"].get<double>(), 0.0);
   EXPECT_GT(c["models1d"][1]["displacement_per_cycle_m"].get<double>(), 0.0);
   EXPECT_GT(c["models1d"][3]["displacement_per_cycle_m"].get<double>(), 100.0 * ref);
-  // speed/accuracy: 1D at three cell counts and 3D at three grids
-  EXPECT_EQ(c["speed_accuracy"].size(), 6u);
+  // speed/accuracy: 1D at three cell counts and three tolerances, 3D at three grids and two
+  // time steps
+  std::map<std::string, int> per_axis;
+  for (const auto& q : c["speed_accuracy"]) ++per_axis[q["tier"].get<std::string>() + " " + q["axis"].get<std::string>()];
+  EXPECT_EQ(per_axis["1d cells"], 3);
+  EXPECT_EQ(per_axis["1d rtol"], 3);
+  EXPECT_EQ(per_axis["3d h"], 3);
+  EXPECT_EQ(per_axis["3d time step"], 2);
+  // the 1D result is converged in the integrator tolerance: rtol 1e-6 and 1e-8 give the same
+  // displacement per cycle to 0.1 % of the reference (the model error is what remains)
+  std::map<std::string, double> err;
+  for (const auto& q : c["speed_accuracy"])
+    if (q["axis"] == "rtol") err[q["resolution"].get<std::string>()] = q["displacement_per_cycle_error"].get<double>();
+  ASSERT_TRUE(err.count("rtol = 1e-06") && err.count("rtol = 1e-08"));
+  EXPECT_LT(std::abs(err["rtol = 1e-06"] - err["rtol = 1e-08"]), 1e-3);
   EXPECT_GT(c["wall_time_ratio_3d_over_1d"].get<double>(), 10.0);
   ASSERT_EQ(r["findings"].size(), 6u);
 
