@@ -96,8 +96,7 @@ void CapacitanceStokes::Impl::setup_cylinder(double radius) {
   if (!L.wall_nodes_masked)
     throw InputError("container.radius", std::to_string(radius),
                      "the capacitance cylinder solver needs every wall-adjacent tangential face outside the "
-                     "cylinder (radius <= duct half-width - h/2); use a smaller radius or "
-                     "full3d.cylinder_wall = \"ghost_linear\" (iterative solver)");
+                     "cylinder (radius <= duct half-width - h/2); use a smaller radius");
   cyl = true;
   const double h = grid.h();
   row_masked.assign(std::size_t(off[3]), 0);
@@ -250,8 +249,7 @@ std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> CapacitanceSt
   auto llt = std::make_unique<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>>(A);
   if (llt->info() != Eigen::Success)
     throw NumericalError("axial-mean factorisation of the cylinder capacitance solver failed",
-                         "change the grid (full3d.grid.cells_across) or use full3d.cylinder_wall = "
-                         "\"ghost_linear\" (iterative solver)");
+                         "change the grid (full3d.grid.cells_across)");
   return llt;
 }
 

@@ -92,7 +92,7 @@ struct CapacitanceStokes::Impl {
   };
   // The factors of the last kCacheSlots alpha values (least recently used replaced): the
   // adaptive time step of the run driver moves over a ladder of a few dt values.
-  static constexpr int kCacheSlots = 6;
+  static constexpr int kCacheSlots = CapacitanceStokes::kCachedAlphas;
   std::array<Factors, kCacheSlots> cache;
   std::array<long, kCacheSlots> used_at{};
   long use_clock = 0;

@@ -222,8 +222,7 @@ void CapacitanceStokes::Impl::factor_blocks(const Eigen::MatrixXd& C, std::array
       throw NumericalError(std::string("capacitance matrix of the ") + what +
                                " Stokes solver is not positive definite for axial mode " + std::to_string(kx) +
                                " (rho/dt = " + std::to_string(alpha) + "; " + e.what() + ")",
-                           "change the time step or the grid (full3d.grid.cells_across), or use "
-                           "full3d.cylinder_wall = \"ghost_linear\" (iterative solver)");
+                           "change the time step or the grid (full3d.grid.cells_across)");
     }
   }
 }

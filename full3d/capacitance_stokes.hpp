@@ -1,5 +1,6 @@
 // Exact fast solver of the backward-Euler Stokes step in the square duct by a
-// capacitance-matrix (Woodbury) correction of a free-slip spectral solve.
+// capacitance-matrix (Woodbury) correction of a free-slip spectral solve: the production
+// path of the duct and of the staircase cylinder behind StokesSolver (stokes.hpp).
 //
 // The step's MAC saddle-point system (stokes.hpp, operators.hpp)
 //   A u + G p = b,  D u = 0,   A = alpha - mu L,  alpha = rho/dt,
@@ -74,8 +75,8 @@
 // inverse of a copy of Y for the ring values, forward of E_R^T lam, inverse of X) plus the
 // block substitutions, about 1.5 bare solves at 128 x 34 x 34 (|R| = 280, 5.3 MB per dt).
 // Output: masked faces zero (their computed round-off is reported by last_mask_residual()),
-// p with zero mean over the cells with a free face, 0 in the others (the Direct path's
-// convention).
+// p with zero mean over the cells with a free face, 0 in the others (the convention of the
+// sparse-LU test reference, tests/full3d/reference/direct_stokes.hpp).
 #pragma once
 
 #include <cstddef>
@@ -89,6 +90,8 @@ namespace swim::full3d {
 
 class CapacitanceStokes {
  public:
+  /// Number of alpha values whose factors are kept (least recently used replaced).
+  static constexpr int kCachedAlphas = 6;
   /// threads: worker threads (>= 1). fft: planner rigor (its thread count is ignored:
   /// plans are single-threaded and executed concurrently on disjoint data).
   /// Throws swim::InputError for a non-duct grid.
