@@ -35,12 +35,8 @@ struct StokesSolver::Impl {
 
   // Square duct and cylinder: the capacitance solver
   std::unique_ptr<CapacitanceStokes> capacitance;
-  // Cylinder: constraint rows; the multiplier is recovered lazily from (b, u, p, alpha) of the last step
+  // Cylinder: the constraint rows
   std::unique_ptr<VelocityConstraints> con;
-  std::vector<double> lam;
-  bool lam_stale = false;
-  VectorField wb, last_u;
-  double last_alpha = 0.0;
 
   Impl(const MacGrid& g, const FluidParams& f, const StokesOptions& o) : grid(g), fluid(f), opt(o), p(g), div(g) {
     if (!(f.rho > 0.0)) throw InputError("fluid.rho", std::to_string(f.rho), "a positive density in kg/m^3");
@@ -66,7 +62,6 @@ struct StokesSolver::Impl {
         throw InputError("container.radius", std::to_string(o.cylinder.radius) + " m",
                          "a cylinder at least half a cell inside the duct walls (the scenes build the duct one "
                          "cell wider than the cylinder on each side)");
-      wb = VectorField(g);
     }
     const double need = CapacitanceStokes::kCachedAlphas * double(CapacitanceStokes::estimate_bytes(g, cyl));
     const double limit = o.memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
@@ -130,19 +125,8 @@ struct StokesSolver::Impl {
 
   // ---- square duct and cylinder: the capacitance solver, exact, no iteration ----------
   StokesStats capacitance_step(VectorField& u, const VectorField& f, double dt) {
-    const double alpha = fluid.rho / dt;
-    if (con) {
-      // cylinder: keep b for the lazily recovered multiplier
-      for (int c = 0; c < 3; ++c)
-        for (std::size_t m = 0; m < wb.c[c].size(); ++m) wb.c[c][m] = alpha * u.c[c][m] + f.c[c][m];
-      zero_wall_faces(grid, wb);
-      capacitance->solve(wb, u, p, alpha);  // wall and masked faces come out exactly 0
-      last_u = u;
-      last_alpha = alpha;
-      lam_stale = true;
-    } else {
-      capacitance->step(u, f, p, alpha);  // b = alpha u^n + f formed inside; wall faces come out exactly 0
-    }
+    // b = alpha u^n + f formed inside; wall and masked faces come out exactly 0
+    capacitance->step(u, f, p, fluid.rho / dt);
     StokesStats st;
     if (capacitance->last_solve_factorized()) st.factorization_seconds = capacitance->last_factorization_seconds();
     divergence(grid, u, div);
@@ -172,20 +156,11 @@ void StokesSolver::set_pressure(const ScalarField& p) {
     throw InputError("pressure", std::to_string(p.v.size()) + " values",
                      "one value per cell (" + std::to_string(impl_->grid.cells()) + ")");
   impl_->p = p;
-  impl_->lam_stale = false;  // the lazily recovered multiplier would mix old and new states
 }
 std::size_t StokesSolver::factor_bytes() const {
   return impl_->capacitance ? impl_->capacitance->factor_bytes() : 0;
 }
 const VelocityConstraints* StokesSolver::constraints() const { return impl_->con.get(); }
-const std::vector<double>& StokesSolver::multiplier() const {
-  Impl& m = *impl_;
-  if (m.lam_stale) {
-    recover_multiplier(*m.con, m.wb, m.last_u, m.p, m.last_alpha, m.fluid.mu, m.lam);
-    m.lam_stale = false;
-  }
-  return m.lam;
-}
 const MacGrid& StokesSolver::grid() const { return impl_->grid; }
 const FluidParams& StokesSolver::fluid() const { return impl_->fluid; }
 

@@ -26,8 +26,8 @@
 //   solved by the same capacitance solver as a constrained free-slip problem (the cylinder at
 //   least half a cell inside the duct walls, as the scenes build it): the constraint is
 //   imposed on the ring of masked faces next to the fluid through a packed Cholesky
-//   factorisation (LAPACK) of the ring capacitance per axial mode. The multiplier is recovered
-//   on demand, lam = E (b - A u - G p).
+//   factorisation (LAPACK) of the ring capacitance per axial mode. The multiplier follows from
+//   the step's result, lam = E (b - A u - G p) (recover_multiplier, container.hpp).
 //
 // Advection (StokesOptions::advection; advection.hpp): when enabled, step() first runs the
 //   explicit Navier-Stokes sub-step (28) on u^n, then the Stokes step.
@@ -99,10 +99,10 @@ class StokesSolver {
   /// Duct and cylinder: measured memory of the cached capacitance factors (up to six dt
   /// values), bytes; 0 for the box.
   std::size_t factor_bytes() const;
-  /// Cylinder: the constraint rows and the multiplier of the last step (N/m^3 per row),
-  /// recovered on demand, lambda = E (b - A u - G p); nullptr / empty otherwise.
+  /// Cylinder: the constraint rows E (nullptr otherwise). The multiplier of a step is
+  /// recover_multiplier(*constraints(), b, u^{n+1}, pressure(), rho/dt, mu, lambda) with
+  /// b = rho/dt u^n + f (container.hpp).
   const VelocityConstraints* constraints() const;
-  const std::vector<double>& multiplier() const;
   const MacGrid& grid() const;
   const FluidParams& fluid() const;
 
