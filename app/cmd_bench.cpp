@@ -19,6 +19,7 @@
 #include "reduced1d/solver.hpp"
 #include "full3d/fft.hpp"
 #include "full3d/protocol3d.hpp"
+#include "full3d/reference_duct_fft.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 
@@ -211,7 +212,8 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
         sum.time_forces += s1.time_forces;
       }
       const double per = seconds_since(t0) / steps;
-      // bare FFT solve with the same forcing size
+      // bare FFT solve (reference::PressureCorrectionStep, full3d/reference_duct_fft.hpp) with the
+      // same forcing size
       full3d::VectorField u(grid), f(grid);
       for (auto& c : f.c)
         for (size_t i = 0; i < c.size(); ++i) c[i] = std::sin(0.37 * double(i));
@@ -221,12 +223,12 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       double bare_per = 1e300;
       for (int fft_threads : {thr, 1}) {
         if (fft_threads == 1 && thr == 1 && bare_per < 1e300) break;
-        full3d::StokesOptions so = o.stokes;
-        so.fft.threads = fft_threads;
-        full3d::StokesSolver bare(grid, p.fluid, so);
-        bare.bare_fft_solve(u, f, p.dt);
+        full3d::FftOptions fo = o.stokes.fft;
+        fo.threads = fft_threads;
+        full3d::reference::PressureCorrectionStep bare(grid, p.fluid, fo);
+        bare.step(u, f, p.dt);
         const auto t1 = std::chrono::steady_clock::now();
-        for (int k = 0; k < steps; ++k) bare.bare_fft_solve(u, f, p.dt);
+        for (int k = 0; k < steps; ++k) bare.step(u, f, p.dt);
         bare_per = std::min(bare_per, seconds_since(t1) / steps);
       }
       per_step_thr[thr] = per;

@@ -92,7 +92,7 @@ struct CapacitanceStokes::Impl {
   };
   // The factors of the last kCacheSlots alpha values (least recently used replaced): the
   // adaptive time step of the run driver moves over a ladder of a few dt values.
-  static constexpr int kCacheSlots = 6;
+  static constexpr int kCacheSlots = CapacitanceStokes::kCachedAlphas;
   std::array<Factors, kCacheSlots> cache;
   std::array<long, kCacheSlots> used_at{};
   long use_clock = 0;
@@ -251,6 +251,17 @@ struct CapacitanceStokes::Impl {
   std::vector<char> cell_fluid;  // per cell k ny + j: has a free face
   std::vector<int> ring;
   std::vector<char> ring_c;
+  // Partial cross-section transforms of the ring (planned on plane 0, new-array execution on
+  // a plane-aligned buffer): per component the inverse along y of every z row (ring values)
+  // and the forward along z of every y column (ring-supported fields); the other halves are
+  // dense sums over the ring nodes only.
+  std::array<FftwPlan, 3> ring_yinv, ring_zfwd;
+  // Values at the ring nodes of the inverse yz transforms of the u, v, w coefficients in fb
+  // (overwritten), times scale, into w (m values).
+  void ring_values(double* fb, double scale, double* w) const;
+  // Forward yz transforms of the field equal to z on the ring nodes and 0 elsewhere into the
+  // u, v, w coefficient slots of fb (all of them written).
+  void ring_forward(const double* z, double* fb) const;
   // Null vectors of C(kx): lam = (G q)|_R for q the indicator of a group of cells connected
   // through non-ring y/z faces (real-space G: (q_j - q_{j-1})/h on y faces, g_x q on x faces in
   // the rotated frame). yz: the y/z-face entries; ux: the ring x faces of the group (coefficient g_x).
@@ -277,13 +288,13 @@ struct CapacitanceStokes::Impl {
   void ring_unit_transform(int a, double* R) const;
   void clear_ring_unit(int a, double* R) const;
   // Capacitance of mode kx for the cylinder: C = E_R S_fs(kx)^{-1} E_R^T + s N N^T (see the
-  // header): one unit solve per column (separable forward transform, spectral projection, three
-  // inverse 2D transforms, gather on the ring). kx = 0: the ring x faces are decoupled
+  // header): one unit solve per column (separable forward transform, spectral projection, the
+  // ring values by ring_values). kx = 0: the ring x faces are decoupled
   // (g_x = 0, exact zeros) and solved separately; their block is replaced by I.
   // (x symbol gx; the tables of mode_tables(gx, alpha) in s)
   Eigen::MatrixXd capacitance_cyl(int kx, double gx, Scratch& s) const;
   // Mode kx's ring correction of the free-slip solution Y = M T b in its np planes F: ring
-  // values y_R (3 inverse transforms of a copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam.
+  // values y_R (ring_values of a copy), lam = C^{-1} y_R, X = Y - M T E_R^T lam (ring_forward).
   void correct_ring(int kx, double* const F[2], int np, double gx, const Factors& fac, Scratch& s) const;
   // The cylinder's axial mean of u (kx = 0) from its sparse factor.
   void mean_x_ring(double* u, const Factors& fac, Scratch& s) const;

@@ -86,6 +86,16 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
   };
   for (int c = 0; c < 3; ++c) yz_fwd[c] = plan_yz(c, true);
   for (int c = 0; c < 4; ++c) yz_inv[c] = plan_yz(c, false);
+  if (cylopt)  // the ring's partial transforms: 1D along y of every z row, along z of every y column
+    for (int c = 0; c < 3; ++c) {
+      const int ly = c == 1 ? ny - 1 : ny, lz = c == 2 ? nz - 1 : nz, row = c == 1 ? ny + 1 : ny;
+      const fftw_r2r_kind ky = c == 1 ? FFTW_RODFT00 : FFTW_REDFT01;  // inverse along y
+      const fftw_r2r_kind kz = c == 2 ? FFTW_RODFT00 : FFTW_REDFT10;  // forward along z
+      const int n1[1] = {ly}, n2[1] = {lz};
+      double* at = p0 + yz_at[c];
+      ring_yinv[c] = plan_many_r2r(1, n1, lz, at, nullptr, 1, row, at, nullptr, 1, row, &ky, fft);
+      ring_zfwd[c] = plan_many_r2r(1, n2, ly, at, nullptr, row, 1, at, nullptr, row, 1, &kz, fft);
+    }
   u0 = FftwBuffer(std::size_t(ny) * nz);
   {
     const int n2[2] = {nz, ny};
@@ -222,8 +232,7 @@ void CapacitanceStokes::Impl::factor_blocks(const Eigen::MatrixXd& C, std::array
       throw NumericalError(std::string("capacitance matrix of the ") + what +
                                " Stokes solver is not positive definite for axial mode " + std::to_string(kx) +
                                " (rho/dt = " + std::to_string(alpha) + "; " + e.what() + ")",
-                           "change the time step or the grid (full3d.grid.cells_across), or use "
-                           "full3d.cylinder_wall = \"ghost_linear\" (iterative solver)");
+                           "change the time step or the grid (full3d.grid.cells_across)");
     }
   }
 }

@@ -1,5 +1,6 @@
 // Exact fast solver of the backward-Euler Stokes step in the square duct by a
-// capacitance-matrix (Woodbury) correction of a free-slip spectral solve.
+// capacitance-matrix (Woodbury) correction of a free-slip spectral solve: the production
+// path of the duct and of the staircase cylinder behind StokesSolver (stokes.hpp).
 //
 // The step's MAC saddle-point system (stokes.hpp, operators.hpp)
 //   A u + G p = b,  D u = 0,   A = alpha - mu L,  alpha = rho/dt,
@@ -70,12 +71,15 @@
 // x component is again solved separately, here by a sparse Cholesky factorisation of the
 // masked 2D Helmholtz operator. When the floating-point staircase is exactly symmetric under
 // both reflections (checked), C is assembled from one unit solve per orbit and factorised in
-// the four character blocks, else as one block. A solve: 13 yz transforms per plane (forward b,
-// inverse of a copy of Y for the ring values, forward of E_R^T lam, inverse of X) plus the
-// block substitutions, about 1.5 bare solves at 128 x 34 x 34 (|R| = 280, 5.3 MB per dt).
+// the four character blocks, else as one block. A solve, per plane: the 3 forward yz transforms
+// of b; the ring values of a copy of Y by partial transforms (the inverse along y of every z
+// row, then dense sums along z at the ring nodes only); the block substitutions; the forward
+// transform of E_R^T lam likewise (dense along y over the ring nodes, then along z); the 4
+// inverse transforms of X: 7 full and 6 half yz transforms (|R| = 280, 5.3 MB per dt at
+// 128 x 34 x 34).
 // Output: masked faces zero (their computed round-off is reported by last_mask_residual()),
-// p with zero mean over the cells with a free face, 0 in the others (the Direct path's
-// convention).
+// p with zero mean over the cells with a free face, 0 in the others (the convention of the
+// sparse-LU test reference, tests/full3d/reference/direct_stokes.hpp).
 #pragma once
 
 #include <cstddef>
@@ -89,6 +93,8 @@ namespace swim::full3d {
 
 class CapacitanceStokes {
  public:
+  /// Number of alpha values whose factors are kept (least recently used replaced).
+  static constexpr int kCachedAlphas = 6;
   /// threads: worker threads (>= 1). fft: planner rigor (its thread count is ignored:
   /// plans are single-threaded and executed concurrently on disjoint data).
   /// Throws swim::InputError for a non-duct grid.

@@ -169,7 +169,7 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
   VectorField& u = work_uh_;
   Eigen::Matrix3Xd U;
   double lambda = 0.0;
-  // the pressure is state for the duct's warm-started PCG: the estimate must not change it
+  // the pressure is the last step's result (fluid-field output): the estimate must not change it
   const ScalarField p_keep = stokes_.pressure();
   struct Restore {
     StokesSolver& s;

@@ -23,13 +23,10 @@ IbOptions ib_options(const Params3d& p) {
   o.dt_key = "full3d.dt";
   o.threads = p.threads;
   o.stokes.fft.threads = p.threads;
-  o.stokes.direct_threads = p.threads;
+  o.stokes.threads = p.threads;
   if (p.container == "cylinder") {
     o.stokes.cylinder.enabled = true;
     o.stokes.cylinder.radius = p.container_radius;
-    o.stokes.cylinder.wall = p.cylinder_wall == "ghost_linear"     ? CylinderWall::GhostLinear
-                             : p.cylinder_wall == "surface_points" ? CylinderWall::SurfacePoints
-                                                                   : CylinderWall::Staircase;
   }
   o.stokes.advection.enabled = p.navier_stokes;
   if (p.threads > 1) fftw_threads_init_once();

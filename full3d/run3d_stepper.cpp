@@ -244,8 +244,8 @@ void Stepper::records(Self& self, F&& f) {
 
 void Stepper::save(CheckpointWriter& w) const {
   records(*this, CheckpointOut(w));
-  // The duct's PCG is warm-started from the previous pressure: with it, the resumed run
-  // repeats the uninterrupted one to round-off.
+  // The pressure of the last step (the fluid-field output between steps); the step itself does
+  // not depend on it (the Stokes solvers are exact), so the resumed run repeats the uninterrupted one.
   if (ib_) w.put("p", ib_->stokes().pressure().v);
   w.put("r_active_prev", std::isfinite(r_active_prev_) ? r_active_prev_ : -1.0);  // NaN: none
 }

@@ -116,8 +116,6 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   {
     Reader f = top.child("full3d");
     const double width = 2.0 * p.container_radius;
-    if (p.container == "cylinder")
-      p.cylinder_wall = f.choice("cylinder_wall", "staircase", {"staircase", "ghost_linear", "surface_points"});
     {
       Reader g = f.child("grid");
       if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {

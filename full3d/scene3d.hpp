@@ -59,7 +59,6 @@ struct Params3d {
   IbScheme scheme = IbScheme::ForwardEuler;
   bool wall_inertia = false;       ///< -m a term of eq. (16) in the fluid-coupled run
   bool navier_stokes = false;      ///< StokesOptions::advection (eq. 28 sub-step before each Stokes step)
-  std::string cylinder_wall = "staircase";  ///< cylinder: staircase | ghost_linear | surface_points
   /// energy: the paper's end of recovery (E < energy_tolerance E_ref); dead_band: also ends
   /// once E is below the energy of the tube uniformly at R0 - delta; shape: ring radii and
   /// axial ring positions back within delta of the reference (docs/full3d.md).

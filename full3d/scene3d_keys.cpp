@@ -4,7 +4,6 @@ namespace swim::full3d {
 
 const scene::json& section_keys() {
   static const scene::json keys = {
-      {"cylinder_wall", "choice:staircase|ghost_linear|surface_points"},
       {"grid", {{"cells_across", "integer"}, {"cell_size", "quantity:m"}}},
       {"dt", "quantity:s"},
       {"adaptive",

@@ -325,7 +325,6 @@ TEST(StrictScene, SectionKeyListsMatchTheTierReaders) {
   const json junk = json::array({1});
   for (const auto& [path, kind] : keys3d) {
     json sc = json::object();
-    if (path == "full3d.cylinder_wall") sc["container"]["kind"] = "cylinder";
     if (path == "full3d.grid.cell_size") sc["full3d"]["grid"] = json::object();
     swim::scene::apply_override(sc, path + "=[1]");
     json r;

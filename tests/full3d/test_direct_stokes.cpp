@@ -1,10 +1,13 @@
-// Direct per-axial-mode Stokes solver (direct_stokes.hpp) behind StokesSolver:
-//  * equals the converged iterative (PCG) solution, duct and staircase cylinder,
-//    even and odd nx (relative 1e-9 in u, pressure up to its constant);
+// The two test references of the duct and cylinder step against each other
+// (tests/full3d/reference/reference_stokes.hpp): the per-axial-mode sparse LU
+// (reference::DirectStokes)
+//  * equals the converged PCG solution, duct and staircase cylinder, even and odd nx
+//    (relative 1e-9 in u, pressure up to its constant);
 //  * discrete divergence at round-off, masked and wall faces exactly zero;
 //  * refactorises when dt changes and reuses the factors of the two last dt values;
-//  * the recovered multiplier matches the PCG's; set_pressure; method selection;
+//  * the recovered multiplier matches the PCG's; the sparse LU takes the staircase wall only;
 //  * 1 and 2 threads give bit-identical results.
+// And the product's StokesSolver::set_pressure.
 #include <gtest/gtest.h>
 
 #include <chrono>
@@ -13,9 +16,9 @@
 #include <random>
 
 #include "common/errors.hpp"
-#include "full3d/direct_stokes.hpp"
 #include "full3d/operators.hpp"
 #include "full3d/stokes.hpp"
+#include "tests/full3d/reference/reference_stokes.hpp"
 #include "tests/full3d/test_support.hpp"
 
 using namespace swim::full3d;
@@ -30,10 +33,10 @@ struct Case {
   bool cylinder;
 };
 
-StokesOptions options(bool cylinder, StokesMethod method, int threads = 1) {
-  StokesOptions o;
+reference::Options options(bool cylinder, reference::Method method, int threads = 1) {
+  reference::Options o;
   o.method = method;
-  o.direct_threads = threads;
+  o.threads = threads;
   o.cg_rtol = 1e-13;
   o.cg_max_iterations = 2000;
   if (cylinder) {
@@ -87,22 +90,18 @@ double rel_pressure_diff(const ScalarField& pa, const ScalarField& pb, Use use) 
 
 void compare_with_iterative(const MacGrid& g, bool cylinder, double dt) {
   const FluidParams water{1.0e3, 1.2e-3};
-  StokesSolver direct(g, water, options(cylinder, StokesMethod::Direct));
-  StokesSolver iter(g, water, options(cylinder, StokesMethod::Iterative));
-  ASSERT_TRUE(direct.uses_direct());
-  ASSERT_FALSE(iter.uses_direct());
+  reference::ReferenceStokes direct(g, water, options(cylinder, reference::Method::SparseLu));
+  reference::ReferenceStokes iter(g, water, options(cylinder, reference::Method::Pcg));
   VectorField u(g), f(g);
   random_state(g, cylinder, u, f, 3);
   VectorField ud = u, ui = u;
   for (int s = 0; s < 2; ++s) {
     const StokesStats sd = direct.step(ud, f, dt);
     const StokesStats si = iter.step(ui, f, dt);
-    EXPECT_TRUE(sd.direct);
     EXPECT_EQ(sd.iterations, 0);
     const double du = rel_diff(ud, ui);
     const int ny = g.ny(), nx = g.nx();
-    StokesOptions co = options(cylinder, StokesMethod::Direct);
-    DirectStokes mask(g, water.mu, cylinder ? &co.cylinder : nullptr, 1, FftOptions{});
+    const reference::ReferenceStokes& mask = direct;
     const double dp = rel_pressure_diff(direct.pressure(), iter.pressure(), [&](std::size_t id) {
       const std::size_t cell = id / std::size_t(nx);
       return mask.has_pressure(int(cell % std::size_t(ny)), int(cell / std::size_t(ny)));
@@ -126,7 +125,7 @@ void compare_with_iterative(const MacGrid& g, bool cylinder, double dt) {
       }
       // multiplier recovered from the direct solution against the PCG's multiplier. Only
       // lambda + E G p is unique (the pressure of fully masked cells trades off with lambda).
-      auto total = [&](const StokesSolver& solver) {
+      auto total = [&](const reference::ReferenceStokes& solver) {
         VectorField gp(g);
         gradient(g, solver.pressure(), gp);
         std::vector<double> egp;
@@ -171,7 +170,7 @@ TEST(DirectStokes, MatchesIterativeCylinderOddNx) {
 TEST(DirectStokes, RefactorisesWhenDtChanges) {
   const MacGrid g(8, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
   const FluidParams water{1.0e3, 1.2e-3};
-  StokesSolver s(g, water, options(true, StokesMethod::Direct));
+  reference::ReferenceStokes s(g, water, options(true, reference::Method::SparseLu));
   VectorField u(g), f(g);
   random_state(g, true, u, f, 7);
   const double dts[4] = {1e-5, 0.5e-5, 1e-5, 0.5e-5};
@@ -185,7 +184,7 @@ TEST(DirectStokes, RefactorisesWhenDtChanges) {
     if (n == 2) last = u;
   }
   // a fresh solver on the state before step 3 gives the same step 3
-  StokesSolver fresh(g, water, options(true, StokesMethod::Direct));
+  reference::ReferenceStokes fresh(g, water, options(true, reference::Method::SparseLu));
   VectorField u2(g), f2(g);
   random_state(g, true, u2, f2, 7);
   for (int n = 0; n < 4; ++n) {
@@ -195,14 +194,14 @@ TEST(DirectStokes, RefactorisesWhenDtChanges) {
     }
   }
   EXPECT_LT(rel_diff(u2, u), 1e-15);
-  EXPECT_GT(s.direct_factor_bytes(), 0u);
+  EXPECT_GT(s.factor_bytes(), 0u);
 }
 
 TEST(DirectStokes, ThreadsGiveIdenticalResults) {
   const MacGrid g(10, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
   const FluidParams water{1.0e3, 1.2e-3};
-  StokesSolver s1(g, water, options(true, StokesMethod::Direct, 1));
-  StokesSolver s2(g, water, options(true, StokesMethod::Direct, 2));
+  reference::ReferenceStokes s1(g, water, options(true, reference::Method::SparseLu, 1));
+  reference::ReferenceStokes s2(g, water, options(true, reference::Method::SparseLu, 2));
   VectorField u(g), f(g);
   random_state(g, true, u, f, 9);
   VectorField u1 = u, u2 = u;
@@ -212,24 +211,16 @@ TEST(DirectStokes, ThreadsGiveIdenticalResults) {
   EXPECT_EQ(s1.pressure().v, s2.pressure().v);
 }
 
-TEST(DirectStokes, MethodSelection) {
+TEST(DirectStokes, StaircaseWallOnly) {
   const MacGrid duct(8, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
+  reference::Options o = options(true, reference::Method::SparseLu);
+  EXPECT_NO_THROW(reference::ReferenceStokes(duct, FluidParams{}, o));
+  o.wall.wall = reference::CylinderWall::GhostLinear;
+  EXPECT_THROW(reference::ReferenceStokes(duct, FluidParams{}, o), swim::InputError);
+  o.method = reference::Method::Pcg;
+  EXPECT_NO_THROW(reference::ReferenceStokes(duct, FluidParams{}, o));
   const MacGrid box(8, 8, 8, 1e-7, ContainerKind::PeriodicBox);
-  StokesOptions o;
-  EXPECT_TRUE(StokesSolver(duct, FluidParams{}, o).uses_direct());  // Auto, plain duct
-  o.cylinder.enabled = true;
-  o.cylinder.radius = kRc;
-  EXPECT_TRUE(StokesSolver(duct, FluidParams{}, o).uses_direct());  // Auto, staircase
-  o.cylinder.wall = CylinderWall::GhostLinear;
-  EXPECT_FALSE(StokesSolver(duct, FluidParams{}, o).uses_direct());  // Auto falls back
-  o.method = StokesMethod::Direct;
-  EXPECT_THROW(StokesSolver(duct, FluidParams{}, o), swim::InputError);
-  o = StokesOptions{};
-  o.direct_memory_limit_gib = 0.0;
-  EXPECT_FALSE(StokesSolver(duct, FluidParams{}, o).uses_direct());  // over the memory limit
-  o.method = StokesMethod::Iterative;
-  EXPECT_FALSE(StokesSolver(duct, FluidParams{}, o).uses_direct());
-  EXPECT_FALSE(StokesSolver(box, FluidParams{}, StokesOptions{}).uses_direct());
+  EXPECT_THROW(reference::ReferenceStokes(box, FluidParams{}, reference::Options{}), swim::InputError);
 }
 
 TEST(DirectStokes, SetPressure) {

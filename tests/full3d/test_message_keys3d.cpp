@@ -37,7 +37,8 @@ std::set<std::string> accepted_keys() {
 TEST(MessageKeys3d, EveryNamedFull3dKeyExists) {
   const std::set<std::string> keys = accepted_keys();
   ASSERT_TRUE(keys.count("full3d.dt"));
-  ASSERT_TRUE(keys.count("full3d.cylinder_wall"));
+  ASSERT_TRUE(keys.count("full3d.scheme"));
+  ASSERT_FALSE(keys.count("full3d.cylinder_wall"));  // the staircase wall is the only product wall
   ASSERT_TRUE(keys.count("full3d.adaptive.dt_min"));
   const std::regex key(R"(\b(?:full3d|stokes|ib)\.[a-z_0-9]+(?:\.[a-z_0-9]+)*)");
   const auto named = swim::testing::named_keys(SWIM_SOURCE_DIR "/full3d", key, {"md", "hpp", "cpp", "json", "vti", "vtp", "pvd", "csv", "bin"});

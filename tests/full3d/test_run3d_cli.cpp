@@ -81,7 +81,7 @@ TEST(SwimRun3d, WritesContractFiles) {
 TEST(SwimRun3d, BadInputExits2AndWritesNothing) {
   const std::string d = dir("bad");
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.kind='\"cylinder\"'"
-                 " --set full3d.cylinder_wall='\"bogus\"'"), 2);
+                 " --set full3d.scheme='\"bogus\"'"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.bogus=1"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
   EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);

@@ -1,4 +1,4 @@
-#include "full3d/direct_stokes.hpp"
+#include "tests/full3d/reference/direct_stokes.hpp"
 
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
@@ -17,7 +17,7 @@
 
 #include "common/errors.hpp"
 
-namespace swim::full3d {
+namespace swim::full3d::reference {
 
 namespace {
 
@@ -247,8 +247,7 @@ struct DirectStokes::Impl {
       if (l->info() != Eigen::Success)
         throw NumericalError("sparse LU of the direct Stokes solver failed for axial mode " + std::to_string(kx) +
                                  ": " + l->lastErrorMessage(),
-                             "change the grid (full3d.grid.cells_across) or use full3d.cylinder_wall = "
-                             "\"ghost_linear\" (iterative solver)");
+                             "change the grid of the test");
       bytes[kx] = std::size_t(l->nnzL() + l->nnzU()) * (sizeof(double) + sizeof(int));
       lu[kx] = std::move(l);
     });
@@ -353,4 +352,4 @@ bool DirectStokes::has_pressure(int j, int k) const {
   return impl_->p_id[std::size_t(k) * impl_->grid.ny() + j] >= 0;
 }
 
-}  // namespace swim::full3d
+}  // namespace swim::full3d::reference

@@ -1,6 +1,8 @@
-// Direct solver of the backward-Euler Stokes step in the square duct and in the
-// staircase cylinder, exploiting the invariance of both geometries along the
-// periodic x axis.
+// TEST REFERENCE (library swim_full3d_reference; reference_stokes.hpp, Method::SparseLu):
+// direct solver of the backward-Euler Stokes step in the square duct and in the staircase
+// cylinder by sparse LU per axial Fourier mode, exploiting the invariance of both geometries
+// along the periodic x axis. An algorithm independent of the product's capacitance solver,
+// against which the tests check it.
 //
 // A batched r2c FFT along x turns the step's saddle-point system
 //   A u + G p = b,  D u = 0,  A = alpha - mu L,  alpha = rho/dt,
@@ -36,7 +38,7 @@
 #include "full3d/fft.hpp"
 #include "full3d/grid.hpp"
 
-namespace swim::full3d {
+namespace swim::full3d::reference {
 
 class DirectStokes {
  public:
@@ -73,4 +75,4 @@ class DirectStokes {
   std::unique_ptr<Impl> impl_;
 };
 
-}  // namespace swim::full3d
+}  // namespace swim::full3d::reference
