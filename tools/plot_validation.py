@@ -8,6 +8,8 @@ import html
 import json
 import math
 import os
+import re
+import struct
 import sys
 
 import matplotlib
@@ -198,6 +200,80 @@ def multicycle_figure(report, path):
     return True
 
 
+def read_vtp_points(path):
+    """Node coordinates of a membrane frame written by swim (VTK XML PolyData, binary
+    Float32 inline: base64 of a UInt32 byte count followed by the values)."""
+    with open(path) as f:
+        text = f.read()
+    m = re.search(r"<Points>\s*<DataArray[^>]*>\s*([A-Za-z0-9+/=]+)\s*</DataArray>", text)
+    if not m:
+        return None
+    raw = base64.b64decode(m.group(1))
+    n = struct.unpack("<I", raw[:4])[0] // 4
+    v = struct.unpack(f"<{n}f", raw[4:4 + 4 * n])
+    return [v[i:i + 3] for i in range(0, n, 3)]
+
+
+def membrane_figure(case, path):
+    """Side views of the membrane over one cycle from the finest 3D run's frames (Figure 5)."""
+    runs = [r for r in case["runs3d"] if r.get("membrane_frames")]
+    if not runs or not runs[-1].get("has_cycle"):
+        return False
+    run = runs[-1]
+    folder = run["folder"]
+    try:
+        with open(f"{folder}/membrane.pvd") as f:
+            pvd = f.read()
+        with open(f"{folder}/summary.json") as f:
+            summ = json.load(f)
+    except OSError:
+        return False
+    frames = [(float(t), fn) for t, fn in re.findall(r'timestep="([^"]+)"[^>]*file="([^"]+)"', pvd)]
+    T = run["cycle_time_s"]
+    frames = [fr for fr in frames if fr[0] <= T * (1 + 1e-9)]
+    if len(frames) < 2:
+        return False
+    pick = [frames[round(k * (len(frames) - 1) / min(7, len(frames) - 1))] for k in range(min(7, len(frames) - 1) + 1)]
+    n_theta = summ["derived"]["n_theta"]
+    R0 = summ["derived"]["aspect_ratio_R0_over_L"] * case["length_m"]
+    fig, ax = plt.subplots(figsize=(8, 1.1 * len(pick) + 1.2))
+    x0 = None
+    for k, (t, fn) in enumerate(pick):
+        pts = read_vtp_points(f"{folder}/{fn}")
+        if not pts:
+            continue
+        yc = sum(p[1] for p in pts) / len(pts)
+        zc = sum(p[2] for p in pts) / len(pts)
+        if x0 is None:
+            x0 = min(p[0] for p in pts)
+        rings = len(pts) // n_theta
+        top, bot = [], []
+        for r in range(rings):
+            ring = pts[r * n_theta:(r + 1) * n_theta]
+            hi = max(ring, key=lambda p: p[1] - yc)  # the node facing +y: the upper outline
+            lo = min(ring, key=lambda p: p[1] - yc)
+            top.append(((hi[0] - x0) * 1e6, (hi[1] - yc) * 1e9))
+            bot.append(((lo[0] - x0) * 1e6, (lo[1] - yc) * 1e9))
+        off = -k * 3.0 * R0 * 1e9
+        for line in (top, bot):
+            ax.plot([q[0] for q in line], [q[1] + off for q in line], "k-", lw=1.2)
+        ax.plot([0, 0], [off - R0 * 1e9, off + R0 * 1e9], color="0.8", lw=0.6)
+        ax.annotate(f"t = {si(t, 's')}", (0, off), xytext=(-8, 0), textcoords="offset points", ha="right",
+                    va="center", fontsize=8)
+    ax.set_xlabel("axial position from the tube's initial rear end [µm]")
+    ax.set_ylabel("transverse position [nm]\n(snapshots offset by 3 R₀)")
+    ax.set_yticks([])
+    ax.set_aspect("auto")
+    ax.set_title(f"Membrane side view over one cycle: {case['name']}\n(3D, h = {si(run['cell_size_m'], 'm')}; "
+                 f"the grey bar marks the initial rear end)")
+    xmin, xmax = ax.get_xlim()
+    ax.set_xlim(xmin - 0.25 * (xmax - xmin), xmax)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
 def markdown(report, figs):
     th = report["thresholds"]
     sel = report.get("cases_selected") or []
@@ -329,6 +405,8 @@ def main(d):
             lst.append(f"fig_velocity_{name}.png")
         if convergence_figure(c, f"{d}/fig_convergence_{name}.png"):
             lst.append(f"fig_convergence_{name}.png")
+        if membrane_figure(c, f"{d}/fig_membrane_{name}.png"):
+            lst.append(f"fig_membrane_{name}.png")
         cal = c["calibration"].get("file")
         if cal and os.path.exists(cal):
             cd = os.path.dirname(cal)
