@@ -30,6 +30,11 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   const validation::OuterOffsetFromDrag tow_a = validation::outer_offset_from_drag(
       tow.geometry, tow.drag_coefficient_N_s_per_m, tow.drag_coefficient_uncertainty_N_s_per_m, hr.a_in_m,
       hr.a_in_uncertainty_m);
+  validation::ConfinedTow tow_eff = tow.geometry;  // sensitivity: the container's effective radius
+  tow_eff.container_radius_m = hr.container_radius_effective_m;
+  const validation::OuterOffsetFromDrag tow_a_eff = validation::outer_offset_from_drag(
+      tow_eff, tow.drag_coefficient_N_s_per_m, tow.drag_coefficient_uncertainty_N_s_per_m, hr.a_in_m,
+      hr.a_in_uncertainty_m);
   // wet confirmation at the largest load of the fit
   validation::WetConfirmation w;
   const validation::LoadPoint* confirm = nullptr;
@@ -44,7 +49,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
   hj.erase("wall_time_s");
   j.update(hj);
-  j.update(validation::to_json(tow, tow_a));
+  j.update(validation::to_json(tow, tow_a, &tow_a_eff));
   if (wet && confirm)
     j["wet_confirmation"] = {{"pressure_Pa", w.pressure_Pa},
                              {"displacement_m", w.displacement_m},
@@ -81,11 +86,13 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
               si(hr.wall_time_s, "s").c_str());
   if (tow_a.found)
     std::printf("  towed tube: drag coefficient %s +- %s (%d CG iterations, %s) -> a_out = %s +- %s from the drag "
-                "(%+.2f h from the profile's)\n",
+                "(%+.2f h from the profile's; %s with the container's effective radius %s)\n",
                 si(tow.drag_coefficient_N_s_per_m, "N s/m", 4).c_str(),
                 si(tow.drag_coefficient_uncertainty_N_s_per_m, "N s/m").c_str(), tow.cg_iterations,
                 si(tow.wall_time_s, "s").c_str(), si(tow_a.a_out_m, "m").c_str(), si(tow_a.uncertainty_m, "m").c_str(),
-                (tow_a.a_out_m - hr.a_out_m) / p.h);
+                (tow_a.a_out_m - hr.a_out_m) / p.h,
+                tow_a_eff.found ? si(tow_a_eff.a_out_m, "m").c_str() : "no root",
+                si(hr.container_radius_effective_m, "m").c_str());
   else
     std::printf("  towed tube: drag coefficient %s +- %s (%d CG iterations, %s); no a_out from the drag: %s\n",
                 si(tow.drag_coefficient_N_s_per_m, "N s/m", 4).c_str(),

@@ -28,8 +28,6 @@ namespace {
 using full3d::MacGrid;
 using full3d::VectorField;
 
-double dot(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) { return a.cwiseProduct(b).sum(); }
-
 struct Sample {
   double r, u;
 };
@@ -162,10 +160,10 @@ class RigidTubeFlow {
     const Eigen::Index n3 = X.size();
     const int threads = p_.threads;
     const int nt = mesh_.n_theta, rings = mesh_.n_rings;
-    // ring modes: unit vectors e_i A_i / |A|_ring over the ring's nodes
+    // ring modes (B): the node forces e_i A_i / |A|_ring over one ring's nodes, e = e_x or e_r
     Eigen::Matrix3Xd er = Eigen::Matrix3Xd::Zero(3, X.cols());
-    Eigen::VectorXd wnode(X.cols());
-    for (int g = 0; g < rings; ++g) {
+    Eigen::VectorXd wnode = Eigen::VectorXd::Zero(X.cols());
+    for (int g = 0; cg.axisymmetric && g < rings; ++g) {
       const double norm = mesh_.node_area.segment(g * nt, nt).norm();
       for (int i = g * nt; i < (g + 1) * nt; ++i) {
         const Eigen::Vector3d rel = X.col(i) - mesh_.axis_start;
@@ -458,6 +456,7 @@ OuterOffsetFromDrag outer_offset_from_drag(const ConfinedTow& g, double zeta, do
                                            double a_in_unc) {
   OuterOffsetFromDrag r;
   r.a_in_m = a_in;
+  r.container_radius_m = g.container_radius_m;
   try {
     r.a_out_m = outer_offset_from_drag(g, zeta, a_in);
     // derivatives of the root by the implicit function theorem, with the partial derivatives
@@ -474,12 +473,13 @@ OuterOffsetFromDrag outer_offset_from_drag(const ConfinedTow& g, double zeta, do
   } catch (const NumericalError& e) {
     r = OuterOffsetFromDrag{};
     r.a_in_m = a_in;
+    r.container_radius_m = g.container_radius_m;
     r.note = e.what();
   }
   return r;
 }
 
-scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a) {
+scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a, const OuterOffsetFromDrag* at_effective_container) {
   scene::json j = scene::json::object();
   j["hydraulic_offset_outer_from_drag_m"] = a.found ? scene::json(a.a_out_m) : scene::json(nullptr);
   j["hydraulic_offset_outer_from_drag_uncertainty_m"] = a.found ? scene::json(a.uncertainty_m) : scene::json(nullptr);
@@ -501,10 +501,11 @@ scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a) {
       {"period_m", t.geometry.period_m},
       {"viscosity_Pa_s", t.geometry.viscosity_Pa_s},
       {"method",
-       "undeformed tube towed rigidly along its axis (conjugate gradients on the node forces) through the scene's "
-       "container (a duct by its inscribed cylinder) in steady Stokes flow, pressure periodic (zero mean pressure "
-       "gradient, net flux free); a_out is the root of the 1D confined drag coefficient "
-       "(reduced1d::outer::confined_drag_coefficient) at the measured a_in"}};
+       "undeformed tube towed rigidly along its axis through the scene's container (a duct by its inscribed "
+       "cylinder) in steady Stokes flow, pressure periodic (zero mean pressure gradient, net flux free); "
+       "axisymmetric node forces (axial and radial per ring) by conjugate gradients on the rings' mean velocities; "
+       "a_out is the root of the 1D confined drag coefficient (reduced1d::outer::confined_drag_coefficient) at the "
+       "profile-fitted a_in and the nominal container radius"}};
   d["hydraulic_offset_inner_used_m"] = a.a_in_m;
   if (a.found) {
     d["a_out_uncertainty_from_a_in_m"] = a.from_a_in_m;
@@ -512,6 +513,14 @@ scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a) {
     d["net_flux_1d_m3_per_s"] = confined_tow_flux_per_speed(t.geometry, a.a_in_m, a.a_out_m) * t.speed_m_per_s;
   } else {
     d["no_offset_reason"] = a.note;
+  }
+  if (at_effective_container) {
+    const OuterOffsetFromDrag& e = *at_effective_container;
+    scene::json s = {{"container_radius_m", e.container_radius_m}};
+    s["hydraulic_offset_outer_from_drag_m"] = e.found ? scene::json(e.a_out_m) : scene::json(nullptr);
+    s["hydraulic_offset_outer_from_drag_uncertainty_m"] = e.found ? scene::json(e.uncertainty_m) : scene::json(nullptr);
+    if (!e.found) s["no_offset_reason"] = e.note;
+    d["at_effective_container_radius"] = s;
   }
   j["towed_tube"] = d;
   return j;

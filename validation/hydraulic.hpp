@@ -40,8 +40,10 @@
 //   - Inversion: a_out is the root of confined_drag_coefficient(R0, L, a_in, a_out, Rc, P, mu)
 //     = zeta (GSL Brent), with a_in from the profile fit and Rc the nominal radius of the
 //     cylinder simulated. The 1D drag is lubrication without end corrections, so this a_out
-//     also absorbs the 3D flow's end effects: it is the outer offset that makes the 1D tier's
-//     drag of the straight tube equal to 3D's.
+//     also absorbs the 3D flow's end effects and the annulus model's error: it is the outer
+//     offset that makes the 1D tier's drag of the straight tube of the scene's length equal
+//     to 3D's (it falls with the length: docs/validation.md), and the 1D tier keeps reading
+//     the profile-fit a_out.
 #pragma once
 
 #include <string>
@@ -116,7 +118,8 @@ double confined_tow_flux_per_speed(const ConfinedTow& g, double a_in_m, double a
 
 struct OuterOffsetFromDrag {
   bool found = false;
-  double a_in_m = 0;        ///< the inner offset the inversion used
+  double a_in_m = 0;              ///< the inner offset the inversion used
+  double container_radius_m = 0;  ///< the container radius the inversion used
   double a_out_m = 0, uncertainty_m = 0;
   double from_a_in_m = 0;   ///< |d a_out / d a_in| sigma(a_in)
   double from_drag_m = 0;   ///< |d a_out / d zeta| sigma(zeta)
@@ -129,8 +132,11 @@ OuterOffsetFromDrag outer_offset_from_drag(const ConfinedTow& g, double zeta_N_s
                                            double a_in_m, double a_in_uncertainty_m);
 
 /// calibration.json entries: the headline figures at the top level
-/// (hydraulic_offset_outer_from_drag_m and its uncertainty, null with a note when there is no
-/// root; towed_drag_coefficient_N_s_per_m) and the details under "towed_tube".
-scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a);
+/// (hydraulic_offset_outer_from_drag_m and its uncertainty, null when there is no root, the
+/// reason under towed_tube.no_offset_reason; towed_drag_coefficient_N_s_per_m) and the details
+/// under "towed_tube". `at_effective_container` (optional): the same inversion with the
+/// container's effective radius from the profile fit, reported as a sensitivity.
+scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a,
+                    const OuterOffsetFromDrag* at_effective_container = nullptr);
 
 }  // namespace swim::validation
