@@ -29,8 +29,8 @@
 //     constraint each ring's mean velocity: node by node, the non-axisymmetric node-force
 //     modes finer than the grid form a near null space in which CG keeps adding forces and
 //     dissipation without converging (the drag grows by 60 % over 2000 iterations on 16
-//     cells across), while on the ring modes it converges to 1e-6 and the drag to about
-//     1e-7. The towing force is sum_i F_x,i, and zeta = force / U.
+//     cells across), while on the ring modes it converges to 1e-6 and the drag to 1e-5
+//     or better. The towing force is sum_i F_x,i, and zeta = force / U.
 //   - Far-field condition: the grid's pressure is periodic along the axis, so the mean pressure
 //     gradient over the period is zero and the net flux is free (the tube drives one). This is
 //     the 1D confined model's condition (the pressure rise along the tube plus along the free
