@@ -270,9 +270,12 @@ class RigidTubeFlow {
   full3d::StokesSolver stokes_;
 };
 
+// The solve on the ring modes: it converges, so to a tight tolerance.
+const RigidTubeFlow::Cg kRingCg{1e-6, 400, true};
+
 }  // namespace
 
-HydraulicRadii measure_hydraulic_radii(const full3d::Params3d& scene) {
+HydraulicRadii measure_hydraulic_radii(const full3d::Params3d& scene, bool axisymmetric_forces) {
   const auto t0 = std::chrono::steady_clock::now();
   const full3d::Params3d p = in_cylinder(scene);
   RigidTubeFlow flow(p);
@@ -285,9 +288,11 @@ HydraulicRadii measure_hydraulic_radii(const full3d::Params3d& scene) {
   std::fill(fb.c[0].begin(), fb.c[0].end(), out.body_force_N_per_m3);
   // held tube: zero velocity at every node. A wall slip of 1e-3 of the flow (where CG stalls)
   // moves the fitted radii by far less than their uncertainty.
-  const RigidTubeFlow::Result held = flow.solve(&fb, Eigen::Matrix3Xd::Zero(3, flow.nodes().cols()), "held-tube", {});
+  const RigidTubeFlow::Result held = flow.solve(&fb, Eigen::Matrix3Xd::Zero(3, flow.nodes().cols()), "held-tube",
+                 axisymmetric_forces ? kRingCg : RigidTubeFlow::Cg{});
   const VectorField& u = held.u;
   out.cg_iterations = held.iterations;
+  out.holding_force_N = held.F.row(0).sum();
   out.max_node_speed_m_per_s = held.max_slip_m_per_s;
   out.max_fluid_speed_m_per_s = held.max_fluid_speed_m_per_s;
 
@@ -346,6 +351,7 @@ scene::json to_json(const HydraulicRadii& h) {
           {"lumen_flux_m3_per_s", h.lumen_flux_m3_per_s},
           {"lumen_flux_poiseuille_fit_m3_per_s", h.lumen_flux_poiseuille_m3_per_s},
           {"body_force_N_per_m3", h.body_force_N_per_m3},
+          {"held_tube_force_N", h.holding_force_N},
           {"held_wall_max_speed_m_per_s", h.max_node_speed_m_per_s},
           {"max_fluid_speed_m_per_s", h.max_fluid_speed_m_per_s},
           {"conjugate_gradient_iterations", h.cg_iterations},
@@ -392,12 +398,8 @@ TowedTube measure_towed_tube(const full3d::Params3d& scene, double speed) {
   V.row(0).setConstant(speed);
   // The axisymmetric node forces: node by node, the non-axisymmetric modes finer than the grid
   // form a near null space in which CG keeps adding forces (and dissipation) without
-  // converging; on the ring modes it converges to round-off.
-  RigidTubeFlow::Cg cg;
-  cg.axisymmetric = true;
-  cg.rtol = 1e-6;
-  cg.max_iterations = 400;
-  const RigidTubeFlow::Result tow = flow.solve(nullptr, V, "towed-tube", cg);
+  // converging.
+  const RigidTubeFlow::Result tow = flow.solve(nullptr, V, "towed-tube", kRingCg);
 
   TowedTube out;
   out.geometry = confined_tow(scene);
