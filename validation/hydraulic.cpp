@@ -528,4 +528,29 @@ scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a, const Oute
   return j;
 }
 
+TowedCalibration calibrate_towed(const full3d::Params3d& p, const HydraulicRadii& hr) {
+  TowedCalibration c;
+  try {
+    c.tube = measure_towed_tube(p);
+  } catch (const NumericalError& e) {
+    c.error = e.what();
+    c.json = {{"hydraulic_offset_outer_from_drag_m", nullptr},
+              {"hydraulic_offset_outer_from_drag_uncertainty_m", nullptr},
+              {"towed_drag_coefficient_N_s_per_m", nullptr},
+              {"towed_tube", {{"status", "failed: " + c.error}}}};
+    return c;
+  }
+  c.measured = true;
+  const TowedTube& t = c.tube;
+  c.nominal = outer_offset_from_drag(t.geometry, t.drag_coefficient_N_s_per_m, t.drag_coefficient_uncertainty_N_s_per_m,
+                                     hr.a_in_m, hr.a_in_uncertainty_m);
+  ConfinedTow eff = t.geometry;
+  eff.container_radius_m = hr.container_radius_effective_m;
+  c.effective = outer_offset_from_drag(eff, t.drag_coefficient_N_s_per_m, t.drag_coefficient_uncertainty_N_s_per_m,
+                                       hr.a_in_m, hr.a_in_uncertainty_m);
+  c.json = to_json(t, c.nominal, &c.effective);
+  c.json["towed_tube"]["status"] = "ok";
+  return c;
+}
+
 }  // namespace swim::validation

@@ -146,4 +146,17 @@ OuterOffsetFromDrag outer_offset_from_drag(const ConfinedTow& g, double zeta_N_s
 scene::json to_json(const TowedTube& t, const OuterOffsetFromDrag& a,
                     const OuterOffsetFromDrag* at_effective_container = nullptr);
 
+/// The towed-tube part of a calibration: the tow at 1 um/s, a_out from its drag at the
+/// profile-fitted a_in, and the same with the container's effective radius. A towed solve that
+/// fails (NumericalError) leaves `measured` false, null offsets in `json` and the reason under
+/// towed_tube.status: the rest of the calibration stands.
+struct TowedCalibration {
+  bool measured = false;
+  TowedTube tube;
+  OuterOffsetFromDrag nominal, effective;
+  std::string error;
+  scene::json json;  ///< the entries for calibration.json
+};
+TowedCalibration calibrate_towed(const full3d::Params3d& p, const HydraulicRadii& hr);
+
 }  // namespace swim::validation

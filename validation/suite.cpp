@@ -564,16 +564,7 @@ json run_suite(const SuiteOptions& o) {
           hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
           hj.erase("wall_time_s");
           cal_j.update(hj);
-          const TowedTube tow = measure_towed_tube(p);
-          ConfinedTow tow_eff = tow.geometry;
-          tow_eff.container_radius_m = hr.container_radius_effective_m;
-          const OuterOffsetFromDrag a = outer_offset_from_drag(tow.geometry, tow.drag_coefficient_N_s_per_m,
-                                                               tow.drag_coefficient_uncertainty_N_s_per_m, hr.a_in_m,
-                                                               hr.a_in_uncertainty_m);
-          const OuterOffsetFromDrag a_eff = outer_offset_from_drag(tow_eff, tow.drag_coefficient_N_s_per_m,
-                                                                   tow.drag_coefficient_uncertainty_N_s_per_m,
-                                                                   hr.a_in_m, hr.a_in_uncertainty_m);
-          cal_j.update(to_json(tow, a, &a_eff));
+          cal_j.update(calibrate_towed(p, hr).json);
           cal_j["wall_time_s"] = seconds_since(t0);
           fs::create_directories(dir);
           output::write_json(cal_file, cal_j);
