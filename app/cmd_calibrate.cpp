@@ -1,4 +1,6 @@
-// swim calibrate SCENE: the 1D tier's wall stiffness from the 3D membrane under uniform loads.
+// swim calibrate SCENE: the 1D tier's wall stiffness from the 3D membrane under uniform loads, and
+// the hydraulic offsets of the immersed wall (profile fits of a held tube; a_out also from the
+// drag of the towed tube).
 #include <chrono>
 #include <cstdio>
 
@@ -24,6 +26,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   const auto loads = validation::default_loads(p);
   const validation::StaticCalibration c = validation::calibrate_static(p, loads);
   const validation::HydraulicRadii hr = validation::measure_hydraulic_radii(p);
+  const validation::TowedCalibration tow = validation::calibrate_towed(p, hr);
   // wet confirmation at the largest load of the fit
   validation::WetConfirmation w;
   const validation::LoadPoint* confirm = nullptr;
@@ -38,6 +41,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
   hj.erase("wall_time_s");
   j.update(hj);
+  j.update(tow.json);
   if (wet && confirm)
     j["wet_confirmation"] = {{"pressure_Pa", w.pressure_Pa},
                              {"displacement_m", w.displacement_m},
@@ -72,6 +76,23 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
               si(hr.a_in_m, "m").c_str(), si(hr.a_in_uncertainty_m, "m").c_str(), si(hr.a_out_m, "m").c_str(),
               si(hr.a_out_uncertainty_m, "m").c_str(), si(p.h, "m").c_str(), hr.cg_iterations,
               si(hr.wall_time_s, "s").c_str());
+  const validation::TowedTube& tt = tow.tube;
+  if (!tow.measured)
+    std::printf("  towed tube: failed (%s)\n", tow.error.c_str());
+  else if (tow.nominal.found)
+    std::printf("  towed tube: drag coefficient %s +- %s (%d CG iterations, %s) -> a_out = %s +- %s from the drag "
+                "(%+.2f h from the profile's; %s with the container's effective radius %s)\n",
+                si(tt.drag_coefficient_N_s_per_m, "N s/m", 4).c_str(),
+                si(tt.drag_coefficient_uncertainty_N_s_per_m, "N s/m").c_str(), tt.cg_iterations,
+                si(tt.wall_time_s, "s").c_str(), si(tow.nominal.a_out_m, "m").c_str(),
+                si(tow.nominal.uncertainty_m, "m").c_str(), (tow.nominal.a_out_m - hr.a_out_m) / p.h,
+                tow.effective.found ? si(tow.effective.a_out_m, "m").c_str() : "no root",
+                si(hr.container_radius_effective_m, "m").c_str());
+  else
+    std::printf("  towed tube: drag coefficient %s +- %s (%d CG iterations, %s); no a_out from the drag: %s\n",
+                si(tt.drag_coefficient_N_s_per_m, "N s/m", 4).c_str(),
+                si(tt.drag_coefficient_uncertainty_N_s_per_m, "N s/m").c_str(), tt.cg_iterations,
+                si(tt.wall_time_s, "s").c_str(), tow.nominal.note.c_str());
   if (wet && confirm)
     std::printf("  wet confirmation at %s: displacement %s against %s static (%+.2f %%), %s after %d steps of %s\n",
                 si(w.pressure_Pa, "Pa").c_str(), si(w.displacement_m, "m").c_str(),

@@ -323,7 +323,13 @@ def markdown(report, figs):
                        f"a_in = {si(cal.get('hydraulic_offset_inner_m'), 'm')} ± "
                        f"{si(cal.get('hydraulic_offset_inner_uncertainty_m'), 'm')}, a_out = "
                        f"{si(cal.get('hydraulic_offset_outer_m'), 'm')} ± "
-                       f"{si(cal.get('hydraulic_offset_outer_uncertainty_m'), 'm')}.")
+                       f"{si(cal.get('hydraulic_offset_outer_uncertainty_m'), 'm')} (profile fits).")
+            if "towed_drag_coefficient_N_s_per_m" in cal:
+                out.append(f"Towed tube: drag coefficient {si(cal['towed_drag_coefficient_N_s_per_m'], 'N s/m', 4)}, "
+                           f"a_out from the drag = {si(cal.get('hydraulic_offset_outer_from_drag_m'), 'm')} ± "
+                           f"{si(cal.get('hydraulic_offset_outer_from_drag_uncertainty_m'), 'm')}"
+                           + (" (no root in the physical range: see calibration.json)."
+                              if cal.get("hydraulic_offset_outer_from_drag_m") is None else "."))
         else:
             out.append(f"Not available: {cal.get('status', 'unknown')}")
         out += ["", "### 1D models", "",

@@ -556,6 +556,7 @@ json run_suite(const SuiteOptions& o) {
           hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
           hj.erase("wall_time_s");
           cal_j.update(hj);
+          cal_j.update(calibrate_towed(p, hr).json);
           cal_j["wall_time_s"] = seconds_since(t0);
           fs::create_directories(dir);
           output::write_json(cal_file, cal_j);
@@ -568,7 +569,9 @@ json run_suite(const SuiteOptions& o) {
     cr["calibration"] = {{"grid_index", cg}, {"grid_value", grids[cg]}, {"file", cal_file}};
     for (const char* k : {"C1_Pa_per_m", "C1_stderr_Pa_per_m", "C1_spring_network_Pa_per_m", "hydraulic_offset_inner_m",
                           "hydraulic_offset_inner_uncertainty_m", "hydraulic_offset_outer_m",
-                          "hydraulic_offset_outer_uncertainty_m", "status", "wall_time_s"})
+                          "hydraulic_offset_outer_uncertainty_m", "hydraulic_offset_outer_from_drag_m",
+                          "hydraulic_offset_outer_from_drag_uncertainty_m", "towed_drag_coefficient_N_s_per_m", "status",
+                          "wall_time_s"})
       if (cal_j.contains(k)) cr["calibration"][k] = cal_j[k];
 
     // 4. every 1D model

@@ -10,18 +10,11 @@
 #include "full3d/scene3d.hpp"
 #include "validation/calibration.hpp"
 #include "validation/hydraulic.hpp"
+#include "paper_scene.hpp"
 
 using namespace swim;
 
-namespace {
-/// The paper's amplitude scene; cells_across > 0 replaces its grid (the membrane follows it).
-full3d::Params3d paper_scene(int cells_across = 0) {
-  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.55.json");
-  if (cells_across > 0) sc["full3d"]["grid"] = {{"cells_across", cells_across}};
-  scene::json resolved;
-  return full3d::read_scene3d(sc, resolved);
-}
-}  // namespace
+using test::paper_scene;
 
 // The paper's Figure 10 relation: for small uniform loads the fitted C1 is the continuum
 // value of the spring network, 2 k_s / (sqrt(3) R0^2), within 2 %, and the response is

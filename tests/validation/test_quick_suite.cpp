@@ -41,6 +41,12 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   const double h = c["runs3d"][2]["cell_size_m"];
   EXPECT_GT(cal["hydraulic_offset_inner_m"].get<double>(), 0.3 * h);
   EXPECT_LT(cal["hydraulic_offset_inner_m"].get<double>(), 2.0 * h);
+  // the towed tube's drag gives a second a_out, of order the cell too
+  ASSERT_TRUE(cal.contains("towed_drag_coefficient_N_s_per_m")) << cal.dump();
+  EXPECT_GT(cal["towed_drag_coefficient_N_s_per_m"].get<double>(), 0.0);
+  ASSERT_TRUE(cal["hydraulic_offset_outer_from_drag_m"].is_number()) << cal.dump();
+  EXPECT_GT(cal["hydraulic_offset_outer_from_drag_m"].get<double>(), 0.3 * h);
+  EXPECT_LT(cal["hydraulic_offset_outer_from_drag_m"].get<double>(), 2.0 * h);
   // every model of the suite ran and carries its verdicts
   ASSERT_EQ(c["models1d"].size(), 4u);
   for (const auto& m : c["models1d"]) {
