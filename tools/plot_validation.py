@@ -135,9 +135,13 @@ def pareto_figure(report, path):
             any_pt = True
             ax.loglog([q["wall_time_s"] for q in p], [100 * q["displacement_per_cycle_error"] for q in p],
                       markers.get(axis, "x-"), label=f"{c['name']}, {tier.upper()}, varying {axis}")
-            for q in p:
+            # labels above left for the resolution axes, below right for the tolerance and step
+            # axes, fanned out so that points that coincide stay readable
+            below = axis in ("rtol", "time step")
+            for j, q in enumerate(p):
                 ax.annotate(q["resolution"], (q["wall_time_s"], 100 * q["displacement_per_cycle_error"]),
-                            fontsize=7, xytext=(-4, 4), textcoords="offset points", ha="right")
+                            fontsize=7, xytext=(4, -10 - 9 * j) if below else (-4, 4),
+                            textcoords="offset points", ha="left" if below else "right")
     if not any_pt:
         plt.close(fig)
         return False
@@ -290,6 +294,20 @@ def markdown(report, figs):
         ev = "; ".join(", ".join(f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in e.items())
                        for e in f["evidence"]) or "the suite has no cases for it"
         out.append(f"| {f['claim']} | **{f['status']}** | {ev} |")
+    ex = report.get("extremes3d") or []
+    if ex:
+        n_ok = sum(1 for e in ex if e["as_expected"])
+        out += ["", "## 3D at the extremes", "",
+                f"{n_ok} of {len(ex)} cases ended as the suite states they should. Each states its expected outcome: "
+                "a valid result (ok), a numerical failure naming its cause and the key to change (failed, exit 3), "
+                "or a rejection as input (rejected, exit 2).", "",
+                "| case | expected | outcome | as expected | displacement / cycle | message |", "|---|---|---|---|---|---|"]
+        for e in ex:
+            msg = e["message"].replace("|", "/")
+            msg = msg[:160] + ("…" if len(msg) > 160 else "")
+            out.append(f"| {e['label']} | {e['expected']}{' (' + e['expected_cause'] + ')' if e['expected_cause'] else ''} "
+                       f"| {e['outcome']} | {'yes' if e['as_expected'] else '**no**'} | "
+                       f"{si(e.get('displacement_per_cycle_m'), 'm')} | {msg} |")
     for c in report["cases"]:
         out += ["", f"## {c['name']}", "", c.get("description", ""), "", "### 3D runs", "",
                 "| grid | h | status | displacement / cycle | cycle time | mean velocity / cycle | steps | wall time |",

@@ -422,6 +422,19 @@ json load_suite(const std::string& path) {
                          "an array of {\"label\": text, \"set\": {\"dotted.key\": value}} (3D time-step variants)");
     }
   }
+  if (s.contains("extremes3d")) {
+    const json& ex = s["extremes3d"];
+    bool ok = ex.is_array();
+    for (const auto& e : ok ? ex : json::array())
+      ok = ok && e.is_object() && e.contains("label") && e["label"].is_string() && e.contains("scene") &&
+           e["scene"].is_string() && e.contains("expect") &&
+           (e["expect"] == "ok" || e["expect"] == "failed" || e["expect"] == "rejected") &&
+           (!e.contains("set") || e["set"].is_object()) && (!e.contains("cause") || e["cause"].is_string());
+    if (!ok)
+      throw InputError("suite.extremes3d", scene::show(ex),
+                       "an array of {\"label\": text, \"scene\": file, \"set\": {...}, \"expect\": \"ok\" | "
+                       "\"failed\" | \"rejected\", \"cause\": text in the message}");
+  }
   const json& models = member(s, "models1d", "suite");
   if (!models.is_array() || models.empty()) throw InputError("suite.models1d", scene::show(models), "a non-empty array");
   for (std::size_t i = 0; i < models.size(); ++i) member(models[i], "label", "suite.models1d[" + std::to_string(i) + "]");
@@ -703,6 +716,42 @@ json run_suite(const SuiteOptions& o) {
     report["cases"].push_back(cr);
   }
   report["findings"] = findings(report["cases"], th_d);
+
+  // 3D at the extremes: each case's outcome against the one the suite states for it
+  json extremes = json::array();
+  const json& ex = suite.contains("extremes3d") && o.only.empty() ? suite["extremes3d"] : json::array();
+  for (std::size_t k = 0; k < ex.size(); ++k) {
+    const json& e = ex[k];
+    json s = scene::load_file(find_scene(e["scene"], suite_dir, o.data_dir));
+    apply_sets(s, e.value("set", json()));
+    const std::string label = e["label"];
+    say("extremes " + std::to_string(k + 1) + "/" + std::to_string(ex.size()) + ": " + label);
+    json entry = {{"label", label}, {"scene", e["scene"]}, {"set", e.value("set", json::object())},
+                  {"expected", e["expect"]}, {"expected_cause", e.value("cause", std::string())}};
+    std::string kind, text;
+    try {
+      bool cached = false;
+      const Run3d r = run_3d(s, runs_dir, o.threads, &cached);
+      const std::string status = r.record.value("status", std::string("unknown"));
+      kind = status == "ok" ? "ok" : "failed";
+      text = status;
+      entry["wall_time_s"] = r.wall;
+      entry["steps"] = r.record.value("steps", 0L);
+      if (r.cyc.has_cycle) {
+        entry["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
+        entry["cycle_time_s"] = r.cyc.cycle_time_s;
+      }
+    } catch (const InputError& err) {
+      kind = "rejected";
+      text = err.what();
+    }
+    entry["outcome"] = kind;
+    entry["message"] = text;
+    const std::string cause = e.value("cause", std::string());
+    entry["as_expected"] = kind == e["expect"].get<std::string>() && (cause.empty() || text.find(cause) != std::string::npos);
+    extremes.push_back(entry);
+  }
+  report["extremes3d"] = extremes;
   report["wall_time_s"] = seconds_since(t_suite);
   return report;
 }

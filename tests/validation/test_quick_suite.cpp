@@ -77,6 +77,11 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   EXPECT_LT(std::abs(err["rtol = 1e-06"] - err["rtol = 1e-08"]), 1e-3);
   EXPECT_GT(c["wall_time_ratio_3d_over_1d"].get<double>(), 10.0);
   ASSERT_EQ(r["findings"].size(), 6u);
+  // 3D at the extremes: each case ends as the suite states (a step beyond the stability limit
+  // and a stiff wall stop naming full3d.dt; a container too tight for the grid is refused)
+  ASSERT_EQ(r["extremes3d"].size(), 3u);
+  for (const auto& e : r["extremes3d"]) EXPECT_TRUE(e["as_expected"].get<bool>()) << e.dump();
+  EXPECT_EQ(r["extremes3d"][2]["outcome"], "rejected");
 
   // a second run reuses every 3D run and the calibration, with identical figures
   const scene::json r2 = validation::run_suite(o);
