@@ -48,10 +48,11 @@ struct Cli {
 };
 
 // Runs the executable; `env` is prepended to the command line (e.g. "SWIM_TEST_FAIL_WRITE=x").
-Cli swim_cli(const std::string& args, const fs::path& scratch, const std::string& env = "") {
+// quiet: add --quiet (swim run; swim calibrate has no progress to silence).
+Cli swim_cli(const std::string& args, const fs::path& scratch, const std::string& env = "", bool quiet = true) {
   const fs::path err = scratch / ("stderr_" + std::to_string(::getpid()) + ".txt");
   const std::string cmd = env + (env.empty() ? "" : " ") + "\"" + SWIM_BINARY_DIR + "/bin/swim\" " + args +
-                          " --quiet > /dev/null 2> \"" + err.string() + "\"";
+                          (quiet ? " --quiet" : "") + " > /dev/null 2> \"" + err.string() + "\"";
   const int status = std::system(cmd.c_str());
   Cli c;
   c.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
@@ -410,4 +411,33 @@ TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
   expect_consistent_folder(out);
   // the same run with the default limit completes
   EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "full").string() + "\"", d).code, 0);
+}
+
+// swim calibrate keeps what it measured: when the hydraulic radii cannot be measured (here a
+// grid so coarse that the lumen holds no velocity sample inside R0 - 2h), calibration.json
+// holds the fitted C1 with a failed status and no offsets (exit 3), and a 1D scene that asks
+// for the offsets from that file is refused naming the key (exit 2).
+TEST(CalibrateCli, AFailedHydraulicMeasurementKeepsTheMeasuredStiffness) {
+  const fs::path d = tmpdir("calibrate_partial");
+  const std::string scene = SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json";
+  const fs::path out = d / "cal";
+  const Cli c = swim_cli("calibrate \"" + scene +
+                             "\" --set full3d.grid.cell_size='\"0.06 um\"' --set container.period='\"1.32 um\"' "
+                             "--set container.radius='\"0.27 um\"' --out \"" + out.string() + "\"",
+                         d, "", false);
+  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_NE(c.err.find("hydraulic radii failed"), std::string::npos) << c.err;
+  const std::string text = slurp(out / "calibration.json");
+  ASSERT_FALSE(text.empty());
+  const json j = json::parse(text);
+  EXPECT_EQ(j["status"].get<std::string>().rfind("failed: hydraulic radii", 0), 0u) << j["status"];
+  EXPECT_NEAR(j["C1_Pa_per_m"].get<double>() / j["C1_spring_network_Pa_per_m"].get<double>(), 1.0, 0.02);
+  EXPECT_FALSE(j.contains("hydraulic_offset_inner_m"));
+  const Cli r = swim_cli("run \"" + kDemo + "\" --set wall.spring_constant=null --set wall.C1=null --set wall.calibration='\"" +
+                             (out / "calibration.json").string() +
+                             "\"' --set model1d.hydraulic_offsets.source=calibration --out \"" + (d / "run").string() + "\"",
+                         d);
+  EXPECT_EQ(r.code, 2) << r.err;
+  EXPECT_NE(r.err.find("hydraulic"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(d / "run"));
 }
