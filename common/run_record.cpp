@@ -263,6 +263,13 @@ CycleFigures cycle_figures(const RunRecord& r) {
   return c;
 }
 
+void check_plausible(RunRecord& r) {
+  r.implausible.clear();
+  const CycleFigures c = cycle_figures(r);
+  if (c.has_cycle && std::abs(c.displacement_per_cycle_m) > r.length_m)
+    r.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
+}
+
 json summary(const RunRecord& r, const json& resolved) {
   const CycleFigures c = cycle_figures(r);
   const Series& s = r.series;

@@ -199,6 +199,11 @@ struct CycleFigures {
 };
 CycleFigures cycle_figures(const RunRecord& r);
 
+/// The plausibility check of both tiers: a peristaltic swimmer in Stokes flow cannot outrun
+/// its wave, and per cycle the wave crosses the tube once, so |displacement per cycle| <=
+/// the swimmer's length. Sets r.implausible (cleared first).
+void check_plausible(RunRecord& r);
+
 /// The summary of a record: the keys common to both tiers, then r.extras. `resolved` is the
 /// resolved scene it ran.
 json summary(const RunRecord& r, const json& resolved);

@@ -145,8 +145,6 @@ void Measurements::events(const ProtocolState& st) {
   auto& e = rec_.events;
   while (e.cycle_start_s.size() < st.cycle_start.size()) rec_.cycle_started(st.cycle_start[e.cycle_start_s.size()]);
   while (e.cycle_end_s.size() < st.cycle_end.size()) rec_.cycle_ended(st.cycle_end[e.cycle_end_s.size()]);
-  e.switches = st.switches;
-  e.segment_reached_s = st.segment_reached;
 }
 
 // --- checkpoint records ------------------------------------------------------------

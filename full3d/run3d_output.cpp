@@ -104,11 +104,9 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
   // the largest edge at the output steps; the no-leak guard needs < 0.5 h
   const double emax = rec_.series.count() ? rec_.series.max("max_edge_m") : 0.0;
   rec_.extras = {{"max_edge_over_h", emax / p.h}, {"steps", n}, {"steps_per_cycle", stepper.steps_per_cycle()}};
-  // Stokes flow: a swimmer cannot outrun its wave; per cycle the wave crosses the tube once
-  rec_.implausible.clear();
-  const record::CycleFigures c = record::cycle_figures(rec_);
-  if (c.has_cycle && std::abs(c.displacement_per_cycle_m) > p.L)
-    rec_.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
+  record::check_plausible(rec_);
+  rec_.events.switches = protocol.state().switches;
+  rec_.events.segment_reached_s = protocol.state().segment_reached;
   const double t = stepper.state().t;
   rec_.stats = {{"steps", n},
                 {"steps_per_cycle", stepper.steps_per_cycle()},

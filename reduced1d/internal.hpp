@@ -8,6 +8,17 @@
 
 namespace swim::reduced1d::detail {
 
+/// Where a run's samples go as they are produced (solve() fills it from its SolveOptions).
+struct Output {
+  Output() = default;
+  Output(ProgressFn p) : progress(std::move(p)) {}  // NOLINT: a progress function alone
+  ProgressFn progress;
+  /// Keep the typed samples (Result::series, radius snapshots) in memory.
+  bool keep_samples = true;
+  /// Also into this record (running figures, events; its stream writes them to disk).
+  record::RunRecord* record = nullptr;
+};
+
 /// Throws swim::InputError for parameters the solver cannot run with (the scene layer is
 /// expected to have rejected them already; this is the solver's own guard).
 void validate(const Params& p);

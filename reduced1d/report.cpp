@@ -59,9 +59,10 @@ Metrics metrics(const Params& p, const Result& r) {
 
 json write_run(const std::string& dir, const Params& p, const json& resolved, Result& r, double wall_time_s) {
   // without a stream the files are written from kept rows: from the typed samples when the
-  // record kept none
-  if (!r.record.stream() && r.record.series.rows() != r.record.series.count()) r.record = record_of(p, r);
-  if (r.record.series.count() == 0 && !r.series.empty()) r.record = record_of(p, r);
+  // record kept none (or is empty: a Result of the solver's internal entry points)
+  const record::Series& kept = r.record.series;
+  if (!r.record.stream() && !r.series.empty() && (kept.count() == 0 || kept.rows() != kept.count()))
+    r.record = record_of(p, r);
   const Metrics m = metrics(p, r);
   record::RunRecord& rec = r.record;
   rec.extras = json::object();

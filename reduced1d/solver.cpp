@@ -220,12 +220,9 @@ void finish_record(const Params& p, const Result& r, record::RunRecord& rec) {
   rec.status = r.failure ? "failed: " + std::string(r.failure->what()) : "ok";
   rec.transit_is_cycle = p.wave != WaveKind::ForceDriven && !r.failure && rec.series.count() > 0 &&
                          rec.t_end() >= end_time(p) * (1 - 1e-9);
-  // A peristaltic swimmer cannot outrun its wave: per cycle the wave crosses the tube once
-  // (length L), so |displacement per cycle| <= L (the paper's inertial model is exempt).
-  const record::CycleFigures c = record::cycle_figures(rec);
-  rec.implausible.clear();
-  if (p.swimmer.model == SwimmerModel::ForceFree && c.has_cycle && std::abs(c.displacement_per_cycle_m) > p.geometry.L)
-    rec.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
+  // the paper's inertial model is exempt from the Stokes-flow bound
+  if (p.swimmer.model == SwimmerModel::ForceFree) record::check_plausible(rec);
+  else rec.implausible.clear();
   for (const auto& [k, v] : r.stats) rec.stats[k] = v;
   rec.stats["protocol_switches"] = r.switches;
 }
@@ -254,7 +251,7 @@ Result solve(const Params& params, const SolveOptions& o) {
   record::RunRecord rec = new_record(params);
   rec.keep(o.keep_record_rows);
   rec.attach(o.stream);
-  Output out(o.progress);
+  detail::Output out(o.progress);
   out.keep_samples = o.keep_samples;
   out.record = &rec;
   Result r = params.wave == WaveKind::ForceDriven ? detail::solve_force_driven(params, out)

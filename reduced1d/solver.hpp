@@ -73,17 +73,6 @@ struct Result {
 /// Called after every output sample with the current and final simulated times.
 using ProgressFn = std::function<void(double t, double t_end)>;
 
-/// Where a run's samples go as they are produced.
-struct Output {
-  Output() = default;
-  Output(ProgressFn p) : progress(std::move(p)) {}  // NOLINT: a progress function alone
-  ProgressFn progress;
-  /// Keep the typed samples (Result::series, radius snapshots) in memory.
-  bool keep_samples = true;
-  /// Also into this record (running figures, events; its stream writes them to disk).
-  record::RunRecord* record = nullptr;
-};
-
 /// How solve() keeps and writes what it produces.
 struct SolveOptions {
   ProgressFn progress;

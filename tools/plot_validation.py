@@ -43,6 +43,13 @@ def legend_right(ax):
     ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
 
 
+def save(fig, path):
+    """Lay out, write and close a figure."""
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def pct(v):
     return "—" if v is None else f"{100 * v:+.1f} %"
 
@@ -113,9 +120,7 @@ def convergence_figure(case, path):
            title=f"{case['name']}: 3D grid convergence")
     ax.set_xlim(left=-0.05 * max(h))
     legend_right(ax)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return True
 
 
@@ -148,9 +153,7 @@ def pareto_figure(report, path):
     ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)",
            title=f"Speed against accuracy: {report['suite']} suite\n(error against the extrapolated 3D reference)")
     legend_right(ax)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return True
 
 
@@ -178,9 +181,7 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title):
         ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
     ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
     legend_right(ax)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return True
 
 
@@ -198,9 +199,7 @@ def multicycle_figure(report, path):
                         label=f"1D: {m['label']}")
     ax.set(xlabel="time [s]", ylabel="centre displacement [nm]", title="Multi-cycle centre histories")
     legend_right(ax)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return True
 
 
@@ -272,9 +271,7 @@ def membrane_figure(case, path):
                  f"the grey bar marks the initial rear end)")
     xmin, xmax = ax.get_xlim()
     ax.set_xlim(xmin - 0.25 * (xmax - xmin), xmax)
-    fig.tight_layout()
-    fig.savefig(path, dpi=110)
-    plt.close(fig)
+    save(fig, path)
     return True
 
 
