@@ -90,20 +90,24 @@ struct CapacitanceStokes::Impl {
     std::unique_ptr<Eigen::SimplicialLLT<Eigen::SparseMatrix<double>>> u0llt;
     std::size_t bytes = 0;
   };
-  // The factors of the last kCacheSlots alpha values (least recently used replaced): the
-  // adaptive time step of the run driver moves over a ladder of a few dt values.
+  // The factors of the last `slots` alpha values (least recently used replaced): the
+  // adaptive time step of the run driver moves over a ladder of dt values, each of which
+  // should be factorised once per run.
   static constexpr int kCacheSlots = CapacitanceStokes::kCachedAlphas;
   std::array<Factors, kCacheSlots> cache;
   std::array<long, kCacheSlots> used_at{};
+  int slots = kCacheSlots;  ///< capacity in use (StokesSolver lowers it to fit its memory limit)
   long use_clock = 0;
   Factors& free_slot() {
     int best = 0;
-    for (int k = 1; k < kCacheSlots; ++k)
+    for (int k = 1; k < slots; ++k)
       if (used_at[k] < used_at[best]) best = k;
     used_at[best] = ++use_clock;
     return cache[best];
   }
   double factor_seconds = 0.0;
+  double factor_seconds_total = 0.0;
+  long factorizations = 0;
   bool factorized_last = false;
   struct Scratch {
     std::vector<double> r, y;       // plane-shaped work arrays (u, v, w, p parts)

@@ -183,7 +183,7 @@ void CapacitanceStokes::Impl::apply_M(const double* B, double* X, double gx, con
 }
 
 const CapacitanceStokes::Impl::Factors& CapacitanceStokes::Impl::factors(double alpha) {
-  for (int k = 0; k < kCacheSlots; ++k)
+  for (int k = 0; k < slots; ++k)
     if (!cache[k].chol.empty() && cache[k].alpha == alpha) {
       used_at[k] = ++use_clock;
       factorized_last = false;
@@ -208,6 +208,8 @@ const CapacitanceStokes::Impl::Factors& CapacitanceStokes::Impl::factors(double 
   if (f.u0llt)
     f.bytes += std::size_t(f.u0llt->matrixL().nestedExpression().nonZeros()) * (sizeof(double) + sizeof(int));
   factor_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  factor_seconds_total += factor_seconds;
+  ++factorizations;
   factorized_last = true;
   return f;
 }
@@ -449,6 +451,16 @@ std::size_t CapacitanceStokes::factor_bytes() const {
 }
 double CapacitanceStokes::last_factorization_seconds() const { return impl_->factor_seconds; }
 bool CapacitanceStokes::last_solve_factorized() const { return impl_->factorized_last; }
+long CapacitanceStokes::factorizations() const { return impl_->factorizations; }
+double CapacitanceStokes::factorization_seconds_total() const { return impl_->factor_seconds_total; }
+int CapacitanceStokes::cache_slots() const { return impl_->slots; }
+void CapacitanceStokes::limit_cache(int slots) {
+  if (slots < 1 || slots > kCachedAlphas)
+    throw InputError("CapacitanceStokes cache slots", std::to_string(slots),
+                     "1 to " + std::to_string(kCachedAlphas));
+  for (int k = slots; k < Impl::kCacheSlots; ++k) impl_->cache[k] = Impl::Factors{};
+  impl_->slots = slots;
+}
 int CapacitanceStokes::wall_nodes() const { return impl_->m; }
 int CapacitanceStokes::threads() const { return impl_->threads; }
 int CapacitanceStokes::symmetry_blocks() const { return impl_->cyl && !impl_->sym_ok ? 1 : 4; }

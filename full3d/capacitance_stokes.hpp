@@ -93,8 +93,9 @@ namespace swim::full3d {
 
 class CapacitanceStokes {
  public:
-  /// Number of alpha values whose factors are kept (least recently used replaced).
-  static constexpr int kCachedAlphas = 6;
+  /// Largest number of alpha values whose factors are kept (least recently used replaced):
+  /// the adaptive step's ladder dt_max 2^(-k/4) spans a factor 256 in dt with 32 levels.
+  static constexpr int kCachedAlphas = 32;
   /// threads: worker threads (>= 1). fft: planner rigor (its thread count is ignored:
   /// plans are single-threaded and executed concurrently on disjoint data).
   /// Throws swim::InputError for a non-duct grid.
@@ -136,6 +137,13 @@ class CapacitanceStokes {
   double last_factorization_seconds() const;
   /// True when the last solve() had to factorise.
   bool last_solve_factorized() const;
+  /// Factorisations so far (one per alpha not in the cache) and their total wall time, s.
+  long factorizations() const;
+  double factorization_seconds_total() const;
+  /// Keep the factors of at most `slots` alpha values (1 <= slots <= kCachedAlphas; the
+  /// default is kCachedAlphas). Factors beyond the new capacity are dropped.
+  void limit_cache(int slots);
+  int cache_slots() const;
   /// Number m of wall-adjacent tangential nodes per cross-section (the capacitance size);
   /// cylinder: the number |R| of ring faces per cross-section.
   int wall_nodes() const;

@@ -98,6 +98,7 @@ class IbSolver {
   const MacGrid& grid() const { return grid_; }
   const CylinderMesh& mesh() const { return mesh_; }
   StokesSolver& stokes() { return stokes_; }
+  const StokesSolver& stokes() const { return stokes_; }
   const IbOptions& options() const { return opt_; }
 
  private:

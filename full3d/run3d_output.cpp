@@ -114,6 +114,7 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                 {"dt_s", run_.adaptive ? (n > 0 ? t / double(n) : 0.0) : p.dt},
                 {"mode", p.dry ? "dry" : "fluid"},
                 {"stokes_iterations_total", measured.stokes_iterations()},
+                {"stokes_setup", stepper.stokes_setup_summary()},
                 {"max_cfl", measured.max_cfl()},
                 {"protocol_switches", protocol.state().switches},
                 {"wall_time_s", wall},

@@ -207,6 +207,15 @@ scene::json Stepper::time_step_summary() const {
           {"steps_by_bound", bounds}};
 }
 
+scene::json Stepper::stokes_setup_summary() const {
+  if (!ib_) return scene::json::object();
+  const StokesSolver& st = ib_->stokes();
+  return {{"factorizations", st.factorizations()},
+          {"factorization_time_s", st.factorization_seconds()},
+          {"cached_time_steps", st.cached_time_steps()},
+          {"factor_bytes", st.factor_bytes()}};
+}
+
 // --- checkpoint records ------------------------------------------------------------
 template <class Self, class F>
 void Stepper::records(Self& self, F&& f) {

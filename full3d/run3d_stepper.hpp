@@ -48,6 +48,10 @@ class Stepper {
   /// The fluid pressure of the last step (fluid-coupled runs).
   const ScalarField& pressure() const { return ib_->stokes().pressure(); }
   bool fluid() const { return !run_.p.dry; }
+  /// The fluid solver's set-up cost in this process (not across a resume): factorisations of
+  /// the Stokes operator (one per time step value not cached), their wall time, and the
+  /// number of time step values the cache keeps. A dry run: {}.
+  scene::json stokes_setup_summary() const;
   long steps() const { return n_; }
   double dt_last() const { return dt_last_; }
 

@@ -63,15 +63,19 @@ struct StokesSolver::Impl {
                          "a cylinder at least half a cell inside the duct walls (the scenes build the duct one "
                          "cell wider than the cylinder on each side)");
     }
-    const double need = CapacitanceStokes::kCachedAlphas * double(CapacitanceStokes::estimate_bytes(g, cyl));
+    // The factors of as many dt values as fit the memory limit (up to kCachedAlphas); at least
+    // two, the midpoint scheme's dt/2 and dt.
+    const double per_alpha = double(CapacitanceStokes::estimate_bytes(g, cyl));
     const double limit = o.memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
-    if (need > limit)
+    const int slots = int(std::min<double>(CapacitanceStokes::kCachedAlphas, std::floor(limit / per_alpha)));
+    if (slots < 2)
       throw InputError("full3d.grid.cells_across",
                        std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) + " cells",
-                       "a grid whose Stokes factors fit the memory limit (" + gib(need) + " needed, " + gib(limit) +
-                           " allowed): fewer cells across or a shorter swimmer");
+                       "a grid whose Stokes factors for two time steps fit the memory limit (" + gib(2 * per_alpha) +
+                           " needed, " + gib(limit) + " allowed): fewer cells across or a shorter swimmer");
     const int thr = o.threads > 0 ? o.threads : std::max(1, o.fft.threads);
     capacitance = std::make_unique<CapacitanceStokes>(g, f.mu, cyl, thr, o.fft);
+    capacitance->limit_cache(slots);
   }
 
   // ---- periodic box: exact Fourier projection --------------------------------
@@ -157,6 +161,11 @@ void StokesSolver::set_pressure(const ScalarField& p) {
                      "one value per cell (" + std::to_string(impl_->grid.cells()) + ")");
   impl_->p = p;
 }
+long StokesSolver::factorizations() const { return impl_->capacitance ? impl_->capacitance->factorizations() : 0; }
+double StokesSolver::factorization_seconds() const {
+  return impl_->capacitance ? impl_->capacitance->factorization_seconds_total() : 0.0;
+}
+int StokesSolver::cached_time_steps() const { return impl_->capacitance ? impl_->capacitance->cache_slots() : 0; }
 std::size_t StokesSolver::factor_bytes() const {
   return impl_->capacitance ? impl_->capacitance->factor_bytes() : 0;
 }

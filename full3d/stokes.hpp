@@ -58,8 +58,9 @@ struct StokesOptions {
   /// Duct and cylinder: threads of the capacitance solver's transforms and per-mode solves
   /// (parallel.hpp); 0 = fft.threads.
   int threads = 0;
-  /// Guard: the largest estimated memory of the capacitance factors for the six cached dt
-  /// values, GiB; a larger grid is rejected with swim::InputError.
+  /// Memory for the capacitance factors, GiB: the cache keeps as many dt values as fit (up to
+  /// CapacitanceStokes::kCachedAlphas); a grid whose factors for two dt values do not fit is
+  /// rejected with swim::InputError.
   double memory_limit_gib = 4.0;
   /// The paper's rigid circular container inside the duct (container.hpp); duct only.
   CylinderOptions cylinder{};
@@ -96,8 +97,15 @@ class StokesSolver {
   /// Replaces the pressure (checkpoint restore). Throws swim::InputError if p does not have
   /// one value per cell.
   void set_pressure(const ScalarField& p);
-  /// Duct and cylinder: measured memory of the cached capacitance factors (up to six dt
-  /// values), bytes; 0 for the box.
+  /// Duct and cylinder: the number of dt values whose factors are kept, up to
+  /// CapacitanceStokes::kCachedAlphas, fewer when their estimated memory exceeds
+  /// StokesOptions::memory_limit_gib; 0 for the box.
+  int cached_time_steps() const;
+  /// Duct and cylinder: capacitance factorisations so far (one per dt not in the cache) and
+  /// their total wall time, s; 0 for the box.
+  long factorizations() const;
+  double factorization_seconds() const;
+  /// Duct and cylinder: measured memory of the cached capacitance factors, bytes; 0 for the box.
   std::size_t factor_bytes() const;
   /// Cylinder: the constraint rows E (nullptr otherwise). The multiplier of a step is
   /// recover_multiplier(*constraints(), b, u^{n+1}, pressure(), rho/dt, mu, lambda) with

@@ -191,6 +191,42 @@ TEST(CapacitanceStokes, CachesTwoDtValues) {
   EXPECT_GT(double(s.factor_bytes()), 0.8 * 2.0 * double(CapacitanceStokes::estimate_bytes(g)));
 }
 
+// The adaptive step moves over a ladder of dt values: each is factorised once while the cache
+// holds them all, least recently used replaced beyond the capacity, and a dt whose factors were
+// dropped and rebuilt gives the bit-identical step.
+TEST(CapacitanceStokes, CacheKeepsTheLadderOfDtValues) {
+  const MacGrid g(8, 8, 8, 1e-7, ContainerKind::SquareDuct);
+  VectorField u0(g), f(g);
+  random_state(g, u0, f, 11);
+  std::vector<double> dts;
+  for (int k = 0; k < 8; ++k) dts.push_back(1e-5 * std::exp2(-k / 4.0));
+  StokesSolver all(g, kWater, options());
+  EXPECT_EQ(all.cached_time_steps(), CapacitanceStokes::kCachedAlphas);
+  std::vector<VectorField> first;
+  for (int pass = 0; pass < 2; ++pass)
+    for (std::size_t k = 0; k < dts.size(); ++k) {
+      VectorField u = u0;
+      all.step(u, f, dts[k]);
+      if (pass == 0) first.push_back(u);
+      else EXPECT_EQ(rel_diff(u, first[k]), 0.0) << "dt " << dts[k];
+    }
+  EXPECT_EQ(all.factorizations(), 8);  // the second pass is served from the cache
+  EXPECT_GT(all.factorization_seconds(), 0.0);
+
+  StokesOptions o = options();  // room for three dt values
+  o.memory_limit_gib = 3.5 * double(CapacitanceStokes::estimate_bytes(g)) / (1024.0 * 1024.0 * 1024.0);
+  StokesSolver three(g, kWater, o);
+  EXPECT_EQ(three.cached_time_steps(), 3);
+  for (int pass = 0; pass < 2; ++pass)
+    for (int k = 0; k < 4; ++k) {
+      VectorField u = u0;
+      three.step(u, f, dts[std::size_t(k)]);
+      EXPECT_EQ(rel_diff(u, first[std::size_t(k)]), 0.0) << "dt " << dts[std::size_t(k)];
+    }
+  EXPECT_EQ(three.factorizations(), 8);  // four values cycled through three slots: every step refactorises
+  EXPECT_LE(three.factor_bytes(), 3 * CapacitanceStokes::estimate_bytes(g));
+}
+
 TEST(CapacitanceStokes, GuardsOfTheProductPath) {
   const MacGrid duct(8, 12, 12, 1e-7, ContainerKind::SquareDuct);
   StokesOptions o;
