@@ -2,6 +2,7 @@
 
 #include <fftw3.h>
 
+#include <algorithm>
 #include <mutex>
 #include <stdexcept>
 #include <utility>
@@ -111,6 +112,15 @@ FftwPlan plan_many_r2r(int rank, const int* n, int howmany, double* in, const in
   set_threads_locked(opt);
   return FftwPlan(fftw_plan_many_r2r(rank, n, howmany, in, inembed, istride, idist, out, onembed, ostride, odist,
                                      kinds, flags_of(opt)));
+}
+
+int fft_friendly_size(int min_n) {
+  for (int n = std::max(min_n, 1);; n += 2) {
+    int r = n;
+    for (int q : {2, 3, 5, 7})
+      while (r % q == 0) r /= q;
+    if (r == 1) return n;
+  }
 }
 
 }  // namespace swim::full3d

@@ -74,6 +74,12 @@ class FftwPlan {
 /// Initialises FFTW threads once per process; returns false if unavailable.
 bool fftw_threads_init_once();
 
+/// The smallest n >= min_n with n - min_n even whose prime factors are all <= 7. FFTW has
+/// straight-line codelets for such sizes; a larger prime factor (34 = 2 x 17) takes its
+/// generic O(p^2) algorithm, which also allocates scratch on every execution: a 34 x 34
+/// DCT-II is about 2 x slower than a 36 x 36 one.
+int fft_friendly_size(int min_n);
+
 /// Plans on arrays of logical shape n = {n0, n1, n2}, n2 contiguous (C order).
 FftwPlan plan_r2r_3d(std::array<int, 3> n, double* in, double* out, std::array<fftw_r2r_kind, 3> kinds,
                      const FftOptions& opt);

@@ -5,6 +5,7 @@
 
 #include "common/errors.hpp"
 #include "common/scene_shared.hpp"
+#include "full3d/fft.hpp"
 
 namespace swim::full3d {
 
@@ -129,9 +130,12 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       if (!multiple_of(p.period, p.h))
         throw InputError("container.period", fmt(p.period, "m"),
                          "must be a multiple of the cell size " + fmt(p.h, "m"));
-      // cylinder: the fictitious square domain is one cell wider than the cylinder on each side
-      // (paper, Remark 1: collocation points between the cylinder and the duct walls)
-      p.ny = p.nz = int(std::lround(width / p.h)) + (p.container == "cylinder" ? 2 : 0);
+      // cylinder: the fictitious square domain is at least one cell wider than the cylinder on
+      // each side (paper, Remark 1: collocation points between the cylinder and the duct walls),
+      // padded to a size the cross-section transforms handle fast (fft_friendly_size; the
+      // masked cells carry u = 0 exactly, so the padding changes nothing but the cost)
+      const int across = int(std::lround(width / p.h));
+      p.ny = p.nz = p.container == "cylinder" ? fft_friendly_size(across + 2) : across;
       p.nx = int(std::lround(p.period / p.h));
       g.finish();
     }

@@ -21,6 +21,7 @@
 
 #include "common/errors.hpp"
 #include "full3d/capacitance_stokes.hpp"
+#include "full3d/fft.hpp"
 #include "full3d/operators.hpp"
 #include "full3d/stokes.hpp"
 #include "tests/full3d/reference/reference_stokes.hpp"
@@ -189,6 +190,65 @@ TEST(CapacitanceStokes, CachesTwoDtValues) {
   EXPECT_GT(s.factor_bytes(), 0u);
   EXPECT_LE(s.factor_bytes(), 2 * CapacitanceStokes::estimate_bytes(g));
   EXPECT_GT(double(s.factor_bytes()), 0.8 * 2.0 * double(CapacitanceStokes::estimate_bytes(g)));
+}
+
+// The scenes pad the cylinder's fictitious duct to a size the cross-section transforms handle
+// fast (fft_friendly_size): the masked faces carry u = 0 exactly, so the same cylinder and the
+// same forcing inside ducts of 12 and 14 cells across give the same velocity to round-off.
+TEST(CapacitanceStokes, DuctPaddingAroundTheCylinderChangesNothing) {
+  const double h = 1e-7;
+  StokesOptions o = options();
+  o.cylinder.enabled = true;
+  o.cylinder.radius = 5 * h;  // 10 cells across
+  auto solve = [&](int n) {
+    const MacGrid g(8, n, n, h, ContainerKind::SquareDuct);
+    StokesSolver s(g, kWater, o);
+    VectorField u(g), f(g);
+    const double c0 = 0.5 * n * h;
+    for (int c = 0; c < 3; ++c) {
+      const auto d = g.dims(c);
+      for (int k = 0; k < d[2]; ++k)
+        for (int j = 0; j < d[1]; ++j)
+          for (int i = 0; i < d[0]; ++i) {
+            const auto x = g.position(c, i, j, k);
+            const double y = x[1] - c0, z = x[2] - c0;
+            f.c[c][MacGrid::index(d, i, j, k)] =
+                1e3 * std::sin(2 * std::numbers::pi * x[0] / g.length(0) + c) * std::exp(-(y * y + 2 * z * z) / (9 * h * h)) *
+                (1 + y / h - 0.3 * z / h);
+          }
+    }
+    s.step(u, f, 1e-5);
+    return std::make_pair(g, u);
+  };
+  const auto [ga, ua] = solve(12);
+  const auto [gb, ub] = solve(14);
+  double d = 0, outside = 0;
+  for (int c = 0; c < 3; ++c) {
+    const auto da = ga.dims(c), db = gb.dims(c);
+    std::vector<char> mapped(ub.c[c].size(), 0);
+    for (int k = 0; k < da[2]; ++k)
+      for (int j = 0; j < da[1]; ++j)
+        for (int i = 0; i < da[0]; ++i) {
+          const std::size_t ib = MacGrid::index(db, i, j + 1, k + 1);
+          d = std::max(d, std::abs(ua.c[c][MacGrid::index(da, i, j, k)] - ub.c[c][ib]));
+          mapped[ib] = 1;
+        }
+    for (std::size_t q = 0; q < mapped.size(); ++q)
+      if (!mapped[q]) outside = std::max(outside, std::abs(ub.c[c][q]));
+  }
+  std::printf("duct 12 vs 14 around the same cylinder: max |du| / max |u| = %.2e\n", d / ua.max_abs());
+  EXPECT_GT(ua.max_abs(), 0.0);
+  EXPECT_LT(d, 1e-12 * ua.max_abs());
+  EXPECT_EQ(outside, 0.0);  // the extra ring of cells is masked
+}
+
+TEST(FftFriendlySize, SmallestSevenSmoothSizeOfTheSameParity) {
+  EXPECT_EQ(fft_friendly_size(34), 36);  // 2 x 17 -> 2^2 x 3^2
+  EXPECT_EQ(fft_friendly_size(50), 50);
+  EXPECT_EQ(fft_friendly_size(26), 28);
+  EXPECT_EQ(fft_friendly_size(17), 21);
+  EXPECT_EQ(fft_friendly_size(66), 70);  // 2 x 3 x 11 -> 2 x 5 x 7
+  EXPECT_EQ(fft_friendly_size(1), 1);
 }
 
 // The adaptive step moves over a ladder of dt values: each is factorised once while the cache

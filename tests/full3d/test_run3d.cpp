@@ -10,6 +10,7 @@
 
 #include "common/errors.hpp"
 #include "common/scene.hpp"
+#include "full3d/fft.hpp"
 #include "full3d/run3d.hpp"
 #include "run3d_scenes.hpp"
 
@@ -242,8 +243,8 @@ TEST(Run3d, DryProtocolReachesTargetOnEverySegment) {
 }
 
 // Scene keys wired to StokesOptions: the paper's rigid circular container
-// (container.kind = cylinder, fictitious domain inside a duct one cell wider on each
-// side) and the Navier-Stokes advection sub-step (full3d.navier_stokes = true). Both are
+// (container.kind = cylinder, fictitious domain inside a duct at least one cell wider on
+// each side, padded to a fast transform size) and the Navier-Stokes advection sub-step (full3d.navier_stokes = true). Both are
 // accepted, echoed, and a short force-driven run completes with finite results.
 TEST(Run3d, CylinderAndNavierStokesScenesRun) {
   for (const bool ns : {false, true}) {
@@ -251,7 +252,7 @@ TEST(Run3d, CylinderAndNavierStokesScenesRun) {
                           "full3d.dt=\"1 ms\"", "time.duration=\"10 ms\"", "time.output_interval=\"1 ms\""});
     EXPECT_EQ(s.p.container, "cylinder");
     EXPECT_EQ(s.p.navier_stokes, ns);
-    EXPECT_EQ(s.p.ny, int(std::lround(2 * s.p.container_radius / s.p.h)) + 2);
+    EXPECT_EQ(s.p.ny, fft_friendly_size(int(std::lround(2 * s.p.container_radius / s.p.h)) + 2));
     const std::string dir = fresh_dir(ns ? "cylinder_ns" : "cylinder");
     RunControl ctl;
     ctl.progress = 0;
