@@ -415,8 +415,8 @@ TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
 
 // The VTK frames count toward the same limit while the run goes: a 3D run with an auto duration
 // (no estimate) and a frame every step stops at the frame that passes output.max_bytes, exit 3
-// naming the key and the frame interval, its files so far complete and listed, and at most one
-// frame beyond the limit.
+// naming the key and the interval of the frames that dominate (membrane or fluid), its files so
+// far complete and listed, and at most one frame beyond the limit.
 TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimit) {
   const fs::path d = tmpdir("runtime_limit_3d");
   const fs::path out = d / "run";
@@ -452,6 +452,18 @@ TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimi
   int listed = 0;
   for (std::size_t at = pvd.find("<DataSet"); at != std::string::npos; at = pvd.find("<DataSet", at + 1)) ++listed;
   EXPECT_EQ(listed, frames);
+  // fluid frames alone: they pass the limit, and their interval is the key to raise
+  const fs::path fluid = d / "fluid";
+  const Cli f = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + fluid.string() +
+                             "\" --set full3d.dt='\"1 ms\"' --set full3d.output.vtk=false"
+                             " --set full3d.output.fluid_fields=true --set full3d.output.vtk_interval='\"1 ms\"'"
+                             " --set full3d.output.fluid_interval='\"1 ms\"' --set output.max_bytes=600000",
+                         d);
+  EXPECT_EQ(f.code, 3) << f.err;
+  EXPECT_NE(f.err.find("fluid frames"), std::string::npos) << f.err;
+  EXPECT_NE(f.err.find("raise full3d.output.fluid_interval or output.max_bytes"), std::string::npos) << f.err;
+  EXPECT_FALSE(fs::exists(fluid / "membrane.pvd"));
+  expect_consistent_folder(fluid);
   fs::remove_all(d);
 }
 
