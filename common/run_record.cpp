@@ -374,11 +374,40 @@ void RunStream::row(std::span<const double> values) {
   check_limit(values[0]);
 }
 
-void RunStream::check_limit(double t) const {
-  if (limit_ == 0 || series_->bytes() + radius_->bytes() <= limit_) return;
-  throw NumericalError("the run's output (series.csv and radius.csv) reached output.max_bytes = " +
-                           std::to_string(limit_) + " bytes before the run ended",
-                       "raise time.output_interval or output.max_bytes", t);
+std::uintmax_t RunStream::bytes() const {
+  std::uintmax_t b = series_->bytes() + radius_->bytes();
+  for (const External& e : external_) b += e.bytes;
+  return b;
+}
+
+void RunStream::add_external(std::uintmax_t bytes, double t, const std::string& key, const std::string& what) {
+  auto it = std::find_if(external_.begin(), external_.end(), [&](const External& e) { return e.key == key; });
+  if (it == external_.end()) it = external_.insert(external_.end(), External{key, what, 0});
+  it->bytes += bytes;
+  check_limit(t);
+}
+
+std::uintmax_t RunStream::external(const std::string& key) const {
+  for (const External& e : external_)
+    if (e.key == key) return e.bytes;
+  return 0;
+}
+
+void RunStream::check_limit(double t) {
+  if (limit_ == 0 || passed_ || bytes() <= limit_) return;
+  passed_ = true;
+  // what was written, and the interval of the largest part: the key to raise
+  const std::uintmax_t csv = series_->bytes() + radius_->bytes();
+  std::string parts = "series.csv and radius.csv " + std::to_string(csv) + " bytes";
+  std::string key = "time.output_interval";
+  std::uintmax_t most = csv;
+  for (const External& e : external_) {
+    parts += ", " + e.what + " " + std::to_string(e.bytes) + " bytes";
+    if (e.bytes > most) most = e.bytes, key = e.key;
+  }
+  throw NumericalError("the run's output reached output.max_bytes = " + std::to_string(limit_) +
+                           " bytes before the run ended (" + parts + ")",
+                       "raise " + key + " or output.max_bytes", t);
 }
 
 void RunStream::radius(double t, std::span<const double> z, std::span<const double> r) {

@@ -219,14 +219,27 @@ class RunStream {
   RunStream(const std::string& dir, const std::vector<double>& marks);
   ~RunStream();
 
-  /// A bound on the two files' total size (output.max_bytes): the row or snapshot that passes
-  /// it ends the run like a numerical failure (NumericalError naming the key: exit 3, the
-  /// results so far written and marked failed). Runs with a known duration are refused
-  /// before they start when their estimate exceeds it; this catches the others (a
+  /// A bound on the run's output (output.max_bytes): the two files and the other files
+  /// counted by add_external. The row, snapshot or file that passes it ends the run like a
+  /// numerical failure (NumericalError naming the key and the interval that dominates: exit
+  /// 3, the results so far written and marked failed). It is raised once: the rows that close
+  /// the run after it (its last state) are still written. Runs with a known duration are
+  /// refused before they start when their estimate exceeds it; this catches the others (a
   /// force-driven run that lasts until its cycles complete).
   void limit(std::uintmax_t max_bytes) { limit_ = max_bytes; }
   void row(std::span<const double> values);
   void radius(double t, std::span<const double> z, std::span<const double> radius);
+  /// Count `bytes` of another file the run wrote at time t (a 3D run's VTK frames, and what
+  /// their .pvd collections grew by) toward the limit, under the interval key that sets how
+  /// often they are written (e.g. "full3d.output.vtk_interval"); `what` names them in the
+  /// message ("membrane frames"). Checked like a row; before limit() (a resume restoring
+  /// its counts) nothing is checked.
+  void add_external(std::uintmax_t bytes, double t, const std::string& key, const std::string& what);
+  /// The bytes counted under `key` so far (0 when none), for a checkpoint.
+  std::uintmax_t external(const std::string& key) const;
+  /// The bytes counted toward the limit so far: both files (written and buffered) and the
+  /// other files.
+  std::uintmax_t bytes() const;
   /// Flush and check both files, record them in the folder's ledger; their marks (size and
   /// checksum of each) for a checkpoint. Throws OutputError.
   std::vector<double> mark();
@@ -236,9 +249,15 @@ class RunStream {
   static bool matches(const std::string& dir, const std::vector<double>& marks);
 
  private:
-  void check_limit(double t) const;
+  void check_limit(double t);
+  struct External {
+    std::string key, what;
+    std::uintmax_t bytes = 0;
+  };
   std::unique_ptr<output::PartFile> series_, radius_;
+  std::vector<External> external_;
   std::uintmax_t limit_ = 0;  ///< 0: none
+  bool passed_ = false;       ///< the limit was passed (and raised)
 };
 
 /// Write the run folder of a record: series.csv and radius.csv (committed from the attached

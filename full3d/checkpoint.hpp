@@ -26,7 +26,7 @@
 
 namespace swim::full3d {
 
-inline constexpr std::uint32_t kCheckpointVersion = 3;
+inline constexpr std::uint32_t kCheckpointVersion = 4;
 
 class CheckpointWriter {
  public:

@@ -56,10 +56,6 @@ class Runner {
       measured_.start(stepper_.state());
       output_.start(ctl_.max_output_bytes);
       measured_.events(stepper_.protocol().state());
-      record();
-      if (output_.vtk()) output_.write_membrane_frame(stepper_);
-      if (output_.fluid()) output_.write_fluid_frame(stepper_);
-      save_checkpoint(0.0);
     }
     Progress progress("3d " + p_.name + (run_.n_end > 0 ? "" : " (auto: until " + std::to_string(p_.protocol.cycles) +
                                                                    " cycle(s), progress against full3d.time_limit)"),
@@ -67,6 +63,12 @@ class Runner {
     long this_process = 0;
     std::optional<NumericalError> failure;
     try {
+      if (!ctl_.resume) {  // the initial state; its output may already pass output.max_bytes
+        record();
+        if (output_.vtk()) output_.write_membrane_frame(stepper_);
+        if (output_.fluid()) output_.write_fluid_frame(stepper_);
+        save_checkpoint(0.0);
+      }
       while (!stepper_.finished()) {
         stepper_.check_time_limit();
         step();

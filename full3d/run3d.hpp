@@ -36,7 +36,7 @@ struct RunControl {
   long stop_after_steps = -1;   ///< testing: stop after this many steps of this process, as if killed
   bool quiet_vtk = false;       ///< testing: suppress VTK output regardless of the scene
   bool keep_rows = false;       ///< keep the record's rows and ring radii in memory (RunOutcome::record)
-  std::uintmax_t max_output_bytes = 0;  ///< output.max_bytes for series.csv + radius.csv (0: none)
+  std::uintmax_t max_output_bytes = 0;  ///< output.max_bytes for series.csv, radius.csv and the VTK frames (0: none)
 };
 
 struct RunOutcome {

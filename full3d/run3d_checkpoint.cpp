@@ -95,6 +95,9 @@ void validate(const CheckpointReader& r, const RunSetup& run) {
   if (r.size_of("series_rows") % width != 0 || r.size_of("radius") != r.size_of("radius_times") * std::size_t(run.mesh.n_rings))
     r.damaged("the checkpoint's kept rows do not match this scene's series columns and rings");
   expect_size(r, kOutputMarks, 6, "output streams (size and checksum of series.csv.part and radius.csv.part)");
+  expect_size(r, kFrameBytes, 2, "VTK frames (bytes of the membrane and fluid frames written)");
+  for (double b : r.get_vector(kFrameBytes))
+    if (b < 0.0 || b > 9.0e15) r.damaged("the checkpoint's VTK frame byte count is negative or out of range");
   // every number finite
   if (const std::string bad = r.first_non_finite(); !bad.empty())
     r.damaged("the checkpoint's record '" + bad + "' holds a NaN or infinite value");

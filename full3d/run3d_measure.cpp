@@ -136,9 +136,17 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
                         rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                         double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
                         last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0};
-  rec_.add_row(row);
-  rec_.add_radius(s.t, {rr.data(), std::size_t(rr.size())});
+  // a row that passes output.max_bytes ends the run (NumericalError) once it is written: its
+  // radius snapshot is still written, and the run's failure path does not record it again
   last_recorded_ = n;
+  const std::size_t rows = rec_.series.count();
+  try {
+    rec_.add_row(row);
+  } catch (const NumericalError&) {
+    if (rec_.series.count() > rows) rec_.add_radius(s.t, {rr.data(), std::size_t(rr.size())});
+    throw;
+  }
+  rec_.add_radius(s.t, {rr.data(), std::size_t(rr.size())});
 }
 
 void Measurements::events(const ProtocolState& st) {

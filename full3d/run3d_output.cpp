@@ -17,6 +17,22 @@ std::string frame_name(const char* kind, const char* ext, std::size_t index) {
   std::snprintf(name, sizeof name, "vtk/%s_%06d.%s", kind, int(index), ext);
   return name;
 }
+
+/// The frame kinds (index 0: membrane, 1: fluid): collection, interval key, name.
+struct FrameKind {
+  const char* pvd;
+  const char* key;
+  const char* what;
+};
+constexpr FrameKind kFrameKinds[2] = {{"membrane.pvd", "full3d.output.vtk_interval", "membrane frames"},
+                                      {"fluid.pvd", "full3d.output.fluid_interval", "fluid frames"}};
+
+/// A file's size; 0 when it is not there.
+std::uintmax_t size_of(const std::string& path) {
+  std::error_code ec;
+  const std::uintmax_t n = std::filesystem::file_size(path, ec);
+  return ec ? 0 : n;
+}
 }  // namespace
 
 RunOutput::RunOutput(const RunSetup& run, const json& resolved, std::string dir, bool vtk, bool fluid,
@@ -30,6 +46,17 @@ void RunOutput::start(std::uintmax_t max_bytes) {
   stream_ = std::make_unique<record::RunStream>(dir_, rec_.series.columns());
   stream_->limit(max_bytes);
   rec_.attach(stream_.get());
+}
+
+void RunOutput::count_frame(int kind, const std::string& frame, double t) {
+  const FrameKind& k = kFrameKinds[kind];
+  const std::uintmax_t bytes = size_of(dir_ + "/" + frame);
+  const std::uintmax_t pvd = size_of(dir_ + "/" + k.pvd);
+  // the collection is rewritten with every frame: count what it grew by
+  const std::uintmax_t grown = pvd > pvd_bytes_[kind] ? pvd - pvd_bytes_[kind] : 0;
+  pvd_bytes_[kind] = pvd;
+  frame_bytes_[kind] += bytes;
+  stream_->add_external(bytes + grown, t, k.key, k.what);
 }
 
 void RunOutput::write_membrane_frame(const Stepper& stepper) {
@@ -50,6 +77,7 @@ void RunOutput::write_membrane_frame(const Stepper& stepper) {
   vtk::write_polydata(dir_ + "/" + name, xyz, mesh.triangles, {vel, act, rad, seg});
   pvd_.add(s.t, name);
   pvd_.write();
+  count_frame(0, name, s.t);
 }
 
 void RunOutput::write_fluid_frame(const Stepper& stepper) {
@@ -75,6 +103,7 @@ void RunOutput::write_fluid_frame(const Stepper& stepper) {
   vtk::write_image_data(dir_ + "/" + name, {nx, ny, nz}, g.h(), {vel, pr});
   fluid_pvd_.add(s.t, name);
   fluid_pvd_.write();
+  count_frame(1, name, s.t);
 }
 
 void RunOutput::fill(const std::string& status, double wall, const Stepper& stepper, const Measurements& measured) {
@@ -143,6 +172,7 @@ void RunOutput::save(CheckpointWriter& w, const std::vector<double>& marks) cons
   ft.clear();
   for (const auto& f : fluid_pvd_.frames()) ft.push_back(f.first);
   w.put("fluid_frames", ft);
+  w.put(kFrameBytes, std::vector<double>{double(frame_bytes_[0]), double(frame_bytes_[1])});
 }
 
 void RunOutput::load(const CheckpointReader& r, std::uintmax_t max_bytes) {
@@ -151,6 +181,16 @@ void RunOutput::load(const CheckpointReader& r, std::uintmax_t max_bytes) {
   if (vtk_) pvd_.write();
   if (fluid_) fluid_pvd_.write();
   stream_ = std::make_unique<record::RunStream>(dir_, r.get_vector(kOutputMarks));
+  // the frames written up to the checkpoint and the collections as they are now count again
+  // (before the limit is set: the checkpoint was within it)
+  const std::vector<double> fb = r.get_vector(kFrameBytes);
+  for (int kind = 0; kind < 2; ++kind) {
+    const FrameKind& k = kFrameKinds[kind];
+    frame_bytes_[kind] = static_cast<std::uintmax_t>(fb.at(kind));
+    pvd_bytes_[kind] = size_of(dir_ + "/" + k.pvd);
+    if (frame_bytes_[kind] + pvd_bytes_[kind] > 0)
+      stream_->add_external(frame_bytes_[kind] + pvd_bytes_[kind], r.get_double("t"), k.key, k.what);
+  }
   stream_->limit(max_bytes);
   rec_.attach(stream_.get());
 }

@@ -24,7 +24,9 @@ class RunOutput {
             record::RunRecord& rec);
   ~RunOutput();
 
-  /// A fresh run: open the streams; max_bytes bounds them (record::RunStream::limit).
+  /// A fresh run: open the streams; max_bytes bounds the run's output (record::RunStream::limit):
+  /// the two streamed files, every VTK frame written and the collections' size count toward
+  /// it, and the row or frame that passes it throws NumericalError.
   void start(std::uintmax_t max_bytes = 0);
 
   bool vtk() const { return vtk_; }
@@ -40,14 +42,18 @@ class RunOutput {
   std::vector<double> write_snapshot(const std::string& status, double wall, const Stepper& stepper,
                                      const Measurements& measured);
 
-  /// The frame times and the streams' marks; load() also rewrites the collections of the
-  /// enabled frame kinds and continues the streams from the marks.
+  /// The frame times, the bytes of the frames written and the streams' marks; load() also
+  /// rewrites the collections of the enabled frame kinds, continues the streams from the
+  /// marks and counts the frames' bytes and the collections toward the limit again.
   void save(CheckpointWriter& w, const std::vector<double>& marks) const;
   void load(const CheckpointReader& r, std::uintmax_t max_bytes = 0);
 
  private:
   /// The record's summary keys of a 3D run (derived values, extras, statistics, status).
   void fill(const std::string& status, double wall, const Stepper& stepper, const Measurements& measured);
+  /// Count a frame just written (kind 0: membrane, 1: fluid), and what its collection grew
+  /// by, toward the output limit.
+  void count_frame(int kind, const std::string& frame, double t);
 
   const RunSetup& run_;
   const scene::json& resolved_;
@@ -56,9 +62,14 @@ class RunOutput {
   vtk::Collection pvd_, fluid_pvd_;
   record::RunRecord& rec_;
   std::unique_ptr<record::RunStream> stream_;
+  std::uintmax_t frame_bytes_[2] = {0, 0};  ///< bytes of the membrane and fluid frames written
+  std::uintmax_t pvd_bytes_[2] = {0, 0};    ///< size of membrane.pvd and fluid.pvd as last counted
 };
 
 /// The checkpoint record of the streams' marks.
 inline constexpr const char* kOutputMarks = "output_marks";
+/// The checkpoint record of the bytes of the frames written: membrane, fluid (without the
+/// collections, which are rewritten and counted again on resume).
+inline constexpr const char* kFrameBytes = "frame_bytes";
 
 }  // namespace swim::full3d

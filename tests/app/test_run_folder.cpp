@@ -413,6 +413,60 @@ TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
   EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "full").string() + "\"", d).code, 0);
 }
 
+// The VTK frames count toward the same limit while the run goes: a 3D run with an auto duration
+// (no estimate) and a frame every step stops at the frame that passes output.max_bytes, exit 3
+// naming the key and the interval of the frames that dominate (membrane or fluid), its files so
+// far complete and listed, and at most one frame beyond the limit.
+TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimit) {
+  const fs::path d = tmpdir("runtime_limit_3d");
+  const fs::path out = d / "run";
+  const std::uintmax_t limit = 2000000;  // frames of this scene: 266 kB each
+  const Cli c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() +
+                             "\" --set full3d.dt='\"1 ms\"' --set full3d.output.vtk_interval='\"1 ms\"'"
+                             " --set output.max_bytes=" + std::to_string(limit),
+                         d);
+  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_NE(c.err.find("output.max_bytes = " + std::to_string(limit)), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("raise full3d.output.vtk_interval or output.max_bytes"), std::string::npos) << c.err;
+  const json s = summary_of(out);
+  ASSERT_TRUE(s.is_object());
+  EXPECT_EQ(s["status"].get<std::string>().rfind("failed", 0), 0u) << s["status"];
+  EXPECT_NE(s["status"].get<std::string>().find("output.max_bytes"), std::string::npos) << s["status"];
+  expect_consistent_folder(out);
+  // what the limit covers: the two series files, the frames and their collection
+  std::uintmax_t written = fs::file_size(out / "series.csv") + fs::file_size(out / "radius.csv") +
+                           fs::file_size(out / "membrane.pvd");
+  std::uintmax_t largest = 0;
+  int frames = 0;
+  for (const auto& e : fs::directory_iterator(out / "vtk")) {
+    written += e.file_size();
+    largest = std::max<std::uintmax_t>(largest, e.file_size());
+    ++frames;
+  }
+  EXPECT_GE(frames, 5);
+  EXPECT_GT(written, limit);
+  // within one frame (and the last row and snapshot, a few kB) of the limit
+  EXPECT_LT(written - largest, limit + 4000) << written << " bytes, " << frames << " frames of up to " << largest;
+  // every frame written is listed in membrane.pvd
+  const std::string pvd = slurp(out / "membrane.pvd");
+  int listed = 0;
+  for (std::size_t at = pvd.find("<DataSet"); at != std::string::npos; at = pvd.find("<DataSet", at + 1)) ++listed;
+  EXPECT_EQ(listed, frames);
+  // fluid frames alone: they pass the limit, and their interval is the key to raise
+  const fs::path fluid = d / "fluid";
+  const Cli f = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + fluid.string() +
+                             "\" --set full3d.dt='\"1 ms\"' --set full3d.output.vtk=false"
+                             " --set full3d.output.fluid_fields=true --set full3d.output.vtk_interval='\"1 ms\"'"
+                             " --set full3d.output.fluid_interval='\"1 ms\"' --set output.max_bytes=600000",
+                         d);
+  EXPECT_EQ(f.code, 3) << f.err;
+  EXPECT_NE(f.err.find("fluid frames"), std::string::npos) << f.err;
+  EXPECT_NE(f.err.find("raise full3d.output.fluid_interval or output.max_bytes"), std::string::npos) << f.err;
+  EXPECT_FALSE(fs::exists(fluid / "membrane.pvd"));
+  expect_consistent_folder(fluid);
+  fs::remove_all(d);
+}
+
 // swim calibrate keeps what it measured: when the hydraulic radii cannot be measured (here a
 // grid so coarse that the lumen holds no velocity sample inside R0 - 2h), calibration.json
 // holds the fitted C1 with a failed status and no offsets (exit 3), and a 1D scene that asks

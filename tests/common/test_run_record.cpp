@@ -242,6 +242,70 @@ TEST(RunRecord, AResumedStreamCutsWhatFollowedTheMarkAndRefusesAChangedFile) {
   EXPECT_THROW(RunStream(f, m2), InputError);
 }
 
+// output.max_bytes counts both streamed files and the other files of the run (a 3D run's VTK
+// frames) in one total: the row or file that passes it throws once, naming the limit and the
+// interval key of the largest part; counts added before the limit is set (a resume restoring
+// them) are not checked but count from then on.
+TEST(RunRecord, TheOutputLimitCountsTheStreamedFilesAndTheFramesInOneTotal) {
+  const std::string d = fresh_dir("limit");
+  RunStream s(d, columns());
+  const std::uintmax_t header = s.bytes();
+  EXPECT_GT(header, 0u);
+  s.row(row_at(0.0));
+  const std::uintmax_t per_row = s.bytes() - header;
+  s.add_external(1000, 0.0, "full3d.output.vtk_interval", "membrane frames");
+  s.add_external(500, 0.0, "full3d.output.fluid_interval", "fluid frames");
+  s.add_external(200, 0.0, "full3d.output.vtk_interval", "membrane frames");
+  EXPECT_EQ(s.external("full3d.output.vtk_interval"), 1200u);
+  EXPECT_EQ(s.external("full3d.output.fluid_interval"), 500u);
+  EXPECT_EQ(s.external("time.output_interval"), 0u);
+  EXPECT_EQ(s.bytes(), header + per_row + 1700u);
+
+  // the limit passed by a frame: the frames dominate
+  const std::uintmax_t limit = s.bytes() + 1000;
+  s.limit(limit);
+  s.row(row_at(0.01));  // below the limit yet
+  const std::uintmax_t room = limit - s.bytes();
+  EXPECT_NO_THROW(s.add_external(room, 0.01, "full3d.output.vtk_interval", "membrane frames"));  // at it
+  try {
+    s.add_external(1, 0.02, "full3d.output.vtk_interval", "membrane frames");
+    FAIL() << "the frame that passes the limit does not end the run";
+  } catch (const NumericalError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("output.max_bytes = " + std::to_string(limit) + " bytes"), std::string::npos) << m;
+    EXPECT_NE(m.find("membrane frames " + std::to_string(1201 + room) + " bytes"), std::string::npos) << m;
+    EXPECT_NE(m.find("fluid frames 500 bytes"), std::string::npos) << m;
+    EXPECT_EQ(e.remedy(), "raise full3d.output.vtk_interval or output.max_bytes");
+    EXPECT_DOUBLE_EQ(e.time(), 0.02);
+  }
+  // raised once: the rows that close the run are still written
+  EXPECT_NO_THROW(s.row(row_at(0.03)));
+  EXPECT_NO_THROW(s.add_external(10, 0.03, "full3d.output.vtk_interval", "membrane frames"));
+
+  // the rows dominate
+  const std::string e = fresh_dir("limit_rows");
+  RunStream r(e, columns());
+  r.add_external(100, 0.0, "full3d.output.vtk_interval", "membrane frames");
+  r.row(row_at(0.0));
+  r.row(row_at(0.01));
+  r.limit(r.bytes() + 1);
+  try {
+    r.row(row_at(0.02));
+    FAIL() << "the row that passes the limit does not end the run";
+  } catch (const NumericalError& x) {
+    EXPECT_EQ(x.remedy(), "raise time.output_interval or output.max_bytes");
+  }
+  // a limit below what is written already: raised at the next write
+  RunStream q(fresh_dir("limit_restore"), columns());
+  q.limit(100);
+  EXPECT_THROW(q.row(row_at(0.0)), NumericalError);
+  // counts added before the limit is set (a resume restoring them) are checked from then on
+  RunStream u(fresh_dir("limit_unset"), columns());
+  EXPECT_NO_THROW(u.add_external(1u << 20, 0.0, "full3d.output.vtk_interval", "membrane frames"));
+  u.limit(1000);
+  EXPECT_THROW(u.row(row_at(0.0)), NumericalError);
+}
+
 TEST(RunRecord, AFullDiskEndsTheStreamAtOnceNamingTheFile) {
   const std::string d = fresh_dir("full");
   ::setenv("SWIM_TEST_FAIL_WRITE", "series.csv:70000", 1);

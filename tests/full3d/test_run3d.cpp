@@ -132,6 +132,46 @@ TEST(Run3d, ResumeEqualsUninterruptedRun) {
   EXPECT_EQ(ra.summary["pumped_volume_m3"].get<double>(), rc.summary["pumped_volume_m3"].get<double>());
 }
 
+// The VTK frames count toward output.max_bytes with series.csv and radius.csv; a resumed run
+// restores the count of the frames written before its checkpoint, so it stops at the same
+// frame, with the same message, as the uninterrupted run.
+TEST(Run3d, AResumedRunStopsAtTheOutputLimitWhereTheUninterruptedRunDid) {
+  const std::vector<std::string> sets = {"full3d.dt=\"1 ms\"", "full3d.output.vtk_interval=\"2 ms\"",
+                                         "full3d.checkpoint_interval=\"5 ms\""};
+  const Scene s = tiny(sets);  // time.duration auto: no estimate before the run
+  RunControl ctl;
+  ctl.progress = 0;
+  ctl.max_output_bytes = 1450000;  // frames of 266 kB: the sixth (step 10) passes it
+  const std::string a = fresh_dir("limit_a"), b = fresh_dir("limit_b");
+  const RunOutcome ra = run3d(s.p, s.resolved, a, ctl);
+  ASSERT_TRUE(ra.failed);
+  std::printf("%s (step %ld)\n", ra.message.c_str(), ra.steps);
+  EXPECT_NE(ra.message.find("output.max_bytes = 1450000"), std::string::npos) << ra.message;
+  EXPECT_NE(ra.message.find("raise full3d.output.vtk_interval"), std::string::npos) << ra.message;
+  ASSERT_GT(ra.steps, 7);  // past the checkpoint the resumed run starts from
+  RunControl stop = ctl;
+  stop.stop_after_steps = 7;  // "killed" at step 7; the last checkpoint is at step 5
+  ASSERT_TRUE(run3d(s.p, s.resolved, b, stop).interrupted);
+  RunControl res = ctl;
+  res.resume = true;
+  const RunOutcome rc = run3d(s.p, s.resolved, b, res);
+  ASSERT_TRUE(rc.failed);
+  EXPECT_EQ(rc.message, ra.message);
+  EXPECT_EQ(rc.steps, ra.steps);
+  EXPECT_EQ(rc.summary["status"], ra.summary["status"]);
+  const auto slurp = [](const std::string& f) {
+    std::ifstream in(f, std::ios::binary);
+    return std::string((std::istreambuf_iterator<char>(in)), {});
+  };
+  for (const char* f : {"/series.csv", "/radius.csv", "/membrane.pvd"}) EXPECT_EQ(slurp(a + f), slurp(b + f)) << f;
+  const auto frames = [](const std::string& d) {
+    int n = 0;
+    for (const auto& e : fs::directory_iterator(d + "/vtk")) n += e.is_regular_file();
+    return n;
+  };
+  EXPECT_EQ(frames(a), frames(b));
+}
+
 TEST(Run3d, ResumeRejectsAnotherScene) {
   const Scene s = tiny({"full3d.dt=\"1 ms\"", "time.duration=\"3 ms\""});
   const std::string d = fresh_dir("resume_other");
