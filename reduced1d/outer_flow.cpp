@@ -120,21 +120,26 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
     lambda_.resize(np);
     last_Ro_.resize(np, -1.0);
     changed_.clear();
+    // One division per point: with n = lambda (Rc^4 - Ro^4) - D2^2 = lambda G_a / c8,
+    // 1 / lambda = n / (lambda n) and 1 / G_a = lambda^2 / (c8 lambda n).
+    const double iRc = 1.0 / Rc;
     for (int p = 0; p < np; ++p) {
       const double Ro = Rpt[p] + a_out;
       if (Ro == last_Ro_[p]) continue;
       last_Ro_[p] = Ro;
       changed_.push_back(p);
-      lambda_[p] = std::log(Rc / Ro);
+      lambda_[p] = -std::log(Ro * iRc);
     }
-    const double Rc2 = Rc * Rc, Rc4 = Rc2 * Rc2, c8 = pi / (8.0 * mu);
+    const double Rc2 = Rc * Rc, Rc4 = Rc2 * Rc2, ic8 = 8.0 * mu / pi;
     for (int p : changed_) {
-      const double Ro = Rpt[p] + a_out, il = 1.0 / lambda_[p];
-      const double D2 = Rc2 - Ro * Ro;
-      const double Ga = c8 * (Rc4 - Ro * Ro * Ro * Ro - D2 * D2 * il);
+      const double Ro = Rpt[p] + a_out, Ro2 = Ro * Ro, lam = lambda_[p];
+      const double D2 = Rc2 - Ro2;
+      const double n = lam * (Rc4 - Ro2 * Ro2) - D2 * D2;
+      const double inv = 1.0 / (lam * n);
+      const double il = n * inv;
       const double S = (0.5 * pi) * D2 * il;
       AnnulusPoint<double>& a = pts_[p];
-      a.rho = 1.0 / Ga;
+      a.rho = (lam * lam * ic8) * inv;
       a.kappa = (pi * Rc2 - S) * a.rho;
       a.S = S;
       a.e = (2.0 * pi * mu) * il;
@@ -152,20 +157,25 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   // Intervals whose two points kept their radii keep their coefficients (cache above).
   const bool all = derivatives || changed_.size() == std::size_t(np) || !interval_valid_;
   std::size_t next = 0;  // index into changed_ (ascending)
+  const double kl = 8.0 * mu / (3.0 * pi);
   for (int j = 0; j < ni; ++j) {
     if (!all) {
       while (next < changed_.size() && changed_[next] < j) ++next;
       if (next == changed_.size() || changed_[next] > j + 1) continue;  // neither j nor j + 1 changed
     }
+    // rl = m / D with m = (8 mu / 3 pi) d (a^2 + ab + b^2), D = (ab)^3; rl and
+    // w = 1 / (rl + ra) = D / (m + ra D) share one division.
     const double ai = Rpt[j] - a_in, bi = Rpt[j + 1] - a_in, ab = ai * bi;
     IntervalCoef<double>& c = k[j];
-    c.rl = (8.0 * mu / pi) * d[j] * (ai * ai + ab + bi * bi) / (3.0 * ab * ab * ab);
     const auto &pa = pts_[j], &pb = pts_[j + 1];
     c.ra = 0.5 * d[j] * (pa.rho + pb.rho);
     c.c = 0.5 * d[j] * (pa.kappa + pb.kappa);
     c.S = 0.5 * (pa.S + pb.S);
     c.e = 0.5 * d[j] * (pa.e + pb.e);
-    w[j] = 1.0 / (c.rl + c.ra);
+    const double m = kl * d[j] * (ai * ai + ab + bi * bi), D = ab * ab * ab, sum = m + c.ra * D;
+    const double inv = 1.0 / (D * sum);
+    c.rl = m * sum * inv;
+    w[j] = D * D * inv;
   }
   interval_valid_ = !derivatives;
   return true;
