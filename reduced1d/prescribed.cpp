@@ -299,14 +299,23 @@ void fill_wall_sample(const PrescribedModel& model, const PrescribedModel::Eval&
     s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
     s.F_outer = -s.F_lumen;
   }
+  // one pass for the four reductions (each summed in the order of disc::elastic_energy and
+  // the volume sum, so the values are those of separate passes)
   const double* R = model.Rpt.data() + 1;
-  s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
-  s.R_min = *std::min_element(R, R + N);
-  s.R_max = *std::max_element(R, R + N);
+  const double R0 = model.R0;
+  double de2 = 0, vol = 0, lo = R[0], hi = R[0];
+  for (int i = 0; i < N; ++i) {
+    const double Ri = R[i];
+    de2 += (Ri - R0) * (Ri - R0);
+    vol += Ri * Ri;
+    lo = Ri < lo ? Ri : lo;
+    hi = Ri > hi ? Ri : hi;
+  }
+  s.energy = 0.5 * model.C1 * de2 * 2.0 * pi * R0 * model.h;
+  s.R_min = lo;
+  s.R_max = hi;
   s.Q_rear = e.Q0;
   s.Q_front = e.QN;
-  double vol = 0;
-  for (int i = 0; i < N; ++i) vol += R[i] * R[i];
   s.tube_volume = pi * vol * model.h;
 }
 
