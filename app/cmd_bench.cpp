@@ -1,10 +1,12 @@
 // swim bench: performance figures, measured in one run so that ratios are meaningful on a
 // shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 and,
 // at N = 200, with the unbounded outer flow and in the paper mode (best
-// of several repetitions) and screening throughput (designs per second) on all cores.
+// of several repetitions) and screening throughput (designs per second) on all cores and on
+// one thread, with the process CPU time per design.
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
+#include <ctime>
 #include <string>
 #include <thread>
 #include <utility>
@@ -29,6 +31,13 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+/// CPU time of the whole process (all threads) [s].
+double process_cpu_seconds() {
+  timespec ts{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+  return double(ts.tv_sec) + 1e-9 * double(ts.tv_nsec);
 }
 
 /// Best wall time of `reps` solves of p; r receives the last result.
@@ -159,15 +168,28 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
         sets.insert(sets.end(), {"protocol.total_force=null", "protocol.load_factor=1.4"});
       designs.push_back(demo_params(sets));
     }
-    const auto t0 = std::chrono::steady_clock::now();
-    const auto res = reduced1d::run_designs(designs, 0);
-    const double wall = seconds_since(t0);
-    long failed = std::count_if(res.begin(), res.end(), [](const auto& r) { return !r.ok; });
+    // On all cores, then on one thread. The process CPU time tells a CPU-starved run (other
+    // jobs on the machine: fewer cores used than threads) from poor scaling (more CPU per
+    // design on more threads).
+    double wall[2], cpu[2];
+    long failed = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+      const double c0 = process_cpu_seconds();
+      const auto t0 = std::chrono::steady_clock::now();
+      const auto res = reduced1d::run_designs(designs, pass == 0 ? 0 : 1);
+      wall[pass] = seconds_since(t0);
+      cpu[pass] = process_cpu_seconds() - c0;
+      if (pass == 0) failed = std::count_if(res.begin(), res.end(), [](const auto& r) { return !r.ok; });
+    }
     const std::string label = c.kind + " N=" + std::to_string(c.cells);
-    std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed)\n", label.c_str(), n, wall, n / wall,
-                failed);
-    screening[label] = {{"designs", n}, {"cells", c.cells}, {"wall_time_s", wall}, {"designs_per_s", n / wall},
-                  {"failed", failed}};
+    std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed); CPU %.3g ms/design, %.2f cores used; "
+                "1 thread: %.1f designs/s, CPU %.3g ms/design\n",
+                label.c_str(), n, wall[0], n / wall[0], failed, 1e3 * cpu[0] / n, cpu[0] / wall[0], n / wall[1],
+                1e3 * cpu[1] / n);
+    screening[label] = {{"designs", n}, {"cells", c.cells}, {"threads", cores}, {"wall_time_s", wall[0]},
+                        {"designs_per_s", n / wall[0]}, {"cpu_time_s", cpu[0]}, {"cores_used", cpu[0] / wall[0]},
+                        {"designs_per_s_1_thread", n / wall[1]}, {"cpu_time_s_1_thread", cpu[1]},
+                        {"failed", failed}};
   }
   report["screening"] = screening;
   }

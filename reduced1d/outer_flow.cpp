@@ -108,10 +108,12 @@ ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, doubl
       dpts_(npoints) {}
 
 bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
-  for (int p = 0; p < np; ++p) {
-    const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
-    if (!(Ro < Rc * (1.0 - 1e-3)) || !(Ri > 0)) return false;
-  }
+  const double Ro_max = Rc * (1.0 - 1e-3);
+  if (derivatives)
+    for (int p = 0; p < np; ++p) {
+      const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
+      if (!(Ro < Ro_max) || !(Ri > 0)) return false;
+    }
   if (!derivatives) {
     // Two passes: the logarithms, then the arithmetic (independent per point, so the
     // divisions pipeline instead of waiting behind each call). A point whose radius is
@@ -120,21 +122,32 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
     lambda_.resize(np);
     last_Ro_.resize(np, -1.0);
     changed_.clear();
+    // One division per point: with n = lambda (Rc^4 - Ro^4) - D2^2 = lambda G_a / c8,
+    // 1 / lambda = n / (lambda n) and 1 / G_a = lambda^2 / (c8 lambda n).
+    const double iRc = 1.0 / Rc;
+    // (an unchanged radius passed the range check before)
     for (int p = 0; p < np; ++p) {
       const double Ro = Rpt[p] + a_out;
       if (Ro == last_Ro_[p]) continue;
+      if (!(Ro < Ro_max) || !(Rpt[p] - a_in > 0)) {
+        last_Ro_.assign(np, -1.0);  // this call's partial updates leave nothing cached
+        interval_valid_ = false;
+        return false;
+      }
       last_Ro_[p] = Ro;
       changed_.push_back(p);
-      lambda_[p] = std::log(Rc / Ro);
+      lambda_[p] = -std::log(Ro * iRc);
     }
-    const double Rc2 = Rc * Rc, Rc4 = Rc2 * Rc2, c8 = pi / (8.0 * mu);
+    const double Rc2 = Rc * Rc, Rc4 = Rc2 * Rc2, ic8 = 8.0 * mu / pi;
     for (int p : changed_) {
-      const double Ro = Rpt[p] + a_out, il = 1.0 / lambda_[p];
-      const double D2 = Rc2 - Ro * Ro;
-      const double Ga = c8 * (Rc4 - Ro * Ro * Ro * Ro - D2 * D2 * il);
+      const double Ro = Rpt[p] + a_out, Ro2 = Ro * Ro, lam = lambda_[p];
+      const double D2 = Rc2 - Ro2;
+      const double n = lam * (Rc4 - Ro2 * Ro2) - D2 * D2;
+      const double inv = 1.0 / (lam * n);
+      const double il = n * inv;
       const double S = (0.5 * pi) * D2 * il;
       AnnulusPoint<double>& a = pts_[p];
-      a.rho = 1.0 / Ga;
+      a.rho = (lam * lam * ic8) * inv;
       a.kappa = (pi * Rc2 - S) * a.rho;
       a.S = S;
       a.e = (2.0 * pi * mu) * il;
@@ -151,21 +164,37 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   }
   // Intervals whose two points kept their radii keep their coefficients (cache above).
   const bool all = derivatives || changed_.size() == std::size_t(np) || !interval_valid_;
-  std::size_t next = 0;  // index into changed_ (ascending)
-  for (int j = 0; j < ni; ++j) {
-    if (!all) {
-      while (next < changed_.size() && changed_[next] < j) ++next;
-      if (next == changed_.size() || changed_[next] > j + 1) continue;  // neither j nor j + 1 changed
-    }
-    const double ai = Rpt[j] - a_in, bi = Rpt[j + 1] - a_in, ab = ai * bi;
-    IntervalCoef<double>& c = k[j];
-    c.rl = (8.0 * mu / pi) * d[j] * (ai * ai + ab + bi * bi) / (3.0 * ab * ab * ab);
-    const auto &pa = pts_[j], &pb = pts_[j + 1];
-    c.ra = 0.5 * d[j] * (pa.rho + pb.rho);
-    c.c = 0.5 * d[j] * (pa.kappa + pb.kappa);
+  const double kl = 8.0 * mu / (3.0 * pi), ain = a_in;
+  const double* dd = d.data();
+  const AnnulusPoint<double>* pt = pts_.data();
+  IntervalCoef<double>* kc = k.data();
+  double* wj = w.data();
+  // rl = m / D with m = (8 mu / 3 pi) d (a^2 + ab + b^2), D = (ab)^3; rl and
+  // w = 1 / (rl + ra) = D / (m + ra D) share one division.
+  auto interval = [&](int j) {
+    const double ai = Rpt[j] - ain, bi = Rpt[j + 1] - ain, ab = ai * bi, dj = dd[j];
+    IntervalCoef<double>& c = kc[j];
+    const auto &pa = pt[j], &pb = pt[j + 1];
+    const double ra = 0.5 * dj * (pa.rho + pb.rho);
+    c.ra = ra;
+    c.c = 0.5 * dj * (pa.kappa + pb.kappa);
     c.S = 0.5 * (pa.S + pb.S);
-    c.e = 0.5 * d[j] * (pa.e + pb.e);
-    w[j] = 1.0 / (c.rl + c.ra);
+    c.e = 0.5 * dj * (pa.e + pb.e);
+    const double m = kl * dj * (ai * ai + ab + bi * bi), D = ab * ab * ab, sum = m + ra * D;
+    const double inv = 1.0 / (D * sum);
+    c.rl = m * sum * inv;
+    wj[j] = D * D * inv;
+  };
+  if (all) {
+    for (int j = 0; j < ni; ++j) interval(j);
+  } else {
+    // the intervals touching a changed point (changed_ ascending), each once
+    int last = -1;
+    for (int p : changed_)
+      for (int j = std::max(p - 1, last + 1); j <= std::min(p, ni - 1); ++j) {
+        interval(j);
+        last = j;
+      }
   }
   interval_valid_ = !derivatives;
   return true;

@@ -34,7 +34,7 @@ struct PrescribedModel {
   bool flow_closure, force_free, confined;
   double a_in, a_out;
   // workspace (sized once)
-  std::vector<double> zpt, dpt, Rpt, At, r, Q, dp, scum, zc, faces, rho, u_ind, pl;
+  std::vector<double> zpt, dpt, Rpt, Rtc, At, r, Q, dp, scum, zc, faces, rho, u_ind, pl;
   std::unique_ptr<outer::ConfinedSystem> sys;
   // state scales: y = (D / D_s, X / X_s, V_rear / V_s, V_front / V_s)
   double D_s = 1, X_s = 1, V_s = 1;
@@ -63,6 +63,7 @@ struct PrescribedModel {
         zpt(N + 2),
         dpt(N + 1),
         Rpt(N + 2),
+        Rtc(N),
         At(N),
         r(N + 1),
         Q(N + 1),
@@ -90,12 +91,12 @@ struct PrescribedModel {
 
   /// Radius at the points, flux at the faces, pressure differences, swimmer integrands at t.
   Eval evaluate(double t) {
-    for (int k = 0; k < N + 2; ++k) {
-      double R, Rt;
-      shape.eval(zpt[k], t, R, Rt);
-      Rpt[k] = R;
-      if (k >= 1 && k <= N) At[k - 1] = 2.0 * pi * R * Rt;
-    }
+    // the end points, then the cell centres (uniform spacing h) in one pass
+    double Rt_end;
+    shape.eval(zpt[0], t, Rpt[0], Rt_end);
+    shape.eval(zpt[N + 1], t, Rpt[N + 1], Rt_end);
+    shape.eval_uniform(zpt[1], h, N, t, Rpt.data() + 1, Rtc.data());
+    for (int i = 0; i < N; ++i) At[i] = 2.0 * pi * Rpt[i + 1] * Rtc[i];
     Eval e;
     if (confined) {
       double S = 0;
@@ -298,14 +299,23 @@ void fill_wall_sample(const PrescribedModel& model, const PrescribedModel::Eval&
     s.F_lumen = pi * (Rb0 * Rb0 * e.p0 - RbL * RbL * e.pL);
     s.F_outer = -s.F_lumen;
   }
+  // one pass for the four reductions (each summed in the order of disc::elastic_energy and
+  // the volume sum, so the values are those of separate passes)
   const double* R = model.Rpt.data() + 1;
-  s.energy = disc::elastic_energy(R, N, model.R0, model.C1, model.h);
-  s.R_min = *std::min_element(R, R + N);
-  s.R_max = *std::max_element(R, R + N);
+  const double R0 = model.R0;
+  double de2 = 0, vol = 0, lo = R[0], hi = R[0];
+  for (int i = 0; i < N; ++i) {
+    const double Ri = R[i];
+    de2 += (Ri - R0) * (Ri - R0);
+    vol += Ri * Ri;
+    lo = Ri < lo ? Ri : lo;
+    hi = Ri > hi ? Ri : hi;
+  }
+  s.energy = 0.5 * model.C1 * de2 * 2.0 * pi * R0 * model.h;
+  s.R_min = lo;
+  s.R_max = hi;
   s.Q_rear = e.Q0;
   s.Q_front = e.QN;
-  double vol = 0;
-  for (int i = 0; i < N; ++i) vol += R[i] * R[i];
   s.tube_volume = pi * vol * model.h;
 }
 
