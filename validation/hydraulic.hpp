@@ -71,11 +71,13 @@ struct HydraulicRadii {
 };
 
 /// Throws NumericalError when the held-tube solve does not converge or a fit is degenerate.
-/// `axisymmetric_forces`: hold the tube with the towed tube's ring forces (CG converges to 1e-6)
-/// instead of a free force per node (CG stalls near 1e-3). Only then is holding_force_N
-/// converged (node by node it is about 10 % off: the towed-tube test of reciprocity), and the
-/// offsets come out smaller (docs/validation.md). The calibration uses the node-by-node solve.
-HydraulicRadii measure_hydraulic_radii(const full3d::Params3d& p, bool axisymmetric_forces = false);
+/// `axisymmetric_forces` (the calibration's choice): hold the tube with one axial and one
+/// radial force per ring, the towed tube's force space (the exact holding force of this
+/// axisymmetric flow is axisymmetric); CG converges to 1e-6 and holding_force_N satisfies
+/// reciprocity with the towed tube. false: a free force per node, whose space includes forces
+/// finer than the grid resolves (a near null space): CG stalls near 1e-3 and the holding force
+/// is about 10 % off (docs/validation.md).
+HydraulicRadii measure_hydraulic_radii(const full3d::Params3d& p, bool axisymmetric_forces = true);
 
 scene::json to_json(const HydraulicRadii& h);
 
