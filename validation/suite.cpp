@@ -31,9 +31,10 @@ using scene::json;
 
 namespace {
 
-/// Changes whenever calibration.json gains or renames keys: cached calibrations of an older
-/// format are then recomputed instead of read.
-constexpr int kCalibrationFormat = 2;
+/// Changes whenever calibration.json gains or renames keys, or a measurement in it changes
+/// method (3: the held tube on the ring forces): cached calibrations of an older format are
+/// then recomputed instead of read.
+constexpr int kCalibrationFormat = 3;
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
