@@ -206,6 +206,24 @@ double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, doubl
   return 0.5 * kb * s;
 }
 
+double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form) {
+  const double R0 = mesh.radius, w = 1e-4 * R0;
+  auto lobed = [&](double amp) {
+    Eigen::Matrix3Xd X = mesh.X0;
+    for (int i = 0; i < mesh.nodes(); ++i) {
+      const double dy = X(1, i) - mesh.axis_start[1], dz = X(2, i) - mesh.axis_start[2];
+      const double f = 1.0 + amp / R0 * std::cos(2.0 * std::atan2(dz, dy));
+      X(1, i) = mesh.axis_start[1] + f * dy;
+      X(2, i) = mesh.axis_start[2] + f * dz;
+    }
+    return bending_energy(mesh, X, 1.0, form);
+  };
+  const double e2 = 0.5 * (lobed(w) + lobed(-w)) - bending_energy(mesh, mesh.X0, 1.0, form);
+  const double length = mesh.ring_spacing * (mesh.n_rings - 1);
+  const double dk = 3.0 * w / (R0 * R0);
+  return 2.0 * e2 / (0.5 * 2.0 * M_PI * R0 * length * dk * dk);
+}
+
 namespace {
 // Bending forces (eq. 8 gradient) of hinges [k0, k1) added to F.
 //

@@ -80,6 +80,13 @@ double dihedral_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
 
 double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks);
 double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form);
+/// The bending rigidity D (J) that eq. (8) gives this mesh's wall per unit k_b (N): the
+/// energy of small ovalisation lobes r = R0 + w cos(2 theta) (second difference in w)
+/// against the continuum (D / 2) int dkappa^2 dA, dkappa = 3 w cos(2 theta) / R0^2. Every
+/// hinge angle scales with the edge length times the curvature, so D / k_b is about a
+/// quarter of the mean edge length (docs/full3d.md, "Wall wrinkling"): eq. (8) with a fixed
+/// k_b softens as the mesh is refined.
+double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form);
 void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F);
 void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                         Eigen::Matrix3Xd& F);

@@ -11,10 +11,23 @@ namespace swim::full3d {
 const std::vector<std::string> kSeriesColumns = [] {
   std::vector<std::string> c = record::common_series_columns();
   for (const char* k : {"elastic_energy_J", "bending_energy_J", "kinetic_energy_J", "active_segment",
-                        "cycles_completed", "cfl", "stokes_iterations", "max_divergence_per_s", "max_edge_m", "dt_s"})
+                        "cycles_completed", "cfl", "stokes_iterations", "max_divergence_per_s", "max_edge_m", "dt_s", "wrinkle_m"})
     c.push_back(k);
   return c;
 }();
+
+double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, const Eigen::VectorXd& ring_r) {
+  double worst = 0.0;
+  for (int r = 0; r < mesh.n_rings; ++r) {
+    double s2 = 0.0;
+    for (int i = 0; i < mesh.n_theta; ++i) {
+      const double d = node_r[mesh.node(r, i)] - ring_r[r];
+      s2 += d * d;
+    }
+    worst = std::max(worst, std::sqrt(s2 / mesh.n_theta));
+  }
+  return worst;
+}
 
 record::RunRecord new_record(const RunSetup& run) {
   std::vector<double> z(run.mesh.n_rings);
@@ -135,7 +148,8 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
   const double row[] = {s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                         rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                         double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
-                        last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0};
+                        last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0,
+                        wall_wrinkle(mesh, rn, rr)};
   // a row that passes output.max_bytes ends the run (NumericalError) once it is written: its
   // radius snapshot is still written, and the run's failure path does not record it again
   last_recorded_ = n;

@@ -20,8 +20,14 @@
 namespace swim::full3d {
 
 /// The columns of a 3D run's series.csv: the common ones (record::common_series_columns()),
-/// then the energy split, protocol state and step statistics.
+/// then the energy split, protocol state and step statistics, and the wall wrinkle.
 extern const std::vector<std::string> kSeriesColumns;
+
+/// The wall's departure from axisymmetry, m: the largest, over the rings, of the RMS
+/// deviation of the node radii from their ring's mean radius. An axisymmetric tube gives
+/// 0; a hoop-compressed lattice that buckles into azimuthal lobes (docs/full3d.md, "Wall
+/// wrinkling") gives the lobes' RMS amplitude.
+double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, const Eigen::VectorXd& ring_r);
 
 /// An empty record of a 3D run (tier, model, length, columns, reference ring positions).
 record::RunRecord new_record(const RunSetup& run);

@@ -129,10 +129,18 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                   {"rings", mesh.n_rings},
                   {"ring_spacing_m", mesh.ring_spacing},
                   {"max_edge_m", max_edge_length(mesh, mesh.X0)},
+                  {"bending_constant_N", p.membrane.kb},
+                  {"bending_rigidity_J", p.membrane.kb * bending_rigidity_per_kb(mesh, p.membrane.bending)},
                   {"segment_boundaries_m", protocol.boundaries()}};
   // the largest edge at the output steps; the no-leak guard needs < 0.5 h
   const double emax = rec_.series.count() ? rec_.series.max("max_edge_m") : 0.0;
-  rec_.extras = {{"max_edge_over_h", emax / p.h}, {"steps", n}, {"steps_per_cycle", stepper.steps_per_cycle()}};
+  // the wall's largest departure from axisymmetry at the output steps (docs/full3d.md, "Wall wrinkling")
+  const double wmax = rec_.series.count() ? rec_.series.max("wrinkle_m") : 0.0;
+  rec_.extras = {{"max_edge_over_h", emax / p.h},
+                 {"max_wrinkle_m", wmax},
+                 {"max_wrinkle_over_h", wmax / p.h},
+                 {"steps", n},
+                 {"steps_per_cycle", stepper.steps_per_cycle()}};
   record::check_plausible(rec_);
   rec_.events.switches = protocol.state().switches;
   rec_.events.segment_reached_s = protocol.state().segment_reached;

@@ -160,7 +160,15 @@ Params3d read_scene3d(const json& scene, json& resolved) {
                                                                                                : IbScheme::ForwardEuler;
     {
       Reader m = f.child("membrane");
-      p.membrane.kb = m.quantity("bending_constant", "N", "1e-15 N", Range::non_negative());
+      if (m.has("bending_rigidity")) {
+        p.bending_rigidity = m.quantity("bending_rigidity", "J", "", Range::positive());
+        if (m.has("bending_constant"))
+          throw InputError(m.path("bending_rigidity"), fmt(p.bending_rigidity, "J"),
+                           "give either full3d.membrane.bending_constant (eq. 8's k_b, N) or "
+                           "full3d.membrane.bending_rigidity (the wall's rigidity D, J), not both");
+      } else {
+        p.membrane.kb = m.quantity("bending_constant", "N", "1e-15 N", Range::non_negative());
+      }
       p.membrane.bending = m.choice("bending_form", "reference_angle", {"reference_angle", "printed"}) == "printed"
                                ? BendingForm::Printed
                                : BendingForm::ReferenceAngle;
@@ -236,6 +244,8 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   if (mesh.nodes() > 2000000)
     throw InputError("full3d.grid", "", "the membrane would have more than 2e6 nodes; use a coarser grid");
   Protocol3d check(p.protocol, mesh, 1.0);  // every segment must hold a ring
+  // a given rigidity sets eq. (8)'s k_b for this mesh (D / k_b scales with the edge length)
+  if (p.bending_rigidity > 0.0) p.membrane.kb = p.bending_rigidity / bending_rigidity_per_kb(mesh, p.membrane.bending);
   return p;
 }
 

@@ -53,6 +53,9 @@ struct Params3d {
   double period = 2.0e-6;          ///< container length along x, m
   int nx = 128, ny = 32, nz = 32;  ///< grid cells
   double h = 0.5e-6 / 32;          ///< cell size, m
+  /// full3d.membrane.bending_rigidity, J (0: not given). When given, membrane.kb is set so
+  /// that eq. (8) gives the wall this rigidity on the run's mesh (bending_rigidity_per_kb).
+  double bending_rigidity = 0.0;
   double spacing_factor = 0.6;     ///< longest reference edge < factor * h/2 (docs/full3d.md)
   double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md); fixed step
   AdaptiveStep adaptive{};         ///< full3d.adaptive: step control instead of the fixed dt

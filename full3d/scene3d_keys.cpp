@@ -17,6 +17,7 @@ const scene::json& section_keys() {
       {"scheme", "choice:forward_euler|midpoint"},
       {"membrane",
        {{"bending_constant", "quantity:N"},
+        {"bending_rigidity", "quantity:J"},
         {"bending_form", "choice:reference_angle|printed"},
         {"spacing_factor", "number"}}},
       {"wall_inertia", "boolean"},

@@ -9,6 +9,7 @@
 
 #include "common/errors.hpp"
 #include "full3d/membrane.hpp"
+#include "full3d/run3d_measure.hpp"
 
 using namespace swim::full3d;
 
@@ -193,4 +194,63 @@ TEST(MembranePressure, UniformContractionAndEffectiveC1) {
     EXPECT_LT((hi - lo) / hi, 0.05);
   }
   EXPECT_NEAR(c1[1] / c1[0], 1.0, 0.02);  // linear regime
+}
+
+// The wall-wrinkle measure of a 3D run's series (run3d_measure.hpp): zero for any
+// axisymmetric shape (here rings contracted to different radii), and the RMS amplitude
+// a / sqrt(2) of an azimuthal lobe pattern r = r_k (1 + ...) + a cos(m theta) on the ring
+// that carries it.
+TEST(MembraneMeasure, WallWrinkleIsTheRmsOfTheAzimuthalLobes) {
+  const CylinderMesh m = small_mesh();
+  Eigen::Matrix3Xd X = m.X0;
+  auto set_radius = [&](int node, double r) {
+    Eigen::Vector3d d = X.col(node) - m.axis_start;
+    const double x = d.x();
+    d.x() = 0;
+    d *= r / d.norm();
+    d.x() = x;
+    X.col(node) = m.axis_start + d;
+  };
+  for (int r = 0; r < m.n_rings; ++r)
+    for (int i = 0; i < m.n_theta; ++i) set_radius(m.node(r, i), kR0 * (0.55 + 0.4 * r / (m.n_rings - 1)));
+  EXPECT_LT(wall_wrinkle(m, node_radii(m, X), ring_radii(m, X)), 1e-12 * kR0);
+  const int ring = m.n_rings / 2, lobes = 3;
+  const double a = 0.1 * kR0, base = node_radii(m, X)[m.node(ring, 0)];
+  for (int i = 0; i < m.n_theta; ++i) {
+    const Eigen::Vector3d d = X.col(m.node(ring, i)) - m.axis_start;
+    set_radius(m.node(ring, i), base + a * std::cos(lobes * std::atan2(d.z(), d.y())));
+  }
+  EXPECT_NEAR(wall_wrinkle(m, node_radii(m, X), ring_radii(m, X)), a / std::sqrt(2.0), 1e-3 * a);
+}
+
+// The bending rigidity that eq. (8) gives the tube wall against azimuthal lobes
+// r = R0 + w cos(m theta): its energy (k_b / 2) sum L_l tan^2(theta_l / 2) against the
+// continuum (D / 2) int dkappa^2 dA, dkappa = (m^2 - 1) w cos(m theta) / R0^2. Every hinge
+// angle scales with the edge length a times the curvature and there are about 2 sqrt(3) / a^2
+// edges per area, so D = c k_b a: halving the mesh spacing halves the wall's bending
+// rigidity (docs/full3d.md, "Wall wrinkling").
+TEST(MembraneForces, PaperBendingRigidityIsProportionalToTheEdgeLength) {
+  double prev = 0.0;
+  for (int n : {63, 126, 252}) {
+    const CylinderMesh m = make_cylinder(kR0, kL, n, Eigen::Vector3d::Zero());
+    const double a = m.rest_length.mean();
+    for (int lobes : {4, 8}) {
+      const double w = 1e-4 * kR0;
+      Eigen::Matrix3Xd X = m.X0;
+      for (int i = 0; i < m.nodes(); ++i) {
+        const double th = std::atan2(X(2, i), X(1, i));
+        X(1, i) *= 1.0 + w / kR0 * std::cos(lobes * th);
+        X(2, i) *= 1.0 + w / kR0 * std::cos(lobes * th);
+      }
+      const double e = bending_energy(m, X, 1.0, BendingForm::ReferenceAngle);
+      const double dk = (lobes * lobes - 1) * w / (kR0 * kR0);
+      const double d_per_kb = 2.0 * e / (0.5 * 2.0 * M_PI * kR0 * kL * dk * dk);
+      std::printf("n_theta %d, edge %.3g m, m = %d: D / k_b = %.4g m, D / (k_b a) = %.4f\n", n, a, lobes, d_per_kb,
+                  d_per_kb / a);
+      if (lobes == 4) {
+        if (prev > 0) EXPECT_NEAR(prev / d_per_kb, 2.0, 0.1);
+        prev = d_per_kb;
+      }
+    }
+  }
 }

@@ -94,3 +94,36 @@ TEST(ShippedScenes3d, FluidFramesFallOnMembraneFrames) {
   sc["full3d"]["output"]["fluid_interval"] = "30 ms";
   EXPECT_NO_THROW(read_scene3d(sc, resolved));
 }
+
+// full3d.membrane.bending_rigidity fixes the wall's bending rigidity D across grids: eq. (8)'s
+// k_b is set per mesh (it halves as the edge length doubles), and the resolved scene reads
+// back to the same wall. With bending_constant as well the scene is rejected.
+TEST(ShippedScenes3d, BendingRigidityIsTheSameWallOnEveryGrid) {
+  const double D = 2.0e-24;
+  double kb_prev = 0.0, edge_prev = 0.0;
+  for (int n : {24, 48}) {
+    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json");
+    sc["full3d"]["grid"]["cells_across"] = n;
+    sc["full3d"]["membrane"]["bending_rigidity"] = "2e-24 J";
+    scene::json resolved;
+    const Params3d p = read_scene3d(sc, resolved);
+    const CylinderMesh mesh = make_mesh(p);
+    EXPECT_NEAR(p.membrane.kb * bending_rigidity_per_kb(mesh, p.membrane.bending), D, 1e-9 * D);
+    scene::json again;
+    EXPECT_DOUBLE_EQ(read_scene3d(resolved, again).membrane.kb, p.membrane.kb);
+    const double edge = mesh.rest_length.mean();
+    if (kb_prev > 0) EXPECT_NEAR(p.membrane.kb / kb_prev, edge_prev / edge, 0.05 * edge_prev / edge);
+    kb_prev = p.membrane.kb;
+    edge_prev = edge;
+  }
+  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json");
+  sc["full3d"]["membrane"]["bending_rigidity"] = "2e-24 J";
+  sc["full3d"]["membrane"]["bending_constant"] = "1e-15 N";
+  scene::json resolved;
+  try {
+    read_scene3d(sc, resolved);
+    ADD_FAILURE() << "bending_rigidity with bending_constant accepted";
+  } catch (const InputError& err) {
+    EXPECT_NE(std::string(err.what()).find("full3d.membrane.bending_rigidity"), std::string::npos) << err.what();
+  }
+}
