@@ -399,10 +399,11 @@ bool small_lu(std::vector<double>& a, std::vector<int>& piv, int r) {
   return true;
 }
 void small_solve(const std::vector<double>& a, const std::vector<int>& piv, int r, double* b) {
-  for (int k = 0; k < r; ++k) {
-    std::swap(b[k], b[piv[k]]);
+  // small_lu swaps whole rows (the multipliers of earlier columns included, as LAPACK's
+  // dgetf2 does), so all the row interchanges apply to b before the forward substitution.
+  for (int k = 0; k < r; ++k) std::swap(b[k], b[piv[k]]);
+  for (int k = 0; k < r; ++k)
     for (int i = k + 1; i < r; ++i) b[i] -= a[k * r + i] * b[k];
-  }
   for (int k = r - 1; k >= 0; --k) {
     for (int j = k + 1; j < r; ++j) b[k] -= a[j * r + k] * b[j];
     b[k] /= a[k * r + k];

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -261,4 +262,20 @@ TEST(ForceFree, PrescribedQuadratureStopsAtTheStepBudget) {
   EXPECT_NE(std::string(r.failure->what()).find("numerics1d.max_steps"), std::string::npos) << r.failure->what();
   EXPECT_GE(r.series.size(), 1u);
   for (const auto& s : r.series) EXPECT_TRUE(finite(s));
+}
+
+// Step count of the default force-driven cycle at N = 200 (docs/performance-1d.md, "Step
+// count"). With an inaccurate Newton solve (the capacitance matrix's row interchanges
+// applied out of order when three or more low-rank terms are active) the last contraction
+// phase alone took about 1 550 steps; with exact Newton corrections the demo-load
+// cycle takes about 3 870 (5 150 before). The bound leaves room for round-off differences
+// between builds.
+TEST(ForceFree, ForceDrivenCycleStepCountAtN200) {
+  Params p = force_free_cycle(200);
+  p.protocol.q = 0.1e-12 / (2.0 * std::numbers::pi * p.geometry.R0 * p.geometry.L);  // demo: 0.1 pN
+  const Result r = solve(p);
+  ASSERT_FALSE(r.failure) << r.failure->what();
+  ASSERT_EQ(metrics(p, r).cycles_completed, 1);
+  EXPECT_LT(r.stats.at("steps"), 4400);
+  EXPECT_LT(r.stats.at("nonlin_iters"), 7000);
 }

@@ -167,3 +167,53 @@ TEST(SundialsKernels, LowRankBandSolverMatchesADenseSolve) {
       for (long i = 0; i < n; ++i) EXPECT_EQ(sun::data(b.get())[i], sun::data(x.get())[i]);
     }
 }
+
+// The Woodbury capacitance matrix I + s W^T M^{-1} Q is factored by a small dense LU with
+// partial pivoting. With O(1) low-rank terms (the held segments' loads and the outer-flow
+// pair of the confined Newton matrix) it is far from the identity and the LU interchanges
+// rows after the first column; the solve must then apply every interchange before the
+// forward substitution (whole-row swaps, as LAPACK's dgetf2). Checked against a dense LU
+// of the assembled matrix to 1e-12 relative, with the capacitance matrix built so that its
+// pivots come from below the diagonal in every column.
+TEST(SundialsKernels, LowRankBandSolverPivotsTheCapacitanceMatrix) {
+  auto ctx = sun::make_context();
+  Rng rng{23};
+  for (long n : {12L, 205L})
+    for (int rank : {3, 4, 5, 7}) {
+      auto y = sun::make_vector(n, ctx.get());
+      sun::Matrix A(SUNBandMatrix(n, 1, 1, ctx.get()));
+      sun::LowRankTerm term;  // scale 1
+      auto solver = sun::make_low_rank_band_solver(y.get(), A.get(), &term, ctx.get());
+      Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+      for (long i = 0; i < n; ++i)
+        for (long j = std::max(0L, i - 1); j <= std::min(n - 1, i + 1); ++j) {
+          const double v = i == j ? 4.0 + rng() : 0.5 * rng();
+          SM_ELEMENT_B(A.get(), i, j) = v;
+          D(i, j) = v;
+        }
+      // U: disjoint blocks of cells (like the held segments), V: the same blocks shifted by
+      // one term, so that V^T M^{-1} U is large below its diagonal.
+      term.rank = rank;
+      term.U.assign(std::size_t(n) * rank, 0.0);
+      term.V.assign(std::size_t(n) * rank, 0.0);
+      const long block = n / rank;
+      for (int k = 0; k < rank; ++k)
+        for (long i = k * block; i < (k + 1) * block; ++i) {
+          term.U[std::size_t(k) * n + i] = 1.0 + 0.1 * rng();
+          const int kv = (k + rank - 1) % rank;  // V_kv lives on block k
+          term.V[std::size_t(kv) * n + i] = (50.0 + 10.0 * rng()) / double(block);
+        }
+      for (int k = 0; k < rank; ++k)
+        for (long i = 0; i < n; ++i)
+          for (long j = 0; j < n; ++j) D(i, j) += term.U[std::size_t(k) * n + i] * term.V[std::size_t(k) * n + j];
+      ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
+      auto b = sun::make_vector(n, ctx.get()), x = sun::make_vector(n, ctx.get());
+      Eigen::VectorXd bb(n);
+      for (long i = 0; i < n; ++i) bb(i) = sun::data(b.get())[i] = rng();
+      ASSERT_EQ(SUNLinSolSolve(solver.get(), A.get(), x.get(), b.get(), 0.0), 0);
+      const Eigen::VectorXd ref = D.partialPivLu().solve(bb);
+      const double scale = ref.cwiseAbs().maxCoeff();
+      for (long i = 0; i < n; ++i)
+        EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-12 * scale) << "n=" << n << " rank=" << rank << " i=" << i;
+    }
+}
