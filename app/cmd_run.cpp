@@ -122,6 +122,14 @@ int run3d(const RunOptions& o, const scene::json& sc) {
               si(s["mean_velocity_m_per_s"].get<double>(), "m/s").c_str(), s["body_lengths_per_s"].get<double>(),
               per_cycle.c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps,
               si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
+  // a wall that buckled into lobes beyond half a cell: its pattern, and the displacement
+  // that depends on it, follow the grid (docs/full3d.md, "Wall wrinkling")
+  if (s.contains("max_wrinkle_over_h") && s["max_wrinkle_over_h"].get<double>() > 0.5)
+    std::fprintf(stderr,
+                 "swim: note: the tube wall wrinkled (azimuthal lobes up to %s RMS, %.2g cells): the lobes follow the "
+                 "grid, so the displacement depends on full3d.grid.cells_across; a wall stiff enough in bending "
+                 "(full3d.membrane.bending_rigidity, docs/full3d.md \"Wall wrinkling\") keeps it round\n",
+                 si(s["max_wrinkle_m"].get<double>(), "m").c_str(), s["max_wrinkle_over_h"].get<double>());
   if (o.plot) plot("plot_run.py", {out});
   if (r.failed) {
     std::fprintf(stderr, "swim: %s\n  partial results and the last checkpoint kept in %s\n", r.message.c_str(),

@@ -216,6 +216,10 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
               {"membrane_frames", fs::exists(fs::path(dir) / "membrane.pvd")},
               {"pumped_volume_m3", summary.value("pumped_volume_m3", 0.0)},
               {"has_cycle", r.cyc.has_cycle}};
+  // the wall's largest departure from axisymmetry (runs written before the wrinkle measure
+  // existed have none)
+  for (const char* k : {"max_wrinkle_m", "max_wrinkle_over_h"})
+    if (summary.contains(k) && summary[k].is_number()) r.record[k] = summary[k];
   if (r.cyc.has_cycle) {
     r.record["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
     r.record["cycle_time_s"] = r.cyc.cycle_time_s;

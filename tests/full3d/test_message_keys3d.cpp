@@ -26,6 +26,7 @@ std::set<std::string> accepted_keys() {
       {"container.kind=\"cylinder\""},
       {"full3d.grid.cell_size=null", "full3d.grid.cells_across=12"},
       {"full3d.adaptive.enabled=true", "full3d.output.fluid_fields=true"},
+      {"full3d.membrane.bending_rigidity=\"2e-24 J\""},
   };
   std::set<std::string> keys = swim::testing::resolved_keys(scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json"), variants,
                                                             [](const scene::json& sc, scene::json& r) { swim::full3d::read_scene3d(sc, r); });
