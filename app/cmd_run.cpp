@@ -124,6 +124,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
               si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
   // a wall that buckled into lobes beyond half a cell: its pattern, and the displacement
   // that depends on it, follow the grid (docs/full3d.md, "Wall wrinkling")
+  std::fflush(stdout);  // the note follows the result line, also when both go to one file
   if (s.contains("max_wrinkle_over_h") && s["max_wrinkle_over_h"].get<double>() > 0.5)
     std::fprintf(stderr,
                  "swim: note: the tube wall wrinkled (azimuthal lobes up to %s RMS, %.2g cells): the lobes follow the "

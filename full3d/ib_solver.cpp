@@ -63,6 +63,29 @@ void IbSolver::guard_finite(const Eigen::Matrix3Xd& A, const char* what, double 
                          dt_remedy(), t);
 }
 
+void project_axisymmetric(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd& U) {
+  const int nt = mesh.n_theta;
+  const double y0 = mesh.axis_start[1], z0 = mesh.axis_start[2];
+  for (int r = 0; r < mesh.n_rings; ++r) {
+    double ux = 0.0, ur = 0.0;
+    for (int i = 0; i < nt; ++i) {
+      const int k = mesh.node(r, i);
+      const double dy = X(1, k) - y0, dz = X(2, k) - z0, rho = std::hypot(dy, dz);
+      ux += U(0, k);
+      if (rho > 0.0) ur += (U(1, k) * dy + U(2, k) * dz) / rho;
+    }
+    ux /= nt;
+    ur /= nt;
+    for (int i = 0; i < nt; ++i) {
+      const int k = mesh.node(r, i);
+      const double dy = X(1, k) - y0, dz = X(2, k) - z0, rho = std::hypot(dy, dz);
+      U(0, k) = ux;
+      U(1, k) = rho > 0.0 ? ur * dy / rho : 0.0;
+      U(2, k) = rho > 0.0 ? ur * dz / rho : 0.0;
+    }
+  }
+}
+
 IbStepStats IbSolver::step(IbState& s, double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(opt_.dt_key, num(dt), "a positive time step in s");
   IbStepStats st;
@@ -94,6 +117,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     st.stokes_iterations = ss.iterations;
     st.max_divergence = ss.max_divergence;
     interpolate(grid_, u, s.X, U, opt_.threads);
+    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, s.X, U);
     lap(st.time_interp);
     Xnew = s.X + dt * U;
   } else {
@@ -104,6 +128,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     const StokesStats s1 = stokes_.step(uh, f, 0.5 * dt);
     lap(st.time_fluid);
     interpolate(grid_, uh, s.X, U, opt_.threads);
+    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, s.X, U);
     lap(st.time_interp);
     guard_finite(U, "node velocity", s.t);
     const Eigen::Matrix3Xd U0 = U;
@@ -118,6 +143,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     st.stokes_iterations = s1.iterations + s2.iterations;
     st.max_divergence = s2.max_divergence;
     interpolate(grid_, u, Xh, U, opt_.threads);
+    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, Xh, U);
     lap(st.time_interp);
     Xnew = s.X + dt * U;
     st.max_velocity_change = (U - U0).colwise().norm().maxCoeff();

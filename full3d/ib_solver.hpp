@@ -40,8 +40,18 @@ struct IbOptions {
   bool reject_on_cfl = false;
   std::string dt_key = "dt";  ///< name of the time step in remedies (the run driver passes "full3d.dt")
   int threads = 1;            ///< threads for spreading, interpolation and membrane forces (parallel.hpp)
+  /// true: the wall moves in axisymmetric ring motions only. Each ring's interpolated node
+  /// velocities are replaced by the ring's mean axial velocity plus its mean radial velocity
+  /// along each node's own radial direction (no azimuthal or lobed motion), so the rings stay
+  /// circles about the tube axis (full3d.membrane.axisymmetric, docs/full3d.md "Wall wrinkling").
+  bool axisymmetric_wall = false;
   StokesOptions stokes{};
 };
+
+/// The axisymmetric part of node velocities U of the mesh's rings (IbOptions::axisymmetric_wall),
+/// in place: per ring, the mean axial velocity and the mean radial velocity along each
+/// node's radial direction from the axis through mesh.axis_start.
+void project_axisymmetric(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd& U);
 
 struct IbState {
   double t = 0.0;          ///< s

@@ -22,6 +22,7 @@ IbOptions ib_options(const Params3d& p) {
   o.max_cfl = p.max_cfl;
   o.dt_key = "full3d.dt";
   o.threads = p.threads;
+  o.axisymmetric_wall = p.axisymmetric_wall;
   o.stokes.fft.threads = p.threads;
   o.stokes.threads = p.threads;
   if (p.container == "cylinder") {

@@ -173,6 +173,7 @@ Params3d read_scene3d(const json& scene, json& resolved) {
                                ? BendingForm::Printed
                                : BendingForm::ReferenceAngle;
       p.spacing_factor = m.number("spacing_factor", 0.6, Range::open(0.0, 1.0));
+      p.axisymmetric_wall = m.boolean("axisymmetric", false);
       m.finish();
     }
     p.wall_inertia = f.boolean("wall_inertia", false);

@@ -56,6 +56,9 @@ struct Params3d {
   /// full3d.membrane.bending_rigidity, J (0: not given). When given, membrane.kb is set so
   /// that eq. (8) gives the wall this rigidity on the run's mesh (bending_rigidity_per_kb).
   double bending_rigidity = 0.0;
+  /// full3d.membrane.axisymmetric: the wall moves in axisymmetric ring motions only
+  /// (IbOptions::axisymmetric_wall); false (default): every node follows the fluid.
+  bool axisymmetric_wall = false;
   double spacing_factor = 0.6;     ///< longest reference edge < factor * h/2 (docs/full3d.md)
   double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md); fixed step
   AdaptiveStep adaptive{};         ///< full3d.adaptive: step control instead of the fixed dt

@@ -9,6 +9,7 @@
 
 #include "common/errors.hpp"
 #include "full3d/membrane.hpp"
+#include "full3d/ib_solver.hpp"
 #include "full3d/run3d_measure.hpp"
 
 using namespace swim::full3d;
@@ -248,9 +249,48 @@ TEST(MembraneForces, PaperBendingRigidityIsProportionalToTheEdgeLength) {
       std::printf("n_theta %d, edge %.3g m, m = %d: D / k_b = %.4g m, D / (k_b a) = %.4f\n", n, a, lobes, d_per_kb,
                   d_per_kb / a);
       if (lobes == 4) {
-        if (prev > 0) EXPECT_NEAR(prev / d_per_kb, 2.0, 0.1);
+        if (prev > 0) {
+          EXPECT_NEAR(prev / d_per_kb, 2.0, 0.1);
+        }
         prev = d_per_kb;
       }
     }
   }
+}
+
+// The axisymmetric wall (IbOptions::axisymmetric_wall): the projected node velocities are,
+// ring by ring, one axial velocity plus one radial speed along each node's radial direction;
+// an axisymmetric field is left as it is; the projection is idempotent; rings moved with it
+// stay circles about the axis (wall wrinkle zero).
+TEST(MembraneMeasure, AxisymmetricProjectionKeepsTheRingsCircles) {
+  const CylinderMesh m = small_mesh();
+  std::mt19937 rng(11);
+  std::normal_distribution<double> N(0.0, 1e-6);
+  Eigen::Matrix3Xd U(3, m.nodes());
+  for (Eigen::Index i = 0; i < U.size(); ++i) U.data()[i] = N(rng);
+  Eigen::Matrix3Xd P = U;
+  project_axisymmetric(m, m.X0, P);
+  for (int r = 0; r < m.n_rings; ++r) {
+    const int k0 = m.node(r, 0);
+    const Eigen::Vector3d d0 = m.X0.col(k0) - m.axis_start;
+    const double ur0 = (P(1, k0) * d0.y() + P(2, k0) * d0.z()) / std::hypot(d0.y(), d0.z());
+    double ux_mean = 0.0;
+    for (int i = 0; i < m.n_theta; ++i) ux_mean += U(0, m.node(r, i)) / m.n_theta;
+    for (int i = 0; i < m.n_theta; ++i) {
+      const int k = m.node(r, i);
+      const Eigen::Vector3d d = m.X0.col(k) - m.axis_start;
+      const double rho = std::hypot(d.y(), d.z());
+      EXPECT_NEAR(P(0, k), ux_mean, 1e-18);
+      EXPECT_NEAR((P(1, k) * d.y() + P(2, k) * d.z()) / rho, ur0, 1e-18);   // one radial speed
+      EXPECT_NEAR((-P(1, k) * d.z() + P(2, k) * d.y()) / rho, 0.0, 1e-18);  // no azimuthal motion
+    }
+  }
+  Eigen::Matrix3Xd Q = P;
+  project_axisymmetric(m, m.X0, Q);
+  EXPECT_LT((Q - P).cwiseAbs().maxCoeff(), 1e-20);
+  // one step of 5 % of R0 with the projected and with the raw velocities
+  const Eigen::Matrix3Xd Xp = m.X0 + (0.05 * kR0 / P.cwiseAbs().maxCoeff()) * P;
+  const Eigen::Matrix3Xd Xu = m.X0 + (0.05 * kR0 / U.cwiseAbs().maxCoeff()) * U;
+  EXPECT_LT(wall_wrinkle(m, node_radii(m, Xp), ring_radii(m, Xp)), 1e-12 * kR0);
+  EXPECT_GT(wall_wrinkle(m, node_radii(m, Xu), ring_radii(m, Xu)), 1e-3 * kR0);
 }

@@ -112,7 +112,9 @@ TEST(ShippedScenes3d, BendingRigidityIsTheSameWallOnEveryGrid) {
     scene::json again;
     EXPECT_DOUBLE_EQ(read_scene3d(resolved, again).membrane.kb, p.membrane.kb);
     const double edge = mesh.rest_length.mean();
-    if (kb_prev > 0) EXPECT_NEAR(p.membrane.kb / kb_prev, edge_prev / edge, 0.05 * edge_prev / edge);
+    if (kb_prev > 0) {
+      EXPECT_NEAR(p.membrane.kb / kb_prev, edge_prev / edge, 0.05 * edge_prev / edge);
+    }
     kb_prev = p.membrane.kb;
     edge_prev = edge;
   }
