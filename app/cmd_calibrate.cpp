@@ -71,8 +71,10 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
                              {"dt_s", w.dt_s},
                              {"simulated_time_s", w.simulated_time_s},
                              {"wall_time_s", w.wall_time_s},
+                             {"axisymmetric_wall", w.axisymmetric_wall},
                              {"method", "fluid-coupled immersed-boundary run of the same uniform load, stepped until "
-                                        "the middle radius is steady"}};
+                                        "the middle radius is steady; the wall moves in ring motions only (the "
+                                        "symmetric branch of the static path)"}};
   output::write_json(out + "/calibration.json", j);
   plot("plot_calibration.py", {out});
   int stable = 0;
@@ -113,7 +115,8 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
                 si(tt.drag_coefficient_uncertainty_N_s_per_m, "N s/m").c_str(), tt.cg_iterations,
                 si(tt.wall_time_s, "s").c_str(), tow.nominal.note.c_str());
   if (wet && confirm)
-    std::printf("  wet confirmation at %s: displacement %s against %s static (%+.2f %%), %s after %d steps of %s\n",
+    std::printf("  wet confirmation at %s (axisymmetric wall): displacement %s against %s static (%+.2f %%), %s after %d "
+                "steps of %s\n",
                 si(w.pressure_Pa, "Pa").c_str(), si(w.displacement_m, "m").c_str(),
                 si(w.static_displacement_m, "m").c_str(), 100.0 * w.relative_difference,
                 w.steady ? "steady" : "NOT steady", w.steps, si(w.dt_s, "s").c_str());

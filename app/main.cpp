@@ -73,7 +73,7 @@ int main(int argc, char** argv) {
   cal->add_option("--out", cal_out, "Output directory (default out/<name>-calibration)");
   cal->add_option("--set", cal_sets, "Override a scene value: key.path=value");
   bool cal_wet = false;
-  cal->add_flag("--wet", cal_wet, "Also confirm the largest fitted load with a fluid-coupled 3D run (up to 4 000 steps: minutes)");
+  cal->add_flag("--wet", cal_wet, "Also confirm the largest fitted load with a fluid-coupled 3D run, the wall held axisymmetric as in the static path (up to 4 000 steps: minutes)");
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
   std::string val_suite, val_out;
   bool val_quick = false;

@@ -184,12 +184,14 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
   return c;
 }
 
-WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m) {
+WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,
+                            bool axisymmetric_wall) {
   const auto t0 = std::chrono::steady_clock::now();
   const full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
   const full3d::CylinderMesh mesh = full3d::make_mesh(p);
   full3d::IbOptions opt = full3d::ib_options(p);
   opt.dt_key = "full3d.dt";
+  opt.axisymmetric_wall = axisymmetric_wall;
   full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), opt);
   const Eigen::VectorXd area = mesh.node_area;
   ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) {
@@ -207,6 +209,7 @@ WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double s
     return mesh.radius - 0.5 * (rr[r0] + rr[r1]);
   };
   WetConfirmation w;
+  w.axisymmetric_wall = axisymmetric_wall;
   w.pressure_Pa = pressure;
   w.static_displacement_m = static_displacement_m;
   std::vector<double> t_hist, d_hist;

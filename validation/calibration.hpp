@@ -64,7 +64,10 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
 /// container, under the same uniform inward pressure, stepped (forward Euler, the step set to
 /// half the explicit stability limit of the coupling, IbSolver::explicit_rate) until the middle
 /// radius is steady: it changes by less than 1e-3 of its displacement over the last tenth of
-/// the elapsed time, or 4 000 steps pass.
+/// the elapsed time, or 4 000 steps pass. With axisymmetric_wall (the default) the wall moves
+/// in ring motions only (IbOptions::axisymmetric_wall), the branch the static path computes
+/// and C1 describes; the free wall buckles into lobes beyond a few per cent of the target load
+/// (docs/validation.md).
 struct WetConfirmation {
   double pressure_Pa = 0;
   double displacement_m = 0;         ///< R0 - R_mid at the end of the wet run
@@ -73,8 +76,10 @@ struct WetConfirmation {
   double simulated_time_s = 0, dt_s = 0, wall_time_s = 0;
   int steps = 0;
   bool steady = false;
+  bool axisymmetric_wall = true;
 };
-WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m);
+WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,
+                            bool axisymmetric_wall = true);
 
 /// calibration.json: the fit, the load points, the wall mass per area, the grid and the scene.
 scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const scene::json& resolved);

@@ -83,3 +83,20 @@ TEST(HydraulicRadii, HeldTubeInPaperCylinder) {
   // the container's no-slip surface is within a cell of its nominal radius
   EXPECT_NEAR(r.container_radius_effective_m, p.container_radius, p.h);
 }
+
+// The wet confirmation of a static load: the immersed tube, its wall held axisymmetric (the
+// branch the static path computes), settles on the static displacement. Coarse grid, 5 % of
+// the load that holds R_f.
+TEST(WetConfirmation, TheImmersedRoundTubeSettlesOnTheStaticDisplacement) {
+  full3d::Params3d p = paper_scene(16);
+  p.threads = 2;
+  const double q = 0.05 * p.c1_estimate() * (p.R0 - p.protocol.R_f);
+  const validation::StaticCalibration c = validation::calibrate_static(p, {q});
+  ASSERT_EQ(c.loads.size(), 1u);
+  const validation::WetConfirmation w = validation::confirm_wet(p, q, c.loads[0].displacement_m);
+  std::printf("static %.4g m, wet %.4g m (%+.2f %%), %d steps of %.3g s, %.1f s\n", w.static_displacement_m,
+              w.displacement_m, 100 * w.relative_difference, w.steps, w.dt_s, w.wall_time_s);
+  EXPECT_TRUE(w.axisymmetric_wall);
+  EXPECT_TRUE(w.steady);
+  EXPECT_NEAR(w.relative_difference, 0.0, 0.02);
+}
