@@ -46,6 +46,20 @@ void expect_same(N_Vector a, N_Vector b, double tol, const char* what) {
     EXPECT_NEAR(sun::data(a)[i], sun::data(b)[i], tol * (1.0 + std::abs(sun::data(b)[i]))) << what << " i=" << i;
 }
 
+
+// Fills the tridiagonal band matrix A (n x n, bandwidths 1) with random entries, diagonal
+// diag + rng() and off-diagonal off * rng(); returns the same matrix dense.
+Eigen::MatrixXd fill_tridiagonal(SUNMatrix A, long n, Rng& rng, double diag, double off) {
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+  for (long i = 0; i < n; ++i)
+    for (long j = std::max(0L, i - 1); j <= std::min(n - 1, i + 1); ++j) {
+      const double v = i == j ? diag + rng() : off * rng();
+      SM_ELEMENT_B(A, i, j) = v;
+      D(i, j) = v;
+    }
+  return D;
+}
+
 }  // namespace
 
 // Every overridden operation gives the reference result to round-off (1e-14 relative).
@@ -129,15 +143,9 @@ TEST(SundialsKernels, LowRankBandSolverMatchesADenseSolve) {
       s_value = -0.37;
       term.scale = [](void*) { return s_value; };
       auto solver = sun::make_low_rank_band_solver(y.get(), A.get(), &term, ctx.get());
-      Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
-      for (long i = 0; i < n; ++i)
-        for (long j = std::max(0L, i - 1); j <= std::min(n - 1, i + 1); ++j) {
-          // a Newton-like matrix whose sub-diagonal often exceeds the diagonal, so that
-          // partial pivoting swaps rows
-          const double v = i == j ? 2.0 + rng() : 3.0 * rng();
-          SM_ELEMENT_B(A.get(), i, j) = v;
-          D(i, j) = v;
-        }
+      // a Newton-like matrix whose sub-diagonal often exceeds the diagonal, so that partial
+      // pivoting swaps rows
+      Eigen::MatrixXd D = fill_tridiagonal(A.get(), n, rng, 2.0, 3.0);
       term.rank = rank;
       term.U.assign(std::size_t(n) * rank, 0.0);
       term.V.assign(std::size_t(n) * rank, 0.0);
@@ -184,13 +192,7 @@ TEST(SundialsKernels, LowRankBandSolverPivotsTheCapacitanceMatrix) {
       sun::Matrix A(SUNBandMatrix(n, 1, 1, ctx.get()));
       sun::LowRankTerm term;  // scale 1
       auto solver = sun::make_low_rank_band_solver(y.get(), A.get(), &term, ctx.get());
-      Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
-      for (long i = 0; i < n; ++i)
-        for (long j = std::max(0L, i - 1); j <= std::min(n - 1, i + 1); ++j) {
-          const double v = i == j ? 4.0 + rng() : 0.5 * rng();
-          SM_ELEMENT_B(A.get(), i, j) = v;
-          D(i, j) = v;
-        }
+      Eigen::MatrixXd D = fill_tridiagonal(A.get(), n, rng, 4.0, 0.5);
       // U: disjoint blocks of cells (like the held segments), V: the same blocks shifted by
       // one term, so that V^T M^{-1} U is large below its diagonal.
       term.rank = rank;
