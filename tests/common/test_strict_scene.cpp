@@ -287,18 +287,6 @@ void leaves(const json& schema, const std::string& path, std::vector<std::pair<s
       out.emplace_back(p, it.value().get<std::string>());
   }
 }
-json at_path(const json& j, const std::string& path) {
-  const json* n = &j;
-  size_t a = 0;
-  for (;;) {
-    const size_t b = path.find('.', a);
-    const std::string k = path.substr(a, b == std::string::npos ? std::string::npos : b - a);
-    if (!n->is_object() || !n->contains(k)) return nullptr;
-    n = &n->at(k);
-    if (b == std::string::npos) return *n;
-    a = b + 1;
-  }
-}
 }  // namespace
 
 TEST(StrictScene, SectionKeyListsMatchTheTierReaders) {
