@@ -64,24 +64,20 @@ void IbSolver::guard_finite(const Eigen::Matrix3Xd& A, const char* what, double 
 }
 
 void project_axisymmetric(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd& U) {
-  const int nt = mesh.n_theta;
-  const double y0 = mesh.axis_start[1], z0 = mesh.axis_start[2];
+  const Eigen::Matrix3Xd er = radial_directions(mesh, X);
   for (int r = 0; r < mesh.n_rings; ++r) {
     double ux = 0.0, ur = 0.0;
-    for (int i = 0; i < nt; ++i) {
+    for (int i = 0; i < mesh.n_theta; ++i) {
       const int k = mesh.node(r, i);
-      const double dy = X(1, k) - y0, dz = X(2, k) - z0, rho = std::hypot(dy, dz);
       ux += U(0, k);
-      if (rho > 0.0) ur += (U(1, k) * dy + U(2, k) * dz) / rho;
+      ur += U.col(k).dot(er.col(k));
     }
-    ux /= nt;
-    ur /= nt;
-    for (int i = 0; i < nt; ++i) {
+    ux /= mesh.n_theta;
+    ur /= mesh.n_theta;
+    for (int i = 0; i < mesh.n_theta; ++i) {
       const int k = mesh.node(r, i);
-      const double dy = X(1, k) - y0, dz = X(2, k) - z0, rho = std::hypot(dy, dz);
+      U.col(k) = ur * er.col(k);
       U(0, k) = ux;
-      U(1, k) = rho > 0.0 ? ur * dy / rho : 0.0;
-      U(2, k) = rho > 0.0 ? ur * dz / rho : 0.0;
     }
   }
 }
