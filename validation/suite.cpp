@@ -132,13 +132,62 @@ json physics_of(json resolved) {
   return resolved;
 }
 
+/// A run folder's scene.resolved.json resolved again by the current scene reader: keys the
+/// reader gained since the run was written appear with their defaults, so a run stays found
+/// as long as its physics is what the scene would resolve to today. null when the reader
+/// no longer accepts it.
+json current_resolution(const json& written) {
+  try {
+    json again;
+    full3d::read_scene3d(written, again);
+    return again;
+  } catch (const std::exception&) {
+    return nullptr;
+  }
+}
+
+/// A calibration file under `cal_dir` written in the current format for a scene whose physics,
+/// resolved by the current reader, is `physics`; empty when there is none. A folder's name
+/// carries the hash of the physics it was written for and of its format version, which
+/// tells an older format apart.
+std::string cached_calibration(const std::string& cal_dir, const json& physics) {
+  if (!fs::is_directory(cal_dir)) return {};
+  for (const auto& e : fs::directory_iterator(cal_dir)) {
+    const fs::path file = e.path() / "calibration.json";
+    std::ifstream in(file);
+    if (!in) continue;
+    const json c = json::parse(in, nullptr, false);
+    if (c.is_discarded() || !c.contains("scene")) continue;
+    const std::string folder = e.path().filename().string();
+    const std::string written_for = output::json_hash({physics_of(c["scene"]), kCalibrationFormat});
+    if (folder.size() < written_for.size() || folder.compare(folder.size() - written_for.size(), written_for.size(), written_for) != 0)
+      continue;
+    if (physics_of(current_resolution(c["scene"])) == physics) return file.string();
+  }
+  return {};
+}
+
+/// A summary written while its run was going on ("running: last checkpoint at ...").
+bool is_running(const json& summary) {
+  const std::string st = summary.value("status", std::string());
+  return st.rfind("running", 0) == 0;
+}
+
 /// A finished run (summary status not "running") in `dir`, or null.
 json finished_summary(const std::string& dir) {
   std::ifstream in(dir + "/summary.json");
   if (!in) return nullptr;
   json s = json::parse(in, nullptr, false);
-  if (s.is_discarded() || !s.contains("status") || s["status"] == "running") return nullptr;
+  if (s.is_discarded() || !s.contains("status") || !s["status"].is_string() || is_running(s)) return nullptr;
   return s;
+}
+
+/// A run that was stopped before its end and left a checkpoint to continue from.
+bool interrupted_run(const std::string& dir) {
+  std::ifstream in(dir + "/summary.json");
+  if (!in) return false;
+  const json s = json::parse(in, nullptr, false);
+  return !s.is_discarded() && is_running(s) && fs::exists(full3d::checkpoint_path(dir));
 }
 
 /// frame_interval > 0: membrane frames (VTK) at that interval, for the side-view figure.
@@ -167,7 +216,7 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
       std::ifstream in(e.path() / "scene.resolved.json");
       if (!in) continue;
       const json other = json::parse(in, nullptr, false);
-      if (other.is_discarded() || output::json_hash(physics_of(other)) != key) continue;
+      if (other.is_discarded() || output::json_hash(physics_of(current_resolution(other))) != key) continue;
       summary = finished_summary(e.path().string());
       if (!summary.is_null()) {
         dir = e.path().string();
@@ -175,7 +224,17 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
       }
     }
   *cached = !summary.is_null();
-  if (!*cached) {
+  // a run of this physics stopped part way (the suite was interrupted) continues from its
+  // checkpoint when the checkpoint matches the scene
+  bool resume = false;
+  if (!*cached && interrupted_run(dir)) {
+    try {
+      full3d::check_resumable(p, resolved, dir);
+      resume = true;
+    } catch (const InputError&) {
+    }
+  }
+  if (!*cached && !resume) {
     fs::remove_all(dir);
     fs::create_directories(dir);
   }
@@ -186,9 +245,11 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
     ctl.progress = 0;
     ctl.quiet_vtk = frame_interval <= 0;
     ctl.keep_rows = true;
+    ctl.resume = resume;
     full3d::RunOutcome out = full3d::run3d(p, resolved, dir, ctl);
     summary = out.summary;
-    rec = std::move(out.record);
+    // a resumed run holds only this process's rows in memory: the whole run is in its folder
+    rec = resume ? record::read_run(dir) : std::move(out.record);
   } else {
     rec = record::read_run(dir);
   }
@@ -560,6 +621,10 @@ json run_suite(const SuiteOptions& o) {
       // keyed by the physics of the resolved scene and the calibration file's format version
       const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
       cal_file = dir + "/calibration.json";
+      if (!fs::exists(cal_file)) {
+        const std::string found = cached_calibration(cal_dir, physics_of(resolved));
+        if (!found.empty()) cal_file = found;
+      }
       if (fs::exists(cal_file)) {
         std::ifstream in(cal_file);
         cal_j = json::parse(in);

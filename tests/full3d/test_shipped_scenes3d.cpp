@@ -45,6 +45,30 @@ TEST(ShippedScenes3d, ResolveWithTheMembraneInsideTheNoLeakBound) {
   }
 }
 
+// A resolved scene read back resolves to itself: run folders keep scene.resolved.json, and
+// the validation cache finds a run by resolving that file again with the current reader.
+TEST(ShippedScenes3d, ResolvedSceneResolvesToItself) {
+  for (const auto& f : shipped_scenes()) {
+    SCOPED_TRACE(f);
+    scene::json resolved, again;
+    const Params3d p = read_scene3d(scene::load_file(f), resolved);
+    const Params3d q = read_scene3d(resolved, again);
+    EXPECT_EQ(again, resolved);
+    EXPECT_EQ(q.nx, p.nx);
+    EXPECT_EQ(q.h, p.h);
+    EXPECT_EQ(q.dt, p.dt);
+    EXPECT_EQ(q.membrane.kb, p.membrane.kb);
+  }
+  // an older resolution without a key the reader gained resolves to the same scene
+  scene::json resolved, again;
+  read_scene3d(scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json"), resolved);
+  ASSERT_TRUE(resolved["full3d"]["membrane"].contains("axisymmetric"));
+  scene::json older = resolved;
+  older["full3d"]["membrane"].erase("axisymmetric");
+  read_scene3d(older, again);
+  EXPECT_EQ(again, resolved);
+}
+
 TEST(ShippedScenes3d, FirstStepsRunOnACoarseGrid) {
   for (const auto& f : shipped_scenes()) {
     SCOPED_TRACE(f);
