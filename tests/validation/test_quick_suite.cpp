@@ -1,5 +1,6 @@
 // The quick validation suite end to end (swim validate --quick, without the figures): three
-// coarse 3D grids of the small duct scene, the calibration, every 1D model, the report.
+// coarse 3D grids of the small duct scene, the calibration, every 1D model, the report; the
+// cache of runs (other output settings, an older resolution, an interrupted run).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,8 @@
 
 #include "common/scene.hpp"
 
+#include "full3d/run3d.hpp"
+#include "full3d/scene3d.hpp"
 #include "validation/suite.hpp"
 
 using namespace swim;
@@ -102,4 +105,40 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   o.suite = edited;
   const scene::json r3 = validation::run_suite(o);
   for (std::size_t g = 0; g < 3; ++g) EXPECT_TRUE(r3["cases"][0]["runs3d"][g]["cached"].get<bool>()) << g;
+
+  // a run folder written before the scene reader gained a key (here the round-wall switch,
+  // whose default leaves the physics as it was), under another folder name, is still found
+  {
+    const fs::path folder = c["runs3d"][1]["folder"].get<std::string>();
+    scene::json older = scene::load_file((folder / "scene.resolved.json").string());
+    ASSERT_TRUE(older["full3d"]["membrane"].contains("axisymmetric"));
+    older["full3d"]["membrane"].erase("axisymmetric");
+    std::ofstream(folder / "scene.resolved.json") << older.dump(2);
+    fs::rename(folder, folder.string() + "-older");
+  }
+  // a run stopped part way (the suite interrupted) continues from its checkpoint and ends
+  // where the uninterrupted run ended
+  const std::string stopped = c["runs3d"][0]["folder"].get<std::string>();
+  {
+    scene::json resolved = scene::load_file(stopped + "/scene.resolved.json"), again;
+    const full3d::Params3d p = full3d::read_scene3d(resolved, again);
+    fs::remove_all(stopped);
+    fs::create_directories(stopped);
+    full3d::RunControl ctl;
+    ctl.progress = 0;
+    ctl.quiet_vtk = true;
+    ctl.stop_after_steps = c["runs3d"][0]["steps"].get<long>() / 2;
+    const full3d::RunOutcome part = full3d::run3d(p, again, stopped, ctl);
+    ASSERT_TRUE(part.interrupted);
+    ASSERT_TRUE(fs::exists(stopped + "/checkpoint.bin"));
+  }
+  const scene::json r4 = validation::run_suite(o);
+  const scene::json& c4 = r4["cases"][0];
+  EXPECT_FALSE(c4["runs3d"][0]["cached"].get<bool>());
+  EXPECT_EQ(c4["runs3d"][0]["folder"], stopped);
+  EXPECT_EQ(c4["runs3d"][0]["displacement_per_cycle_m"], c["runs3d"][0]["displacement_per_cycle_m"]);
+  EXPECT_EQ(c4["runs3d"][0]["cycle_time_s"], c["runs3d"][0]["cycle_time_s"]);
+  EXPECT_TRUE(c4["runs3d"][1]["cached"].get<bool>());
+  EXPECT_EQ(c4["runs3d"][1]["folder"], c["runs3d"][1]["folder"].get<std::string>() + "-older");
+  EXPECT_EQ(c4["runs3d"][1]["displacement_per_cycle_m"], c["runs3d"][1]["displacement_per_cycle_m"]);
 }
