@@ -72,8 +72,19 @@ double Measurements::kinetic_energy(const IbState& s) const {
   return k;
 }
 
+std::array<double, 2> Measurements::elastic_parts(const IbState& s) const {
+  if (s.t != parts_t_ || s.X.data() != parts_x_) {
+    const MembraneParams& m = run_.p.membrane;
+    parts_ = {stretching_energy(run_.mesh, s.X, m.ks), bending_energy(run_.mesh, s.X, m.kb, m.bending)};
+    parts_t_ = s.t;
+    parts_x_ = s.X.data();
+  }
+  return parts_;
+}
+
 double Measurements::wall_energy(const IbState& s) const {
-  return elastic_energy(run_.mesh, s.X, run_.p.membrane) + kinetic_energy(s);
+  const auto [es, eb] = elastic_parts(s);
+  return es + eb + kinetic_energy(s);
 }
 
 void Measurements::guards(double e, const IbState& s) {
@@ -130,11 +141,10 @@ double Measurements::disc_flux(int ring, const IbState& s, const MacGrid& grid) 
 
 void Measurements::record(const IbState& s, const ProtocolState& st, long n, double dt_last) {
   const CylinderMesh& mesh = run_.mesh;
-  const MembraneParams& membrane = run_.p.membrane;
-  const Eigen::VectorXd rr = ring_radii(mesh, s.X);
   const Eigen::VectorXd rn = node_radii(mesh, s.X);
-  const double es = stretching_energy(mesh, s.X, membrane.ks);
-  const double eb = bending_energy(mesh, s.X, membrane.kb, membrane.bending);
+  Eigen::VectorXd rr = Eigen::VectorXd::Zero(mesh.n_rings);  // ring_radii from rn
+  for (int i = 0; i < mesh.nodes(); ++i) rr[mesh.ring_of(i)] += rn[i] / mesh.n_theta;
+  const auto [es, eb] = elastic_parts(s);
   const double ek = kinetic_energy(s);
   double vol = 0;
   const int nt = mesh.n_theta;

@@ -62,6 +62,9 @@ class Measurements {
   template <class Self, class F>
   static void records(Self& self, F&& f);
   double kinetic_energy(const IbState& s) const;
+  /// Stretching and bending energy of the wall in state s; kept for the state at s.t, which the
+  /// energy guard and the output row of one step both ask for.
+  std::array<double, 2> elastic_parts(const IbState& s) const;
   double disc_flux(int ring, const IbState& s, const MacGrid& grid) const;
 
   const RunSetup& run_;
@@ -73,6 +76,9 @@ class Measurements {
   double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0;
   long iterations_total_ = 0, last_iterations_ = 0;
   long last_recorded_ = -1;
+  mutable double parts_t_ = -1.0;
+  mutable const double* parts_x_ = nullptr;
+  mutable std::array<double, 2> parts_{};
 };
 
 }  // namespace swim::full3d

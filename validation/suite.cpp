@@ -132,6 +132,18 @@ json physics_of(json resolved) {
   return resolved;
 }
 
+/// The physics without the scene's name and description: two scenes that differ only in
+/// those (the paper's amplitude sweep at 0.55 R0 and its aspect sweep at 0.4 um are one
+/// swimmer) share their runs and calibrations.
+json same_swimmer(json resolved) {
+  resolved = physics_of(std::move(resolved));
+  if (resolved.is_object()) {
+    resolved.erase("name");
+    resolved.erase("description");
+  }
+  return resolved;
+}
+
 /// A run folder's scene.resolved.json resolved again by the current scene reader: keys the
 /// reader gained since the run was written appear with their defaults, so a run stays found
 /// as long as its physics is what the scene would resolve to today. null when the reader
@@ -147,9 +159,9 @@ json current_resolution(const json& written) {
 }
 
 /// A calibration file under `cal_dir` written in the current format for a scene whose physics,
-/// resolved by the current reader, is `physics`; empty when there is none. A folder's name
-/// carries the hash of the physics it was written for and of its format version, which
-/// tells an older format apart.
+/// resolved by the current reader, is `physics` (same_swimmer); empty when there is none. A
+/// folder's name carries the hash of the physics it was written for and of its format
+/// version, which tells an older format apart.
 std::string cached_calibration(const std::string& cal_dir, const json& physics) {
   if (!fs::is_directory(cal_dir)) return {};
   for (const auto& e : fs::directory_iterator(cal_dir)) {
@@ -162,7 +174,7 @@ std::string cached_calibration(const std::string& cal_dir, const json& physics) 
     const std::string written_for = output::json_hash({physics_of(c["scene"]), kCalibrationFormat});
     if (folder.size() < written_for.size() || folder.compare(folder.size() - written_for.size(), written_for.size(), written_for) != 0)
       continue;
-    if (physics_of(current_resolution(c["scene"])) == physics) return file.string();
+    if (same_swimmer(current_resolution(c["scene"])) == physics) return file.string();
   }
   return {};
 }
@@ -205,7 +217,7 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   const full3d::Params3d p = full3d::read_scene3d(s, resolved);
   // the cache is keyed by the physics of the resolved scene; a folder under another name
   // (written with other output settings) is found by its own scene.resolved.json
-  const std::string key = output::json_hash(physics_of(resolved));
+  const std::string key = output::json_hash(same_swimmer(resolved));
   std::string dir = runs_dir + "/" + p.name + "-3d-" + key;
   Run3d r;
   r.h = p.h;
@@ -216,7 +228,7 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
       std::ifstream in(e.path() / "scene.resolved.json");
       if (!in) continue;
       const json other = json::parse(in, nullptr, false);
-      if (other.is_discarded() || output::json_hash(physics_of(current_resolution(other))) != key) continue;
+      if (other.is_discarded() || output::json_hash(same_swimmer(current_resolution(other))) != key) continue;
       summary = finished_summary(e.path().string());
       if (!summary.is_null()) {
         dir = e.path().string();
@@ -622,7 +634,7 @@ json run_suite(const SuiteOptions& o) {
       const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
       cal_file = dir + "/calibration.json";
       if (!fs::exists(cal_file)) {
-        const std::string found = cached_calibration(cal_dir, physics_of(resolved));
+        const std::string found = cached_calibration(cal_dir, same_swimmer(resolved));
         if (!found.empty()) cal_file = found;
       }
       if (fs::exists(cal_file)) {
