@@ -38,6 +38,16 @@ def si(v, unit, digits=3):
     return f"{v / scale:.{digits}g} {p}{unit}"
 
 
+def wrinkle(run):
+    """The wall-wrinkle cell of a 3D run: absent for runs written before the measure, and
+    "round" below 1e-6 h (a wall held axisymmetric departs from circles by round-off only)."""
+    if "max_wrinkle_m" not in run:
+        return "—"
+    if run.get("max_wrinkle_over_h", 1.0) < 1e-6:
+        return "round"
+    return si(run["max_wrinkle_m"], "m")
+
+
 def legend_right(ax):
     """Legend beside the axes, off the data."""
     ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
@@ -313,7 +323,7 @@ def markdown(report, figs):
             out.append(f"| {json.dumps(r['grid_value'])} | {si(r['cell_size_m'], 'm')} | {r['status'][:60]} | "
                        f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
                        f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | "
-                       f"{si(r.get('max_wrinkle_m'), 'm') if 'max_wrinkle_m' in r else '—'} | {r['steps']} | "
+                       f"{wrinkle(r)} | {r['steps']} | "
                        f"{si(r['wall_time_s'], 's')}{' (cached)' if r['cached'] else ''} |")
         wr = [r for r in c["runs3d"] if r.get("max_wrinkle_over_h", 0) > 0.5]
         if wr:
