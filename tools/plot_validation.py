@@ -167,7 +167,7 @@ def pareto_figure(report, path):
     return True
 
 
-def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title):
+def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title, logx=False):
     cases = sorted([c for c in report["cases"] if c.get("group") == group and c.get("sweep_value") is not None],
                    key=lambda c: c["sweep_value"])
     if len(cases) < 2:
@@ -190,6 +190,11 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title):
             continue
         ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
     ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
+    if logx:
+        ax.set_xscale("log")
+        ax.set_xticks(x)
+        ax.set_xticklabels([f"{v:g}" for v in x])
+        ax.minorticks_off()
     legend_right(ax)
     save(fig, path)
     return True
@@ -465,6 +470,10 @@ def main(d):
                     "mean velocity per cycle [nm/s]", 1e9, f"{d}/fig_velocity_vs_length.png",
                     "Mean velocity per cycle against swimmer length (Figure 13)"):
         glob.append("fig_velocity_vs_length.png")
+    if sweep_figure(report, "container", "container radius Rc / R₀", "displacement_per_cycle_m",
+                    "displacement per cycle [nm]", 1e9, f"{d}/fig_distance_vs_container.png",
+                    "Distance per cycle against the container radius, L = 0.2 µm", logx=True):
+        glob.append("fig_distance_vs_container.png")
     if multicycle_figure(report, f"{d}/fig_multicycle.png"):
         glob.append("fig_multicycle.png")
     if pareto_figure(report, f"{d}/fig_pareto.png"):
