@@ -17,17 +17,24 @@ void make_dir(const std::string& dir) {
   if (ec) throw InputError("--out", "\"" + dir + "\"", "cannot create the output directory: " + ec.message());
 }
 
-bool all_finite(const json& v) {
-  if (v.is_number_float()) return std::isfinite(v.get<double>());
-  if (v.is_structured())
-    for (const auto& e : v)
-      if (!all_finite(e)) return false;
-  return true;
+std::string first_non_finite(const json& v, const std::string& at) {
+  if (v.is_number_float()) return std::isfinite(v.get<double>()) ? std::string() : (at.empty() ? "(top)" : at);
+  if (v.is_object()) {
+    for (const auto& [k, e] : v.items())
+      if (std::string p = first_non_finite(e, at.empty() ? k : at + "." + k); !p.empty()) return p;
+  } else if (v.is_array()) {
+    for (std::size_t i = 0; i < v.size(); ++i)
+      if (std::string p = first_non_finite(v[i], at + "[" + std::to_string(i) + "]"); !p.empty()) return p;
+  }
+  return {};
 }
 
+bool all_finite(const json& v) { return first_non_finite(v).empty(); }
+
 void write_json(const std::string& path, const json& value) {
-  if (!all_finite(value))
-    throw NumericalError("a non-finite number reached " + path, "report this scene; the solver should have stopped earlier");
+  if (const std::string at = first_non_finite(value); !at.empty())
+    throw NumericalError("a non-finite number reached " + path + " (at " + at + ")",
+                         "report this scene; the solver should have stopped earlier");
   const fs::path p(path);
   const bool summary = p.filename() == "summary.json";
   const json* out = &value;

@@ -30,6 +30,9 @@ void write_json(const std::string& path, const json& value);
 
 /// True when `value` holds no NaN/Inf number anywhere.
 bool all_finite(const json& value);
+/// The path of the first non-finite number in `value` ("cases[3].models1d[0].x_m"), empty
+/// when every number is finite; `at` prefixes the path.
+std::string first_non_finite(const json& value, const std::string& at = "");
 
 /// A CSV file with a fixed header; rows of doubles written with 10 significant digits.
 /// The file appears under its name at close() (or when the writer goes out of scope

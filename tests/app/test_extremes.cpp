@@ -42,11 +42,15 @@ Outcome run_case(const std::vector<std::string>& sets) {
   swim::reduced1d::SolveOptions so;
   so.keep_samples = false;
   const auto r = swim::reduced1d::solve(p, so);
-  if (!r.failure) EXPECT_GT(r.record.series.count(), 0u);
+  if (!r.failure) {
+    EXPECT_GT(r.record.series.count(), 0u);
+  }
   EXPECT_EQ(r.record.radius.count(), r.record.series.count());
-  if (r.record.series.count() > 0)
-    for (const auto& c : r.record.series.columns())
+  if (r.record.series.count() > 0) {
+    for (const auto& c : r.record.series.columns()) {
       EXPECT_TRUE(std::isfinite(r.record.series.min(c)) && std::isfinite(r.record.series.max(c))) << c;
+    }
+  }
   const auto m = swim::reduced1d::metrics(p, r);
   char b[160];
   if (r.failure) {
@@ -78,7 +82,9 @@ void check(const std::string& label, const std::vector<std::string>& sets, const
   const auto o = run_case(sets);
   report(label, o);
   EXPECT_EQ(o.kind, e.kind) << label << ": " << o.text;
-  if (!e.cause.empty()) EXPECT_NE(o.text.find(e.cause), std::string::npos) << label << ": " << o.text;
+  if (!e.cause.empty()) {
+    EXPECT_NE(o.text.find(e.cause), std::string::npos) << label << ": " << o.text;
+  }
 }
 
 TEST(Extremes, ForceDrivenWithActuationScaledToTheTarget) {

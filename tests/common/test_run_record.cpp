@@ -9,6 +9,7 @@
 
 #include "common/checksum.hpp"
 #include "common/errors.hpp"
+#include "common/output.hpp"
 #include "common/run_record.hpp"
 
 namespace fs = std::filesystem;
@@ -326,4 +327,18 @@ TEST(RunRecord, AFullDiskEndsTheStreamAtOnceNamingTheFile) {
   // the failure surfaces within a buffer (64 KiB) of the limit, not at the end of the run
   EXPECT_LT(written, 2000);
   r.attach(nullptr);
+}
+
+TEST(RunRecord, AJsonFileWithANonFiniteNumberIsRefusedNamingWhereItIs) {
+  const std::string d = fresh_dir("nonfinite_json");
+  json v = {{"cases", json::array({{{"name", "a"}, {"x_m", 1.0}}, {{"name", "b"}, {"models", {{{"x_m", 2.0}}, {{"x_m", std::nan("")}}}}}})}};
+  EXPECT_EQ(swim::output::first_non_finite(v), "cases[1].models[1].x_m");
+  EXPECT_TRUE(swim::output::first_non_finite(json{{"x", 1.0}, {"y", json::array({1, 2})}}).empty());
+  try {
+    swim::output::write_json(d + "/report.json", v);
+    FAIL() << "wrote a NaN";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("cases[1].models[1].x_m"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(fs::exists(d + "/report.json"));
 }
