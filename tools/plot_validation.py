@@ -48,6 +48,19 @@ def wrinkle(run):
     return si(run["max_wrinkle_m"], "m")
 
 
+def evidence_value(key, v):
+    """One value of a finding's evidence: SI prefixes for lengths and speeds, a dash for a
+    value the suite could not compute (a case whose 3D runs all failed)."""
+    if v is None:
+        return "— (no 3D value)"
+    if isinstance(v, float):
+        for suffix, unit in (("_m_per_s", "m/s"), ("_m", "m"), ("_s", "s")):
+            if key.endswith(suffix):
+                return si(v, unit)
+        return f"{v:.3g}"
+    return f"{v}"
+
+
 def legend_right(ax):
     """Legend beside the axes, off the data."""
     ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
@@ -303,7 +316,7 @@ def markdown(report, figs):
            "(against the finest 3D run).", "", "## The paper's conclusions", "",
            "| claim | status | evidence |", "|---|---|---|"]
     for f in report["findings"]:
-        ev = "; ".join(", ".join(f"{k} = {v:.3g}" if isinstance(v, float) else f"{k} = {v}" for k, v in e.items())
+        ev = "; ".join(", ".join(f"{k} = {evidence_value(k, v)}" for k, v in e.items())
                        for e in f["evidence"]) or "the suite has no cases for it"
         out.append(f"| {f['claim']} | **{f['status']}** | {ev} |")
     ex = report.get("extremes3d") or []

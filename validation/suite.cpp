@@ -376,6 +376,9 @@ double reference_value(const json& c, const std::string& key) {
   return std::nan("");
 }
 
+/// A figure for the report: null when it could not be computed (a case whose 3D runs all failed).
+json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
 json findings(const json& cases, double th_d) {
   auto group = [&](const std::string& g) {
     std::vector<const json*> v;
@@ -393,7 +396,7 @@ json findings(const json& cases, double th_d) {
     double prev = std::nan("");
     for (const json* c : v) {
       const double x = reference_value(*c, key);
-      ev.push_back({{"case", (*c)["name"]}, {"sweep_value", (*c)["sweep_value"]}, {key, x}});
+      ev.push_back({{"case", (*c)["name"]}, {"sweep_value", (*c)["sweep_value"]}, {key, finite_or_null(x)}});
       if (!std::isfinite(x)) return std::string("not assessed");
       if (std::isfinite(prev) && (increasing ? x <= prev : x >= prev)) ok = false;
       prev = x;
@@ -411,19 +414,23 @@ json findings(const json& cases, double th_d) {
   }
   // index of the case with the largest reference mean velocity per cycle (evidence appended)
   auto fastest = [&](const std::vector<const json*>& v, const char* sweep_name, json& ev) {
-    std::size_t best = 0;
+    // -1: a case has no 3D value, so the largest is not known
+    long best = 0;
     double bv = -1e300;
     for (std::size_t i = 0; i < v.size(); ++i) {
       const double x = reference_value(*v[i], "mean_velocity_per_cycle_m_per_s");
-      ev.push_back({{"case", (*v[i])["name"]}, {sweep_name, (*v[i])["sweep_value"]}, {"mean_velocity_per_cycle_m_per_s", x}});
-      if (x > bv) bv = x, best = i;
+      ev.push_back({{"case", (*v[i])["name"]}, {sweep_name, (*v[i])["sweep_value"]},
+                    {"mean_velocity_per_cycle_m_per_s", finite_or_null(x)}});
+      if (!std::isfinite(x)) best = -1;
+      if (best >= 0 && x > bv) bv = x, best = long(i);
     }
     return best;
   };
   {
     const auto a = group("aspect");
     json ev = json::array();
-    const std::string st = a.size() < 2 ? "not assessed" : fastest(a, "L_um", ev) == 0 ? "reproduced" : "refuted";
+    const long best = a.size() < 2 ? -1 : fastest(a, "L_um", ev);
+    const std::string st = best < 0 ? "not assessed" : best == 0 ? "reproduced" : "refuted";
     out.push_back(finding("mean velocity per cycle is largest for the shortest swimmer", st, ev));
   }
   {
@@ -431,8 +438,10 @@ json findings(const json& cases, double th_d) {
     json ev = json::array();
     std::string st = "not assessed";
     if (m.size() >= 2) {
-      const double rf = (*m[fastest(m, "R_f_over_R0", ev)])["sweep_value"];
-      st = std::abs(rf - 0.5) <= 0.1 ? "reproduced" : "refuted";
+      if (const long best = fastest(m, "R_f_over_R0", ev); best >= 0) {
+        const double rf = (*m[std::size_t(best)])["sweep_value"];
+        st = std::abs(rf - 0.5) <= 0.1 ? "reproduced" : "refuted";
+      }
     }
     out.push_back(finding("mean velocity per cycle is largest at about 50 % deformation", st, ev));
   }
@@ -464,7 +473,7 @@ json findings(const json& cases, double th_d) {
     for (const json* c : o) {
       const double v = reference_value(*c, "mean_velocity_per_cycle_m_per_s"), L = (*c)["length_m"];
       const double bl = v / L;
-      ev.push_back({{"case", (*c)["name"]}, {"body_lengths_per_s", bl}, {"paper_body_lengths_per_s", 1.5}});
+      ev.push_back({{"case", (*c)["name"]}, {"body_lengths_per_s", finite_or_null(bl)}, {"paper_body_lengths_per_s", 1.5}});
       st = std::isfinite(bl) && std::abs(bl / 1.5 - 1.0) <= 0.2 ? "reproduced" : "refuted";
     }
     out.push_back(finding("the optimal swimmer makes 1.5 body lengths/s (within 20 %)", st, ev));
