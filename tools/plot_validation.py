@@ -53,6 +53,8 @@ def evidence_value(key, v):
     value the suite could not compute (a case whose 3D runs all failed)."""
     if v is None:
         return "— (no 3D value)"
+    if isinstance(v, (int, float)) and key.endswith("body_lengths_per_s"):
+        return f"{v:.3g} body lengths/s"
     if isinstance(v, float):
         for suffix, unit in (("_m_per_s", "m/s"), ("_m", "m"), ("_s", "s")):
             if key.endswith(suffix):

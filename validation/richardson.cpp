@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <memory>
+#include <cstdio>
 #include <numeric>
 
 #include <gsl/gsl_errno.h>
@@ -48,12 +49,25 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
   const double f3 = fs[n - 1], f2 = fs[n - 2], h3 = hs[n - 1], h2 = hs[n - 2];
   Extrapolation e;
   auto extrapolate = [&](double p) { return f3 + (f3 - f2) / (std::pow(h2 / h3, p) - 1.0); };
+  // a correction larger than half the finest value: the grids are too coarse for the error
+  // expansion to hold (it would, for instance, extrapolate a cycle time to a negative one)
+  auto too_large = [&](double value) { return std::abs(value - f3) > kMaxCorrection * std::abs(f3); };
   if (n == 2) {
+    const double v = extrapolate(assumed_order);
+    if (too_large(v)) {
+      e.value = f3;
+      e.error = std::abs(f3 - f2);
+      e.note = "two grids too coarse (the extrapolation would change the finest value by more than half): finest "
+               "grid, error = difference of the two";
+      return e;
+    }
     e.order = assumed_order;
-    e.value = extrapolate(assumed_order);
+    e.value = v;
     e.error = std::abs(e.value - f3);
     e.asymptotic = true;
-    e.note = "two grids, assumed order " + std::to_string(assumed_order);
+    char b[32];
+    std::snprintf(b, sizeof b, "%g", assumed_order);
+    e.note = std::string("two grids, assumed order ") + b;
     return e;
   }
   const double f1 = fs[n - 3], h1 = hs[n - 3];
@@ -79,7 +93,9 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
     return (std::pow(h1, p) - std::pow(h2, p)) / (std::pow(h2, p) - std::pow(h3, p)) - ratio;
   };
   if (g(0.25) * g(8.0) > 0) return not_asymptotic("observed order outside [0.25, 8]");
-  e.order = bracketed_root(g, 0.25, 8.0);
+  const double order = bracketed_root(g, 0.25, 8.0);
+  if (too_large(extrapolate(order))) return not_asymptotic("the extrapolation would change the finest value by more than half");
+  e.order = order;
   e.value = extrapolate(e.order);
   e.error = std::abs(e.value - f3);
   e.asymptotic = true;

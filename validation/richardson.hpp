@@ -15,6 +15,9 @@
 
 namespace swim::validation {
 
+/// Largest accepted correction of an extrapolation, as a fraction of the finest value.
+constexpr double kMaxCorrection = 0.5;
+
 struct Extrapolation {
   double value = 0;      ///< extrapolated f0 (or the finest value when not asymptotic)
   double error = 0;      ///< estimated error of `value`

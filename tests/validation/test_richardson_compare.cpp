@@ -19,7 +19,7 @@ TEST(Richardson, RecoversOrderAndLimitOfAnExactPowerLaw) {
   for (double p : {1.0, 1.5, 2.0}) {
     for (const std::vector<double>& h : {std::vector<double>{0.04, 0.02, 0.01}, std::vector<double>{15.6, 12.5, 10.4}}) {
       std::vector<double> f;
-      for (double x : h) f.push_back(29.0 - 3.0 * std::pow(x, p));
+      for (double x : h) f.push_back(29.0 - 3.0 * std::pow(x / h.front(), p));  // corrections below 3
       const Extrapolation e = richardson(h, f);
       EXPECT_TRUE(e.asymptotic);
       EXPECT_NEAR(e.order, p, 1e-9);
@@ -48,6 +48,25 @@ TEST(Richardson, TwoGridsUseTheAssumedOrder) {
   const Extrapolation e = richardson({2, 1}, {3.0, 2.0}, 1.0);
   EXPECT_NEAR(e.value, 1.0, 1e-12);
   EXPECT_THROW(richardson({1}, {1.0}), InputError);
+  EXPECT_EQ(e.note, "two grids, assumed order 1");
+}
+
+// A correction larger than half the finest value is not an extrapolation the grids support:
+// two coarse grids whose values would extrapolate through zero (cycle times 3 s and 2.05 s at
+// h = 20.8 and 15.6 nm, the ten-cycle paper swimmer) give the finest value and the
+// difference as its error; so do three grids whose observed order is very low.
+TEST(Richardson, ACorrectionLargerThanHalfTheFinestValueIsNotTrusted) {
+  const Extrapolation e = richardson({20.8, 15.6}, {3.0, 2.05}, 1.0);
+  EXPECT_FALSE(e.asymptotic);
+  EXPECT_DOUBLE_EQ(e.value, 2.05);
+  EXPECT_NEAR(e.error, 0.95, 1e-12);
+  EXPECT_GT(e.value, 0.0);
+  // f = 1 + 3 h^0.3 on h = 4, 2, 1: order 0.3 in range, limit 1, correction 3 / (1.0) > half of 4
+  std::vector<double> h{4, 2, 1}, f;
+  for (double x : h) f.push_back(1.0 + 3.0 * std::pow(x, 0.3));
+  const Extrapolation g = richardson(h, f);
+  EXPECT_FALSE(g.asymptotic);
+  EXPECT_DOUBLE_EQ(g.value, f.back());
   EXPECT_THROW(richardson({1, 1}, {1.0, 2.0}), InputError);
 }
 
