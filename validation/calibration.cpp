@@ -129,7 +129,17 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
   for (double pr : P) {
     if (!(pr > 0) || !std::isfinite(pr))
       throw InputError("calibration load", std::to_string(pr), "every load must be a positive pressure");
-    const full3d::PressureResponse r = full3d::relax_under_pressure(mesh, p.membrane, pr);
+    full3d::PressureResponse r;
+    try {
+      r = full3d::relax_under_pressure(mesh, p.membrane, pr);
+    } catch (const NumericalError& e) {
+      // loads are tried in increasing order: the first one without a static state ends the
+      // series (the larger ones would not reach one either); three points still fit C1
+      if (c.loads.size() < 3) throw;
+      c.no_static_state_from_Pa = pr;
+      c.no_static_state_reason = e.what();
+      break;
+    }
     LoadPoint lp;
     lp.pressure_Pa = pr;
     lp.displacement_m = p.R0 - r.mid_radius;
@@ -265,6 +275,8 @@ scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const
   j["linear_over_all_loads"] = c.fit.linear_over_all_loads;
   j["fit_points"] = c.fit.points;
   j["load_points"] = pts;
+  if (c.no_static_state_from_Pa > 0)
+    j["loads_without_static_state"] = {{"from_Pa", c.no_static_state_from_Pa}, {"reason", c.no_static_state_reason}};
   j["C1_spring_network_Pa_per_m"] = c.spring_network_c1;
   j["method"] = "static: uniform inward pressure on the 3D spring-network membrane, relaxed to equilibrium";
   j["mass_per_area_kg_per_m2"] = p.mass_per_area;

@@ -49,13 +49,20 @@ struct StaticCalibration {
   C1Fit fit;
   double spring_network_c1 = 0;  ///< 2 k_s / (sqrt 3 R0^2), Pa/m
   int n_theta = 0, n_rings = 0, nodes = 0;
+  /// > 0: the loads from this pressure on reached no static state (the first such load's
+  /// reason below); they are not in `loads`
+  double no_static_state_from_Pa = 0;
+  std::string no_static_state_reason;
 };
 
 /// Loads as fractions of the static load C1_net (R0 - R_f) that holds the scene's target
 /// radius (C1_net the spring-network estimate): thirteen loads from 1 % to 150 %, dense below 20 % where ring buckling sets in.
 std::vector<double> default_loads(const full3d::Params3d& p);
 
-/// Throws NumericalError if a relaxation does not converge, InputError for loads <= 0.
+/// Loads are relaxed in increasing order. A load whose relaxation does not converge ends the
+/// series when three or more loads have converged (StaticCalibration::no_static_state_from_Pa;
+/// a deep target such as R_f = 0.35 R0 puts the largest default loads beyond the tube's
+/// range); before that it throws NumericalError. InputError for loads <= 0.
 /// Points that are unstable to ring buckling (LoadPoint::stable) are reported and left out of
 /// the fits.
 StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures);

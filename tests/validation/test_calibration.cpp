@@ -60,6 +60,22 @@ TEST(StaticCalibration, DetectsRingBucklingAndLeavesItOutOfTheFit) {
   EXPECT_NEAR(k(0) + slope * (pr(2) - pr(0)), k(2), 0.02 * std::abs(k(2)));
 }
 
+// A load the tube cannot carry statically (here twice the load that would flatten it
+// linearly, C1 R0) ends the series: the loads before it are kept and fitted, and the
+// calibration names the load and the reason. Before three loads have converged it is an error.
+TEST(StaticCalibration, ALoadWithoutStaticStateEndsTheSeries) {
+  const full3d::Params3d p = paper_scene(24);
+  const double q = p.c1_estimate() * (p.R0 - p.protocol.R_f), flat = p.c1_estimate() * p.R0;
+  const validation::StaticCalibration c =
+      validation::calibrate_static(p, {0.005 * q, 0.01 * q, 0.02 * q, 2.0 * flat, 3.0 * flat});
+  ASSERT_EQ(c.loads.size(), 3u);
+  EXPECT_EQ(c.fit.points, 3);
+  EXPECT_NEAR(c.fit.c1 / c.spring_network_c1, 1.0, 0.02);
+  EXPECT_DOUBLE_EQ(c.no_static_state_from_Pa, 2.0 * flat);
+  EXPECT_FALSE(c.no_static_state_reason.empty());
+  EXPECT_THROW(validation::calibrate_static(p, {0.005 * q, 2.0 * flat}), NumericalError);
+}
+
 TEST(StaticCalibration, RejectsNonPositiveLoads) {
   const full3d::Params3d p = paper_scene();
   EXPECT_THROW(validation::calibrate_static(p, {0.0}), InputError);
