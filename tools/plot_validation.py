@@ -150,21 +150,39 @@ def convergence_figure(case, path):
 
 
 def pareto_figure(report, path):
-    fig, ax = plt.subplots(figsize=(8, 4.8))
-    any_pt = False
-    for c in report["cases"]:
+    """Error against wall time of every run of the speed/accuracy study. With a few cases each
+    (case, tier, axis) is its own line with its resolutions written beside the points; with
+    many, the colour and marker say the tier and the axis (one legend entry each) and each
+    case is a thin line, without point labels."""
+    cases = [c for c in report["cases"]
+             if any(q.get("displacement_per_cycle_error", 0) > 0 for q in c.get("speed_accuracy", []))]
+    if not cases:
+        return False
+    many = len(cases) > 3
+    fig, ax = plt.subplots(figsize=(9, 5.2))
+    markers = {"cells": "o-", "rtol": "^--", "h": "s-", "time step": "D--"}
+    colours = {("1d", "cells"): "tab:blue", ("1d", "rtol"): "tab:orange", ("3d", "h"): "black",
+               ("3d", "time step"): "tab:red"}
+    named = set()
+    for c in cases:
         pts = [q for q in c.get("speed_accuracy", []) if q.get("displacement_per_cycle_error", 0) > 0]
         axes = []
         for q in pts:
             if (q["tier"], q.get("axis", "")) not in axes:
                 axes.append((q["tier"], q.get("axis", "")))
-        markers = {"cells": "o-", "rtol": "^--", "h": "s-", "time step": "D--"}
         for tier, axis in axes:
             p = [q for q in pts if q["tier"] == tier and q.get("axis", "") == axis]
             p.sort(key=lambda q: q["wall_time_s"])
-            any_pt = True
-            ax.loglog([q["wall_time_s"] for q in p], [100 * q["displacement_per_cycle_error"] for q in p],
-                      markers.get(axis, "x-"), label=f"{c['name']}, {tier.upper()}, varying {axis}")
+            xs = [q["wall_time_s"] for q in p]
+            ys = [100 * q["displacement_per_cycle_error"] for q in p]
+            if many:
+                key = (tier, axis)
+                label = None if key in named else f"{tier.upper()}, varying {axis}"
+                named.add(key)
+                ax.loglog(xs, ys, markers.get(axis, "x-"), color=colours.get(key, "tab:gray"), lw=0.8, ms=4,
+                          alpha=0.8, label=label)
+                continue
+            ax.loglog(xs, ys, markers.get(axis, "x-"), label=f"{c['name']}, {tier.upper()}, varying {axis}")
             # labels above left for the resolution axes, below right for the tolerance and step
             # axes, fanned out so that points that coincide stay readable
             below = axis in ("rtol", "time step")
@@ -172,11 +190,10 @@ def pareto_figure(report, path):
                 ax.annotate(q["resolution"], (q["wall_time_s"], 100 * q["displacement_per_cycle_error"]),
                             fontsize=7, xytext=(4, -10 - 9 * j) if below else (-4, 4),
                             textcoords="offset points", ha="left" if below else "right")
-    if not any_pt:
-        plt.close(fig)
-        return False
-    ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)",
-           title=f"Speed against accuracy: {report['suite']} suite\n(error against the extrapolated 3D reference)")
+    ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)")
+    sub = f"{len(cases)} cases, one line per case and axis" if many else "error against the extrapolated 3D reference"
+    fig.suptitle(f"Speed against accuracy: {report['suite']} suite\n({sub}; error against the 3D reference)"
+                 if many else f"Speed against accuracy: {report['suite']} suite\n({sub})")
     legend_right(ax)
     save(fig, path)
     return True
@@ -187,14 +204,14 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title, logx=Fa
                    key=lambda c: c["sweep_value"])
     if len(cases) < 2:
         return False
-    fig, ax = plt.subplots(figsize=(7, 4.6))
+    fig, ax = plt.subplots(figsize=(9, 4.6))
     x = [c["sweep_value"] for c in cases]
     y, e = [], []
     for c in cases:
         ref = c["reference3d"].get(key)
         y.append(ref["value"] * scale if ref else float("nan"))
         e.append(ref["error"] * scale if ref else 0)
-    ax.errorbar(x, y, yerr=e, fmt="ks-", capsize=4, label="3D, extrapolated")
+    ax.errorbar(x, y, yerr=e, fmt="ks-", capsize=4, label="3D reference (h → 0, or finest grid)")
     labels = [m["label"] for m in cases[0]["models1d"]]
     for k, lab in enumerate(labels):
         v = []
@@ -204,7 +221,8 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title, logx=Fa
         if all(not math.isfinite(a) or abs(a) > 50 * max(abs(b) for b in y if math.isfinite(b)) for a in v):
             continue
         ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
-    ax.set(xlabel=xlabel, ylabel=ylabel, title=title)
+    ax.set(xlabel=xlabel, ylabel=ylabel)
+    fig.suptitle(title)
     if logx:
         ax.set_xscale("log")
         ax.set_xticks(x)
@@ -219,15 +237,28 @@ def multicycle_figure(report, path):
     cases = [c for c in report["cases"] if c.get("group") == "optimal"]
     if not cases:
         return False
-    fig, ax = plt.subplots(figsize=(7, 4.6))
+    fig, ax = plt.subplots(figsize=(9, 4.6))
+    off = []
     for c in cases:
-        r = c["runs3d"][-1]
-        ax.plot(r["series"]["t_s"], [v * 1e9 for v in r["series"]["x_m"]], "k-", label=f"{c['name']}, 3D finest")
+        for r in c["runs3d"]:
+            fin = r is c["runs3d"][-1]
+            ax.plot(r["series"]["t_s"], [v * 1e9 for v in r["series"]["x_m"]], "-",
+                    color="black" if fin else "0.6", lw=2 if fin else 1,
+                    label=f"3D, h = {si(r['cell_size_m'], 'm')} ({r.get('cycles_completed', 0)} cycles, {r['status'][:6]})")
+        x3 = max((abs(v) for r in c["runs3d"] for v in r["series"]["x_m"]), default=0.0)
         for k, m in enumerate(c["models1d"]):
-            if "series" in m:
-                ax.plot(m["series"]["t_s"], [v * 1e9 for v in m["series"]["x_m"]], MODEL_STYLES[k % 6],
-                        label=f"1D: {m['label']}")
-    ax.set(xlabel="time [s]", ylabel="centre displacement [nm]", title="Multi-cycle centre histories")
+            if "series" not in m:
+                continue
+            if x3 > 0 and max(abs(v) for v in m["series"]["x_m"]) > 50 * x3:
+                off.append(m["label"])
+                continue
+            ax.plot(m["series"]["t_s"], [v * 1e9 for v in m["series"]["x_m"]], MODEL_STYLES[k % 6],
+                    label=f"1D: {m['label']}")
+    title = f"{cases[0]['name']}: centre displacement over the run (Figure 14)"
+    if off:
+        title += "\noff scale, not drawn: " + ", ".join(off)
+    ax.set(xlabel="time t [s]", ylabel="centre displacement [nm]")
+    fig.suptitle(title)
     legend_right(ax)
     save(fig, path)
     return True

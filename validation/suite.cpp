@@ -298,8 +298,9 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
     r.record["cycle_time_s"] = r.cyc.cycle_time_s;
     r.record["mean_velocity_per_cycle_m_per_s"] = r.cyc.mean_velocity_per_cycle_m_per_s;
   }
+  // the first cycle of a one-cycle scene; the whole run of a multi-cycle one (Figure 14)
   const double t_end = r.series.t.empty() ? 0.0 : r.series.t.back();
-  r.record["series"] = downsample(r.series, r.cyc.has_cycle ? r.cyc.cycle_time_s : t_end);
+  r.record["series"] = downsample(r.series, r.cyc.has_cycle && p.protocol.cycles == 1 ? r.cyc.cycle_time_s : t_end);
   return r;
 }
 
@@ -347,7 +348,7 @@ Run1d run_1d(const json& sc, const std::string& label, const std::string& scene_
       r.record["no_cycle_reason"] = m.no_cycle_reason;
     }
     r.record["plausible"] = m.implausible.empty();
-    r.record["series"] = downsample(r.series, m.has_cycle ? m.mean_cycle_time_s : m.t_end_s);
+    r.record["series"] = downsample(r.series, m.has_cycle && p.protocol.cycles == 1 ? m.mean_cycle_time_s : m.t_end_s);
   } catch (const InputError& e) {
     r.record["status"] = std::string("not run: ") + e.what();
   } catch (const NumericalError& e) {
