@@ -8,7 +8,7 @@ namespace swim {
 
 Progress::Progress(std::string label, double t_end, int enabled)
     : label_(std::move(label)), t_end_(t_end),
-      on_(enabled < 0 ? isatty(STDERR_FILENO) != 0 : enabled > 0),
+      on_(enabled < 0 ? isatty(STDERR_FILENO) != 0 : enabled > 0), tty_(isatty(STDERR_FILENO) != 0),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 Progress::~Progress() { done(); }
@@ -16,21 +16,25 @@ Progress::~Progress() { done(); }
 void Progress::update(double t) {
   if (!on_ || t_end_ <= 0) return;
   const auto now = std::chrono::steady_clock::now();
-  if (now - last_ < std::chrono::milliseconds(250)) return;
+  if (now - last_ < std::chrono::milliseconds(tty_ ? 250 : 10000)) return;
   last_ = now;
   const double wall = std::chrono::duration<double>(now - start_).count();
   const double frac = t / t_end_;
   const double rate = wall > 0 ? t / wall : 0.0;  // simulated seconds per wall second
   const double left = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
-  std::fprintf(stderr, "\r%s: %5.1f%%  t = %.4g s  %.3g sim-s/s  ~%.0f s left   ", label_.c_str(), 100.0 * frac, t,
-               rate, left);
+  std::fprintf(stderr, tty_ ? "\r%s: %5.1f%%  t = %.4g s  %.3g sim-s/s  ~%.0f s left   "
+                            : "%s: %5.1f%%  t = %.4g s  %.3g sim-s/s  ~%.0f s left\n",
+               label_.c_str(), 100.0 * frac, t, rate, left);
   std::fflush(stderr);
 }
 
 void Progress::done() {
   if (on_ && !finished_) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-    std::fprintf(stderr, "\r%s: done in %.2f s%40s\n", label_.c_str(), wall, "");
+    if (tty_)
+      std::fprintf(stderr, "\r%s: done in %.2f s%40s\n", label_.c_str(), wall, "");
+    else
+      std::fprintf(stderr, "%s: done in %.2f s\n", label_.c_str(), wall);
   }
   finished_ = true;
 }

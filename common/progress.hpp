@@ -1,5 +1,7 @@
 // Progress of long runs on stderr: percent of simulated time, simulation rate and the
-// estimated wall time left. Quiet when stderr is not a terminal unless forced on.
+// estimated wall time left. Quiet when stderr is not a terminal unless forced on; then (a log
+// file, a pipe) it writes one whole line every 10 s instead of rewriting one line 4 times a
+// second.
 #pragma once
 
 #include <chrono>
@@ -19,6 +21,7 @@ class Progress {
   std::string label_;
   double t_end_;
   bool on_;
+  bool tty_;
   bool finished_ = false;
   std::chrono::steady_clock::time_point start_, last_;
 };

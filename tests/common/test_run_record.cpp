@@ -1,8 +1,14 @@
 // The run record of both tiers and its one writer (common/run_record.hpp): running figures
-// without kept rows, events, the streamed files and their resume, reading a folder back.
+// without kept rows, events, the streamed files and their resume, reading a folder back; the
+// JSON writer's refusal of non-finite numbers; progress lines in a log file.
 #include <gtest/gtest.h>
 
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
 #include <cstdlib>
+#include <iterator>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -10,6 +16,7 @@
 #include "common/checksum.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/progress.hpp"
 #include "common/run_record.hpp"
 
 namespace fs = std::filesystem;
@@ -341,4 +348,29 @@ TEST(RunRecord, AJsonFileWithANonFiniteNumberIsRefusedNamingWhereItIs) {
     EXPECT_NE(std::string(e.what()).find("cases[1].models[1].x_m"), std::string::npos) << e.what();
   }
   EXPECT_FALSE(fs::exists(d + "/report.json"));
+}
+
+// Progress forced on with stderr not a terminal (a log file): whole lines, no carriage
+// returns, and nothing between two updates closer than 10 s.
+TEST(Progress, ToALogFileItWritesWholeLinesOnly) {
+  const std::string d = fresh_dir("progress");
+  const std::string path = d + "/stderr.log";
+  std::fflush(stderr);
+  const int saved = dup(STDERR_FILENO);
+  FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  dup2(fileno(f), STDERR_FILENO);
+  {
+    swim::Progress p("3d test", 1.0, 1);
+    for (int k = 1; k <= 100; ++k) p.update(0.01 * k);  // all within 10 s of the start
+  }
+  std::fflush(stderr);
+  dup2(saved, STDERR_FILENO);
+  close(saved);
+  std::fclose(f);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.find('\r'), std::string::npos) << text;
+  EXPECT_EQ(text.rfind("3d test: done in ", 0), 0u) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
 }
