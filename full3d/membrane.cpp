@@ -331,7 +331,10 @@ Eigen::VectorXd node_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) 
 }
 
 Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
-  const Eigen::VectorXd r = node_radii(mesh, X);
+  return ring_radii(mesh, node_radii(mesh, X));
+}
+
+Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::VectorXd& r) {
   Eigen::VectorXd rr = Eigen::VectorXd::Zero(mesh.n_rings);
   for (int i = 0; i < mesh.nodes(); ++i) rr[mesh.ring_of(i)] += r[i] / mesh.n_theta;
   return rr;

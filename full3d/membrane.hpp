@@ -105,6 +105,8 @@ Eigen::VectorXd node_masses(const CylinderMesh& mesh, double areal_density);
 Eigen::VectorXd node_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
 /// Mean radius of each ring, m.
 Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
+/// The same from node radii already computed (node_radii).
+Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::VectorXd& node_r);
 
 /// Outward radial unit vector of every node (from the reference axis).
 Eigen::Matrix3Xd radial_directions(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);

@@ -142,8 +142,7 @@ double Measurements::disc_flux(int ring, const IbState& s, const MacGrid& grid) 
 void Measurements::record(const IbState& s, const ProtocolState& st, long n, double dt_last) {
   const CylinderMesh& mesh = run_.mesh;
   const Eigen::VectorXd rn = node_radii(mesh, s.X);
-  Eigen::VectorXd rr = Eigen::VectorXd::Zero(mesh.n_rings);  // ring_radii from rn
-  for (int i = 0; i < mesh.nodes(); ++i) rr[mesh.ring_of(i)] += rn[i] / mesh.n_theta;
+  const Eigen::VectorXd rr = ring_radii(mesh, rn);
   const auto [es, eb] = elastic_parts(s);
   const double ek = kinetic_energy(s);
   double vol = 0;

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -158,11 +159,33 @@ json current_resolution(const json& written) {
   }
 }
 
+/// json_hash(same_swimmer(current_resolution(...))) of a run folder's scene.resolved.json or
+/// of a calibration file's "scene" (member), "" when unreadable. Resolving a scene again costs
+/// tens of ms and every cache lookup scans every folder, so the key is kept per file and its
+/// modification time for the life of the process.
+std::string swimmer_key(const fs::path& file, const char* member) {
+  static std::map<std::string, std::pair<fs::file_time_type, std::string>> memo;
+  std::error_code ec;
+  const auto mtime = fs::last_write_time(file, ec);
+  if (ec) return {};
+  std::string id = file.string();
+  if (member) id.append("#").append(member);
+  if (auto it = memo.find(id); it != memo.end() && it->second.first == mtime) return it->second.second;
+  std::ifstream in(file);
+  json j = json::parse(in, nullptr, false);
+  std::string key;
+  if (!j.is_discarded() && (!member || j.contains(member)))
+    key = output::json_hash(same_swimmer(current_resolution(member ? j[member] : j)));
+  memo[id] = {mtime, key};
+  return key;
+}
+
 /// A calibration file under `cal_dir` written in the current format for a scene whose physics,
 /// resolved by the current reader, is `physics` (same_swimmer); empty when there is none. A
 /// folder's name carries the hash of the physics it was written for and of its format
 /// version, which tells an older format apart.
 std::string cached_calibration(const std::string& cal_dir, const json& physics) {
+  const std::string wanted = output::json_hash(physics);
   if (!fs::is_directory(cal_dir)) return {};
   for (const auto& e : fs::directory_iterator(cal_dir)) {
     const fs::path file = e.path() / "calibration.json";
@@ -174,7 +197,7 @@ std::string cached_calibration(const std::string& cal_dir, const json& physics) 
     const std::string written_for = output::json_hash({physics_of(c["scene"]), kCalibrationFormat});
     if (folder.size() < written_for.size() || folder.compare(folder.size() - written_for.size(), written_for.size(), written_for) != 0)
       continue;
-    if (same_swimmer(current_resolution(c["scene"])) == physics) return file.string();
+    if (swimmer_key(file, "scene") == wanted) return file.string();
   }
   return {};
 }
@@ -225,10 +248,7 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   json summary = finished_summary(dir);
   if (summary.is_null())
     for (const auto& e : fs::directory_iterator(runs_dir)) {
-      std::ifstream in(e.path() / "scene.resolved.json");
-      if (!in) continue;
-      const json other = json::parse(in, nullptr, false);
-      if (other.is_discarded() || output::json_hash(same_swimmer(current_resolution(other))) != key) continue;
+      if (swimmer_key(e.path() / "scene.resolved.json", nullptr) != key) continue;
       summary = finished_summary(e.path().string());
       if (!summary.is_null()) {
         dir = e.path().string();
