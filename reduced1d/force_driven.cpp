@@ -79,7 +79,12 @@ struct ForceModel {
   bool force_free, confined;  // force-free model; confined outer flow
   double a_in, a_out;
   disc::BalanceCoefficients bal;
-  int stride;          // unknowns per cell: 1 (a) or 3 (a, V, p)
+  AbsKQuadrature tq;   // short-wave traction: |k| quadrature (empty without it)
+  int J;               // traction fields per cell (tq nodes)
+  bool dae;            // IDA path: wall inertia or short-wave traction
+  int stride;          // unknowns per cell: 1 (a) or 3 + J (a, V, p, psi_0..psi_{J-1})
+  int band_mu = 0, band_ml = 0;  // IDA band of the interleaved layout
+  std::vector<double> tr_s2, tr_c;  // (s_j h)^2 and 4 mu c_j Vel_s / P_s (per scaled psi_j)
   int iD, iX, iVr, iVf, iVrl, iVfl, n;  // extras and total size
   double T_s, D_s, X_s, V_s, Vel_s, P_s;
   // actuation laws (fixed between protocol events)
@@ -126,7 +131,12 @@ struct ForceModel {
         a_in(P.swimmer.model == SwimmerModel::ForceFree ? P.swimmer.a_in : 0.0),
         a_out(P.swimmer.model == SwimmerModel::ForceFree ? P.swimmer.a_out : 0.0),
         bal(disc::BalanceCoefficients::from(P)),
-        stride(P.wall.inertia ? 3 : 1),
+        tq(P.swimmer.model == SwimmerModel::ForceFree && P.swimmer.short_wave_traction
+               ? abs_k_quadrature(P.geometry.L, P.geometry.L / P.numerics.cells)
+               : AbsKQuadrature{}),
+        J(int(tq.s.size())),
+        dae(P.wall.inertia || J > 0),
+        stride(dae ? 3 + J : 1),
         Rb0_static(R0),
         RbL_static(R0),
         q(N, 0.0),
@@ -167,12 +177,21 @@ struct ForceModel {
       }
     }
     T_s = 0.1 * relaxation_time(P);
+    // Band of the interleaved (a, V, p, psi) layout: the continuity row of cell i reaches
+    // a_{i-1} (stride + 2 below) and p_{i+1} (stride above); the traction row psi_{i,j}
+    // reaches V_{i-1} (stride + 2 + j below). V_rear (first) and V_front stay inside.
+    band_mu = stride;
+    band_ml = stride + 2 + std::max(J - 1, 0);
     const double f_s = bal.per_length ? pi * C1 * R0 * R0 * R0 / L : C1 * R0 * R0 / (2.0 * L);
     D_s = f_s * T_s;
     X_s = force_free ? R0 : D_s * T_s / (bal.m_eff + bal.c_ext * T_s);
     V_s = pi * R0 * R0 * L;
     Vel_s = R0 / T_s;
     P_s = C1 * R0;
+    for (int j = 0; j < J; ++j) {
+      tr_s2.push_back(tq.s[j] * h * tq.s[j] * h);
+      tr_c.push_back(4.0 * mu * tq.c[j] * Vel_s / P_s);
+    }
   }
 
   /// Install the actuation laws of the current protocol state.
@@ -247,9 +266,9 @@ struct ForceModel {
       if (seg_law[seg_a[i]]) qi += frac[i] * qs[seg_a[i]];
       if (seg_b[i] != seg_a[i] && seg_law[seg_b[i]]) qi += (1.0 - frac[i]) * qs[seg_b[i]];
       q[i] = qi;
-      if (inertia) {
-        V[i] = Vel_s * y[3 * i + 2];
-        p[i] = P_s * y[3 * i + 3];
+      if (dae) {
+        V[i] = Vel_s * y[1 + stride * i + 1];
+        p[i] = P_s * y[1 + stride * i + 2];
       } else {
         p[i] = C1 * (Ri - R0) + qi;
       }
@@ -577,19 +596,39 @@ struct ForceModel {
   std::vector<SegChain> seg_x_;
   std::vector<double> fq_, fu_, dg1pi_, dg2pi_, al_, be_;  // confined Jacobian workspace
 
-  // Residual with inertia (IDA).
+  /// Coefficient of (C1 (R - R0) + q + traction - p) in the wall row of the IDA residual:
+  /// 1 / (m Vel_s) with inertia (F_V = V' + cv (...)), 1 / P_s without (an algebraic row).
+  double wall_row_coefficient() const { return inertia ? 1.0 / (m * Vel_s) : 1.0 / P_s; }
+
+  // Residual of the IDA path (wall inertia and/or short-wave traction). Per cell
+  // (a, V, p, psi_0..psi_{J-1}), psi_j = D2 / (D2 - (s_j h)^2) V in units of Vel_s:
+  //   F_a = a' - 2 R V / R0^2,   F_V = [V'] + cv (C1 (R - R0) + q + T - p),
+  //   F_p = continuity,          F_psi_j = ((s_j h)^2 psi_j - D2 psi_j + D2 V) / ((s_j h)^2 + 4),
+  // with T = 4 mu sum_j c_j psi_j (the traction 2 mu |k| V of each fluid) and D2 the cell
+  // second difference with mirror ends (a uniform wall velocity has no short-wave traction).
   int res(const double* y, const double* yp, double* F) {
     if (!unpack(y)) return 1;
     fluxes();
     const double cu = 2.0 * Vel_s / (R0 * R0);
-    const double cv = 1.0 / (m * Vel_s);
+    const double cv = wall_row_coefficient();
     const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
     const double A0 = pi * R0 * R0;
+    const int S = stride;
     for (int i = 0; i < N; ++i) {
-      const int k = 1 + 3 * i;
+      const int k = 1 + S * i;
+      double T = 0;
+      for (int j = 0; j < J; ++j) T += tr_c[j] * y[k + 3 + j];
       F[k] = yp[k] - cu * R[i] * y[k + 1];
-      F[k + 1] = yp[k + 1] - cv * (p[i] - C1 * (R[i] - R0) - q[i]);
+      F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (C1 * (R[i] - R0) + q[i] + P_s * T - p[i]);
       F[k + 2] = cp * ((Q[i + 1] - Q[i]) / h + A0 * yp[k]);
+      if (J > 0) {
+        const int km = i > 0 ? k - S : k, kp = i + 1 < N ? k + S : k;  // mirror ends
+        const double d2v = y[km + 1] - 2.0 * y[k + 1] + y[kp + 1];
+        for (int j = 0; j < J; ++j) {
+          const double d2p = y[km + 3 + j] - 2.0 * y[k + 3 + j] + y[kp + 3 + j];
+          F[k + 3 + j] = (tr_s2[j] * y[k + 3 + j] - d2p + d2v) / (tr_s2[j] + 4.0);
+        }
+      }
     }
     if (!geometry_ok) return 1;
     double d[6];
@@ -601,15 +640,24 @@ struct ForceModel {
     return 0;
   }
 
-  /// Rank-1 segment terms of the IDA residual Jacobian dF/dy (the band part is obtained by
-  /// difference quotients with the segment actuation frozen). Same layout as jacobian().
+  /// Rank-1 terms of the IDA residual Jacobian dF/dy (the band part is obtained by difference
+  /// quotients with the segment actuation, the end radii and the confined closure (W, U)
+  /// frozen): one per held segment, and with the confined outer flow the two closure terms
+  /// dF/dW (dW/dy)^T + dF/dU (dU/dy)^T, d(W, U)/dy = -G^{-1} dg/dy. Same layout as jacobian().
   int residual_low_rank(const double* y, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
     fluxes(true);
     FluxSens& s = sens_;
     flux_sensitivities(s, false);
-    const double cv = 1.0 / (m * Vel_s);
+    const double cv = wall_row_coefficient();
     const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
+    const int S = stride;
+    double Gi[2][2] = {{0, 0}, {0, 0}};
+    if (confined) {
+      const auto& G = sys->M;
+      const double det = G[0][0] * G[1][1] - G[0][1] * G[1][0];
+      Gi[0][0] = G[1][1] / det, Gi[0][1] = -G[0][1] / det, Gi[1][0] = -G[1][0] / det, Gi[1][1] = G[0][0] / det;
+    }
     int rank = 0;
     U.clear();
     Vt.clear();
@@ -623,20 +671,63 @@ struct ForceModel {
         double u = 0;
         if (seg_a[i] == k) u += frac[i];
         if (seg_b[i] == k && seg_b[i] != seg_a[i]) u += 1.0 - frac[i];
-        U[off + 1 + 3 * i + 1] = cv * u;  // F_V = V' - cv (p - C1 (R - R0) - q)
-        Vt[off + 1 + 3 * i] = dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
+        U[off + 1 + S * i + 1] = cv * u;  // F_V = [V'] + cv (C1 (R - R0) + q + T - p)
+        Vt[off + 1 + S * i] = dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
       }
+      double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii
       if (endL_seg && seg_a[N - 1] == k) {  // Q_N depends on RbL = R0 - qs/C1
         const double dQN = s.QbL * (-1.0 / C1);
-        U[off + 1 + 3 * (N - 1) + 2] += cp * dQN / h;
+        U[off + 1 + S * (N - 1) + 2] += cp * dQN / h;
         U[off + iVf] += -dQN / V_s;
+        if (confined) g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
       }
       if (end0_seg && seg_a[0] == k) {
         const double dQ0 = s.Qb0 * (-1.0 / C1);
         U[off + 1 + 2] += -cp * dQ0 / h;
         U[off + iVr] += -dQ0 / V_s;
+        if (confined) g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
       }
+      if (confined && (g1 != 0.0 || g2 != 0.0))
+        seg_x_.push_back({-(Gi[0][0] * g1 + Gi[0][1] * g2), -(Gi[1][0] * g1 + Gi[1][1] * g2), off});
       ++rank;
+    }
+    if (confined) {
+      // Q_in,j = alpha_j W + beta_j U - gamma_j (outer::ConfinedSystem::transmural)
+      const std::size_t off = U.size();
+      U.resize(off + 2 * std::size_t(n), 0.0);
+      Vt.resize(off + 2 * std::size_t(n), 0.0);
+      double* fw = U.data() + off;
+      double* fu = U.data() + off + n;
+      auto al = [&](int j) { return sys->k[j].ra * sys->w[j]; };
+      auto be = [&](int j) { return (sys->k[j].c - sys->A_c * sys->k[j].ra) * sys->w[j]; };
+      for (int i = 0; i < N; ++i) {
+        fw[1 + S * i + 2] = cp * (al(i + 1) - al(i)) / h;
+        fu[1 + S * i + 2] = cp * (be(i + 1) - be(i)) / h;
+      }
+      // extras: F = y' - d with d = (0, U / X_s, Q_0 / V_s, Q_N / V_s, (Q_0 + U pi Rb0^2) / V_s, ...)
+      fw[iVr] = -al(0) / V_s, fu[iVr] = -be(0) / V_s;
+      fw[iVf] = -al(N) / V_s, fu[iVf] = -be(N) / V_s;
+      fu[iX] = -1.0 / X_s;
+      fw[iVrl] = -al(0) / V_s, fu[iVrl] = -(be(0) + pi * Rb0 * Rb0) / V_s;
+      fw[iVfl] = -al(N) / V_s, fu[iVfl] = -(be(N) + pi * RbL * RbL) / V_s;
+      double* vw = Vt.data() + off;
+      double* vu = Vt.data() + off + n;
+      for (int i = 0; i < N; ++i) {  // point i + 1 = cell i: right end of interval i, left of i + 1
+        const double dRda = 0.5 * R0 * R0 / R[i];
+        const double g1a = (s.g1b[i] + s.g1a[i + 1]) * dRda, g2a = (s.g2b[i] + s.g2a[i + 1]) * dRda;
+        const double g1p = (s.g1pi[i] - s.g1pi[i + 1]) * P_s, g2p = (s.g2pi[i] - s.g2pi[i + 1]) * P_s;
+        vw[1 + S * i] = -(Gi[0][0] * g1a + Gi[0][1] * g2a);
+        vu[1 + S * i] = -(Gi[1][0] * g1a + Gi[1][1] * g2a);
+        vw[1 + S * i + 2] = -(Gi[0][0] * g1p + Gi[0][1] * g2p);
+        vu[1 + S * i + 2] = -(Gi[1][0] * g1p + Gi[1][1] * g2p);
+      }
+      for (const auto& sx : seg_x_)
+        for (int row = 0; row < n; ++row) {
+          vw[row] += sx.xw * Vt[sx.off + row];
+          vu[row] += sx.xu * Vt[sx.off + row];
+        }
+      seg_x_.clear();
+      rank += 2;
     }
     return rank;
   }
@@ -744,7 +835,7 @@ struct RootEval {
       if (M->inertia) {
         double k = 0;
         for (int i = 0; i < N; ++i) {
-          const double v = M->Vel_s * y[3 * i + 2];
+          const double v = M->Vel_s * y[1 + st * i + 1];
           k += v * v;
         }
         E += 0.5 * M->m * k * 2.0 * pi * M->R0 * M->h;
@@ -989,8 +1080,11 @@ class IdaBackend final : public Backend {
     double* id = sun::data(id_.get());
     for (int k = 0; k < M.n; ++k) id[k] = 1.0;
     for (int i = 0; i < M.N; ++i) {
-      y[1 + 3 * i] = 1.0;       // A = pi R0^2
-      id[1 + 3 * i + 2] = 0.0;  // p is algebraic
+      const int k = 1 + M.stride * i;
+      y[k] = 1.0;                            // A = pi R0^2
+      if (!M.inertia) id[k + 1] = 0.0;       // V is algebraic without wall inertia
+      id[k + 2] = 0.0;                       // p is algebraic
+      for (int j = 0; j < M.J; ++j) id[k + 3 + j] = 0.0;  // traction fields are algebraic
     }
     ic_step_ = 1e-3 * M.T_s;
     mem_ = sun::make_ida(ctx_.get());
@@ -1000,9 +1094,7 @@ class IdaBackend final : public Backend {
     sun::check(IDASStolerances(mem, P.numerics.rtol, P.numerics.atol_scale), "IDASStolerances");
     sun::check(IDASetUserData(mem, &pb_), "IDASetUserData");
     sun::check(IDASetId(mem, id_.get()), "IDASetId");
-    // Interleaved (a, V, p) per cell: the continuity row of cell i reaches a_{i-1} (5 below)
-    // and p_{i+1} (3 above); V_rear (first) and V_front (after the cells) stay inside.
-    A_ = sun::make_band_matrix(M.n, 3, 5, ctx_.get());
+    A_ = sun::make_band_matrix(M.n, M.band_mu, M.band_ml, ctx_.get());
     pb.low_rank.scale = nullptr;  // IDA: J = dF/dy + cj dF/dy', the segment terms are in dF/dy
     LS_ = sun::make_low_rank_band_solver(y_.get(), A_.get(), &pb.low_rank, ctx_.get());
     sun::check(IDASetLinearSolver(mem, LS_.get(), A_.get()), "IDASetLinearSolver");
@@ -1013,8 +1105,8 @@ class IdaBackend final : public Backend {
   double* y() override { return sun::data(y_.get()); }
   void restart(double t) override {
     // Differential derivatives from the residual at yp = 0 (F = yp - g(y)); the algebraic
-    // pressures are made consistent by IDACalcIC (they are continuous across a switch, only
-    // V' jumps with the actuation).
+    // unknowns (p; V and the traction fields without inertia) are made consistent by
+    // IDACalcIC.
     double* y = sun::data(y_.get());
     double* yp = sun::data(yp_.get());
     const double* id = sun::data(id_.get());
@@ -1080,7 +1172,11 @@ class IdaBackend final : public Backend {
     Problem* pb = &pbr;
     ForceModel& M = pb->M;
     M.unpack(sun::data(yv));  // segment actuation at y, frozen below
-    const int n = M.n, mu = 3, ml = 5, width = mu + ml + 1;
+    if (M.confined) {         // and the confined closure (W, U) at y
+      M.fluxes();
+      M.sys->hold_closure = true;
+    }
+    const int n = M.n, mu = M.band_mu, ml = M.band_ml, width = mu + ml + 1;
     const double* y = sun::data(yv);
     const double* yp = sun::data(ypv);
     const double* r0 = sun::data(rv);
@@ -1113,7 +1209,16 @@ class IdaBackend final : public Backend {
       }
     }
     (void)r0;
+    // Unbounded: U, the slender-body average over every cell, enters only X and the lab-frame
+    // volumes and does not feed back; grouped quotients would alias it into their rows, which
+    // keep only their own derivative (as in the CVODE path's Jacobian).
+    if (M.force_free && !M.confined && status == 0)
+      for (int i : {M.iX, M.iVrl, M.iVfl}) {
+        for (int j = std::max(0, i - ml); j <= std::min(n - 1, i + mu); ++j) SM_ELEMENT_B(J, i, j) = 0.0;
+        SM_ELEMENT_B(J, i, i) = cj;
+      }
     M.freeze_segments = false;
+    if (M.confined) M.sys->hold_closure = false;
     M.unpack(y);
     return status;
   }
@@ -1170,7 +1275,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
   std::unique_ptr<Backend> be;
   std::function<void(double)> check_ends;
 
-  M.velocity_quadrature = M.force_free && !M.confined && !M.inertia && !velocity_in_rhs;
+  M.velocity_quadrature = M.force_free && !M.confined && !M.dae && !velocity_in_rhs;
   VelocityQuadrature vq;
   auto record = [&](double tt, const double* y) -> bool {
     const bool ok = M.unpack(y);
@@ -1233,7 +1338,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
     }
     machine.laws(lawbuf, seglawbuf);
     M.set_actuation(machine, lawbuf, seglawbuf);
-    if (M.inertia)
+    if (M.dae)
       be = std::make_unique<IdaBackend>(*pb, P);
     else
       be = std::make_unique<CvodeBackend>(*pb, P);
@@ -1257,7 +1362,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
               " Pa or raise wave.contracted_ratio",
           0.0);
     }
-    if (M.inertia) be->restart(0.0);  // consistent initial derivatives (IDACalcIC)
+    if (M.dae) be->restart(0.0);  // consistent initial derivatives (IDACalcIC)
 
     long steps_before = 0;  // steps of earlier restarts
     std::vector<int> found;
@@ -1336,7 +1441,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
           "the tube wall reached the container wall (outer hydraulic radius R + a_out >= container radius)",
           "raise container.radius or lower the actuation (protocol.pressure) (the recovery overshoots R0)", t);
     else res.failure = NumericalError(
-        std::string(M.inertia ? "IDA" : "CVODE") + " failed: " + e.what(),
+        std::string(M.dae ? "IDA" : "CVODE") + " failed: " + e.what(),
         "tighten numerics1d.rtol or numerics1d.atol_scale or raise numerics1d.cells; if the radius nearly closes, "
         "lower the actuation (protocol.pressure) or raise wave.contracted_ratio",
         t);
@@ -1350,6 +1455,26 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
 }
 
 }  // namespace
+
+AbsKQuadrature abs_k_quadrature(double L, double h) {
+  // Trapezoid rule in tau = ln s for (2/pi) int k^2 e^tau / (k^2 + e^(2 tau)) dtau: the
+  // integrand is k / (2 cosh(tau - ln k)), so the rule converges exponentially in 1/dtau
+  // (step 1.5: about 0.3 %). The range covers the tube's lowest mode pi/L and the grid's
+  // highest discrete wavenumber 2/h with a margin of 3 on each side; the tails beyond are
+  // int_-inf^lo ~ s_lo k^2 / (k^2 + s_lo^2) and int_hi^inf ~ s_hi k^2 / (k^2 + s_hi^2) for
+  // k well inside, so each end node takes the weight s_end on top of its half step.
+  const double lo = std::log(pi / L) - 3.0, hi = std::log(2.0 / h) + 3.0;
+  const int n = int(std::ceil((hi - lo) / 1.5)) + 1;
+  const double d = (hi - lo) / (n - 1);
+  AbsKQuadrature q;
+  for (int j = 0; j < n; ++j) {
+    const double sj = std::exp(lo + j * d);
+    const double w = (j == 0 || j == n - 1) ? 0.5 * d + 1.0 : d;
+    q.s.push_back(sj);
+    q.c.push_back((2.0 / pi) * w * sj);
+  }
+  return q;
+}
 
 JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned seed) {
   validate(P);
@@ -1375,10 +1500,8 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
     const bool held = seg[M.seg_a[i]] != nullptr;
     const double Ri = held ? Rf + d * (4.0 * uni() - 2.0) : R0 * (0.45 + 0.6 * uni());
     y[1 + M.stride * i] = (Ri / R0) * (Ri / R0);
-    if (M.inertia) {
-      y[3 * i + 2] = uni() - 0.5;
-      y[3 * i + 3] = uni() - 0.5;
-    }
+    if (M.dae)
+      for (int k = 1; k < M.stride; ++k) y[1 + M.stride * i + k] = uni() - 0.5;
   }
   // Shift each held segment so that its mean radius sits on a ramp of the held law (a few
   // passes: cells straddling two segments couple neighbouring means).
@@ -1403,13 +1526,13 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
   std::vector<double> U, Vt;
   int rank = 0;
   const double cj = 1e3;
-  if (!M.inertia) {
+  if (!M.dae) {
     rank = M.jacobian(y.data(), [&](int i, int j, double v) { J[std::size_t(i) * n + j] = v; }, U, Vt);
   } else {
     rank = M.residual_low_rank(y.data(), U, Vt);
     // band part: the backend's difference-quotient routine on a band matrix
     auto ctx = sun::make_context();
-    auto A = sun::make_band_matrix(n, 3, 5, ctx.get());
+    auto A = sun::make_band_matrix(n, M.band_mu, M.band_ml, ctx.get());
     auto yv = sun::make_vector(n, ctx.get()), ypv = sun::make_vector(n, ctx.get()), rv = sun::make_vector(n, ctx.get());
     std::copy(y.begin(), y.end(), sun::data(yv.get()));
     std::copy(yp.begin(), yp.end(), sun::data(ypv.get()));
@@ -1417,7 +1540,8 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
     pb.low_rank.rank = rank;
     IdaBackend::band_dq(pb, cj, yv.get(), ypv.get(), rv.get(), A.get());
     for (int i = 0; i < n; ++i)
-      for (int j = std::max(0, i - 5); j <= std::min(n - 1, i + 3); ++j) J[std::size_t(i) * n + j] = SM_ELEMENT_B(A.get(), i, j);
+      for (int j = std::max(0, i - M.band_ml); j <= std::min(n - 1, i + M.band_mu); ++j)
+        J[std::size_t(i) * n + j] = SM_ELEMENT_B(A.get(), i, j);
     M.residual_low_rank(y.data(), U, Vt);
   }
   for (int k = 0; k < rank; ++k)
@@ -1430,10 +1554,10 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
     const double inc = 1e-6 * std::max(std::abs(y[j]), 1e-2);
     yy[j] = y[j] + inc;
     yyp[j] = yp[j] + cj * inc;
-    if (M.inertia) M.res(yy.data(), yyp.data(), fp.data()); else M.rhs(yy.data(), fp.data());
+    if (M.dae) M.res(yy.data(), yyp.data(), fp.data()); else M.rhs(yy.data(), fp.data());
     yy[j] = y[j] - inc;
     yyp[j] = yp[j] - cj * inc;
-    if (M.inertia) M.res(yy.data(), yyp.data(), fm.data()); else M.rhs(yy.data(), fm.data());
+    if (M.dae) M.res(yy.data(), yyp.data(), fm.data()); else M.rhs(yy.data(), fm.data());
     yy[j] = y[j];
     yyp[j] = yp[j];
     for (int i = 0; i < n; ++i) Jfd[std::size_t(i) * n + j] = (fp[i] - fm[i]) / (2.0 * inc);

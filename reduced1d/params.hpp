@@ -9,6 +9,7 @@
 // Force-free Stokes swimmer (the default, SwimmerModel::ForceFree). In the swimmer frame
 // (zeta = z - X(t) in [0, L]):
 //   tube wall   m R_tt + C1 (R - R0) = p_in - p_out - q(z,t)       (tube law with actuation q)
+//               [- 4 mu |k| R_t with model1d.short_wave_traction: the wall's normal viscous stress]
 //   lumen       Q_in = -(pi (R - a_in)^4 / 8 mu) dp_in/dz,  d(pi R^2)/dt + dQ_in/dz = 0
 //   outer flow  confined : Poiseuille-Couette annulus (R + a_out .. Rc) in parallel with the
 //                          lumen, a free pipe of radius Rc over the rest of the period P - L,
@@ -125,6 +126,10 @@ struct Swimmer {
   OuterFlow outer = OuterFlow::Confined;
   double a_in = 0.0;   ///< hydraulic offset of the lumen: the lumen conducts as radius R - a_in [m]
   double a_out = 0.0;  ///< hydraulic offset of the outside: the outer flow sees radius R + a_out [m]
+  /// Short-wave wall traction (force-driven wave only): the viscous normal stress 2 mu |k| Rdot
+  /// that each fluid (lumen, outside) exerts on a wall moving at axial wavenumbers the
+  /// lubrication flow does not resolve, added to the tube law (docs/outer-flow-1d.md, 3b).
+  bool short_wave_traction = false;
   /// Paper mode only:
   Closure closure = Closure::TubeLaw;
   Balance balance = Balance::PerArea;

@@ -185,6 +185,14 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
                        "wall inertia is available with model1d.outer_flow = \"unbounded\" and model1d.model = "
                        "\"paper\"; the confined force-free model runs without it (at Re ~ 1e-6 the wall's inertia "
                        "is negligible: its time scale 2 pi sqrt(m / C1) is below 0.1 ms)");
+    p.swimmer.short_wave_traction = m.boolean("short_wave_traction", false);
+    if (p.swimmer.short_wave_traction && p.swimmer.model != SwimmerModel::ForceFree)
+      throw InputError(m.path("short_wave_traction"), "true",
+                       "the short-wave wall traction belongs to the force-free model (model1d.model = \"force_free\")");
+    if (p.swimmer.short_wave_traction && !forced)
+      throw InputError(m.path("short_wave_traction"), "true",
+                       "the short-wave wall traction only applies to wave.kind = \"force_driven\" (a prescribed wave "
+                       "fixes R(z,t), and the normal stress then does not change the swimmer's velocity)");
     if (p.wall.inertia && !forced)
       throw InputError(m.path("wall_inertia"), "true", "wall inertia only applies to wave.kind = \"force_driven\" "
                                                        "(a prescribed wave fixes R(z,t))");

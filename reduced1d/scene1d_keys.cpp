@@ -13,7 +13,8 @@ const scene::json& section_keys() {
           {"balance", "choice:per_area|per_length"},
           {"thrust", "boolean"},
           {"external_drag", "choice:none|resistive_force"}}},
-        {"wall_inertia", "boolean"}}},
+        {"wall_inertia", "boolean"},
+        {"short_wave_traction", "boolean"}}},
       {"numerics1d", {{"cells", "integer"}, {"rtol", "number"}, {"atol_scale", "number"}, {"max_steps", "integer"}}}};
   return keys;
 }

@@ -1,0 +1,137 @@
+// Short-wave wall traction of the force-free force-driven model (model1d.short_wave_traction):
+// the |k| quadrature, the Newton matrix of the IDA path that carries it (confined closure
+// included), the relaxation rate of a short-wave load against the linear Stokes-lubrication
+// prediction, and the scene's guards.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "reduced1d/internal.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "reduced1d/solver.hpp"
+
+using namespace swim::reduced1d;
+
+namespace {
+constexpr double kPi = 3.14159265358979323846;
+
+Params force_free_cycle(int N) {
+  Params p;  // defaults: force-free, confined, force-driven protocol
+  p.wave = WaveKind::ForceDriven;
+  p.numerics.cells = N;
+  p.numerics.output_interval = 2e-3;
+  p.swimmer.short_wave_traction = true;
+  return p;
+}
+}  // namespace
+
+// |k| ~= sum_j c_j k^2 / (k^2 + s_j^2) for the discrete wavenumber k_d = (2/h) sin(k h / 2)
+// of every cosine mode k = m pi / L of the grid (the eigenvalues of the mirror-end second
+// difference), within 1 % from the tube's lowest mode to the cell scale, on coarse and fine
+// grids; the number of nodes grows only logarithmically with N.
+TEST(WallTraction, QuadratureOfAbsKIsWithinOnePercentOnEveryGridMode) {
+  const double L = 0.4e-6;
+  for (int N : {20, 200, 3200}) {
+    const double h = L / N;
+    const auto q = detail::abs_k_quadrature(L, h);
+    ASSERT_EQ(q.s.size(), q.c.size());
+    EXPECT_GE(q.s.size(), 5u);
+    EXPECT_LE(q.s.size(), 12u);
+    double worst = 0;
+    for (int m = 1; m < N; ++m) {
+      const double k = m * kPi / L, kd = 2.0 / h * std::sin(0.5 * k * h);
+      double a = 0;
+      for (std::size_t j = 0; j < q.s.size(); ++j) a += q.c[j] * kd * kd / (kd * kd + q.s[j] * q.s[j]);
+      worst = std::max(worst, std::abs(a / kd - 1.0));
+    }
+    EXPECT_LT(worst, 0.01) << "N = " << N;
+  }
+}
+
+// The IDA Newton matrix with the traction fields: a frozen-closure difference-quotient band,
+// one rank-1 term per held segment and, confined, two rank-1 terms for the closure (W, U),
+// against central differences of the full residual at random states.
+TEST(WallTraction, NewtonMatrixMatchesFiniteDifferences) {
+  for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
+    for (int N : {37, 60}) {
+      Params p = force_free_cycle(N);
+      p.swimmer.outer = outer;
+      p.swimmer.a_in = 2e-9;
+      p.swimmer.a_out = 3e-9;
+      const int n = p.protocol.segments;
+      for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
+        for (unsigned seed : {1u, 2u}) {
+          const auto c = detail::check_jacobian(p, phase, active, seed);
+          EXPECT_LT(c.max_rel_error, 1e-6) << "N=" << N << " phase=" << phase << " active=" << active;
+          const int held = phase == 0 ? n - 1 - active : 0;
+          EXPECT_EQ(c.rank, held + (outer == OuterFlow::Confined ? 2 : 0));
+        }
+    }
+}
+
+// A small load q_i = q0 cos(k z_i) on a long tube (unbounded outer flow: p_out = 0, local
+// lumen lubrication) relaxes, far from the ends, as R - R0 = -(q0/C1) cos(k z) (1 - e^{-lambda t})
+// with lambda = C1 / (eta_lub + eta_tr): eta_lub = 16 mu / (R0^3 k_d^2) from the lumen's
+// lubrication flow and eta_tr = 4 mu k_d from the traction of the two fluids (discrete
+// wavenumber k_d). At k R0 = 4 the traction is 16 times the lubrication resistance: the
+// relaxation is 17 times slower with it, and each model meets its own rate to 2 %.
+TEST(WallTraction, ShortWaveLoadRelaxesAtTheLinearStokesRate) {
+  for (bool traction : {true, false}) {
+    Params p;
+    p.wave = WaveKind::ForceDriven;
+    p.swimmer.outer = OuterFlow::Unbounded;
+    p.swimmer.short_wave_traction = traction;
+    const double R0 = p.geometry.R0, C1 = p.wall.C1, mu = p.fluid.mu;
+    const int N = 400;
+    p.geometry.L = 40 * R0;
+    p.numerics.cells = N;
+    p.numerics.rtol = 1e-8;
+    const double L = p.geometry.L, h = L / N;
+    const int m = 51;  // k R0 = 4.006
+    const double k = m * kPi / L, kd = 2.0 / h * std::sin(0.5 * k * h);
+    const double eta = 16.0 * mu / (R0 * R0 * R0 * kd * kd) + (traction ? 4.0 * mu * kd : 0.0);
+    const double lambda = C1 / eta;
+    const double t1 = 1.0 / lambda;
+    const double q0 = 2e-3 * C1 * R0;
+    std::vector<double> q(N), c(N);
+    for (int i = 0; i < N; ++i) {
+      c[i] = std::cos(k * (i + 0.5) * h);
+      q[i] = q0 * c[i];
+    }
+    p.numerics.output_interval = t1;
+    const Result r = detail::solve_fixed_actuation(p, q, t1);
+    ASSERT_FALSE(r.failure) << r.failure->what();
+    ASSERT_EQ(r.radius_times.size(), 2u);
+    EXPECT_NEAR(r.radius_times[1], t1, 1e-9 * t1);
+    // amplitude of the mode over the middle half of the tube
+    double num = 0, den = 0;
+    for (int i = N / 4; i < 3 * N / 4; ++i) {
+      num += (r.radius[std::size_t(N) + i] - R0) * c[i];
+      den += c[i] * c[i];
+    }
+    const double amplitude = -(num / den) / (q0 / C1);
+    EXPECT_NEAR(amplitude, 1.0 - std::exp(-1.0), 0.02 * (1.0 - std::exp(-1.0))) << "traction " << traction;
+  }
+}
+
+// The traction belongs to the force-free force-driven model: a scene that asks for it with the
+// paper's model or with a prescribed wave is refused, naming the key.
+TEST(WallTraction, SceneRefusesItOutsideTheForceFreeForceDrivenModel) {
+  using swim::scene::json;
+  json resolved;
+  const Params p = read_scene(json{{"model1d", {{"short_wave_traction", true}}}}, resolved);
+  EXPECT_TRUE(p.swimmer.short_wave_traction);
+  EXPECT_EQ(resolved["model1d"]["short_wave_traction"], true);
+  for (const json& bad : {json{{"model1d", {{"short_wave_traction", true}, {"model", "paper"}}}},
+                          json{{"model1d", {{"short_wave_traction", true}}}, {"wave", {{"kind", "step"}}}}}) {
+    try {
+      read_scene(bad, resolved);
+      ADD_FAILURE() << "accepted " << bad.dump();
+    } catch (const swim::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("model1d.short_wave_traction"), std::string::npos) << e.what();
+    }
+  }
+}
