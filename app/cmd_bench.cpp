@@ -1,6 +1,6 @@
 // swim bench: performance figures, measured in one run so that ratios are meaningful on a
 // shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 and,
-// at N = 200, with the unbounded outer flow and in the paper mode (best
+// at N = 200, with the short-wave wall traction, the unbounded outer flow and in the paper mode (best
 // of several repetitions) and screening throughput (designs per second) on all cores and on
 // one thread, with the process CPU time per design.
 #include <algorithm>
@@ -124,9 +124,11 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
                       {"cycle_time_s", m.mean_cycle_time_s}, {"ok", !r.failure}});
   }
   report["force_driven_cycle"] = cycles;
-  // The other outer flow and the paper's reproduction mode at the screening resolution.
+  // The short-wave wall traction, the other outer flow and the paper's reproduction mode at
+  // the screening resolution.
   scene::json variants = scene::json::array();
-  for (const std::string& v : {std::string("model1d.outer_flow=\"unbounded\""), std::string("model1d.model=\"paper\"")}) {
+  for (const std::string& v : {std::string("model1d.short_wave_traction=true"), std::string("model1d.outer_flow=\"unbounded\""),
+                                std::string("model1d.model=\"paper\"")}) {
     std::vector<std::string> sets = {"numerics1d.cells=200", "protocol.cycles=1", "time.duration=\"auto\"", v};
     if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
     const auto p = demo_params(sets);

@@ -19,6 +19,7 @@
 // Unbounded: p_out = 0, the lumen fluxes are local as above and U is the slender-body
 // average of the induced axial flow (it does not feed back into the radii).
 // State scaling: A/(pi R0^2), V/(R0/T_s), p/(C1 R0), D/D_s, X/X_s, V/(pi R0^2 L).
+#include <Eigen/Dense>
 #include <cvode/cvode.h>
 #include <cvode/cvode_ls.h>
 #include <ida/ida.h>
@@ -1457,21 +1458,34 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
 }  // namespace
 
 AbsKQuadrature abs_k_quadrature(double L, double h) {
-  // Trapezoid rule in tau = ln s for (2/pi) int k^2 e^tau / (k^2 + e^(2 tau)) dtau: the
-  // integrand is k / (2 cosh(tau - ln k)), so the rule converges exponentially in 1/dtau
-  // (step 1.5: about 0.3 %). The range covers the tube's lowest mode pi/L and the grid's
-  // highest discrete wavenumber 2/h with a margin of 3 on each side; the tails beyond are
-  // int_-inf^lo ~ s_lo k^2 / (k^2 + s_lo^2) and int_hi^inf ~ s_hi k^2 / (k^2 + s_hi^2) for
-  // k well inside, so each end node takes the weight s_end on top of its half step.
-  const double lo = std::log(pi / L) - 3.0, hi = std::log(2.0 / h) + 3.0;
+  // Nodes: log-spaced, step <= 1.5 in ln s, from (pi/L)/e to (2/h) e (the tube's lowest
+  // mode and the grid's highest discrete wavenumber, one unit of ln s beyond each). Weights:
+  // least squares on the relative error at 200 log-spaced wavenumbers over [pi/L, 2/h]
+  // (Householder QR). The trapezoid rule in ln s on the same nodes, (2/pi) ds_j s_j, is the
+  // exact quadrature of |k| = (2/pi) int_0^inf k^2 / (k^2 + s^2) ds apart from its two
+  // truncated tails; the fit corrects the tails and the end nodes, so that 5-10 nodes reach
+  // < 1 % where the plain rule needs twice as many. All weights come out positive (the
+  // operator stays dissipative); a fit that did not would be refused.
+  const double k_lo = pi / L, k_hi = 2.0 / h;
+  const double lo = std::log(k_lo) - 1.0, hi = std::log(k_hi) + 1.0;
   const int n = int(std::ceil((hi - lo) / 1.5)) + 1;
   const double d = (hi - lo) / (n - 1);
   AbsKQuadrature q;
+  for (int j = 0; j < n; ++j) q.s.push_back(std::exp(lo + j * d));
+  constexpr int kSamples = 200;
+  Eigen::MatrixXd A(kSamples, n);
+  Eigen::VectorXd ones = Eigen::VectorXd::Ones(kSamples);
+  for (int r = 0; r < kSamples; ++r) {
+    const double k = std::exp(std::log(k_lo) + (std::log(k_hi) - std::log(k_lo)) * r / (kSamples - 1));
+    for (int j = 0; j < n; ++j) A(r, j) = k / (k * k + q.s[j] * q.s[j]);  // (k^2 / (k^2 + s^2)) / k
+  }
+  const Eigen::VectorXd c = A.householderQr().solve(ones);
   for (int j = 0; j < n; ++j) {
-    const double sj = std::exp(lo + j * d);
-    const double w = (j == 0 || j == n - 1) ? 0.5 * d + 1.0 : d;
-    q.s.push_back(sj);
-    q.c.push_back((2.0 / pi) * w * sj);
+    if (!(c[j] > 0.0))
+      throw NumericalError("the short-wave traction's |k| quadrature has a non-positive weight at N = " +
+                               std::to_string(int(std::lround(L / h))) + " cells",
+                           "use another numerics1d.cells or model1d.short_wave_traction = false", 0.0);
+    q.c.push_back(c[j]);
   }
   return q;
 }

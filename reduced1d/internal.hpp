@@ -65,11 +65,11 @@ struct JacobianCheck {
 JacobianCheck check_jacobian(const Params& p, int phase, int active, unsigned seed);
 
 /// The short-wave wall traction's operator |k| on the cells (docs/outer-flow-1d.md, 3b):
-/// |k| = (2/pi) int_0^inf k^2 / (k^2 + s^2) ds by the trapezoid rule in log s (step <= 1.5)
-/// from s = (pi/L) e^-3 to (2/h) e^3, each tail folded into its end weight, so that
-/// |k| ~= sum_j c_j k^2 / (k^2 + s_j^2) within 1 % for every wavenumber of the grid. Each term
-/// is one tridiagonal relation per cell, (s_j^2 - D2) psi_j = -D2 V, with D2 the cell
-/// second difference with mirror ends.
+/// |k| ~= sum_j c_j k^2 / (k^2 + s_j^2) within 1 % for every wavenumber of the grid, from the
+/// tube's lowest mode pi/L to the discrete 2/h, with log-spaced nodes s_j (step <= 1.5 in
+/// ln s) and positive least-squares weights c_j (5 to 10 nodes). Each term is one tridiagonal
+/// relation per cell, (s_j^2 - D2) psi_j = -D2 V, with D2 the cell second difference with
+/// mirror ends.
 struct AbsKQuadrature {
   std::vector<double> s, c;  ///< nodes s_j [1/m] and weights c_j [1/m]
 };

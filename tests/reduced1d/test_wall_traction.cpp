@@ -31,15 +31,17 @@ Params force_free_cycle(int N) {
 // |k| ~= sum_j c_j k^2 / (k^2 + s_j^2) for the discrete wavenumber k_d = (2/h) sin(k h / 2)
 // of every cosine mode k = m pi / L of the grid (the eigenvalues of the mirror-end second
 // difference), within 1 % from the tube's lowest mode to the cell scale, on coarse and fine
-// grids; the number of nodes grows only logarithmically with N.
+// grids, with positive weights (a dissipative operator); the number of nodes grows only
+// logarithmically with N.
 TEST(WallTraction, QuadratureOfAbsKIsWithinOnePercentOnEveryGridMode) {
   const double L = 0.4e-6;
-  for (int N : {20, 200, 3200}) {
+  for (int N : {4, 7, 20, 200, 3200, 100000}) {
     const double h = L / N;
     const auto q = detail::abs_k_quadrature(L, h);
     ASSERT_EQ(q.s.size(), q.c.size());
-    EXPECT_GE(q.s.size(), 5u);
-    EXPECT_LE(q.s.size(), 12u);
+    EXPECT_GE(q.s.size(), 3u);
+    EXPECT_LE(q.s.size(), 10u);
+    for (double c : q.c) EXPECT_GT(c, 0.0);
     double worst = 0;
     for (int m = 1; m < N; ++m) {
       const double k = m * kPi / L, kd = 2.0 / h * std::sin(0.5 * k * h);
