@@ -1,6 +1,8 @@
 """Figure 10 done with pressures: uniform inward pressure against the radial displacement
 of the middle ring, with the C1 fit through the origin, the secant stiffness against the load,
 and the ring's stiffness against its modes cos(n phi) (ring buckling where it turns negative).
+A load at which the wall found no static state (the series stops there) is marked on all
+three panels, and its reason is printed under them.
 
 usage: plot_calibration.py DIR   (reads DIR/calibration.json, writes DIR/calibration.png)
 """
@@ -39,9 +41,18 @@ def main(d):
                label=f"C1 = {c['C1_Pa_per_m'] / 1e6:.4g} MPa/m (fit)")
     ax[0].plot([0, xm], [0, c["C1_spring_network_Pa_per_m"] * xm * 1e-9 * 1e3], "k:", lw=1,
                label=f"2 k\u209b / (\u221a3 R\u2080\u00b2) = {c['C1_spring_network_Pa_per_m'] / 1e6:.4g} MPa/m")
+    lost = c.get("loads_without_static_state")
+    if lost:
+        p_lost = lost["from_Pa"] * 1e3
+        ax[0].axhline(p_lost, color="tab:red", ls="--", lw=1, label=f"no static state at {p_lost:.3g} mPa")
+        for a in ax[1:]:
+            a.axvline(p_lost, color="tab:red", ls="--", lw=1, label=f"no static state at {p_lost:.3g} mPa")
+        import textwrap
+        fig.text(0.01, 0.01, "\n".join(textwrap.wrap(f"No static state from {p_lost:.3g} mPa: {lost['reason']}", 190)),
+                 fontsize=8, color="tab:red", va="bottom")
     ax[0].set(xlabel="radial displacement R\u2080 \u2212 R_mid [nm]", ylabel="pressure [mPa]",
               title="pressure against displacement")
-    ax[0].legend(loc="upper left", fontsize="small", frameon=False)
+    ax[0].legend(loc="lower right", fontsize="small", frameon=False)
 
     P = [p["pressure_Pa"] * 1e3 for p in pts]
     sec = [p["secant_C1_Pa_per_m"] / 1e6 for p in pts]
@@ -65,7 +76,7 @@ def main(d):
     ax[2].set(xlabel="pressure [mPa] (log scale)", ylabel="ring-mode stiffness [pN/m]",
               title="ring buckling: unstable below zero")
     ax[2].legend(loc="lower left", fontsize="small", frameon=False)
-    fig.tight_layout()
+    fig.tight_layout(rect=(0, 0.06 if lost else 0, 1, 1))
     fig.savefig(f"{d}/calibration.png", dpi=110)
 
 
