@@ -146,7 +146,11 @@ double end_time(const Params& p) {
       // grows as q approaches the least pressure C1 (R0 - R_f) that can reach R_f.
       const double R0 = p.geometry.R0;
       const double Rf = p.protocol.R_f;
-      const double tau = detail::relaxation_time(p) * std::pow(R0 / Rf, 3);
+      double tau = detail::relaxation_time(p) * std::pow(R0 / Rf, 3);
+      // The short-wave traction resists a wall motion of wavenumber k by 4 mu k, whatever
+      // the radius: on the segment scale k = pi n / L that adds 4 mu pi n / (C1 L).
+      if (p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.short_wave_traction)
+        tau += 4.0 * p.fluid.mu * M_PI * p.protocol.segments / (p.wall.C1 * p.geometry.L);
       const double need = p.wall.C1 * (R0 - Rf);
       const double margin = need / std::max(p.protocol.q - need, 1e-12 * need);
       return p.protocol.cycles * 5.0 * tau * (1.0 + std::log1p(std::min(margin, 1e6)));
