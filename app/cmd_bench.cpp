@@ -1,6 +1,6 @@
 // swim bench: performance figures, measured in one run so that ratios are meaningful on a
 // shared machine. 3D part at the end (full3d). 1D part: wall time of one force-driven cycle at N = 50, 200, 800 and,
-// at N = 200, with the short-wave wall traction, the unbounded outer flow and in the paper mode (best
+// at N = 200, with the lubrication-only wall, the unbounded outer flow and in the paper mode (best
 // of several repetitions) and screening throughput (designs per second) on all cores and on
 // one thread, with the process CPU time per design.
 #include <algorithm>
@@ -124,10 +124,10 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
                       {"cycle_time_s", m.mean_cycle_time_s}, {"ok", !r.failure}});
   }
   report["force_driven_cycle"] = cycles;
-  // The short-wave wall traction, the other outer flow and the paper's reproduction mode at
-  // the screening resolution.
+  // The lubrication-only wall (no short-wave traction), the other outer flow and the paper's
+  // reproduction mode at the screening resolution.
   scene::json variants = scene::json::array();
-  for (const std::string& v : {std::string("model1d.short_wave_traction=true"), std::string("model1d.outer_flow=\"unbounded\""),
+  for (const std::string& v : {std::string("model1d.short_wave_traction=false"), std::string("model1d.outer_flow=\"unbounded\""),
                                 std::string("model1d.model=\"paper\"")}) {
     std::vector<std::string> sets = {"numerics1d.cells=200", "protocol.cycles=1", "time.duration=\"auto\"", v};
     if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
@@ -146,14 +146,17 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   // Screening throughput: a 10 x 10 grid over lambda = R_f/R0 in [0.35, 0.85] and
   // L in [0.2, 0.8] um. Force-driven designs drive at 1.4x the static load so that every
   // design is reachable and runs a whole cycle (failing designs would cost nothing and
-  // inflate the figure); N = 200 (the scene default) and N = 50 (a coarse screening grid).
+  // inflate the figure); N = 200 (the shipped scenes' grid) and N = 50 (the default grid
+  // with the short-wave traction), and the lubrication-only wall at N = 200.
   std::printf("screening throughput (%u threads, 10 x 10 grid over lambda and L):\n", cores);
   scene::json screening = scene::json::object();
   struct Case {
     std::string kind;
     int cells;
+    bool traction = true;
   };
-  for (const Case& c : {Case{"step", 200}, Case{"force_driven", 200}, Case{"force_driven", 50}}) {
+  for (const Case& c : {Case{"step", 200}, Case{"force_driven", 200}, Case{"force_driven", 50},
+                        Case{"force_driven", 200, false}}) {
     const int n = c.kind == "step" ? (quick ? 100 : 1000) : (quick ? 20 : 100);
     std::vector<reduced1d::Params> designs;
     for (int k = 0; k < n; ++k) {
@@ -164,6 +167,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       std::snprintf(s, sizeof s, "swimmer.length=\"%.4f um\"", length_um);
       std::vector<std::string> sets = {l, s, "wave.kind=\"" + c.kind + "\"",
                                        "numerics1d.cells=" + std::to_string(c.cells)};
+      if (!c.traction) sets.push_back("model1d.short_wave_traction=false");
       if (c.kind == "step")
         sets.push_back("protocol=null");
       else
@@ -183,7 +187,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       cpu[pass] = process_cpu_seconds() - c0;
       if (pass == 0) failed = std::count_if(res.begin(), res.end(), [](const auto& r) { return !r.ok; });
     }
-    const std::string label = c.kind + " N=" + std::to_string(c.cells);
+    const std::string label = c.kind + (c.traction ? "" : " lubrication wall") + " N=" + std::to_string(c.cells);
     std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed); CPU %.3g ms/design, %.2f cores used; "
                 "1 thread: %.1f designs/s, CPU %.3g ms/design\n",
                 label.c_str(), n, wall[0], n / wall[0], failed, 1e3 * cpu[0] / n, cpu[0] / wall[0], n / wall[1],

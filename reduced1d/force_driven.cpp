@@ -116,6 +116,8 @@ struct ForceModel {
   // want_velocity is set.
   bool velocity_quadrature = false;
   bool want_velocity = true;
+  // IDA difference quotients: U feeds only rows that keep their own derivative (band_dq)
+  bool skip_velocity = false;
 
   explicit ForceModel(const Params& P)
       : N(P.numerics.cells),
@@ -308,7 +310,7 @@ struct ForceModel {
     r[N] = disc::resistance(mu, 0.5 * h, R[N - 1] - a_in, RbL - a_in);
     Q[N] = p[N - 1] / r[N];
     for (int j = 0; j <= N; ++j) cond[j] = 1.0 / r[j];
-    if (force_free && (!velocity_quadrature || want_velocity)) {  // unbounded: slender-body average
+    if (force_free && !skip_velocity && (!velocity_quadrature || want_velocity)) {  // unbounded: slender-body average
       for (int i = 0; i < N; ++i) {
         sigma[i] = (Q[i] - Q[i + 1]) / h;  // d(pi R^2)/dt per unit length
         rho[i] = R[i] + a_out;
@@ -1176,6 +1178,8 @@ class IdaBackend final : public Backend {
     if (M.confined) {         // and the confined closure (W, U) at y
       M.fluxes();
       M.sys->hold_closure = true;
+    } else if (M.force_free) {  // unbounded: U (O(N^2)) is not needed by the band
+      M.skip_velocity = true;
     }
     const int n = M.n, mu = M.band_mu, ml = M.band_ml, width = mu + ml + 1;
     const double* y = sun::data(yv);
@@ -1219,6 +1223,7 @@ class IdaBackend final : public Backend {
         SM_ELEMENT_B(J, i, i) = cj;
       }
     M.freeze_segments = false;
+    M.skip_velocity = false;
     if (M.confined) M.sys->hold_closure = false;
     M.unpack(y);
     return status;

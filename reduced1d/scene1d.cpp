@@ -185,7 +185,8 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
                        "wall inertia is available with model1d.outer_flow = \"unbounded\" and model1d.model = "
                        "\"paper\"; the confined force-free model runs without it (at Re ~ 1e-6 the wall's inertia "
                        "is negligible: its time scale 2 pi sqrt(m / C1) is below 0.1 ms)");
-    p.swimmer.short_wave_traction = m.boolean("short_wave_traction", false);
+    // default on for the force-free force-driven wave (docs/outer-flow-1d.md, 3b)
+    p.swimmer.short_wave_traction = m.boolean("short_wave_traction", p.swimmer.model == SwimmerModel::ForceFree && forced);
     if (p.swimmer.short_wave_traction && p.swimmer.model != SwimmerModel::ForceFree)
       throw InputError(m.path("short_wave_traction"), "true",
                        "the short-wave wall traction belongs to the force-free model (model1d.model = \"force_free\")");
@@ -200,7 +201,16 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   }
   {
     Reader n = top.child("numerics1d");
-    p.numerics.cells = static_cast<int>(n.integer("cells", 200, 4, 100000));
+    // With the short-wave traction the cell-scale motion is damped and N = 50 is as accurate
+    // as N = 400 without it (docs/outer-flow-1d.md, 3b): 50 cells, and at least 4 per
+    // protocol segment; 200 otherwise.
+    int cells_default = 200;
+    if (p.swimmer.short_wave_traction) {
+      const double seg = L / (p.protocol.first_ratio + p.protocol.segments - 1);
+      const int needed = static_cast<int>(std::ceil(L / std::min(seg, seg * p.protocol.first_ratio) - 1e-9));
+      cells_default = std::max(50, 4 * needed);
+    }
+    p.numerics.cells = static_cast<int>(n.integer("cells", cells_default, 4, 100000));
     p.numerics.rtol = n.number("rtol", 1e-6, Range::closed(1e-12, 1e-2));
     p.numerics.atol_scale = n.number("atol_scale", 1e-6, Range::closed(1e-14, 1e-2));
     p.numerics.max_steps = n.integer("max_steps", 2000000, 100, 1000000000);

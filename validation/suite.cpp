@@ -133,14 +133,17 @@ json physics_of(json resolved) {
   return resolved;
 }
 
-/// The physics without the scene's name and description: two scenes that differ only in
-/// those (the paper's amplitude sweep at 0.55 R0 and its aspect sweep at 0.4 um are one
-/// swimmer) share their runs and calibrations.
+/// The physics without the scene's name and description and without the 1D tier's sections:
+/// two scenes that differ only in those (the paper's amplitude sweep at 0.55 R0 and its aspect
+/// sweep at 0.4 um are one swimmer) share their 3D runs and calibrations.
 json same_swimmer(json resolved) {
   resolved = physics_of(std::move(resolved));
   if (resolved.is_object()) {
     resolved.erase("name");
     resolved.erase("description");
+    // the 1D tier's sections: a 3D run or calibration does not depend on them
+    resolved.erase("model1d");
+    resolved.erase("numerics1d");
   }
   return resolved;
 }

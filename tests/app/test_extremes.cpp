@@ -1,5 +1,6 @@
 // Stability at the extremes of the design space (1D tier, through the scene layer, the
-// force-free default): R_f/R0 from 0.1 to 0.95, eps = R0/L from 0.02 to 3.2, C1 and viscosity
+// force-free default with the short-wave wall traction): R_f/R0 from 0.1 to 0.95,
+// eps = R0/L from 0.02 to 3.2, C1 and viscosity
 // over four decades, container radius from 1.2 R0 to 20 R0. Each case states its outcome: a
 // valid result (finite outputs, the protocol completed), a numerical failure naming its cause
 // and a remedy, or (unreachable by construction) a rejection as input before running.
@@ -119,29 +120,28 @@ TEST(Extremes, ForceDrivenWithActuationScaledToTheTarget) {
             {"ok", ""});
 }
 
-TEST(Extremes, ForceDrivenWithTheShortWaveTraction) {
-  // The same extremes with model1d.short_wave_traction (IDA with the traction fields): the
-  // same outcomes as without it, the collapse below R_f/R0 = 1/3 included.
-  // (One case at eps = 0.02: its 69 s cycle writes 69 000 samples and takes about 10 s.)
-  const std::string tr = "model1d.short_wave_traction=true";
+TEST(Extremes, ForceDrivenWithoutTheShortWaveTraction) {
+  // The lubrication-only wall (model1d.short_wave_traction = false, CVODE) at the same
+  // extremes: the same outcomes as the default, the collapse below R_f/R0 = 1/3 included.
+  const std::string tr = "model1d.short_wave_traction=false";
   for (auto [ratio, length] : {std::pair{"0.1", "0.125 um"}, std::pair{"0.55", "6.25 um"}, std::pair{"0.55", "0.125 um"},
                                std::pair{"0.95", "0.125 um"}}) {
     const bool collapses = std::stod(ratio) < 1.0 / 3.0;
-    check(std::string("force_driven traction, R_f/R0 = ") + ratio + ", L = " + length,
+    check(std::string("force_driven lubrication wall, R_f/R0 = ") + ratio + ", L = " + length,
           {tr, "protocol.load_factor=1.5", std::string("wave.contracted_ratio=") + ratio,
            std::string("swimmer.length=") + length, "container.period=25 um"},
           collapses ? Expect{"failed", "collapsed"} : Expect{"ok", ""});
   }
-  // (not the soft, viscous corner: its 4 560 s cycle writes 4.6 million samples)
+  // (not the soft, viscous corner: its 2 840 s cycle is slow to sample; the default covers it)
   for (auto [c1, mu] : {std::pair{"4.06e4 Pa/m", "1.2e-5 Pa*s"}, std::pair{"4.06e8 Pa/m", "1.2e-5 Pa*s"},
                         std::pair{"4.06e8 Pa/m", "1.2e-1 Pa*s"}})
-    check(std::string("force_driven traction, C1 = ") + c1 + ", mu = " + mu,
+    check(std::string("force_driven lubrication wall, C1 = ") + c1 + ", mu = " + mu,
           {tr, "protocol.load_factor=1.5", std::string("wall.C1=") + c1, std::string("fluid.viscosity=") + mu},
           {"ok", ""});
   for (const char* rc : {"0.15 um", "2.5 um"})
-    check(std::string("force_driven traction, Rc = ") + rc,
+    check(std::string("force_driven lubrication wall, Rc = ") + rc,
           {tr, "protocol.load_factor=1.5", std::string("container.radius=") + rc, "container.period=16 um"}, {"ok", ""});
-  check("force_driven traction unbounded, R_f/R0 = 0.55, L = 0.125 um",
+  check("force_driven lubrication wall unbounded, R_f/R0 = 0.55, L = 0.125 um",
         {tr, "protocol.load_factor=1.5", "model1d.outer_flow=unbounded", "swimmer.length=0.125 um",
          "container.period=25 um"},
         {"ok", ""});
