@@ -101,7 +101,6 @@ struct ForceModel {
   std::vector<double> q, dq;          // total actuation and d(own law)/dR per cell
   std::vector<double> Rbar, qs, dqs;  // per segment (only where seg_law != nullptr)
   double Rb0, RbL;
-  bool freeze_segments = false;  // reuse qs and the end radii (difference quotients)
   // workspace
   std::vector<double> R, V, p, r, Q;
   std::vector<double> cond;  // dQ_j / d(-dPi_j): 1 / r_j, or 1 / (r_in + r_out) when confined
@@ -116,8 +115,6 @@ struct ForceModel {
   // want_velocity is set.
   bool velocity_quadrature = false;
   bool want_velocity = true;
-  // IDA difference quotients: U feeds only rows that keep their own derivative (band_dq)
-  bool skip_velocity = false;
 
   explicit ForceModel(const Params& P)
       : N(P.numerics.cells),
@@ -249,20 +246,18 @@ struct ForceModel {
     } else {
       for (int i = 0; i < N; ++i) Rd[i] = R0 * std::sqrt(std::max(y[1 + stride * i], 1e-300));
     }
-    if (!freeze_segments) {
-      for (int k = 0; k < nseg; ++k) {
-        if (!seg_law[k]) continue;
-        double s = 0;
-        for (int i = seg_first[k]; i <= seg_last[k]; ++i) {
-          if (seg_a[i] == k) s += frac[i] * R[i];
-          if (seg_b[i] == k && seg_b[i] != seg_a[i]) s += (1.0 - frac[i]) * R[i];
-        }
-        Rbar[k] = s / seg_w[k];
-        qs[k] = seg_law[k]->eval(Rbar[k], dqs[k]);
+    for (int k = 0; k < nseg; ++k) {
+      if (!seg_law[k]) continue;
+      double s = 0;
+      for (int i = seg_first[k]; i <= seg_last[k]; ++i) {
+        if (seg_a[i] == k) s += frac[i] * R[i];
+        if (seg_b[i] == k && seg_b[i] != seg_a[i]) s += (1.0 - frac[i]) * R[i];
       }
-      if (end0_seg) Rb0 = law[0].a->rest_radius(R0, C1, qs[seg_a[0]]);
-      if (endL_seg) RbL = law[N - 1].a->rest_radius(R0, C1, qs[seg_a[N - 1]]);
+      Rbar[k] = s / seg_w[k];
+      qs[k] = seg_law[k]->eval(Rbar[k], dqs[k]);
     }
+    if (end0_seg) Rb0 = law[0].a->rest_radius(R0, C1, qs[seg_a[0]]);
+    if (endL_seg) RbL = law[N - 1].a->rest_radius(R0, C1, qs[seg_a[N - 1]]);
     for (int i = 0; i < N; ++i) {
       const double Ri = R[i];
       double qi = law[i].eval(Ri, dq[i]);
@@ -310,7 +305,7 @@ struct ForceModel {
     r[N] = disc::resistance(mu, 0.5 * h, R[N - 1] - a_in, RbL - a_in);
     Q[N] = p[N - 1] / r[N];
     for (int j = 0; j <= N; ++j) cond[j] = 1.0 / r[j];
-    if (force_free && !skip_velocity && (!velocity_quadrature || want_velocity)) {  // unbounded: slender-body average
+    if (force_free && (!velocity_quadrature || want_velocity)) {  // unbounded: slender-body average
       for (int i = 0; i < N; ++i) {
         sigma[i] = (Q[i] - Q[i + 1]) / h;  // d(pi R^2)/dt per unit length
         rho[i] = R[i] + a_out;
@@ -641,6 +636,64 @@ struct ForceModel {
     for (int k = 0; k < n; ++k)
       if (!std::isfinite(F[k])) return 1;
     return 0;
+  }
+
+  /// Band part of the IDA Newton matrix dF/dy + cj dF/dy' at (y, yp), analytic, with the
+  /// segment actuation, the end radii and the confined closure (W, U) held (they enter as the
+  /// low-rank terms of residual_low_rank, which must be called first at the same y: it leaves
+  /// the flux sensitivities this reads). Rows of D, X and the lab-frame volumes keep their own
+  /// derivative (and the paper balance's D-X block): their dependence on the cells does not
+  /// feed back. `band(i, j, v)` adds v at (i, j).
+  template <class Band>
+  void ida_band(const double* y, double cj, Band band) const {
+    const FluxSens& s = sens_;
+    const int S = stride;
+    const double cu = 2.0 * Vel_s / (R0 * R0);
+    const double cv = wall_row_coefficient();
+    const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
+    const double A0 = pi * R0 * R0;
+    auto dRda = [&](int i) { return 0.5 * R0 * R0 / R[i]; };
+    for (int i = 0; i < N; ++i) {
+      const int k = 1 + S * i;
+      // F_a = a' - cu R V
+      band(k, k, cj - cu * y[k + 1] * dRda(i));
+      band(k, k + 1, -cu * R[i]);
+      // F_V = [V'] + cv (C1 (R - R0) + q + P_s T - p)
+      band(k + 1, k, cv * (C1 + dq[i]) * dRda(i));
+      if (inertia) band(k + 1, k + 1, cj);
+      band(k + 1, k + 2, -cv * P_s);
+      for (int j = 0; j < J; ++j) band(k + 1, k + 3 + j, cv * P_s * tr_c[j]);
+      // F_p = cp ((Q_{i+1} - Q_i) / h + A0 a'): Q_i on (R_{i-1}, R_i), (p_{i-1}, p_i)
+      const double c = cp / h;
+      band(k + 2, k, c * (s.QL[i + 1] - s.QR[i]) * dRda(i) + cp * A0 * cj);
+      if (i > 0) band(k + 2, k - S, -c * s.QL[i] * dRda(i - 1));
+      if (i + 1 < N) band(k + 2, k + S, c * s.QR[i + 1] * dRda(i + 1));
+      band(k + 2, k + 2, c * (cond[i + 1] + cond[i]) * P_s);
+      if (i > 0) band(k + 2, k + 2 - S, -c * cond[i] * P_s);
+      if (i + 1 < N) band(k + 2, k + 2 + S, -c * cond[i + 1] * P_s);
+      // F_psi_j = ((s_j h)^2 psi - D2 psi + D2 V) / ((s_j h)^2 + 4), mirror ends
+      const int nb = (i > 0) + (i + 1 < N);
+      for (int j = 0; j < J; ++j) {
+        const int r = k + 3 + j;
+        const double w = 1.0 / (tr_s2[j] + 4.0);
+        band(r, r, (tr_s2[j] + nb) * w);
+        band(r, k + 1, -nb * w);
+        if (i > 0) band(r, r - S, -w), band(r, k + 1 - S, w);
+        if (i + 1 < N) band(r, r + S, -w), band(r, k + 1 + S, w);
+      }
+    }
+    // end volumes: F = V' - Q_end / V_s
+    band(iVr, iVr, cj);
+    band(iVr, 1, -s.QR[0] * dRda(0) / V_s);
+    band(iVr, 3, cond[0] * P_s / V_s);
+    band(iVf, iVf, cj);
+    band(iVf, 1 + S * (N - 1), -s.QL[N] * dRda(N - 1) / V_s);
+    band(iVf, 1 + S * (N - 1) + 2, -cond[N] * P_s / V_s);
+    for (int i : {iD, iX, iVrl, iVfl}) band(i, i, cj);
+    if (!force_free) {  // F_X = X' - W / X_s, W = (thrust - D - c_ext X) / m_eff
+      band(iX, iD, D_s / (bal.m_eff * X_s));
+      band(iX, iX, bal.c_ext / bal.m_eff);
+    }
   }
 
   /// Rank-1 terms of the IDA residual Jacobian dF/dy (the band part is obtained by difference
@@ -1160,73 +1213,15 @@ class IdaBackend final : public Backend {
   static int F(double, N_Vector y, N_Vector yp, N_Vector r, void* user) {
     return static_cast<Problem*>(user)->M.res(sun::data(y), sun::data(yp), sun::data(r));
   }
-  // Band part by grouped difference quotients with the segment actuation (and end radii)
-  // frozen at y, so that the non-local segment coupling does not alias into the band; the
-  // segment coupling itself is added exactly as rank-1 terms.
+  // Band part analytic (ForceModel::ida_band) with the segment actuation, the end radii and
+  // the confined closure held; their couplings are the exact low-rank terms.
   static int jac(double, double cj, N_Vector yv, N_Vector ypv, N_Vector rv, SUNMatrix J, void* user,
                  N_Vector, N_Vector, N_Vector) {
     auto* pb = static_cast<Problem*>(user);
     pb->low_rank.rank = pb->M.residual_low_rank(sun::data(yv), pb->low_rank.U, pb->low_rank.V);
-    return band_dq(*pb, cj, yv, ypv, rv, J);
-  }
-
- public:
-  static int band_dq(Problem& pbr, double cj, N_Vector yv, N_Vector ypv, N_Vector rv, SUNMatrix J) {
-    Problem* pb = &pbr;
-    ForceModel& M = pb->M;
-    M.unpack(sun::data(yv));  // segment actuation at y, frozen below
-    if (M.confined) {         // and the confined closure (W, U) at y
-      M.fluxes();
-      M.sys->hold_closure = true;
-    } else if (M.force_free) {  // unbounded: U (O(N^2)) is not needed by the band
-      M.skip_velocity = true;
-    }
-    const int n = M.n, mu = M.band_mu, ml = M.band_ml, width = mu + ml + 1;
-    const double* y = sun::data(yv);
-    const double* yp = sun::data(ypv);
-    const double* r0 = sun::data(rv);
-    pb->ytmp.assign(y, y + n);
-    pb->yptmp.assign(yp, yp + n);
-    pb->rtmp.assign(n, 0.0);
     SUNMatZero(J);
-    const double srur = 6e-6;  // ~ cube root of the unit roundoff (central differences)
-    M.freeze_segments = true;
-    int status = 0;
-    // Central differences: the ramps of the actuation laws have large curvature, and a
-    // one-sided quotient is then only accurate to a few 1e-6.
-    pb->ftmp.assign(n, 0.0);
-    for (int g = 0; g < width && status == 0; ++g) {
-      for (int sgn : {1, -1}) {
-        for (int j = g; j < n; j += width) {
-          const double inc = sgn * srur * std::max(std::abs(y[j]), 1e-2);
-          pb->ytmp[j] = y[j] + inc;
-          pb->yptmp[j] = yp[j] + cj * inc;
-        }
-        status = M.res(pb->ytmp.data(), pb->yptmp.data(), sgn > 0 ? pb->rtmp.data() : pb->ftmp.data());
-        if (status != 0) break;
-      }
-      for (int j = g; j < n; j += width) {
-        const double inc = srur * std::max(std::abs(y[j]), 1e-2);
-        pb->ytmp[j] = y[j];
-        pb->yptmp[j] = yp[j];
-        for (int i = std::max(0, j - mu); i <= std::min(n - 1, j + ml); ++i)
-          SM_ELEMENT_B(J, i, j) = (pb->rtmp[i] - pb->ftmp[i]) / (2.0 * inc);
-      }
-    }
-    (void)r0;
-    // Unbounded: U, the slender-body average over every cell, enters only X and the lab-frame
-    // volumes and does not feed back; grouped quotients would alias it into their rows, which
-    // keep only their own derivative (as in the CVODE path's Jacobian).
-    if (M.force_free && !M.confined && status == 0)
-      for (int i : {M.iX, M.iVrl, M.iVfl}) {
-        for (int j = std::max(0, i - ml); j <= std::min(n - 1, i + mu); ++j) SM_ELEMENT_B(J, i, j) = 0.0;
-        SM_ELEMENT_B(J, i, i) = cj;
-      }
-    M.freeze_segments = false;
-    M.skip_velocity = false;
-    if (M.confined) M.sys->hold_closure = false;
-    M.unpack(y);
-    return status;
+    pb->M.ida_band(sun::data(yv), cj, [J](int i, int j, double v) { SM_ELEMENT_B(J, i, j) += v; });
+    return 0;
   }
 
  private:
@@ -1549,19 +1544,19 @@ JacobianCheck check_jacobian(const Params& P, int phase, int active, unsigned se
     rank = M.jacobian(y.data(), [&](int i, int j, double v) { J[std::size_t(i) * n + j] = v; }, U, Vt);
   } else {
     rank = M.residual_low_rank(y.data(), U, Vt);
-    // band part: the backend's difference-quotient routine on a band matrix
+    // band part: the backend's analytic band on a band matrix (an entry outside the band
+    // the matrix was sized for is an error)
     auto ctx = sun::make_context();
     auto A = sun::make_band_matrix(n, M.band_mu, M.band_ml, ctx.get());
-    auto yv = sun::make_vector(n, ctx.get()), ypv = sun::make_vector(n, ctx.get()), rv = sun::make_vector(n, ctx.get());
-    std::copy(y.begin(), y.end(), sun::data(yv.get()));
-    std::copy(yp.begin(), yp.end(), sun::data(ypv.get()));
-    M.res(y.data(), yp.data(), sun::data(rv.get()));
-    pb.low_rank.rank = rank;
-    IdaBackend::band_dq(pb, cj, yv.get(), ypv.get(), rv.get(), A.get());
+    SUNMatZero(A.get());
+    M.ida_band(y.data(), cj, [&](int i, int j, double v) {
+      if (j - i > M.band_mu || i - j > M.band_ml)
+        throw std::logic_error("IDA band entry (" + std::to_string(i) + ", " + std::to_string(j) + ") outside the band");
+      SM_ELEMENT_B(A.get(), i, j) += v;
+    });
     for (int i = 0; i < n; ++i)
       for (int j = std::max(0, i - M.band_ml); j <= std::min(n - 1, i + M.band_mu); ++j)
         J[std::size_t(i) * n + j] = SM_ELEMENT_B(A.get(), i, j);
-    M.residual_low_rank(y.data(), U, Vt);
   }
   for (int k = 0; k < rank; ++k)
     for (int i = 0; i < n; ++i)

@@ -207,27 +207,23 @@ void ConfinedSystem::transmural(const double* Pi, double F_ext) {
   //   beta = (c - A_c ra) / (rl + ra),  gamma = dPi / (rl + ra).
   // Periodicity: sum rl Q_in + r_free W = 0.  Force: sum S dp_out + U sum e = F_ext with
   // dp_out = -rl Q_in - dPi.
-  if (hold_closure) {
-    for (int j = 0; j < ni; ++j) dPi[j] = Pi[j + 1] - Pi[j];
-  } else {
-    double m11 = r_free, m12 = 0, b1 = 0, m21 = 0, m22 = 0, b2 = F_ext;
-    for (int j = 0; j < ni; ++j) {
-      const auto& c = k[j];
-      const double wj = w[j];
-      const double alpha = c.ra * wj, beta = (c.c - A_c * c.ra) * wj, dpi = Pi[j + 1] - Pi[j];
-      dPi[j] = dpi;
-      m11 += c.rl * alpha;
-      m12 += c.rl * beta;
-      b1 += c.rl * dpi * wj;
-      m21 -= c.S * c.rl * alpha;
-      m22 += c.e - c.S * c.rl * beta;
-      b2 += c.S * alpha * dpi;
-    }
-    M[0][0] = m11, M[0][1] = m12, M[1][0] = m21, M[1][1] = m22;
-    const double det = m11 * m22 - m12 * m21;
-    W = (b1 * m22 - m12 * b2) / det;
-    U = (m11 * b2 - m21 * b1) / det;
+  double m11 = r_free, m12 = 0, b1 = 0, m21 = 0, m22 = 0, b2 = F_ext;
+  for (int j = 0; j < ni; ++j) {
+    const auto& c = k[j];
+    const double wj = w[j];
+    const double alpha = c.ra * wj, beta = (c.c - A_c * c.ra) * wj, dpi = Pi[j + 1] - Pi[j];
+    dPi[j] = dpi;
+    m11 += c.rl * alpha;
+    m12 += c.rl * beta;
+    b1 += c.rl * dpi * wj;
+    m21 -= c.S * c.rl * alpha;
+    m22 += c.e - c.S * c.rl * beta;
+    b2 += c.S * alpha * dpi;
   }
+  M[0][0] = m11, M[0][1] = m12, M[1][0] = m21, M[1][1] = m22;
+  const double det = m11 * m22 - m12 * m21;
+  W = (b1 * m22 - m12 * b2) / det;
+  U = (m11 * b2 - m21 * b1) / det;
   Q_tot = W - A_c * U;
   dp_tube = 0;
   for (int j = 0; j < ni; ++j) {

@@ -101,10 +101,6 @@ class ConfinedSystem {
   std::vector<double> w;                ///< 1 / (rl + ra) per interval (valid after geometry())
   double U = 0, Q_tot = 0, dp_tube = 0;  ///< velocity, total swimmer-frame flux, pL - p0
   double W = 0;                          ///< Q_tot + U pi Rc^2: lab-frame flux through the free pipe
-  /// transmural() keeps W and U as they are (and M of the last solve) instead of solving for
-  /// them: the band of a Newton matrix by difference quotients, with the closure's global
-  /// coupling added exactly as low-rank terms.
-  bool hold_closure = false;
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
 
  private:
