@@ -133,13 +133,16 @@ TEST(ForceFree, DisplacementIsIndependentOfTheViscosity) {
   EXPECT_NEAR(mb.cycle_times_s[0], 10 * ma.cycle_times_s[0], 1e-4 * mb.cycle_times_s[0]);
 }
 
-// The Newton matrix of the force-free models: exact tridiagonal part, one rank-1 term per
+// The Newton matrix of the force-free models: exact tridiagonal part (CVODE, lubrication
+// wall) or analytic band (IDA, with the short-wave traction's fields), one rank-1 term per
 // held segment and, when confined, two rank-1 terms for the global unknowns (W, U), against
-// central differences of the right-hand side at random states (CVODE, no wall inertia).
+// central differences of the right-hand side or residual at random states.
 TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
+  for (bool traction : {false, true})
   for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
     for (int N : {37, 60}) {
       Params p = force_free_cycle(N);
+      p.swimmer.short_wave_traction = traction;
       p.swimmer.outer = outer;
       p.swimmer.a_in = 2e-9;
       p.swimmer.a_out = 3e-9;
@@ -147,7 +150,8 @@ TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
           const auto c = detail::check_jacobian(p, phase, active, seed);
-          EXPECT_LT(c.max_rel_error, 1e-6) << "N=" << N << " phase=" << phase << " active=" << active;
+          EXPECT_LT(c.max_rel_error, 1e-6)
+              << "traction=" << traction << " N=" << N << " phase=" << phase << " active=" << active;
           const int held = phase == 0 ? n - 1 - active : 0;
           EXPECT_EQ(c.rank, held + (outer == OuterFlow::Confined ? 2 : 0));
         }

@@ -1,7 +1,7 @@
 // Short-wave wall traction of the force-free force-driven model (model1d.short_wave_traction):
-// the |k| quadrature, the Newton matrix of the IDA path that carries it (confined closure
-// included), the relaxation rate of a short-wave load against the linear Stokes-lubrication
-// prediction, and the scene's guards.
+// the |k| quadrature, the relaxation rate of a short-wave load against the linear
+// Stokes-lubrication prediction, and the scene's guards. (The Newton matrix of the IDA path
+// that carries it is checked with the other force-free Jacobians, test_force_free.cpp.)
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,15 +17,6 @@ using namespace swim::reduced1d;
 
 namespace {
 constexpr double kPi = 3.14159265358979323846;
-
-Params force_free_cycle(int N) {
-  Params p;  // defaults: force-free, confined, force-driven protocol
-  p.wave = WaveKind::ForceDriven;
-  p.numerics.cells = N;
-  p.numerics.output_interval = 2e-3;
-  p.swimmer.short_wave_traction = true;
-  return p;
-}
 }  // namespace
 
 // |k| ~= sum_j c_j k^2 / (k^2 + s_j^2) for the discrete wavenumber k_d = (2/h) sin(k h / 2)
@@ -51,27 +42,6 @@ TEST(WallTraction, QuadratureOfAbsKIsWithinOnePercentOnEveryGridMode) {
     }
     EXPECT_LT(worst, 0.01) << "N = " << N;
   }
-}
-
-// The IDA Newton matrix with the traction fields: a frozen-closure difference-quotient band,
-// one rank-1 term per held segment and, confined, two rank-1 terms for the closure (W, U),
-// against central differences of the full residual at random states.
-TEST(WallTraction, NewtonMatrixMatchesFiniteDifferences) {
-  for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
-    for (int N : {37, 60}) {
-      Params p = force_free_cycle(N);
-      p.swimmer.outer = outer;
-      p.swimmer.a_in = 2e-9;
-      p.swimmer.a_out = 3e-9;
-      const int n = p.protocol.segments;
-      for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
-        for (unsigned seed : {1u, 2u}) {
-          const auto c = detail::check_jacobian(p, phase, active, seed);
-          EXPECT_LT(c.max_rel_error, 1e-6) << "N=" << N << " phase=" << phase << " active=" << active;
-          const int held = phase == 0 ? n - 1 - active : 0;
-          EXPECT_EQ(c.rank, held + (outer == OuterFlow::Confined ? 2 : 0));
-        }
-    }
 }
 
 // A small load q_i = q0 cos(k z_i) on a long tube (unbounded outer flow: p_out = 0, local
