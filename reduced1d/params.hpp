@@ -129,6 +129,8 @@ struct Swimmer {
   /// Short-wave wall traction (force-driven wave only): the viscous normal stress 2 mu |k| Rdot
   /// that each fluid (lumen, outside) exerts on a wall moving at axial wavenumbers the
   /// lubrication flow does not resolve, added to the tube law (docs/outer-flow-1d.md, 3b).
+  /// Off in this struct (the library's lubrication-only wall, as the struct's wave defaults
+  /// to a prescribed step); the scene layer turns it on for the force-free force-driven wave.
   bool short_wave_traction = false;
   /// Paper mode only:
   Closure closure = Closure::TubeLaw;
