@@ -66,9 +66,10 @@ TEST(OuterFlow, RigidTubeTowedThroughTheContainerMatchesTheClosedForm) {
         const double Gl = pi * Ri * Ri * Ri * Ri / (8 * kMu);
         const double Ga = pi / (8 * kMu) * (std::pow(kRc, 4) - std::pow(Ro, 4) - std::pow(kRc * kRc - Ro * Ro, 2) / lam);
         const double Gc = pi * std::pow(kRc, 4) / (8 * kMu);
-        const double S = pi * (kRc * kRc - Ro * Ro) / (2 * lam), K = pi * kRc * kRc - S, Ac = pi * kRc * kRc;
-        // unknowns (dp = p(L) - p(0), U): total flux Q = -(Gl + Ga) dp / L - U K;
-        // free pipe dp = (Q + U Ac) (P - L) / Gc; force F = S dp + 2 pi mu U L / lambda.
+        const double S = pi * (kRc * kRc - Ro * Ro) / (2 * lam);
+        // unknowns (dp = p(L) - p(0), U): total flux Q = -(Gl + Ga) dp / L - U K with
+        // K = Ac - S, Ac = pi Rc^2; free pipe dp = (Q + U Ac) (P - L) / Gc; force
+        // F = S dp + 2 pi mu U L / lambda.
         // => dp [1 + (Gl + Ga)(P - L)/(Gc L)] = U (Ac - K)(P - L)/Gc = U S (P - L) / Gc
         const double a = 1 + (Gl + Ga) * (kP - kL) / (Gc * kL), b = S * (kP - kL) / Gc;
         const double U_exact = F / (S * b / a + 2 * pi * kMu * kL / lam);
@@ -80,8 +81,9 @@ TEST(OuterFlow, RigidTubeTowedThroughTheContainerMatchesTheClosedForm) {
         EXPECT_NEAR(sys.U, U_exact, 1e-12 * U_exact) << "R/R0 " << R / kR0 << " N " << N;
         EXPECT_NEAR(sys.drag_coefficient(), F / U_exact, 1e-12 * F / U_exact);
         EXPECT_NEAR(sys.dp_tube, U_exact * b / a, 1e-11 * std::abs(U_exact * b / a));
-        if (N == 4 && a_out == 0.0 && R == kR0)
+        if (N == 4 && a_out == 0.0 && R == kR0) {
           EXPECT_NEAR(confined_drag_coefficient(R, kL, a_in, a_out, kRc, kP, kMu), F / U_exact, 1e-12 * F / U_exact);
+        }
       }
 }
 
