@@ -606,7 +606,9 @@ struct ForceModel {
   // second difference with mirror ends (a uniform wall velocity has no short-wave traction).
   int res(const double* y, const double* yp, double* F) {
     if (!unpack(y)) return 1;
+    want_velocity = false;  // with the velocity quadrature U is integrated along the steps
     fluxes();
+    want_velocity = true;
     const double cu = 2.0 * Vel_s / (R0 * R0);
     const double cv = wall_row_coefficient();
     const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
@@ -674,12 +676,12 @@ struct ForceModel {
       // F_psi_j = ((s_j h)^2 psi - D2 psi + D2 V) / ((s_j h)^2 + 4), mirror ends
       const int nb = (i > 0) + (i + 1 < N);
       for (int j = 0; j < J; ++j) {
-        const int r = k + 3 + j;
+        const int row = k + 3 + j;
         const double w = 1.0 / (tr_s2[j] + 4.0);
-        band(r, r, (tr_s2[j] + nb) * w);
-        band(r, k + 1, -nb * w);
-        if (i > 0) band(r, r - S, -w), band(r, k + 1 - S, w);
-        if (i + 1 < N) band(r, r + S, -w), band(r, k + 1 + S, w);
+        band(row, row, (tr_s2[j] + nb) * w);
+        band(row, k + 1, -nb * w);
+        if (i > 0) band(row, row - S, -w), band(row, k + 1 - S, w);
+        if (i + 1 < N) band(row, row + S, -w), band(row, k + 1 + S, w);
       }
     }
     // end volumes: F = V' - Q_end / V_s
@@ -702,7 +704,9 @@ struct ForceModel {
   /// dF/dW (dW/dy)^T + dF/dU (dU/dy)^T, d(W, U)/dy = -G^{-1} dg/dy. Same layout as jacobian().
   int residual_low_rank(const double* y, std::vector<double>& U, std::vector<double>& Vt) {
     unpack(y);
+    want_velocity = false;
     fluxes(true);
+    want_velocity = true;
     FluxSens& s = sens_;
     flux_sensitivities(s, false);
     const double cv = wall_row_coefficient();
@@ -941,9 +945,56 @@ class Backend {
   virtual long steps() = 0;  ///< steps since the last restart
   virtual void harvest(std::map<std::string, long>& stats) = 0;
   std::string last_msg;
-  /// Called after every accepted step with (t_n, y_n) (CVODE only; advance then steps one
-  /// at a time and interpolates to tout, the same steps as CV_NORMAL).
+  /// Called after every accepted step with (t_n, y_n) (advance then steps one at a time and
+  /// interpolates to tout, the same steps as CV_NORMAL / IDA_NORMAL).
   std::function<void(double, const double*)> on_step;
+
+ protected:
+  /// advance() with on_step: one step at a time from tn to tout, on_step after each accepted
+  /// step, y(tout) interpolated. A root found beyond tout is held back until the outputs
+  /// before it are reported, as the NORMAL modes do. one_step(tout, t) takes one step and
+  /// returns 1 at a root, 2 at the stop time, 0 otherwise (it throws on failure);
+  /// interpolate(tout) writes y(tout) into y(); n is the size of y().
+  template <class OneStep, class Interpolate>
+  int advance_by_steps(double tout, double& t, double tn, int n, OneStep one_step, Interpolate interpolate) {
+    if (pending_root_) {
+      if (tout < root_t_) {
+        interpolate(tout);
+        t = tout;
+        return 0;
+      }
+      pending_root_ = false;
+      std::copy(root_y_.begin(), root_y_.end(), y());
+      t = root_t_;
+      return 1;
+    }
+    for (long k = 0; tn < tout; ++k) {
+      if (k >= max_steps_) return -1;
+      const int kind = one_step(tout, t);
+      if (kind == 1) {
+        if (t <= tout) return 1;
+        on_step(t, y());  // the step up to the root, laws before the switch
+        pending_root_ = true;
+        root_t_ = t;
+        root_y_.assign(y(), y() + n);
+        interpolate(tout);
+        t = tout;
+        return 0;
+      }
+      tn = t;
+      on_step(tn, y());
+      if (kind == 2) return 2;
+    }
+    interpolate(tout);
+    t = tout;
+    return 0;
+  }
+  long max_steps_ = 500;
+
+ private:
+  bool pending_root_ = false;
+  double root_t_ = 0;
+  std::vector<double> root_y_;
 };
 
 class CvodeBackend final : public Backend {
@@ -1006,40 +1057,17 @@ class CvodeBackend final : public Backend {
   int advance(double tout, double& t) override {
     if (on_step) {
       void* mem = mem_.get();
-      if (pending_root_) {  // a root beyond an earlier tout (CV_NORMAL reports the touts first)
-        if (tout < root_t_) {
-          sun::check(CVodeGetDky(mem, tout, 0, y_.get()), "CVodeGetDky", last_msg);
-          t = tout;
-          return 0;
-        }
-        pending_root_ = false;
-        std::copy(root_y_.begin(), root_y_.end(), sun::data(y_.get()));
-        t = root_t_;
-        return 1;
-      }
       double tn = 0;
       CVodeGetCurrentTime(mem, &tn);
-      for (long k = 0; tn < tout; ++k) {
-        if (k >= max_steps_) return -1;
-        const int flag = CVode(mem, tout, y_.get(), &t, CV_ONE_STEP);
-        if (flag == CV_ROOT_RETURN) {
-          if (t <= tout) return 1;
-          on_step(t, sun::data(y_.get()));  // the step up to the root, laws before the switch
-          pending_root_ = true;
-          root_t_ = t;
-          root_y_.assign(sun::data(y_.get()), sun::data(y_.get()) + pb_.M.n);
-          sun::check(CVodeGetDky(mem, tout, 0, y_.get()), "CVodeGetDky", last_msg);
-          t = tout;
-          return 0;
-        }
-        sun::check(flag, "CVode", last_msg);
-        tn = t;
-        on_step(tn, sun::data(y_.get()));
-        if (flag == CV_TSTOP_RETURN) return 2;
-      }
-      sun::check(CVodeGetDky(mem, tout, 0, y_.get()), "CVodeGetDky", last_msg);
-      t = tout;
-      return 0;
+      return advance_by_steps(
+          tout, t, tn, pb_.M.n,
+          [&](double to, double& tt) {
+            const int flag = CVode(mem, to, y_.get(), &tt, CV_ONE_STEP);
+            if (flag == CV_ROOT_RETURN) return 1;
+            sun::check(flag, "CVode", last_msg);
+            return flag == CV_TSTOP_RETURN ? 2 : 0;
+          },
+          [&](double to) { sun::check(CVodeGetDky(mem, to, 0, y_.get()), "CVodeGetDky", last_msg); });
     }
     const int flag = CVode(mem_.get(), tout, y_.get(), &t, CV_NORMAL);
     if (flag == CV_ROOT_RETURN) return 1;
@@ -1110,10 +1138,6 @@ class CvodeBackend final : public Backend {
     return 0;
   }
   Problem& pb_;
-  long max_steps_ = 500;
-  bool pending_root_ = false;
-  double root_t_ = 0;
-  std::vector<double> root_y_;
   sun::Context ctx_;
   sun::Vector y_;
   sun::CvodeMem mem_;
@@ -1181,8 +1205,25 @@ class IdaBackend final : public Backend {
     if (n > 0) sun::check(IDASetRootDirection(mem_.get(), dirs_.data()), "IDASetRootDirection");
   }
   void set_stop_time(double t) override { sun::check(IDASetStopTime(mem_.get(), t), "IDASetStopTime"); }
-  void set_max_steps(long n) override { sun::check(IDASetMaxNumSteps(mem_.get(), n), "IDASetMaxNumSteps"); }
+  void set_max_steps(long n) override {
+    max_steps_ = n;
+    sun::check(IDASetMaxNumSteps(mem_.get(), n), "IDASetMaxNumSteps");
+  }
   int advance(double tout, double& t) override {
+    if (on_step) {
+      void* mem = mem_.get();
+      double tn = 0;
+      IDAGetCurrentTime(mem, &tn);
+      return advance_by_steps(
+          tout, t, tn, pb_.M.n,
+          [&](double to, double& tt) {
+            const int flag = IDASolve(mem, to, &tt, y_.get(), yp_.get(), IDA_ONE_STEP);
+            if (flag == IDA_ROOT_RETURN) return 1;
+            sun::check(flag, "IDASolve", last_msg);
+            return flag == IDA_TSTOP_RETURN ? 2 : 0;
+          },
+          [&](double to) { sun::check(IDAGetDky(mem, to, 0, y_.get()), "IDAGetDky", last_msg); });
+    }
     const int flag = IDASolve(mem_.get(), tout, &t, y_.get(), yp_.get(), IDA_NORMAL);
     if (flag == IDA_ROOT_RETURN) return 1;
     if (flag == IDA_TSTOP_RETURN) return 2;
@@ -1276,7 +1317,7 @@ Result run(const Params& P, std::vector<double> fixed_q, double t_fixed_end, con
   std::unique_ptr<Backend> be;
   std::function<void(double)> check_ends;
 
-  M.velocity_quadrature = M.force_free && !M.confined && !M.dae && !velocity_in_rhs;
+  M.velocity_quadrature = M.force_free && !M.confined && !velocity_in_rhs;
   VelocityQuadrature vq;
   auto record = [&](double tt, const double* y) -> bool {
     const bool ok = M.unpack(y);
