@@ -594,9 +594,17 @@ struct ForceModel {
   std::vector<SegChain> seg_x_;
   std::vector<double> fq_, fu_, dg1pi_, dg2pi_, al_, be_;  // confined Jacobian workspace
 
-  /// Coefficient of (C1 (R - R0) + q + traction - p) in the wall row of the IDA residual:
-  /// 1 / (m Vel_s) with inertia (F_V = V' + cv (...)), 1 / P_s without (an algebraic row).
-  double wall_row_coefficient() const { return inertia ? 1.0 / (m * Vel_s) : 1.0 / P_s; }
+  /// Row scalings of the IDA residual (scaled state): cu in F_a = a' - cu R V; cv, the
+  /// coefficient of (C1 (R - R0) + q + traction - p) in the wall row, 1 / (m Vel_s) with
+  /// inertia (F_V = V' + cv (...)) and 1 / P_s without (an algebraic row); cp the continuity
+  /// row's; A0 = pi R0^2.
+  struct IdaRows {
+    double cu, cv, cp, A0;
+  };
+  IdaRows ida_rows() const {
+    return {2.0 * Vel_s / (R0 * R0), inertia ? 1.0 / (m * Vel_s) : 1.0 / P_s, 1.0 / (2.0 * pi * R0 * Vel_s),
+            pi * R0 * R0};
+  }
 
   // Residual of the IDA path (wall inertia and/or short-wave traction). Per cell
   // (a, V, p, psi_0..psi_{J-1}), psi_j = D2 / (D2 - (s_j h)^2) V in units of Vel_s:
@@ -609,10 +617,7 @@ struct ForceModel {
     want_velocity = false;  // with the velocity quadrature U is integrated along the steps
     fluxes();
     want_velocity = true;
-    const double cu = 2.0 * Vel_s / (R0 * R0);
-    const double cv = wall_row_coefficient();
-    const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
-    const double A0 = pi * R0 * R0;
+    const auto [cu, cv, cp, A0] = ida_rows();
     const int S = stride;
     for (int i = 0; i < N; ++i) {
       const int k = 1 + S * i;
@@ -650,10 +655,7 @@ struct ForceModel {
   void ida_band(const double* y, double cj, Band band) const {
     const FluxSens& s = sens_;
     const int S = stride;
-    const double cu = 2.0 * Vel_s / (R0 * R0);
-    const double cv = wall_row_coefficient();
-    const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
-    const double A0 = pi * R0 * R0;
+    const auto [cu, cv, cp, A0] = ida_rows();
     auto dRda = [&](int i) { return 0.5 * R0 * R0 / R[i]; };
     for (int i = 0; i < N; ++i) {
       const int k = 1 + S * i;
@@ -709,8 +711,7 @@ struct ForceModel {
     want_velocity = true;
     FluxSens& s = sens_;
     flux_sensitivities(s, false);
-    const double cv = wall_row_coefficient();
-    const double cp = 1.0 / (2.0 * pi * R0 * Vel_s);
+    const double cv = ida_rows().cv, cp = ida_rows().cp;
     const int S = stride;
     double Gi[2][2] = {{0, 0}, {0, 0}};
     if (confined) {
@@ -912,7 +913,6 @@ struct Problem {
   ProtocolMachine machine;
   RootEval roots;
   sun::LowRankTerm low_rank;  // segment couplings of the Newton matrix
-  std::vector<double> ftmp, ytmp, yptmp, rtmp;  // Jacobian workspace
   Problem(const Params& P, std::vector<double> fixed_q) : M(P), machine(P, std::move(fixed_q)) {
     roots.M = &M;
     roots.machine = &machine;

@@ -201,24 +201,20 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   }
   {
     Reader n = top.child("numerics1d");
+    // the shortest protocol segment and the cells it needs to span one (force-driven wave)
+    const double seg_other = forced ? L / (p.protocol.first_ratio + p.protocol.segments - 1) : L;
+    const double shortest = std::min(seg_other, seg_other * (forced ? p.protocol.first_ratio : 1.0));
+    const int needed = static_cast<int>(std::ceil(L / shortest - 1e-9));
     // With the short-wave traction the cell-scale motion is damped and N = 50 is as accurate
     // as N = 400 without it (docs/outer-flow-1d.md, 3b): 50 cells, and at least 4 per
     // protocol segment; 200 otherwise.
-    int cells_default = 200;
-    if (p.swimmer.short_wave_traction) {
-      const double seg = L / (p.protocol.first_ratio + p.protocol.segments - 1);
-      const int needed = static_cast<int>(std::ceil(L / std::min(seg, seg * p.protocol.first_ratio) - 1e-9));
-      cells_default = std::max(50, 4 * needed);
-    }
+    const int cells_default = p.swimmer.short_wave_traction ? std::max(50, 4 * needed) : 200;
     p.numerics.cells = static_cast<int>(n.integer("cells", cells_default, 4, 100000));
     p.numerics.rtol = n.number("rtol", 1e-6, Range::closed(1e-12, 1e-2));
     p.numerics.atol_scale = n.number("atol_scale", 1e-6, Range::closed(1e-14, 1e-2));
     p.numerics.max_steps = n.integer("max_steps", 2000000, 100, 1000000000);
     n.finish();
     if (forced) {  // every protocol segment must span at least one cell
-      const double other = L / (p.protocol.first_ratio + p.protocol.segments - 1);
-      const double shortest = std::min(other, other * p.protocol.first_ratio);
-      const int needed = static_cast<int>(std::ceil(L / shortest - 1e-9));
       if (p.numerics.cells < needed)
         throw InputError(n.path("cells"), std::to_string(p.numerics.cells),
                          "too few cells to resolve the shortest protocol segment (length " + fmt(shortest, "m") +
