@@ -382,43 +382,61 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
                   sizeof(double) * std::size_t(hi - lo) * nx);
     });
   });
+  // Sums and maxima below: per static block, combined in block order (reproducible for a
+  // given thread count, parallel.hpp).
+  const int T = block_count(long(grid.cells() / std::size_t(nx)), threads);
   if (cyl) {
     // masked faces: zero in exact arithmetic (ring: the constraint; outer: the homogeneous
     // outside problem); record their round-off and set them to 0. Pressure: zero mean over
-    // the fluid cells, 0 in the others (serial sums: deterministic).
-    double res = 0.0;
-    for (int c = 0; c < 3; ++c) {
-      const auto d = grid.dims(c);
-      for (int r = 0; r < d[1] * d[2]; ++r)
-        if (row_masked[off[c] + r]) {
-          double* x = u.c[c].data() + std::size_t(r) * nx;
-          for (int i = 0; i < nx; ++i) res = std::max(res, std::abs(x[i]));
-          std::fill_n(x, nx, 0.0);
+    // the fluid cells, 0 in the others.
+    std::vector<double> res(std::size_t(T), 0.0), psum(std::size_t(T), 0.0);
+    std::vector<std::size_t> cnt(std::size_t(T), 0);
+    parallel_blocks(off[3], T, [&](long rb, long re, int t) {
+      rows_of(rb, re, [&](int c, long lo, long hi) {
+        for (long r = lo; r < hi; ++r)
+          if (row_masked[r]) {
+            double* x = u.c[c].data() + std::size_t(r - off[c]) * nx;
+            for (int i = 0; i < nx; ++i) res[std::size_t(t)] = std::max(res[std::size_t(t)], std::abs(x[i]));
+            std::fill_n(x, nx, 0.0);
+          }
+      });
+    });
+    parallel_blocks(long(cell_fluid.size()), T, [&](long cb, long ce, int t) {
+      for (long cell = cb; cell < ce; ++cell)
+        if (cell_fluid[std::size_t(cell)]) {
+          const double* pc = p.v.data() + std::size_t(cell) * nx;
+          for (int i = 0; i < nx; ++i) psum[std::size_t(t)] += pc[i];
+          cnt[std::size_t(t)] += std::size_t(nx);
         }
-    }
-    mask_residual = res;
-    double psum = 0.0;
-    std::size_t cnt = 0;
-    for (std::size_t cell = 0; cell < cell_fluid.size(); ++cell)
-      if (cell_fluid[cell]) {
-        for (int i = 0; i < nx; ++i) psum += p.v[cell * nx + i];
-        cnt += std::size_t(nx);
+    });
+    double r = 0.0, ps = 0.0;
+    std::size_t n = 0;
+    for (int t = 0; t < T; ++t) r = std::max(r, res[std::size_t(t)]), ps += psum[std::size_t(t)], n += cnt[std::size_t(t)];
+    mask_residual = r;
+    const double pm = n ? ps / double(n) : 0.0;
+    parallel_blocks(long(cell_fluid.size()), T, [&](long cb, long ce, int) {
+      for (long cell = cb; cell < ce; ++cell) {
+        double* pc = p.v.data() + std::size_t(cell) * nx;
+        if (cell_fluid[std::size_t(cell)])
+          for (int i = 0; i < nx; ++i) pc[i] -= pm;
+        else
+          std::fill_n(pc, nx, 0.0);
       }
-    const double pm = cnt ? psum / double(cnt) : 0.0;
-    for (std::size_t cell = 0; cell < cell_fluid.size(); ++cell) {
-      double* pc = p.v.data() + cell * nx;
-      if (cell_fluid[cell])
-        for (int i = 0; i < nx; ++i) pc[i] -= pm;
-      else
-        std::fill_n(pc, nx, 0.0);
-    }
+    });
     return;
   }
-  // the pressure's zero mode is the gauge (0); remove its round-off mean (serial sum: deterministic)
+  // the pressure's zero mode is the gauge (0); remove its round-off mean
+  std::vector<double> part(std::size_t(T), 0.0);
+  const long rows = long(p.v.size() / std::size_t(nx));
+  parallel_blocks(rows, T, [&](long rb, long re, int t) {
+    for (std::size_t m = std::size_t(rb) * nx; m < std::size_t(re) * nx; ++m) part[std::size_t(t)] += p.v[m];
+  });
   double sum = 0.0;
-  for (double x : p.v) sum += x;
+  for (double x : part) sum += x;
   const double mean = sum / double(p.v.size());
-  for (double& x : p.v) x -= mean;
+  parallel_blocks(rows, T, [&](long rb, long re, int) {
+    for (std::size_t m = std::size_t(rb) * nx; m < std::size_t(re) * nx; ++m) p.v[m] -= mean;
+  });
 }
 
 CapacitanceStokes::CapacitanceStokes(const MacGrid& g, double mu, int threads, const FftOptions& fft)
@@ -437,6 +455,10 @@ void CapacitanceStokes::solve(const VectorField& b, VectorField& u, ScalarField&
 }
 void CapacitanceStokes::step(VectorField& u, const VectorField& f, ScalarField& p, double alpha) {
   impl_->solve(&u, alpha, f, u, p, alpha);
+}
+void CapacitanceStokes::step(const VectorField& un, const VectorField& f, VectorField& u, ScalarField& p,
+                             double alpha) {
+  impl_->solve(&un, alpha, f, u, p, alpha);
 }
 
 std::size_t CapacitanceStokes::estimate_bytes(const MacGrid& g) {

@@ -121,6 +121,8 @@ class CapacitanceStokes {
   /// The backward-Euler step itself: u (in u^n, out u^{n+1}) and p solve the system above with
   /// b = alpha u^n + f, formed on the fly (wall-face entries of u^n and f ignored).
   void step(VectorField& u, const VectorField& f, ScalarField& p, double alpha);
+  /// The same step from un = u^n into u (un may be u).
+  void step(const VectorField& un, const VectorField& f, VectorField& u, ScalarField& p, double alpha);
 
   /// Upper bound of the capacitance factor memory for one alpha, bytes: (nx/2+1) packed
   /// Cholesky factors of four symmetry blocks of about m/4 (about (nx/2+1) m^2/8 doubles).

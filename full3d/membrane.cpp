@@ -161,13 +161,33 @@ double dihedral_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
   return theta;
 }
 
-double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks) {
+namespace {
+double stretching_energy_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, std::size_t e0, std::size_t e1) {
   double s = 0.0;
-  for (std::size_t e = 0; e < mesh.edges.size(); ++e) {
+  for (std::size_t e = e0; e < e1; ++e) {
     const double dl = (X.col(mesh.edges[e][1]) - X.col(mesh.edges[e][0])).norm() - mesh.rest_length[Eigen::Index(e)];
     s += dl * dl;
   }
-  return 0.5 * ks * s;
+  return s;
+}
+
+/// Sum of a per-range quantity over [0, n) split into the static blocks of parallel_blocks,
+/// the block sums added in block order (reproducible for a given thread count).
+template <class F>
+double blocked_sum(std::size_t n, int threads, F&& range_sum) {
+  const int T = block_count(long(n), threads);
+  std::vector<double> part(std::size_t(T), 0.0);
+  parallel_blocks(long(n), T, [&](long b, long e, int t) { part[std::size_t(t)] = range_sum(std::size_t(b), std::size_t(e)); });
+  double s = 0.0;
+  for (double v : part) s += v;
+  return s;
+}
+}  // namespace
+
+double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, int threads) {
+  return 0.5 * ks * blocked_sum(mesh.edges.size(), threads, [&](std::size_t b, std::size_t e) {
+           return stretching_energy_range(mesh, X, b, e);
+         });
 }
 
 namespace {
@@ -187,23 +207,6 @@ void add_stretching_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, d
 
 void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F) {
   add_stretching_range(mesh, X, ks, 0, mesh.edges.size(), F);
-}
-
-namespace {
-double ref_angle(const CylinderMesh& mesh, std::size_t k, BendingForm form) {
-  return form == BendingForm::ReferenceAngle ? mesh.rest_angle[Eigen::Index(k)] : 0.0;
-}
-}  // namespace
-
-double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form) {
-  double s = 0.0;
-  for (std::size_t k = 0; k < mesh.hinges.size(); ++k) {
-    const auto& h = mesh.hinges[k];
-    const double th = dihedral_angle(X.col(h[0]), X.col(h[1]), X.col(h[2]), X.col(h[3]));
-    const double t = std::tan(0.5 * (th - ref_angle(mesh, k, form)));
-    s += (X.col(h[1]) - X.col(h[0])).norm() * t * t;
-  }
-  return 0.5 * kb * s;
 }
 
 double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form) {
@@ -234,28 +237,67 @@ namespace {
 //   t = tan(D/2) = sin D / (1 + cos D) = (S cos0 - C sin0) / (rho + C cos0 + S sin0),
 // which equals tan((atan2(S, C) - theta0)/2) exactly (the rest angle enters through
 // cos0 = cos(theta0), sin0 = sin(theta0), precomputed in the mesh).
+struct Hinge {
+  V3 e, ca, da, n1, n2;  ///< edge b - a, c - a, d - a, normals of (a, b, c) and (b, a, d)
+  double l2, l, t;       ///< |e|^2, |e|, tan((theta - theta0)/2)
+};
+
+/// The reference angle's cosine and sine per hinge (or none: BendingForm::Printed, theta0 = 0).
+class RestAngles {
+ public:
+  RestAngles(const CylinderMesh& mesh, BendingForm form)
+      : mesh_(mesh), ref_(form == BendingForm::ReferenceAngle),
+        have_cs_(mesh.rest_cos.size() == mesh.rest_angle.size() && mesh.rest_sin.size() == mesh.rest_angle.size()) {}
+  void get(std::size_t k, double& cos0, double& sin0) const {
+    cos0 = 1.0, sin0 = 0.0;
+    if (!ref_) return;
+    const Eigen::Index i = Eigen::Index(k);
+    cos0 = have_cs_ ? mesh_.rest_cos[i] : std::cos(mesh_.rest_angle[i]);
+    sin0 = have_cs_ ? mesh_.rest_sin[i] : std::sin(mesh_.rest_angle[i]);
+  }
+
+ private:
+  const CylinderMesh& mesh_;
+  bool ref_, have_cs_;
+};
+
+Hinge hinge(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const RestAngles& rest, std::size_t k) {
+  const auto& h = mesh.hinges[k];
+  Hinge g;
+  const V3 a = X.col(h[0]);
+  g.e = X.col(h[1]) - a;
+  g.ca = X.col(h[2]) - a;
+  g.da = X.col(h[3]) - a;
+  g.n1 = g.e.cross(g.ca);
+  g.n2 = g.da.cross(g.e);
+  g.l2 = g.e.squaredNorm();
+  g.l = std::sqrt(g.l2);
+  const double C = g.n1.dot(g.n2), S = g.n1.cross(g.n2).dot(g.e) / g.l;
+  const double rho = std::sqrt(C * C + S * S);
+  double cos0, sin0;
+  rest.get(k, cos0, sin0);
+  g.t = (S * cos0 - C * sin0) / (rho + C * cos0 + S * sin0);
+  return g;
+}
+
+double bending_energy_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const RestAngles& rest,
+                            std::size_t k0, std::size_t k1) {
+  double s = 0.0;
+  for (std::size_t k = k0; k < k1; ++k) {
+    const Hinge g = hinge(mesh, X, rest, k);
+    s += g.l * g.t * g.t;
+  }
+  return s;
+}
+
 void add_bending_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                        std::size_t k0, std::size_t k1, Eigen::Matrix3Xd& F) {
-  const bool ref = form == BendingForm::ReferenceAngle;
-  const bool have_cs = mesh.rest_cos.size() == mesh.rest_angle.size() &&
-                       mesh.rest_sin.size() == mesh.rest_angle.size();
+  const RestAngles rest(mesh, form);
   for (std::size_t k = k0; k < k1; ++k) {
     const auto& h = mesh.hinges[k];
-    const V3 a = X.col(h[0]);
-    const V3 e = X.col(h[1]) - a;
-    const V3 ca = X.col(h[2]) - a, da = X.col(h[3]) - a;
-    const V3 n1 = e.cross(ca);  // normal of (a, b, c)
-    const V3 n2 = da.cross(e);  // normal of (b, a, d)
-    const double l2 = e.squaredNorm(), l = std::sqrt(l2);
-    const double C = n1.dot(n2), S = n1.cross(n2).dot(e) / l;
-    const double rho = std::sqrt(C * C + S * S);
-    double cos0 = 1.0, sin0 = 0.0;  // BendingForm::Printed: theta0 = 0
-    if (ref) {
-      const Eigen::Index i = Eigen::Index(k);
-      cos0 = have_cs ? mesh.rest_cos[i] : std::cos(mesh.rest_angle[i]);
-      sin0 = have_cs ? mesh.rest_sin[i] : std::sin(mesh.rest_angle[i]);
-    }
-    const double t = (S * cos0 - C * sin0) / (rho + C * cos0 + S * sin0);
+    const Hinge g = hinge(mesh, X, rest, k);
+    const V3 &e = g.e, &ca = g.ca, &da = g.da, &n1 = g.n1, &n2 = g.n2;
+    const double l2 = g.l2, l = g.l, t = g.t;
     // d theta / d(c, d) = -|e| n / |n|^2; d theta / d(a, b) from translation and rotation invariance
     const V3 gc = -l / n1.squaredNorm() * n1;
     const V3 gd = -l / n2.squaredNorm() * n2;
@@ -272,13 +314,20 @@ void add_bending_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, doub
 }
 }  // namespace
 
+double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form, int threads) {
+  const RestAngles rest(mesh, form);
+  return 0.5 * kb * blocked_sum(mesh.hinges.size(), threads, [&](std::size_t b, std::size_t e) {
+           return bending_energy_range(mesh, X, rest, b, e);
+         });
+}
+
 void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                         Eigen::Matrix3Xd& F) {
   add_bending_range(mesh, X, kb, form, 0, mesh.hinges.size(), F);
 }
 
-double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p) {
-  return stretching_energy(mesh, X, p.ks) + bending_energy(mesh, X, p.kb, p.bending);
+double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p, int threads) {
+  return stretching_energy(mesh, X, p.ks, threads) + bending_energy(mesh, X, p.kb, p.bending, threads);
 }
 
 Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p,
@@ -322,10 +371,10 @@ Eigen::Matrix3Xd radial_directions(const CylinderMesh& mesh, const Eigen::Matrix
 
 Eigen::VectorXd node_radii(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
   Eigen::VectorXd r(X.cols());
+  const double ay = mesh.axis_start[1], az = mesh.axis_start[2];
   for (Eigen::Index i = 0; i < X.cols(); ++i) {
-    V3 v = X.col(i) - mesh.axis_start;
-    v.x() = 0.0;
-    r[i] = v.norm();
+    const double y = X(1, i) - ay, z = X(2, i) - az;
+    r[i] = std::sqrt(y * y + z * z);  // (a plain loop: Eigen's 3-vector norm here is several times slower)
   }
   return r;
 }

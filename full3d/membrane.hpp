@@ -78,8 +78,13 @@ struct MembraneParams {
 double dihedral_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const Eigen::Vector3d& c,
                       const Eigen::Vector3d& d, Eigen::Matrix<double, 3, 4>* grad = nullptr);
 
-double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks);
-double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form);
+/// Spring (eq. 7) and hinge (eq. 8) energies, J. With threads > 1 the edges (hinges) are
+/// summed in the static blocks of parallel_blocks and the block sums added in order:
+/// reproducible for a given thread count, equal to threads = 1 up to round-off. The hinge
+/// term is evaluated as add_bending_forces does, without trigonometric calls.
+double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, int threads = 1);
+double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
+                      int threads = 1);
 /// The bending rigidity D (J) that eq. (8) gives this mesh's wall per unit k_b (N): the
 /// energy of small ovalisation lobes r = R0 + w cos(2 theta) (second difference in w)
 /// against the continuum (D / 2) int dkappa^2 dA, dkappa = 3 w cos(2 theta) / R0^2. Every
@@ -90,7 +95,8 @@ double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form);
 void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F);
 void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                         Eigen::Matrix3Xd& F);
-double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p);
+double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p,
+                      int threads = 1);
 /// F_i = -dE/dX_i (eq. 9), N. With threads > 1 the edges and hinges are split into static
 /// blocks, each accumulated into its own buffer and the buffers summed in a fixed order
 /// (parallel.hpp): reproducible for a given thread count, equal to threads = 1 up to round-off.

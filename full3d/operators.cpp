@@ -1,5 +1,11 @@
 #include "full3d/operators.hpp"
 
+#include <cmath>
+#include <limits>
+#include <vector>
+
+#include "full3d/parallel.hpp"
+
 namespace swim::full3d {
 
 namespace {
@@ -23,6 +29,42 @@ void divergence(const MacGrid& g, const VectorField& u, ScalarField& div) {
                   u.c[1][MacGrid::index(dv, i, jp, k)] - u.c[1][MacGrid::index(dv, i, j, k)] +
                   u.c[2][MacGrid::index(dw, i, j, kp)] - u.c[2][MacGrid::index(dw, i, j, k)]);
       }
+}
+
+double max_abs_divergence(const MacGrid& g, const VectorField& u, int threads) {
+  const int nx = g.nx(), ny = g.ny(), nz = g.nz();
+  const double ih = 1.0 / g.h();
+  const auto du = g.dims(0), dv = g.dims(1), dw = g.dims(2);
+  const bool py = g.periodic(1), pz = g.periodic(2);
+  const int T = block_count(nz, threads);
+  std::vector<double> part(std::size_t(T), 0.0);
+  parallel_blocks(nz, T, [&](long kb, long ke, int t) {
+    double m = 0.0;
+    bool finite = true;
+    for (int k = int(kb); k < int(ke); ++k)
+      for (int j = 0; j < ny; ++j) {
+        const int jp = py ? wrap(j + 1, ny) : j + 1;
+        const int kp = pz ? wrap(k + 1, nz) : k + 1;
+        const double* u0 = &u.c[0][MacGrid::index(du, 0, j, k)];
+        const double* v0 = &u.c[1][MacGrid::index(dv, 0, j, k)];
+        const double* v1 = &u.c[1][MacGrid::index(dv, 0, jp, k)];
+        const double* w0 = &u.c[2][MacGrid::index(dw, 0, j, k)];
+        const double* w1 = &u.c[2][MacGrid::index(dw, 0, j, kp)];
+        for (int i = 0; i < nx; ++i) {
+          const int ip = i + 1 < nx ? i + 1 : 0;
+          const double d = std::abs(u0[ip] - u0[i] + v1[i] - v0[i] + w1[i] - w0[i]);
+          finite = finite && std::isfinite(d);
+          m = std::max(m, d);
+        }
+      }
+    part[std::size_t(t)] = finite ? m : std::numeric_limits<double>::quiet_NaN();
+  });
+  double m = 0.0;
+  for (double x : part) {
+    if (!std::isfinite(x)) return std::numeric_limits<double>::quiet_NaN();
+    m = std::max(m, x);
+  }
+  return ih * m;
 }
 
 void gradient(const MacGrid& g, const ScalarField& p, VectorField& grad) {

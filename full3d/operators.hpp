@@ -16,6 +16,10 @@
 namespace swim::full3d {
 
 void divergence(const MacGrid& g, const VectorField& u, ScalarField& div);
+/// max over the cells of |D u|, 1/s, without storing D u, the z planes split over `threads`
+/// (a maximum: the same for any thread count). NaN when any velocity is not finite: every
+/// face value enters the divergence of a cell next to it.
+double max_abs_divergence(const MacGrid& g, const VectorField& u, int threads = 1);
 void gradient(const MacGrid& g, const ScalarField& p, VectorField& grad);
 void laplacian(const MacGrid& g, const VectorField& u, VectorField& lap);
 

@@ -75,9 +75,12 @@ class Runner {
         step();
         ++this_process;
         if (stepper_.due(run_.out_every, p_.output_interval)) record();
+        Lap lap(split_);
         if (output_.vtk() && stepper_.due(run_.vtk_every, p_.vtk_interval)) output_.write_membrane_frame(stepper_);
         if (output_.fluid() && stepper_.due(run_.fluid_every, p_.fluid_interval)) output_.write_fluid_frame(stepper_);
+        lap("vtk_frames");
         if (stepper_.due(run_.ckpt_every, p_.checkpoint_interval)) save_checkpoint(wall_before_ + seconds_since(t0));
+        lap("checkpoints");
         progress.update(stepper_.state().t);
         if (ctl_.stop_after_steps > 0 && this_process >= ctl_.stop_after_steps && !stepper_.finished()) {
           res.interrupted = true;
@@ -116,16 +119,26 @@ class Runner {
 
   /// One time step: advance, measure, check, then the protocol and the next step size.
   void step() {
+    Lap lap(split_);
     const IbStepStats st = stepper_.step();
+    split_.add_step(st);
+    lap("step_other");
     measured_.after_step(st, stepper_.state(), stepper_.dt_last(), stepper_.grid());
+    lap("end_fluxes");
     const double e = measured_.wall_energy(stepper_.state());
     measured_.guards(e, stepper_.state());
+    lap("wall_energy_and_guards");
+    const double before = stepper_.stability_seconds();
     stepper_.finish_step(e);
     measured_.events(stepper_.protocol().state());
+    split_.add("stability_estimates", stepper_.stability_seconds() - before);
+    lap("protocol_and_step_control", stepper_.stability_seconds() - before);
   }
 
   void record() {
+    Lap lap(split_);
     measured_.record(stepper_.state(), stepper_.protocol().state(), stepper_.steps(), stepper_.dt_last());
+    lap("series_rows");
   }
 
   void save_checkpoint(double wall) {
@@ -148,6 +161,7 @@ class Runner {
   RunOutput output_;
   RunCheckpoint checkpoint_;
   double wall_before_ = 0;
+  WallSplit& split_ = measured_.split();
 };
 
 }  // namespace

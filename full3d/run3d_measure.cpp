@@ -29,6 +29,21 @@ double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, con
   return worst;
 }
 
+void WallSplit::add_step(const IbStepStats& st) {
+  add("step_forces", st.time_forces);
+  add("step_spread", st.time_spread);
+  add("step_fluid", st.time_fluid);
+  add("step_interp", st.time_interp);
+  // the step's own remainder (copies, guards, CFL) is what the caller's lap adds to "step_other"
+  add("step_other", -(st.time_forces + st.time_spread + st.time_fluid + st.time_interp));
+}
+
+scene::json WallSplit::to_json() const {
+  scene::json j = scene::json::object();
+  for (const auto& [k, v] : parts_) j[k] = v;
+  return j;
+}
+
 record::RunRecord new_record(const RunSetup& run) {
   std::vector<double> z(run.mesh.n_rings);
   for (int r = 0; r < run.mesh.n_rings; ++r) z[r] = r * run.mesh.ring_spacing;
@@ -75,7 +90,8 @@ double Measurements::kinetic_energy(const IbState& s) const {
 std::array<double, 2> Measurements::elastic_parts(const IbState& s) const {
   if (s.t != parts_t_ || s.X.data() != parts_x_) {
     const MembraneParams& m = run_.p.membrane;
-    parts_ = {stretching_energy(run_.mesh, s.X, m.ks), bending_energy(run_.mesh, s.X, m.kb, m.bending)};
+    const int T = run_.p.threads;
+    parts_ = {stretching_energy(run_.mesh, s.X, m.ks, T), bending_energy(run_.mesh, s.X, m.kb, m.bending, T)};
     parts_t_ = s.t;
     parts_x_ = s.X.data();
   }

@@ -7,6 +7,8 @@
 #pragma once
 
 #include <array>
+#include <chrono>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -32,6 +34,37 @@ double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, con
 /// An empty record of a 3D run (tier, model, length, columns, reference ring positions).
 record::RunRecord new_record(const RunSetup& run);
 
+/// Wall time of the parts of a run in this process, s (summary.json
+/// "statistics.wall_time_split_s"; a resumed run counts from its restart): the IB step's own
+/// parts (forces, spread, fluid, interp), the stability estimates of the adaptive step, the
+/// measurements, the output and the checkpoints.
+class WallSplit {
+ public:
+  void add(const std::string& part, double seconds) { parts_[part] += seconds; }
+  /// The timed parts of one IB step.
+  void add_step(const IbStepStats& st);
+  scene::json to_json() const;
+
+ private:
+  std::map<std::string, double> parts_;
+};
+
+/// Times consecutive parts: each call adds the time since the previous one (or the
+/// construction) to `part`, less `exclude` (a sub-part already counted elsewhere).
+class Lap {
+ public:
+  explicit Lap(WallSplit& w) : w_(w), t_(std::chrono::steady_clock::now()) {}
+  void operator()(const char* part, double exclude = 0.0) {
+    const auto now = std::chrono::steady_clock::now();
+    w_.add(part, std::chrono::duration<double>(now - t_).count() - exclude);
+    t_ = now;
+  }
+
+ private:
+  WallSplit& w_;
+  std::chrono::steady_clock::time_point t_;
+};
+
 class Measurements {
  public:
   /// Rows and ring radii go into `rec`.
@@ -53,6 +86,8 @@ class Measurements {
   double pumped_volume() const { return -vol_rear_; }
   double max_cfl() const { return max_cfl_; }
   long stokes_iterations() const { return iterations_total_; }
+  WallSplit& split() { return split_; }
+  const WallSplit& split() const { return split_; }
 
   void save(CheckpointWriter& w) const;
   void load(const CheckpointReader& r);
@@ -79,6 +114,7 @@ class Measurements {
   mutable double parts_t_ = -1.0;
   mutable const double* parts_x_ = nullptr;
   mutable std::array<double, 2> parts_{};
+  WallSplit split_;
 };
 
 }  // namespace swim::full3d

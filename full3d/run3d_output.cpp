@@ -156,6 +156,7 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                 {"protocol_switches", protocol.state().switches},
                 {"wall_time_s", wall},
                 {"steps_per_s", wall > 0 ? n / wall : 0.0},
+                {"wall_time_split_s", measured.split().to_json()},
                 {"output_every_steps", run_.out_every},
                 {"checkpoint_every_steps", run_.ckpt_every}};
 }

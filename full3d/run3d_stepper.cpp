@@ -1,6 +1,7 @@
 #include "full3d/run3d_stepper.hpp"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -149,7 +150,9 @@ void Stepper::next_step(int switches) {
   // stability of the explicit coupling: dt lambda_max < 2
   const long step = n_ + 1;
   if (switches > 0 || lambda_step_ < 0 || step - lambda_step_ >= kStabilityEvery) {
+    const auto t0 = std::chrono::steady_clock::now();
     lambda_ = ib_->explicit_rate(s_, dt_last_, kStabilityIterations);
+    stability_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     lambda_step_ = step;
     lambda_max_seen_ = std::max(lambda_max_seen_, lambda_);
     ++estimates_;

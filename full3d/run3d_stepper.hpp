@@ -54,6 +54,8 @@ class Stepper {
   scene::json stokes_setup_summary() const;
   long steps() const { return n_; }
   double dt_last() const { return dt_last_; }
+  /// Wall time spent in the adaptive step's stability estimates in this process, s.
+  double stability_seconds() const { return stability_seconds_; }
 
   /// Steps taken by each completed cycle.
   std::vector<long> steps_per_cycle() const;
@@ -82,6 +84,7 @@ class Stepper {
   double dt_used_min_ = 1e300, dt_used_max_ = 0.0, last_speed_ = 0.0, last_dv_ = 0.0;
   double lambda_ = 0.0, lambda_max_seen_ = 0.0;  ///< explicit-coupling rate estimates, 1/s
   long lambda_step_ = -1, estimates_ = 0, rejected_ = 0;
+  double stability_seconds_ = 0.0;
   bool after_event_ = true;
   double r_active_prev_;
   std::map<std::string, long> bound_count_ = {{"growth", 0}, {"cfl", 0}, {"accuracy", 0}, {"stability", 0}, {"event", 0}};

@@ -25,7 +25,6 @@ struct StokesSolver::Impl {
   FluidParams fluid;
   StokesOptions opt;
   ScalarField p;
-  ScalarField div;
 
   // Periodic box
   std::array<FftwBuffer, 3> real;
@@ -38,7 +37,7 @@ struct StokesSolver::Impl {
   // Cylinder: the constraint rows
   std::unique_ptr<VelocityConstraints> con;
 
-  Impl(const MacGrid& g, const FluidParams& f, const StokesOptions& o) : grid(g), fluid(f), opt(o), p(g), div(g) {
+  Impl(const MacGrid& g, const FluidParams& f, const StokesOptions& o) : grid(g), fluid(f), opt(o), p(g) {
     if (!(f.rho > 0.0)) throw InputError("fluid.rho", std::to_string(f.rho), "a positive density in kg/m^3");
     if (!(f.mu > 0.0)) throw InputError("fluid.mu", std::to_string(f.mu), "a positive dynamic viscosity in Pa s");
     const int nx = g.nx(), ny = g.ny(), nz = g.nz();
@@ -122,19 +121,40 @@ struct StokesSolver::Impl {
     c2r.execute_c2r(pspec.complex(), real[0].data());
     for (std::size_t m = 0; m < n; ++m) p.v[m] = real[0][m];
     StokesStats st;
-    divergence(grid, u, div);
-    st.max_divergence = div.max_abs();
+    st.max_divergence = max_abs_divergence(grid, u, threads());
     return st;
   }
 
+  int threads() const { return opt.threads > 0 ? opt.threads : std::max(1, opt.fft.threads); }
+
   // ---- square duct and cylinder: the capacitance solver, exact, no iteration ----------
-  StokesStats capacitance_step(VectorField& u, const VectorField& f, double dt) {
+  /// un: u^n (may be u itself), nullptr for a fluid at rest.
+  StokesStats capacitance_step(const VectorField* un, VectorField& u, const VectorField& f, double dt) {
     // b = alpha u^n + f formed inside; wall and masked faces come out exactly 0
-    capacitance->step(u, f, p, fluid.rho / dt);
+    if (un)
+      capacitance->step(*un, f, u, p, fluid.rho / dt);
+    else
+      capacitance->solve(f, u, p, fluid.rho / dt);
     StokesStats st;
     if (capacitance->last_solve_factorized()) st.factorization_seconds = capacitance->last_factorization_seconds();
-    divergence(grid, u, div);
-    st.max_divergence = div.max_abs();
+    st.max_divergence = max_abs_divergence(grid, u, threads());
+    return st;
+  }
+
+  StokesStats step(const VectorField* un, VectorField& u, const VectorField& f, double dt) {
+    if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError("dt", std::to_string(dt), "a positive time step in s");
+    double cfl = 0.0;
+    if (opt.advection.enabled || !capacitance) {  // in place: u^n first into u
+      if (!un) {
+        u = VectorField(grid);
+      } else if (un != &u) {
+        u = *un;
+      }
+      un = &u;
+      if (opt.advection.enabled) cfl = advect(grid, u, dt, opt.advection);  // module (28)
+    }
+    StokesStats st = capacitance ? capacitance_step(un, u, f, dt) : box_step(u, f, dt);
+    st.advection_cfl = cfl;
     return st;
   }
 };
@@ -145,13 +165,12 @@ StokesSolver::~StokesSolver() = default;
 StokesSolver::StokesSolver(StokesSolver&&) noexcept = default;
 StokesSolver& StokesSolver::operator=(StokesSolver&&) noexcept = default;
 
-StokesStats StokesSolver::step(VectorField& u, const VectorField& f, double dt) {
-  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError("dt", std::to_string(dt), "a positive time step in s");
-  double cfl = 0.0;
-  if (impl_->opt.advection.enabled) cfl = advect(impl_->grid, u, dt, impl_->opt.advection);  // module (28)
-  StokesStats st = impl_->capacitance ? impl_->capacitance_step(u, f, dt) : impl_->box_step(u, f, dt);
-  st.advection_cfl = cfl;
-  return st;
+StokesStats StokesSolver::step(VectorField& u, const VectorField& f, double dt) { return impl_->step(&u, u, f, dt); }
+StokesStats StokesSolver::step(const VectorField& un, VectorField& u, const VectorField& f, double dt) {
+  return impl_->step(&un, u, f, dt);
+}
+StokesStats StokesSolver::step_from_rest(VectorField& u, const VectorField& f, double dt) {
+  return impl_->step(nullptr, u, f, dt);
 }
 
 const ScalarField& StokesSolver::pressure() const { return impl_->p; }

@@ -90,6 +90,10 @@ class StokesSolver {
   /// u: in u^n, out u^{n+1}; f: body-force density on the faces, N/m^3.
   /// Throws swim::NumericalError if a capacitance matrix is not positive definite.
   StokesStats step(VectorField& u, const VectorField& f, double dt);
+  /// The same step from un = u^n into u (duct and cylinder without advection: no copy of u^n).
+  StokesStats step(const VectorField& un, VectorField& u, const VectorField& f, double dt);
+  /// The same step from a fluid at rest, u^n = 0, into u.
+  StokesStats step_from_rest(VectorField& u, const VectorField& f, double dt);
 
   /// Pressure of the last step, Pa: zero mean (cylinder: zero mean over the cells with a free
   /// face, 0 in the others).
