@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <utility>
 
@@ -40,8 +41,24 @@ IbState IbSolver::initial_state() const {
   return s;
 }
 
+const Eigen::Matrix3Xd& IbSolver::elastic(const Eigen::Matrix3Xd& X) const {
+  ElasticPass& e = elastic_;
+  const bool same = e.X.cols() == X.cols() && X.cols() > 0 &&
+                    std::memcmp(e.X.data(), X.data(), sizeof(double) * std::size_t(X.size())) == 0;
+  if (!same) {
+    e.F = elastic_forces(mesh_, X, membrane_, opt_.threads, &e.energy);
+    e.X = X;
+  }
+  return e.F;
+}
+
+std::array<double, 2> IbSolver::elastic_energy_parts(const Eigen::Matrix3Xd& X) const {
+  elastic(X);
+  return elastic_.energy;
+}
+
 Eigen::Matrix3Xd IbSolver::fluid_force(const Eigen::Matrix3Xd& X, double t, const Eigen::Matrix3Xd& accel) const {
-  Eigen::Matrix3Xd F = elastic_forces(mesh_, X, membrane_, opt_.threads);
+  Eigen::Matrix3Xd F = elastic(X);
   if (external_) F += external_(t, X);
   if (mass_.size() > 0 && mass_.maxCoeff() > 0.0)
     for (Eigen::Index i = 0; i < F.cols(); ++i) F.col(i) -= mass_[i] * accel.col(i);
@@ -176,7 +193,7 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
   // membrane forces only: the actuation relays are saturating (their level moves by at most
   // one over a ramp of a fraction of delta), so their steep slope bounds an oscillation to the
   // ramp width instead of growing it
-  const Eigen::Matrix3Xd F0 = elastic_forces(mesh_, s.X, membrane_, opt_.threads);
+  const Eigen::Matrix3Xd F0 = elastic(s.X);
   // fixed pseudo-random start (a linear congruential sequence): reproducible on resume
   Eigen::Matrix3Xd v(3, n);
   std::uint64_t r = 0x9E3779B97F4A7C15ull;

@@ -105,6 +105,11 @@ class IbSolver {
   /// Force the structure exerts on the fluid, -Fbar of eq. (16), N per node.
   Eigen::Matrix3Xd fluid_force(const Eigen::Matrix3Xd& X, double t, const Eigen::Matrix3Xd& accel) const;
 
+  /// The wall's stretching and bending energies at X, J. They come from the same pass as
+  /// the elastic forces at X, which is kept for the next step from X (a run asks for the
+  /// energy of each new state, then steps from it: one pass per step serves both).
+  std::array<double, 2> elastic_energy_parts(const Eigen::Matrix3Xd& X) const;
+
   const MacGrid& grid() const { return grid_; }
   const CylinderMesh& mesh() const { return mesh_; }
   StokesSolver& stokes() { return stokes_; }
@@ -113,6 +118,13 @@ class IbSolver {
 
  private:
   void guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const;
+  /// The elastic forces at X, from the kept pass when it was made at the same X.
+  const Eigen::Matrix3Xd& elastic(const Eigen::Matrix3Xd& X) const;
+  struct ElasticPass {
+    Eigen::Matrix3Xd X, F;
+    std::array<double, 2> energy{};
+  };
+  mutable ElasticPass elastic_;
   std::string dt_remedy() const;
   MacGrid grid_;
   CylinderMesh mesh_;

@@ -192,16 +192,20 @@ double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, do
 
 namespace {
 // Spring forces (eq. 7 gradient) of edges [e0, e1) added to F.
-void add_stretching_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, std::size_t e0,
-                          std::size_t e1, Eigen::Matrix3Xd& F) {
+// Returns the sum of (l - l0)^2 over the range (the energy without ks / 2).
+double add_stretching_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, std::size_t e0,
+                            std::size_t e1, Eigen::Matrix3Xd& F) {
+  double s = 0.0;
   for (std::size_t e = e0; e < e1; ++e) {
     const int a = mesh.edges[e][0], b = mesh.edges[e][1];
     const V3 v = X.col(b) - X.col(a);
-    const double l = v.norm();
-    const V3 fb = -ks * (l - mesh.rest_length[Eigen::Index(e)]) / l * v;  // -dE/dX_b
+    const double l = v.norm(), dl = l - mesh.rest_length[Eigen::Index(e)];
+    const V3 fb = -ks * dl / l * v;  // -dE/dX_b
     F.col(b) += fb;
     F.col(a) -= fb;
+    s += dl * dl;
   }
+  return s;
 }
 }  // namespace
 
@@ -290,9 +294,11 @@ double bending_energy_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X,
   return s;
 }
 
-void add_bending_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
-                       std::size_t k0, std::size_t k1, Eigen::Matrix3Xd& F) {
+// Returns the sum of |e| t^2 over the range (the energy without kb / 2).
+double add_bending_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
+                         std::size_t k0, std::size_t k1, Eigen::Matrix3Xd& F) {
   const RestAngles rest(mesh, form);
+  double energy = 0.0;
   for (std::size_t k = k0; k < k1; ++k) {
     const auto& h = mesh.hinges[k];
     const Hinge g = hinge(mesh, X, rest, k);
@@ -310,7 +316,9 @@ void add_bending_range(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, doub
     F.col(h[1]) -= ct * (-ac * gc - ad * gd) + cl * dl_db;
     F.col(h[2]) -= ct * gc;
     F.col(h[3]) -= ct * gd;
+    energy += l * t * t;
   }
+  return energy;
 }
 }  // namespace
 
@@ -331,10 +339,11 @@ double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const
 }
 
 Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p,
-                                int threads) {
+                                int threads, std::array<double, 2>* energy) {
   const std::size_t ne = mesh.edges.size(), nh = mesh.hinges.size();
   const int T = block_count(long(std::max(ne, nh)), threads);
   Eigen::Matrix3Xd F(3, X.cols());
+  std::vector<std::array<double, 2>> sums(std::size_t(T), {0.0, 0.0});
   // Thread t accumulates the springs of edge block t and the hinges of hinge block t
   // (static blocks) into its own buffer (thread 0: F itself); the buffers are then summed
   // in the fixed order 0, 1, .., T-1. T = 1 is the plain serial loop.
@@ -343,9 +352,15 @@ Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd
     const std::size_t t = std::size_t(tb);
     Eigen::Matrix3Xd& Ft = t == 0 ? F : part[t - 1];
     Ft.setZero(3, X.cols());
-    add_stretching_range(mesh, X, p.ks, ne * t / T, ne * (t + 1) / T, Ft);
-    add_bending_range(mesh, X, p.kb, p.bending, nh * t / T, nh * (t + 1) / T, Ft);
+    sums[t][0] = add_stretching_range(mesh, X, p.ks, ne * t / T, ne * (t + 1) / T, Ft);
+    sums[t][1] = add_bending_range(mesh, X, p.kb, p.bending, nh * t / T, nh * (t + 1) / T, Ft);
   });
+  if (energy) {
+    *energy = {0.0, 0.0};
+    for (const auto& b : sums) (*energy)[0] += b[0], (*energy)[1] += b[1];
+    (*energy)[0] *= 0.5 * p.ks;
+    (*energy)[1] *= 0.5 * p.kb;
+  }
   if (T > 1)
     parallel_blocks(long(X.cols()), T, [&](long b, long e, int) {
       for (const auto& Ft : part) F.middleCols(b, e - b) += Ft.middleCols(b, e - b);
@@ -361,10 +376,12 @@ Eigen::VectorXd node_masses(const CylinderMesh& mesh, double areal_density) {
 
 Eigen::Matrix3Xd radial_directions(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
   Eigen::Matrix3Xd R(3, X.cols());
-  for (Eigen::Index i = 0; i < X.cols(); ++i) {
-    V3 r = X.col(i) - mesh.axis_start;
-    r.x() = 0.0;
-    R.col(i) = r.normalized();
+  const double ay = mesh.axis_start[1], az = mesh.axis_start[2];
+  for (Eigen::Index i = 0; i < X.cols(); ++i) {  // plain loop, as node_radii
+    const double y = X(1, i) - ay, z = X(2, i) - az, r = std::sqrt(y * y + z * z);
+    R(0, i) = 0.0;  // a node on the axis: no direction (0, as Eigen's normalized())
+    R(1, i) = r > 0.0 ? y / r : 0.0;
+    R(2, i) = r > 0.0 ? z / r : 0.0;
   }
   return R;
 }

@@ -100,8 +100,10 @@ double elastic_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const
 /// F_i = -dE/dX_i (eq. 9), N. With threads > 1 the edges and hinges are split into static
 /// blocks, each accumulated into its own buffer and the buffers summed in a fixed order
 /// (parallel.hpp): reproducible for a given thread count, equal to threads = 1 up to round-off.
+/// `energy`: also the stretching and bending energies of X, J, from the same pass (equal to
+/// stretching_energy and bending_energy with the same threads).
 Eigen::Matrix3Xd elastic_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const MembraneParams& p,
-                                int threads = 1);
+                                int threads = 1, std::array<double, 2>* energy = nullptr);
 
 /// Node masses m_i = areal_density (kg/m^2) * node_area_i. The paper's equal
 /// masses are recovered by passing total/N_n per node directly instead.

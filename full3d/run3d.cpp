@@ -45,6 +45,7 @@ class Runner {
         output_(run_, resolved, out, p.vtk && !ctl.quiet_vtk, p.fluid_fields && !p.dry && !ctl.quiet_vtk, rec_),
         checkpoint_(run_, resolved, out) {
     rec_.keep(ctl.keep_rows);
+    measured_.energy_source([this](const Eigen::Matrix3Xd& X) { return stepper_.elastic_energy_parts(X); });
   }
 
   RunOutcome run() {

@@ -91,7 +91,9 @@ std::array<double, 2> Measurements::elastic_parts(const IbState& s) const {
   if (s.t != parts_t_ || s.X.data() != parts_x_) {
     const MembraneParams& m = run_.p.membrane;
     const int T = run_.p.threads;
-    parts_ = {stretching_energy(run_.mesh, s.X, m.ks, T), bending_energy(run_.mesh, s.X, m.kb, m.bending, T)};
+    parts_ = energy_source_ ? energy_source_(s.X)
+                            : std::array<double, 2>{stretching_energy(run_.mesh, s.X, m.ks, T),
+                                                    bending_energy(run_.mesh, s.X, m.kb, m.bending, T)};
     parts_t_ = s.t;
     parts_x_ = s.X.data();
   }

@@ -8,6 +8,7 @@
 
 #include <array>
 #include <chrono>
+#include <functional>
 #include <map>
 #include <string>
 #include <vector>
@@ -70,6 +71,10 @@ class Measurements {
   /// Rows and ring radii go into `rec`.
   Measurements(const RunSetup& run, record::RunRecord& rec);
 
+  /// Where the wall's stretching and bending energies come from (the stepper's elastic pass,
+  /// shared with the next step's forces); without one, they are computed here.
+  using EnergySource = std::function<std::array<double, 2>(const Eigen::Matrix3Xd& X)>;
+  void energy_source(EnergySource f) { energy_source_ = std::move(f); }
   /// A fresh run: the reference of the centre displacement.
   void start(const IbState& s);
   /// After a step: solver statistics, end-disc fluxes and volumes (fluid-coupled runs).
@@ -115,6 +120,7 @@ class Measurements {
   mutable const double* parts_x_ = nullptr;
   mutable std::array<double, 2> parts_{};
   WallSplit split_;
+  EnergySource energy_source_;
 };
 
 }  // namespace swim::full3d

@@ -51,6 +51,12 @@ Stepper::Stepper(const RunSetup& run)
   if (run.adaptive) dt_next_ = dt_last_ = dt_before_last_ = ladder(p.adaptive.event_dt);
 }
 
+std::array<double, 2> Stepper::elastic_energy_parts(const Eigen::Matrix3Xd& X) const {
+  if (ib_) return ib_->elastic_energy_parts(X);
+  const MembraneParams& m = run_.p.membrane;
+  return {stretching_energy(run_.mesh, X, m.ks, run_.p.threads), bending_energy(run_.mesh, X, m.kb, m.bending, run_.p.threads)};
+}
+
 void Stepper::start() {
   protocol_.start(0.0, s_.X);
   step_marks_.push_back(0.0);

@@ -47,6 +47,9 @@ class Stepper {
   const MacGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
   /// The fluid pressure of the last step (fluid-coupled runs).
   const ScalarField& pressure() const { return ib_->stokes().pressure(); }
+  /// The wall's stretching and bending energies at X, J (fluid-coupled runs: from the
+  /// solver's elastic pass, which the next step from X reuses).
+  std::array<double, 2> elastic_energy_parts(const Eigen::Matrix3Xd& X) const;
   bool fluid() const { return !run_.p.dry; }
   /// The fluid solver's set-up cost in this process (not across a resume): factorisations of
   /// the Stokes operator (one per time step value not cached), their wall time, and the
