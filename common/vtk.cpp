@@ -19,22 +19,21 @@ constexpr char kB64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz012
 }  // namespace
 
 std::string base64(const unsigned char* p, std::size_t n) {
-  std::string s;
-  s.reserve(4 * ((n + 2) / 3));
+  std::string s(4 * ((n + 2) / 3), '=');
+  char* o = s.data();
   std::size_t i = 0;
-  for (; i + 2 < n; i += 3) {
+  for (; i + 2 < n; i += 3, o += 4) {
     const std::uint32_t v = (std::uint32_t(p[i]) << 16) | (std::uint32_t(p[i + 1]) << 8) | p[i + 2];
-    s += kB64[v >> 18];
-    s += kB64[(v >> 12) & 63];
-    s += kB64[(v >> 6) & 63];
-    s += kB64[v & 63];
+    o[0] = kB64[v >> 18];
+    o[1] = kB64[(v >> 12) & 63];
+    o[2] = kB64[(v >> 6) & 63];
+    o[3] = kB64[v & 63];
   }
-  if (i < n) {
+  if (i < n) {  // one or two bytes left: the padding '=' is already in place
     const std::uint32_t v = (std::uint32_t(p[i]) << 16) | (i + 1 < n ? std::uint32_t(p[i + 1]) << 8 : 0u);
-    s += kB64[v >> 18];
-    s += kB64[(v >> 12) & 63];
-    s += i + 1 < n ? kB64[(v >> 6) & 63] : '=';
-    s += '=';
+    o[0] = kB64[v >> 18];
+    o[1] = kB64[(v >> 12) & 63];
+    if (i + 1 < n) o[2] = kB64[(v >> 6) & 63];
   }
   return s;
 }
