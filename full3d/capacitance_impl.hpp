@@ -60,6 +60,8 @@ struct CapacitanceStokes::Impl {
   // plane r holding Re (r <= nx/2) or Im (r > nx/2) of axial mode min(r, nx - r).
   FftwBuffer real, planes;
   std::vector<FftwPlan> xfwd, xbwd;  // per thread block of rows
+  std::vector<FftwPlan> xbwd_u;      // the same without the pressure rows (CapacitanceStokes::compute_pressure)
+  bool pressure_wanted = true;
   std::array<FftwPlan, 3> yz_fwd;    // u, v, w (planned on plane 0)
   std::array<FftwPlan, 4> yz_inv;    // u, v, w, p
   std::array<std::size_t, 4> yz_at{};  // first transformed element of each component in a plane
@@ -136,7 +138,7 @@ struct CapacitanceStokes::Impl {
   // Mode kx's np planes F to the yz spectral (rotated) frame and back (the common first and
   // last stages of the duct's and the cylinder's mode solves).
   void mode_to_spectral(int kx, double* const F[2], int np, Scratch& s);
-  void mode_from_spectral(int kx, double* const F[2], int np);
+  void mode_from_spectral(int kx, double* const F[2], int np, bool pressure);
   // The whole cross-section solve of axial mode kx on its one or two planes.
   void solve_mode(int kx, const Factors& fac, double alpha, Scratch& s);
   // Rotation of the x component of a paired mode into the real frame, q = i e^{i theta/2} u^

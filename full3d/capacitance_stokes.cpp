@@ -64,6 +64,7 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
   };
   plan_x(off[3], true, xfwd);
   plan_x(off[4], false, xbwd);
+  plan_x(off[3], false, xbwd_u);
 
   // 2D cross-section transforms of one plane (new-array execution on every plane)
   double* p0 = planes.data();
@@ -253,7 +254,7 @@ void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alph
     correct_ring(kx, F, np, gx, fac, s);
   else
     correct_walls(kx, F, np, gx, fac, s);
-  mode_from_spectral(kx, F, np);
+  mode_from_spectral(kx, F, np, pressure_wanted);
   if (kx == 0) {
     if (cyl) {
       mean_x_ring(F[0] + off[0], fac, s);
@@ -274,8 +275,8 @@ void CapacitanceStokes::Impl::mode_to_spectral(int kx, double* const F[2], int n
 }
 
 // The way back: rotation of a paired mode, the wall faces (not transformed) set to zero,
-// the inverse yz transforms of u, v, w, p.
-void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int np) {
+// the inverse yz transforms of u, v, w and (pressure) p.
+void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int np, bool pressure) {
   if (np == 2) rotate(F[0], F[1], kx, -1);
   for (int q = 0; q < np; ++q) {
     double* f = F[q];
@@ -285,7 +286,7 @@ void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int
     }
     std::fill(f + off[2], f + off[2] + ny, 0.0);
     std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
-    for (int c = 0; c < 4; ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
+    for (int c = 0; c < (pressure ? 4 : 3); ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
   }
 }
 
@@ -374,8 +375,9 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
   parallel_blocks(nxh, threads, [&](long kb, long ke, int t) {
     for (long kx = kb; kx < ke; ++kx) solve_mode(int(kx), fac, alpha, scratch[t]);
   });
-  parallel_blocks(off[4], threads, [&](long rb, long re, int t) {
-    xbwd[t].execute();
+  const bool with_p = pressure_wanted;
+  parallel_blocks(with_p ? off[4] : off[3], threads, [&](long rb, long re, int t) {
+    (with_p ? xbwd : xbwd_u)[t].execute();
     rows_of(rb, re, [&](int c, long lo, long hi) {
       double* dst = c < 3 ? u.c[c].data() : p.v.data();
       std::memcpy(dst + std::size_t(lo - off[c]) * nx, real.data() + std::size_t(lo) * nx,
@@ -401,6 +403,10 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
           }
       });
     });
+    if (!with_p) {
+      mask_residual = *std::max_element(res.begin(), res.end());
+      return;
+    }
     parallel_blocks(long(cell_fluid.size()), T, [&](long cb, long ce, int t) {
       for (long cell = cb; cell < ce; ++cell)
         if (cell_fluid[std::size_t(cell)]) {
@@ -425,6 +431,7 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
     });
     return;
   }
+  if (!with_p) return;
   // the pressure's zero mode is the gauge (0); remove its round-off mean
   std::vector<double> part(std::size_t(T), 0.0);
   const long rows = long(p.v.size() / std::size_t(nx));
@@ -484,6 +491,8 @@ void CapacitanceStokes::limit_cache(int slots) {
   impl_->slots = slots;
 }
 int CapacitanceStokes::wall_nodes() const { return impl_->m; }
+void CapacitanceStokes::compute_pressure(bool on) { impl_->pressure_wanted = on; }
+bool CapacitanceStokes::computes_pressure() const { return impl_->pressure_wanted; }
 int CapacitanceStokes::threads() const { return impl_->threads; }
 int CapacitanceStokes::symmetry_blocks() const { return impl_->cyl && !impl_->sym_ok ? 1 : 4; }
 

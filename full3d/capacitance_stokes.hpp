@@ -123,6 +123,11 @@ class CapacitanceStokes {
   void step(VectorField& u, const VectorField& f, ScalarField& p, double alpha);
   /// The same step from un = u^n into u (un may be u).
   void step(const VectorField& un, const VectorField& f, VectorField& u, ScalarField& p, double alpha);
+  /// Whether solves produce the pressure (default true). Off, p is left as it was: the
+  /// velocity does not depend on it (the solve is exact), and its inverse transforms are
+  /// 1 of the 7 per solve along x and 1 of 7 across.
+  void compute_pressure(bool on);
+  bool computes_pressure() const;
 
   /// Upper bound of the capacitance factor memory for one alpha, bytes: (nx/2+1) packed
   /// Cholesky factors of four symmetry blocks of about m/4 (about (nx/2+1) m^2/8 doubles).

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <optional>
 #include <string>
 #include <utility>
 
@@ -207,12 +208,17 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
   Eigen::Matrix3Xd U;
   double lambda = 0.0;
   // the pressure is the last step's result (fluid-field output): the estimate must not change it
-  const ScalarField p_keep = stokes_.pressure();
   struct Restore {
     StokesSolver& s;
-    const ScalarField& p;
-    ~Restore() { s.set_pressure(p); }
-  } restore{stokes_, p_keep};
+    bool was;
+    std::optional<ScalarField> p;  // the box computes it anyway: kept and put back
+    ~Restore() {
+      s.compute_pressure(was);
+      if (p) s.set_pressure(*p);
+    }
+  } restore{stokes_, stokes_.computes_pressure(), std::nullopt};
+  stokes_.compute_pressure(false);
+  if (stokes_.computes_pressure()) restore.p = stokes_.pressure();
   for (int it = 0; it < iterations; ++it) {
     const double vmax = v.cwiseAbs().maxCoeff();
     if (!(vmax > 0.0) || !std::isfinite(vmax)) return lambda;

@@ -46,6 +46,7 @@ class Runner {
         checkpoint_(run_, resolved, out) {
     rec_.keep(ctl.keep_rows);
     measured_.energy_source([this](const Eigen::Matrix3Xd& X) { return stepper_.elastic_energy_parts(X); });
+    stepper_.compute_pressure(output_.fluid());
   }
 
   RunOutcome run() {

@@ -47,6 +47,11 @@ class Stepper {
   const MacGrid* grid() const { return grid_ ? &*grid_ : nullptr; }
   /// The fluid pressure of the last step (fluid-coupled runs).
   const ScalarField& pressure() const { return ib_->stokes().pressure(); }
+  /// Whether the steps compute the fluid pressure (StokesSolver::compute_pressure): only a
+  /// run that writes fluid frames needs it.
+  void compute_pressure(bool on) {
+    if (ib_) ib_->stokes().compute_pressure(on);
+  }
   /// The wall's stretching and bending energies at X, J (fluid-coupled runs: from the
   /// solver's elastic pass, which the next step from X reuses).
   std::array<double, 2> elastic_energy_parts(const Eigen::Matrix3Xd& X) const;

@@ -174,6 +174,12 @@ StokesStats StokesSolver::step_from_rest(VectorField& u, const VectorField& f, d
 }
 
 const ScalarField& StokesSolver::pressure() const { return impl_->p; }
+void StokesSolver::compute_pressure(bool on) {
+  if (impl_->capacitance) impl_->capacitance->compute_pressure(on);
+}
+bool StokesSolver::computes_pressure() const {
+  return impl_->capacitance ? impl_->capacitance->computes_pressure() : true;
+}
 void StokesSolver::set_pressure(const ScalarField& p) {
   if (p.v.size() != impl_->grid.cells())
     throw InputError("pressure", std::to_string(p.v.size()) + " values",

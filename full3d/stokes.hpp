@@ -95,9 +95,14 @@ class StokesSolver {
   /// The same step from a fluid at rest, u^n = 0, into u.
   StokesStats step_from_rest(VectorField& u, const VectorField& f, double dt);
 
-  /// Pressure of the last step, Pa: zero mean (cylinder: zero mean over the cells with a free
-  /// face, 0 in the others).
+  /// Pressure of the last step that computed it, Pa: zero mean (cylinder: zero mean over the
+  /// cells with a free face, 0 in the others).
   const ScalarField& pressure() const;
+  /// Duct and cylinder: whether steps compute the pressure (default true; the box always
+  /// does). The velocity does not depend on it; a run that writes no pressure turns it off
+  /// and on again before a step whose pressure it writes.
+  void compute_pressure(bool on);
+  bool computes_pressure() const;
   /// Replaces the pressure (checkpoint restore). Throws swim::InputError if p does not have
   /// one value per cell.
   void set_pressure(const ScalarField& p);
