@@ -225,6 +225,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
       const full3d::IbOptions o = full3d::ib_options(p);
       full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), o);
+      ib.stokes().compute_pressure(false);  // the step of a run that writes no fluid frames (the default)
       full3d::Protocol3d proto(p.protocol, mesh, full3d::uniform_contraction_energy(mesh, p.membrane, p.protocol.R_f));
       proto.start(0.0, mesh.X0);
       ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) { return proto.force(X); });
@@ -277,6 +278,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
         full3d::StokesOptions so = o.stokes;
         so.cylinder.enabled = false;
         full3d::StokesSolver duct(grid, p.fluid, so);
+        duct.compute_pressure(false);  // as the cylinder's solver in the step above
         full3d::StokesSolver& cyl = ib.stokes();
         double t_duct = 1e300, t_cyl = 1e300;
         duct.step(u, f, p.dt);
