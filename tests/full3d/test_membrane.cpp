@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -299,4 +300,38 @@ TEST(MembraneMeasure, AxisymmetricProjectionKeepsTheRingsCircles) {
   const Eigen::Matrix3Xd Xu = m.X0 + (0.05 * kR0 / U.cwiseAbs().maxCoeff()) * U;
   EXPECT_LT(wall_wrinkle(m, node_radii(m, Xp), ring_radii(m, Xp)), 1e-12 * kR0);
   EXPECT_GT(wall_wrinkle(m, node_radii(m, Xu), ring_radii(m, Xu)), 1e-3 * kR0);
+}
+
+TEST(MembraneForces, EnergyOfTheForcePassAndOfTheThreadsEqualsTheAngleDefinition) {
+  // the energies of elastic_forces' pass equal stretching_energy / bending_energy with the same
+  // threads bit for bit, differ between thread counts only at round-off, and the hinge term
+  // (evaluated without trigonometry) equals kb/2 sum |e| tan^2((theta - theta0)/2) with theta
+  // from dihedral_angle (atan2) to round-off
+  const CylinderMesh m = small_mesh();
+  const Eigen::Matrix3Xd X = perturbed(m, 0.05, 3);
+  for (auto form : {BendingForm::ReferenceAngle, BendingForm::Printed}) {
+    MembraneParams p;
+    p.ks = 5.5e-8;
+    p.kb = 1e-15;
+    p.bending = form;
+    double by_angle = 0.0;
+    for (std::size_t k = 0; k < m.hinges.size(); ++k) {
+      const auto& h = m.hinges[k];
+      const double th = dihedral_angle(X.col(h[0]), X.col(h[1]), X.col(h[2]), X.col(h[3]));
+      const double t = std::tan(0.5 * (th - (form == BendingForm::ReferenceAngle ? m.rest_angle[Eigen::Index(k)] : 0.0)));
+      by_angle += (X.col(h[1]) - X.col(h[0])).norm() * t * t;
+    }
+    by_angle *= 0.5 * p.kb;
+    for (int threads : {1, 2, 3}) {
+      std::array<double, 2> e{};
+      const Eigen::Matrix3Xd F = elastic_forces(m, X, p, threads, &e);
+      EXPECT_EQ(e[0], stretching_energy(m, X, p.ks, threads));
+      EXPECT_EQ(e[1], bending_energy(m, X, p.kb, form, threads));
+      EXPECT_EQ(F, elastic_forces(m, X, p, threads)) << "the energy does not change the forces";
+      EXPECT_NEAR(e[0], stretching_energy(m, X, p.ks, 1), 1e-13 * e[0]);
+      EXPECT_NEAR(e[1], by_angle, 1e-12 * by_angle);
+      EXPECT_GT(e[0], 0.0);
+      EXPECT_GT(e[1], 0.0);
+    }
+  }
 }
