@@ -84,8 +84,7 @@ void CsvWriter::row(const std::vector<double>& values) {
     if (!std::isfinite(values[i]))
       throw NumericalError("non-finite value in column '" + header_[i] + "' of " + path_,
                            "tighten the solver tolerances or reduce the time step");
-    std::snprintf(b, sizeof b, "%.10g", values[i]);
-    o << (i ? "," : "") << b;
+    o << (i ? "," : "") << csv_number(values[i], b);
   }
   o << "\n";
 }

@@ -8,15 +8,24 @@
 // ("files").
 #pragma once
 
+#include <charconv>
 #include <initializer_list>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "common/atomic_file.hpp"
 
 namespace swim::output {
+
+/// v with 10 significant digits, as printf("%.10g") writes it (the CSV files' number format),
+/// into b; returns the characters written. std::to_chars: several times faster than printf.
+inline std::string_view csv_number(double v, char (&b)[40]) {
+  const auto r = std::to_chars(b, b + sizeof b, v, std::chars_format::general, 10);
+  return {b, std::size_t(r.ptr - b)};
+}
 
 using json = nlohmann::ordered_json;
 

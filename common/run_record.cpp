@@ -330,9 +330,8 @@ void write_header(std::ostream& o, const std::vector<std::string>& columns) {
 }
 void write_number(std::ostream& o, double v, bool first) {
   char b[40];
-  std::snprintf(b, sizeof b, "%.10g", v);
   if (!first) o << ',';
-  o << b;
+  o << output::csv_number(v, b);
 }
 const std::vector<std::string> kRadiusColumns = {"t_s", "z_m", "radius_m"};
 }  // namespace
