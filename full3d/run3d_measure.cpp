@@ -70,6 +70,7 @@ void Measurements::after_step(const IbStepStats& st, const IbState& s, double dt
   last_cfl_ = st.cfl;
   last_iterations_ = st.stokes_iterations;
   last_divergence_ = st.max_divergence;
+  if (st.max_edge > 0.0) max_edge_ = st.max_edge, max_edge_t_ = s.t;  // the step's no-leak guard measured it at s.X
   if (!grid) return;  // the dry swimmer: no fluid
   max_cfl_ = std::max(max_cfl_, st.cfl);
   iterations_total_ += st.stokes_iterations;
@@ -175,7 +176,8 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
   const double row[] = {s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                         rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                         double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
-                        last_divergence_, max_edge_length(mesh, s.X), n > 0 ? dt_last : 0.0,
+                        last_divergence_, max_edge_t_ == s.t ? max_edge_ : max_edge_length(mesh, s.X),
+                        n > 0 ? dt_last : 0.0,
                         wall_wrinkle(mesh, rn, rr)};
   // a row that passes output.max_bytes ends the run (NumericalError) once it is written: its
   // radius snapshot is still written, and the run's failure path does not record it again

@@ -113,6 +113,7 @@ class Measurements {
   std::vector<std::array<double, 3>> disc_;  ///< unit-disc quadrature: y, z, weight
   double x_center0_ = 0, vol_rear_ = 0, vol_front_ = 0, q_rear_ = 0, q_front_ = 0, q_rear_prev_ = 0, q_front_prev_ = 0;
   double rmin_seen_ = 1e300;
+  double max_edge_ = 0.0, max_edge_t_ = -1.0;  ///< longest edge after the last step, and the time of that state
   double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0;
   long iterations_total_ = 0, last_iterations_ = 0;
   long last_recorded_ = -1;
