@@ -338,6 +338,19 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
                                     {"cycle_completed", done}, {"cycle_end_s", t_cycle},
                                     {"steps", r.steps}, {"wall_time_s", wall},
                                     {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", r.failed}};
+    // where the run's wall time went (solver_stats.json "wall_time_split_s"), largest parts first
+    const scene::json split = r.record.stats.value("wall_time_split_s", scene::json::object());
+    report["full3d_paper_cycle"]["wall_time_split_s"] = split;
+    std::vector<std::pair<double, std::string>> parts;
+    for (const auto& [k, v] : split.items()) parts.emplace_back(v.get<double>(), k);
+    std::sort(parts.rbegin(), parts.rend());
+    std::string line;
+    for (std::size_t i = 0; i < parts.size() && i < 6; ++i) {
+      char b[96];
+      std::snprintf(b, sizeof b, "%s%s %.1f s", i ? ", " : "", parts[i].second.c_str(), parts[i].first);
+      line += b;
+    }
+    if (!line.empty()) std::printf("  wall time: %s\n", line.c_str());
   } else {
     std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
   }
