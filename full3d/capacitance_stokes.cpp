@@ -403,10 +403,8 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
           }
       });
     });
-    if (!with_p) {
-      mask_residual = *std::max_element(res.begin(), res.end());
-      return;
-    }
+    mask_residual = *std::max_element(res.begin(), res.end());
+    if (!with_p) return;
     parallel_blocks(long(cell_fluid.size()), T, [&](long cb, long ce, int t) {
       for (long cell = cb; cell < ce; ++cell)
         if (cell_fluid[std::size_t(cell)]) {
@@ -415,10 +413,9 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
           cnt[std::size_t(t)] += std::size_t(nx);
         }
     });
-    double r = 0.0, ps = 0.0;
+    double ps = 0.0;
     std::size_t n = 0;
-    for (int t = 0; t < T; ++t) r = std::max(r, res[std::size_t(t)]), ps += psum[std::size_t(t)], n += cnt[std::size_t(t)];
-    mask_residual = r;
+    for (int t = 0; t < T; ++t) ps += psum[std::size_t(t)], n += cnt[std::size_t(t)];
     const double pm = n ? ps / double(n) : 0.0;
     parallel_blocks(long(cell_fluid.size()), T, [&](long cb, long ce, int) {
       for (long cell = cb; cell < ce; ++cell) {
@@ -436,13 +433,13 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
   std::vector<double> part(std::size_t(T), 0.0);
   const long rows = long(p.v.size() / std::size_t(nx));
   parallel_blocks(rows, T, [&](long rb, long re, int t) {
-    for (std::size_t m = std::size_t(rb) * nx; m < std::size_t(re) * nx; ++m) part[std::size_t(t)] += p.v[m];
+    for (std::size_t i = std::size_t(rb) * nx; i < std::size_t(re) * nx; ++i) part[std::size_t(t)] += p.v[i];
   });
   double sum = 0.0;
   for (double x : part) sum += x;
   const double mean = sum / double(p.v.size());
   parallel_blocks(rows, T, [&](long rb, long re, int) {
-    for (std::size_t m = std::size_t(rb) * nx; m < std::size_t(re) * nx; ++m) p.v[m] -= mean;
+    for (std::size_t i = std::size_t(rb) * nx; i < std::size_t(re) * nx; ++i) p.v[i] -= mean;
   });
 }
 

@@ -41,11 +41,11 @@ namespace {
 class Runner {
  public:
   Runner(const Params3d& p, const json& resolved, const std::string& out, const RunControl& ctl)
-      : p_(p), out_(out), ctl_(ctl), run_(p), rec_(new_record(run_)), stepper_(run_), measured_(run_, rec_),
+      : p_(p), out_(out), ctl_(ctl), run_(p), rec_(new_record(run_)), stepper_(run_),
+        measured_(run_, rec_, [this](const Eigen::Matrix3Xd& X) { return stepper_.elastic_energy_parts(X); }),
         output_(run_, resolved, out, p.vtk && !ctl.quiet_vtk, p.fluid_fields && !p.dry && !ctl.quiet_vtk, rec_),
         checkpoint_(run_, resolved, out) {
     rec_.keep(ctl.keep_rows);
-    measured_.energy_source([this](const Eigen::Matrix3Xd& X) { return stepper_.elastic_energy_parts(X); });
     stepper_.compute_pressure(output_.fluid());
   }
 

@@ -51,7 +51,8 @@ record::RunRecord new_record(const RunSetup& run) {
                            std::move(z));
 }
 
-Measurements::Measurements(const RunSetup& run, record::RunRecord& rec) : run_(run), rec_(rec) {
+Measurements::Measurements(const RunSetup& run, record::RunRecord& rec, EnergySource energy)
+    : run_(run), rec_(rec), energy_source_(std::move(energy)) {
   const Params3d& p = run.p;
   const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
   e_cap_ = p.energy_growth * run.e_ref * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
@@ -90,11 +91,7 @@ double Measurements::kinetic_energy(const IbState& s) const {
 
 std::array<double, 2> Measurements::elastic_parts(const IbState& s) const {
   if (s.t != parts_t_ || s.X.data() != parts_x_) {
-    const MembraneParams& m = run_.p.membrane;
-    const int T = run_.p.threads;
-    parts_ = energy_source_ ? energy_source_(s.X)
-                            : std::array<double, 2>{stretching_energy(run_.mesh, s.X, m.ks, T),
-                                                    bending_energy(run_.mesh, s.X, m.kb, m.bending, T)};
+    parts_ = energy_source_(s.X);
     parts_t_ = s.t;
     parts_x_ = s.X.data();
   }

@@ -68,13 +68,11 @@ class Lap {
 
 class Measurements {
  public:
-  /// Rows and ring radii go into `rec`.
-  Measurements(const RunSetup& run, record::RunRecord& rec);
-
-  /// Where the wall's stretching and bending energies come from (the stepper's elastic pass,
-  /// shared with the next step's forces); without one, they are computed here.
+  /// The wall's stretching and bending energies at X, J (the stepper's elastic pass, shared
+  /// with the next step's forces).
   using EnergySource = std::function<std::array<double, 2>(const Eigen::Matrix3Xd& X)>;
-  void energy_source(EnergySource f) { energy_source_ = std::move(f); }
+  /// Rows and ring radii go into `rec`; the wall energies come from `energy`.
+  Measurements(const RunSetup& run, record::RunRecord& rec, EnergySource energy);
   /// A fresh run: the reference of the centre displacement.
   void start(const IbState& s);
   /// After a step: solver statistics, end-disc fluxes and volumes (fluid-coupled runs).
