@@ -83,9 +83,10 @@ struct ForceModel {
   AbsKQuadrature tq;   // short-wave traction: |k| quadrature (empty without it)
   int J;               // traction fields per cell (tq nodes)
   bool dae;            // IDA path: wall inertia or short-wave traction
-  int stride;          // unknowns per cell: 1 (a) or 3 + J (a, V, p, psi_0..psi_{J-1})
+  int stride;          // unknowns per cell: 1 (a) or 3 + J (a, V, p, phi_0..phi_{J-1})
   int band_mu = 0, band_ml = 0;  // IDA band of the interleaved layout
-  std::vector<double> tr_s2, tr_c;  // (s_j h)^2 and 4 mu c_j Vel_s / P_s (per scaled psi_j)
+  std::vector<double> tr_s2, tr_c;  // (s_j h)^2 and 4 mu c_j Vel_s / P_s (per scaled phi_j)
+  double tr_csum = 0;               // sum_j tr_c[j]
   int iD, iX, iVr, iVf, iVrl, iVfl, n;  // extras and total size
   double T_s, D_s, X_s, V_s, Vel_s, P_s;
   // actuation laws (fixed between protocol events)
@@ -177,11 +178,12 @@ struct ForceModel {
       }
     }
     T_s = 0.1 * relaxation_time(P);
-    // Band of the interleaved (a, V, p, psi) layout: the continuity row of cell i reaches
-    // a_{i-1} (stride + 2 below) and p_{i+1} (stride above); the traction row psi_{i,j}
-    // reaches V_{i-1} (stride + 2 + j below). V_rear (first) and V_front stay inside.
+    // Band of the interleaved (a, V, p, phi) layout: the continuity row of cell i reaches
+    // a_{i-1} (stride + 2 below) and p_{i+1} (stride above); the traction row phi_{i,j}
+    // reaches phi_{i+-1,j} (stride) and V_i of its own cell only. V_rear (first) and V_front
+    // stay inside.
     band_mu = stride;
-    band_ml = stride + 2 + std::max(J - 1, 0);
+    band_ml = stride + 2;
     const double f_s = bal.per_length ? pi * C1 * R0 * R0 * R0 / L : C1 * R0 * R0 / (2.0 * L);
     D_s = f_s * T_s;
     X_s = force_free ? R0 : D_s * T_s / (bal.m_eff + bal.c_ext * T_s);
@@ -191,6 +193,7 @@ struct ForceModel {
     for (int j = 0; j < J; ++j) {
       tr_s2.push_back(tq.s[j] * h * tq.s[j] * h);
       tr_c.push_back(4.0 * mu * tq.c[j] * Vel_s / P_s);
+      tr_csum += tr_c.back();
     }
   }
 
@@ -607,11 +610,14 @@ struct ForceModel {
   }
 
   // Residual of the IDA path (wall inertia and/or short-wave traction). Per cell
-  // (a, V, p, psi_0..psi_{J-1}), psi_j = D2 / (D2 - (s_j h)^2) V in units of Vel_s:
+  // (a, V, p, phi_0..phi_{J-1}), phi_j = (s_j h)^2 / ((s_j h)^2 - D2) V in units of Vel_s:
   //   F_a = a' - 2 R V / R0^2,   F_V = [V'] + cv (C1 (R - R0) + q + T - p),
-  //   F_p = continuity,          F_psi_j = ((s_j h)^2 psi_j - D2 psi_j + D2 V) / ((s_j h)^2 + 4),
-  // with T = 4 mu sum_j c_j psi_j (the traction 2 mu |k| V of each fluid) and D2 the cell
+  //   F_p = continuity,          F_phi_j = ((s_j h)^2 (phi_j - V) - D2 phi_j) / ((s_j h)^2 + 4),
+  // with T = 4 mu sum_j c_j (V - phi_j) (the traction 2 mu |k| V of each fluid; V - phi_j is
+  // the field psi_j = -D2 / ((s_j h)^2 - D2) V of docs/outer-flow-1d.md) and D2 the cell
   // second difference with mirror ends (a uniform wall velocity has no short-wave traction).
+  // phi_j rather than psi_j: its row reaches V of its own cell only, which keeps the band
+  // of the Newton matrix at stride + 2 below the diagonal instead of 2 stride.
   int res(const double* y, const double* yp, double* F) {
     if (!unpack(y)) return 1;
     want_velocity = false;  // with the velocity quadrature U is integrated along the steps
@@ -621,17 +627,16 @@ struct ForceModel {
     const int S = stride;
     for (int i = 0; i < N; ++i) {
       const int k = 1 + S * i;
-      double T = 0;
-      for (int j = 0; j < J; ++j) T += tr_c[j] * y[k + 3 + j];
+      double T = tr_csum * y[k + 1];
+      for (int j = 0; j < J; ++j) T -= tr_c[j] * y[k + 3 + j];
       F[k] = yp[k] - cu * R[i] * y[k + 1];
       F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (C1 * (R[i] - R0) + q[i] + P_s * T - p[i]);
       F[k + 2] = cp * ((Q[i + 1] - Q[i]) / h + A0 * yp[k]);
       if (J > 0) {
         const int km = i > 0 ? k - S : k, kp = i + 1 < N ? k + S : k;  // mirror ends
-        const double d2v = y[km + 1] - 2.0 * y[k + 1] + y[kp + 1];
         for (int j = 0; j < J; ++j) {
           const double d2p = y[km + 3 + j] - 2.0 * y[k + 3 + j] + y[kp + 3 + j];
-          F[k + 3 + j] = (tr_s2[j] * y[k + 3 + j] - d2p + d2v) / (tr_s2[j] + 4.0);
+          F[k + 3 + j] = (tr_s2[j] * (y[k + 3 + j] - y[k + 1]) - d2p) / (tr_s2[j] + 4.0);
         }
       }
     }
@@ -665,8 +670,9 @@ struct ForceModel {
       // F_V = [V'] + cv (C1 (R - R0) + q + P_s T - p)
       band(k + 1, k, cv * (C1 + dq[i]) * dRda(i));
       if (inertia) band(k + 1, k + 1, cj);
+      if (J > 0) band(k + 1, k + 1, cv * P_s * tr_csum);
       band(k + 1, k + 2, -cv * P_s);
-      for (int j = 0; j < J; ++j) band(k + 1, k + 3 + j, cv * P_s * tr_c[j]);
+      for (int j = 0; j < J; ++j) band(k + 1, k + 3 + j, -cv * P_s * tr_c[j]);
       // F_p = cp ((Q_{i+1} - Q_i) / h + A0 a'): Q_i on (R_{i-1}, R_i), (p_{i-1}, p_i)
       const double c = cp / h;
       band(k + 2, k, c * (s.QL[i + 1] - s.QR[i]) * dRda(i) + cp * A0 * cj);
@@ -675,15 +681,15 @@ struct ForceModel {
       band(k + 2, k + 2, c * (cond[i + 1] + cond[i]) * P_s);
       if (i > 0) band(k + 2, k + 2 - S, -c * cond[i] * P_s);
       if (i + 1 < N) band(k + 2, k + 2 + S, -c * cond[i + 1] * P_s);
-      // F_psi_j = ((s_j h)^2 psi - D2 psi + D2 V) / ((s_j h)^2 + 4), mirror ends
+      // F_phi_j = ((s_j h)^2 (phi - V) - D2 phi) / ((s_j h)^2 + 4), mirror ends
       const int nb = (i > 0) + (i + 1 < N);
       for (int j = 0; j < J; ++j) {
         const int row = k + 3 + j;
         const double w = 1.0 / (tr_s2[j] + 4.0);
         band(row, row, (tr_s2[j] + nb) * w);
-        band(row, k + 1, -nb * w);
-        if (i > 0) band(row, row - S, -w), band(row, k + 1 - S, w);
-        if (i + 1 < N) band(row, row + S, -w), band(row, k + 1 + S, w);
+        band(row, k + 1, -tr_s2[j] * w);
+        if (i > 0) band(row, row - S, -w);
+        if (i + 1 < N) band(row, row + S, -w);
       }
     }
     // end volumes: F = V' - Q_end / V_s

