@@ -630,7 +630,7 @@ CaseScene case_scene(const json& cs, const std::string& suite_dir, const std::st
 
 // ---- the suite's 3D runs and calibrations, two at a time ------------------------------------
 //
-// On the 2-core machines the suite is made for, a 3D run on 2 threads is only 1.4-1.6 times as
+// On the 2-core machines the suite is made for, a 3D run on 2 threads is only 1.2-1.7 times as
 // fast as on 1 (docs/performance-3d.md), so two runs on one thread each get through the
 // suite's runs sooner. Before the report is assembled, every 3D run and calibration the
 // selected cases need goes into the cache this way, and the assembly then finds them there.
