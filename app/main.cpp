@@ -81,9 +81,7 @@ int main(int argc, char** argv) {
   val->add_option("suite", val_suite, "Suite file (default: data/validation/default.json, or quick.json with --quick)");
   val->add_flag("--quick", val_quick, "The reduced suite (small grids, minutes)");
   val->add_option("--out", val_out, "Output directory (default out/validation-<suite name>); completed runs in it are reused");
-  val->add_option("--threads", val_threads,
-                  "Threads of the 3D runs and calibrations (default 2); with 2 or more, two run side by side on half "
-                  "the threads each");
+  val->add_option("--threads", val_threads, "Threads of the 3D runs and calibrations (default 2)");
   std::vector<std::string> val_cases;
   val->add_option("--case", val_cases, "Run only this case (its scene file name); repeatable");
   add_progress(val);

@@ -5,13 +5,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
-#include <condition_variable>
 #include <map>
-#include <mutex>
 #include <optional>
-#include <set>
 #include <sstream>
-#include <thread>
 
 #include "common/errors.hpp"
 #include "common/output.hpp"
@@ -172,22 +168,17 @@ json current_resolution(const json& written) {
 /// modification time for the life of the process.
 std::string swimmer_key(const fs::path& file, const char* member) {
   static std::map<std::string, std::pair<fs::file_time_type, std::string>> memo;
-  static std::mutex memo_mutex;  // the suite's 3D runs look up the cache from two threads
   std::error_code ec;
   const auto mtime = fs::last_write_time(file, ec);
   if (ec) return {};
   std::string id = file.string();
   if (member) id.append("#").append(member);
-  {
-    std::lock_guard lock(memo_mutex);
-    if (auto it = memo.find(id); it != memo.end() && it->second.first == mtime) return it->second.second;
-  }
+  if (auto it = memo.find(id); it != memo.end() && it->second.first == mtime) return it->second.second;
   std::ifstream in(file);
   json j = json::parse(in, nullptr, false);
   std::string key;
   if (!j.is_discarded() && (!member || j.contains(member)))
     key = output::json_hash(same_swimmer(current_resolution(member ? j[member] : j)));
-  std::lock_guard lock(memo_mutex);
   memo[id] = {mtime, key};
   return key;
 }
@@ -237,63 +228,6 @@ bool interrupted_run(const std::string& dir) {
   return !s.is_discarded() && is_running(s) && fs::exists(full3d::checkpoint_path(dir));
 }
 
-/// The summary of a finished run of the physics `key` (json_hash of same_swimmer) in `dir`
-/// or, written with other output settings, in another folder of `runs_dir`, which `dir` then
-/// names; null when there is none. The cache is keyed by the physics of the resolved scene;
-/// a folder is found by its own scene.resolved.json.
-json cached_run(const std::string& runs_dir, std::string& dir, const std::string& key) {
-  json summary = finished_summary(dir);
-  if (summary.is_null())
-    for (const auto& e : fs::directory_iterator(runs_dir)) {
-      if (swimmer_key(e.path() / "scene.resolved.json", nullptr) != key) continue;
-      summary = finished_summary(e.path().string());
-      if (!summary.is_null()) {
-        dir = e.path().string();
-        break;
-      }
-    }
-  return summary;
-}
-
-/// The calibration of scene `s` (its grid set), keyed by the physics of the resolved scene
-/// and the calibration file's format version: read from `cal_dir` when a calibration of the
-/// same swimmer is there, else measured (`on_start` called first) and written there.
-/// `cal_file` names the file it came from, "" when the measurement failed.
-json calibration_of(const json& s, const std::string& name, const std::string& cal_dir, std::string& cal_file,
-                    const std::function<void()>& on_start) {
-  json resolved;
-  const full3d::Params3d p = full3d::read_scene3d(s, resolved);
-  const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
-  cal_file = dir + "/calibration.json";
-  if (!fs::exists(cal_file)) {
-    const std::string found = cached_calibration(cal_dir, same_swimmer(resolved));
-    if (!found.empty()) cal_file = found;
-  }
-  if (fs::exists(cal_file)) {
-    std::ifstream in(cal_file);
-    return json::parse(in);
-  }
-  if (on_start) on_start();
-  try {
-    const auto t0 = std::chrono::steady_clock::now();
-    const StaticCalibration c = calibrate_static(p, default_loads(p));
-    const HydraulicRadii hr = measure_hydraulic_radii(p);
-    json cal_j = to_json(c, p, resolved);
-    json hj = to_json(hr);
-    hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
-    hj.erase("wall_time_s");
-    cal_j.update(hj);
-    cal_j.update(calibrate_towed(p, hr).json);
-    cal_j["wall_time_s"] = seconds_since(t0);
-    fs::create_directories(dir);
-    output::write_json(cal_file, cal_j);
-    return cal_j;
-  } catch (const NumericalError& e) {
-    cal_file.clear();
-    return {{"status", std::string("failed: ") + e.what()}};
-  }
-}
-
 /// frame_interval > 0: membrane frames (VTK) at that interval, for the side-view figure.
 Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached, double frame_interval = 0) {
   json s = sc;
@@ -307,12 +241,23 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   }
   json resolved;
   const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+  // the cache is keyed by the physics of the resolved scene; a folder under another name
+  // (written with other output settings) is found by its own scene.resolved.json
   const std::string key = output::json_hash(same_swimmer(resolved));
   std::string dir = runs_dir + "/" + p.name + "-3d-" + key;
   Run3d r;
   r.h = p.h;
   r.length = p.L;
-  json summary = cached_run(runs_dir, dir, key);
+  json summary = finished_summary(dir);
+  if (summary.is_null())
+    for (const auto& e : fs::directory_iterator(runs_dir)) {
+      if (swimmer_key(e.path() / "scene.resolved.json", nullptr) != key) continue;
+      summary = finished_summary(e.path().string());
+      if (!summary.is_null()) {
+        dir = e.path().string();
+        break;
+      }
+    }
   *cached = !summary.is_null();
   // a run of this physics stopped part way (the suite was interrupted) continues from its
   // checkpoint when the checkpoint matches the scene
@@ -611,108 +556,6 @@ json load_suite(const std::string& path) {
   return s;
 }
 
-/// A case's scene file, its scene with the case's settings, its name and the scene key its
-/// grids set.
-struct CaseScene {
-  std::string path;
-  json base;
-  std::string name, grid_key;
-};
-CaseScene case_scene(const json& cs, const std::string& suite_dir, const std::string& data_dir) {
-  CaseScene c;
-  c.path = find_scene(cs["scene"], suite_dir, data_dir);
-  c.base = scene::load_file(c.path);
-  apply_sets(c.base, cs.value("set", json()));
-  c.name = c.base.value("name", fs::path(c.path).stem().string());
-  c.grid_key = cs.value("grid_key", std::string("full3d.grid.cells_across"));
-  return c;
-}
-
-// ---- the suite's 3D runs and calibrations, two at a time ------------------------------------
-//
-// On the 2-core machines the suite is made for, a 3D run on 2 threads is only 1.2-1.7 times as
-// fast as on 1 (docs/performance-3d.md), so two runs on one thread each get through the
-// suite's runs sooner. Before the report is assembled, every 3D run and calibration the
-// selected cases need goes into the cache this way, and the assembly then finds them there.
-// A case's finest grid writes membrane frames at an interval taken from the cycle of the grid
-// before it, so it waits for that run. This is a pure speed-up: a job that fails here is run
-// again, and its failure reported, by the assembly.
-
-struct AheadJob {
-  bool calibration = false;
-  json scene;         // full3d.threads set
-  std::string name;   // the case's name (calibration folders)
-  std::string label;  // progress
-  int after = -1;     // run whose cycle sets the membrane frame interval (-1: `frames`)
-  double frames = 0;  // membrane frame interval when after < 0 (0: no frames)
-  double cost = 0;    // grid cells x swimmer length / R0 x cycles: the larger first
-};
-
-/// Runs `jobs` on `workers` threads into the caches; returns the folders of the 3D runs it ran
-/// (not found in the cache).
-std::set<std::string> run_ahead(const std::vector<AheadJob>& jobs, const std::string& runs_dir,
-                                const std::string& cal_dir, int workers,
-                                const std::function<void(const std::string&)>& say) {
-  std::mutex m;
-  std::condition_variable cv;
-  std::vector<int> state(jobs.size(), 0);             // 0 waiting, 1 running, 2 done
-  std::vector<double> frames_of(jobs.size(), 0.0);    // cycle time / 12 of a run with a cycle
-  std::set<std::string> fresh;
-  std::size_t finished = 0;
-  auto worker = [&] {
-    std::unique_lock lock(m);
-    for (;;) {
-      int pick = -1;
-      bool blocked = false;
-      for (std::size_t i = 0; i < jobs.size(); ++i) {
-        if (state[i] != 0) continue;
-        if (jobs[i].after >= 0 && state[std::size_t(jobs[i].after)] != 2) {
-          blocked = true;
-          continue;
-        }
-        if (pick < 0 || jobs[i].cost > jobs[std::size_t(pick)].cost) pick = int(i);
-      }
-      if (pick < 0) {
-        if (!blocked) return;
-        cv.wait(lock);
-        continue;
-      }
-      const AheadJob& job = jobs[std::size_t(pick)];
-      state[std::size_t(pick)] = 1;
-      const double frames = job.after >= 0 ? frames_of[std::size_t(job.after)] : job.frames;
-      say("ahead, two at a time: " + job.label + " started");
-      lock.unlock();
-      double fr = 0;
-      std::string ran;
-      try {
-        if (job.calibration) {
-          std::string file;
-          calibration_of(job.scene, job.name, cal_dir, file, {});
-        } else {
-          bool cached = false;
-          const Run3d r = run_3d(job.scene, runs_dir, job.scene["full3d"]["threads"].get<int>(), &cached, frames);
-          if (r.cyc.has_cycle) fr = r.cyc.cycle_time_s / 12.0;
-          if (!cached) ran = r.record["folder"].get<std::string>();
-        }
-      } catch (const std::exception&) {
-        // run again by the assembly, which reports the failure
-      }
-      lock.lock();
-      state[std::size_t(pick)] = 2;
-      frames_of[std::size_t(pick)] = fr;
-      if (!ran.empty()) fresh.insert(ran);
-      ++finished;
-      say("ahead, two at a time: " + job.label + " done (" + std::to_string(finished) + "/" +
-          std::to_string(jobs.size()) + ")");
-      cv.notify_all();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (int w = 0; w < workers; ++w) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
-  return fresh;
-}
-
 json run_suite(const SuiteOptions& o) {
   const json suite = load_suite(o.suite);
   const std::string suite_dir = fs::path(o.suite).parent_path().string();
@@ -741,103 +584,14 @@ json run_suite(const SuiteOptions& o) {
   if (cases.empty())
     throw InputError("--case", o.only.empty() ? "" : o.only.front(), "the scene file name of a case of the suite");
   report["cases_selected"] = o.only;
-  const json& ex = suite.contains("extremes3d") && o.only.empty() ? suite["extremes3d"] : json::array();
-
-  // Every 3D run and calibration ahead of the assembly, two at a time (run_ahead).
-  std::set<std::string> fresh;
-  if (o.threads >= 2) {
-    const int per_run = std::max(1, o.threads / 2);
-    std::vector<AheadJob> jobs;
-    std::map<std::string, int> by_key;  // physics -> job, so that shared swimmers run once
-    // job index, -1 when the scene is rejected or found in the cache; *frames_cached: the
-    // frame interval a cached run gives the grid after it
-    auto add = [&](json s, bool calibration, const std::string& name, const std::string& label, int after,
-                   double frames, double* frames_cached) -> int {
-      set_key(s, "full3d.threads", per_run);
-      json resolved;
-      full3d::Params3d p;
-      try {
-        p = full3d::read_scene3d(s, resolved);
-      } catch (const std::exception&) {
-        return -1;  // the assembly reports it
-      }
-      const std::string swimmer = output::json_hash(same_swimmer(resolved));
-      const std::string key = (calibration ? "calibration " : "run ") + swimmer;
-      if (const auto it = by_key.find(key); it != by_key.end()) return it->second;
-      if (calibration) {
-        const std::string file =
-            cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat}) + "/calibration.json";
-        if (fs::exists(file) || !cached_calibration(cal_dir, same_swimmer(resolved)).empty()) return -1;
-      } else {
-        std::string dir = runs_dir + "/" + p.name + "-3d-" + swimmer;
-        const json summary = cached_run(runs_dir, dir, swimmer);
-        if (!summary.is_null()) {
-          if (frames_cached && summary.contains("cycle_time_s") && summary["cycle_time_s"].is_number())
-            *frames_cached = summary["cycle_time_s"].get<double>() / 12.0;
-          return -1;
-        }
-      }
-      AheadJob j;
-      j.calibration = calibration;
-      j.scene = std::move(s);
-      j.name = name;
-      j.label = label;
-      j.after = after;
-      j.frames = frames;
-      j.cost = double(p.nx) * p.ny * p.nz * (p.L / p.R0) * std::max(1, p.protocol.cycles) * (calibration ? 0.5 : 1.0);
-      jobs.push_back(std::move(j));
-      by_key[key] = int(jobs.size()) - 1;
-      return int(jobs.size()) - 1;
-    };
-    for (const json& cs : cases) {
-      const CaseScene sc = case_scene(cs, suite_dir, o.data_dir);
-      const json& grids = cs["grids"];
-      int prev = -1;
-      double prev_frames = 0;
-      for (std::size_t g = 0; g < grids.size(); ++g) {
-        json s = sc.base;
-        set_key(s, sc.grid_key, grids[g]);
-        const bool finest = g + 1 == grids.size() && g > 0;
-        double frames_cached = 0;
-        const int k = add(s, false, sc.name, sc.name + ", " + sc.grid_key + " = " + grids[g].dump(),
-                          finest ? prev : -1, finest && prev < 0 ? prev_frames : 0.0, &frames_cached);
-        prev = k;
-        prev_frames = frames_cached;
-      }
-      const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
-      json s = sc.base;
-      set_key(s, sc.grid_key, grids[cg]);
-      add(s, true, sc.name, sc.name + ", calibration", -1, 0.0, nullptr);
-      const json& variants = cs.contains("time_variants3d") ? cs["time_variants3d"] : json::array();
-      for (const json& v : variants) {
-        json sv = s;
-        apply_sets(sv, v.value("set", json()));
-        add(sv, false, sc.name, sc.name + ", " + v.value("label", std::string("time-step variant")), -1, 0.0, nullptr);
-      }
-    }
-    for (const json& e : ex) {
-      json s = scene::load_file(find_scene(e["scene"], suite_dir, o.data_dir));
-      apply_sets(s, e.value("set", json()));
-      add(s, false, "", "extremes: " + e["label"].get<std::string>(), -1, 0.0, nullptr);
-    }
-    if (jobs.size() >= 2) fresh = run_ahead(jobs, runs_dir, cal_dir, 2, say);
-  }
-  // a run made ahead is reported as made by this suite, not as found in the cache
-  auto run3 = [&](const json& s, double frames) {
-    bool cached = false;
-    Run3d r = run_3d(s, runs_dir, o.threads, &cached, frames);
-    if (cached && fresh.count(r.record["folder"].get<std::string>())) r.record["cached"] = false;
-    return r;
-  };
-
   for (std::size_t ci = 0; ci < cases.size(); ++ci) {
     const json& cs = cases[ci];
-    const CaseScene sc = case_scene(cs, suite_dir, o.data_dir);
-    const std::string& scene_path = sc.path;
+    const std::string scene_path = find_scene(cs["scene"], suite_dir, o.data_dir);
     const std::string scene_dir = fs::path(scene_path).parent_path().string();
-    const json& base = sc.base;
-    const std::string& name = sc.name;
-    const std::string& grid_key = sc.grid_key;
+    json base = scene::load_file(scene_path);
+    apply_sets(base, cs.value("set", json()));
+    const std::string name = base.value("name", fs::path(scene_path).stem().string());
+    const std::string grid_key = cs.value("grid_key", std::string("full3d.grid.cells_across"));
     const std::string tag = "case " + std::to_string(ci + 1) + "/" + std::to_string(cases.size()) + " (" + name + ")";
     // shipped scenes are named relative to the source tree, so that reports compare across machines
     const fs::path rel = fs::path(scene_path).lexically_relative(fs::path(o.data_dir).parent_path());
@@ -856,10 +610,11 @@ json run_suite(const SuiteOptions& o) {
       set_key(s, grid_key, grids[g]);
       say(tag + ": 3D grid " + std::to_string(g + 1) + "/" + std::to_string(grids.size()) + " (" + grid_key + " = " +
           grids[g].dump() + ")");
+      bool cached = false;
       // the finest grid writes membrane frames, about 12 per cycle of the grid before it
       double frames = 0;
       if (g + 1 == grids.size() && g > 0 && runs.back().cyc.has_cycle) frames = runs.back().cyc.cycle_time_s / 12.0;
-      Run3d r = run3(s, frames);
+      Run3d r = run_3d(s, runs_dir, o.threads, &cached, frames);
       cr["length_m"] = r.length;
       r.record["grid_value"] = grids[g];
       runs_j.push_back(r.record);
@@ -901,14 +656,44 @@ json run_suite(const SuiteOptions& o) {
 
     // 3. calibration at the chosen grid
     const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
-    std::string cal_file;
     json cal_j;
+    std::string cal_file;
     {
       json s = base;
       set_key(s, grid_key, grids[cg]);
-      set_key(s, "full3d.threads", o.threads);
-      cal_j = calibration_of(s, name, cal_dir, cal_file,
-                             [&] { say(tag + ": calibration at grid " + std::to_string(cg + 1)); });
+      set_key(s, "full3d.threads", o.threads);  // as the 3D runs; not part of the key
+      json resolved;
+      const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+      // keyed by the physics of the resolved scene and the calibration file's format version
+      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
+      cal_file = dir + "/calibration.json";
+      if (!fs::exists(cal_file)) {
+        const std::string found = cached_calibration(cal_dir, same_swimmer(resolved));
+        if (!found.empty()) cal_file = found;
+      }
+      if (fs::exists(cal_file)) {
+        std::ifstream in(cal_file);
+        cal_j = json::parse(in);
+      } else {
+        say(tag + ": calibration at grid " + std::to_string(cg + 1));
+        try {
+          const auto t0 = std::chrono::steady_clock::now();
+          const StaticCalibration c = calibrate_static(p, default_loads(p));
+          const HydraulicRadii hr = measure_hydraulic_radii(p);
+          cal_j = to_json(c, p, resolved);
+          json hj = to_json(hr);
+          hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
+          hj.erase("wall_time_s");
+          cal_j.update(hj);
+          cal_j.update(calibrate_towed(p, hr).json);
+          cal_j["wall_time_s"] = seconds_since(t0);
+          fs::create_directories(dir);
+          output::write_json(cal_file, cal_j);
+        } catch (const NumericalError& e) {
+          cal_j = {{"status", std::string("failed: ") + e.what()}};
+          cal_file.clear();
+        }
+      }
     }
     cr["calibration"] = {{"grid_index", cg}, {"grid_value", grids[cg]}, {"file", cal_file}};
     for (const char* k : {"C1_Pa_per_m", "C1_stderr_Pa_per_m", "C1_spring_network_Pa_per_m", "hydraulic_offset_inner_m",
@@ -1028,7 +813,8 @@ json run_suite(const SuiteOptions& o) {
         const std::string label = variants[v].value("label", "variant " + std::to_string(v + 1));
         say(tag + ": 3D time-step variant " + std::to_string(v + 1) + "/" + std::to_string(variants.size()) + " (" +
             label + ")");
-        const Run3d r = run3(s, 0.0);
+        bool cached = false;
+        const Run3d r = run_3d(s, runs_dir, o.threads, &cached);
         if (r.cyc.has_cycle) point("3d", "time step", label, r.wall, r.cyc.displacement_per_cycle_m);
         else  // a step beyond the stability limit: the outcome is reported, not a point
           trade.push_back({{"tier", "3d"}, {"axis", "time step"}, {"resolution", label}, {"wall_time_s", r.wall},
@@ -1049,6 +835,7 @@ json run_suite(const SuiteOptions& o) {
 
   // 3D at the extremes: each case's outcome against the one the suite states for it
   json extremes = json::array();
+  const json& ex = suite.contains("extremes3d") && o.only.empty() ? suite["extremes3d"] : json::array();
   for (std::size_t k = 0; k < ex.size(); ++k) {
     const json& e = ex[k];
     json s = scene::load_file(find_scene(e["scene"], suite_dir, o.data_dir));
@@ -1059,7 +846,8 @@ json run_suite(const SuiteOptions& o) {
                   {"expected", e["expect"]}, {"expected_cause", e.value("cause", std::string())}};
     std::string kind, text;
     try {
-      const Run3d r = run3(s, 0.0);
+      bool cached = false;
+      const Run3d r = run_3d(s, runs_dir, o.threads, &cached);
       const std::string status = r.record.value("status", std::string("unknown"));
       kind = status == "ok" ? "ok" : "failed";
       text = status;

@@ -1,7 +1,6 @@
 // The quick validation suite end to end (swim validate --quick, without the figures): three
 // coarse 3D grids of the small duct scene, the calibration, every 1D model, the report; the
-// runs made ahead two at a time; the cache of runs (other output settings, an older
-// resolution, an interrupted run).
+// cache of runs (other output settings, an older resolution, an interrupted run).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -87,34 +86,6 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   for (const auto& e : r["extremes3d"]) EXPECT_TRUE(e["as_expected"].get<bool>()) << e.dump();
   EXPECT_EQ(r["extremes3d"][2]["outcome"], "rejected");
 
-  // With two threads the suite makes its 3D runs and calibrations ahead of the report, two at
-  // a time on one thread each: the same runs as the one-thread suite, bit for bit, reported as
-  // made by this suite; the finest grid waits for the grid before it and writes its frames.
-  {
-    validation::SuiteOptions o2 = o;
-    o2.out_dir = out + "-two";
-    fs::remove_all(o2.out_dir);
-    fs::create_directories(o2.out_dir);
-    o2.threads = 2;
-    const scene::json two = validation::run_suite(o2);
-    const scene::json& t = two["cases"][0];
-    ASSERT_EQ(t["runs3d"].size(), 3u);
-    for (std::size_t g = 0; g < 3; ++g) {
-      EXPECT_FALSE(t["runs3d"][g]["cached"].get<bool>()) << g;
-      EXPECT_EQ(t["runs3d"][g]["steps"], c["runs3d"][g]["steps"]) << g;
-      EXPECT_EQ(t["runs3d"][g]["displacement_per_cycle_m"], c["runs3d"][g]["displacement_per_cycle_m"]) << g;
-      EXPECT_EQ(t["runs3d"][g]["cycle_time_s"], c["runs3d"][g]["cycle_time_s"]) << g;
-    }
-    EXPECT_TRUE(t["runs3d"][2]["membrane_frames"].get<bool>());
-    EXPECT_EQ(t["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
-    EXPECT_EQ(t["calibration"]["hydraulic_offset_inner_m"], cal["hydraulic_offset_inner_m"]);
-    ASSERT_EQ(two["extremes3d"].size(), r["extremes3d"].size());
-    for (std::size_t k = 0; k < r["extremes3d"].size(); ++k) {
-      EXPECT_EQ(two["extremes3d"][k]["outcome"], r["extremes3d"][k]["outcome"]) << k;
-      EXPECT_EQ(two["extremes3d"][k]["message"], r["extremes3d"][k]["message"]) << k;
-    }
-  }
-
   // a second run reuses every 3D run and the calibration, with identical figures
   const scene::json r2 = validation::run_suite(o);
   const scene::json& c2 = r2["cases"][0];
@@ -171,4 +142,3 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   EXPECT_EQ(c4["runs3d"][1]["folder"], c["runs3d"][1]["folder"].get<std::string>() + "-older");
   EXPECT_EQ(c4["runs3d"][1]["displacement_per_cycle_m"], c["runs3d"][1]["displacement_per_cycle_m"]);
 }
-
