@@ -617,7 +617,7 @@ struct ForceModel {
   // the field psi_j = -D2 / ((s_j h)^2 - D2) V of docs/outer-flow-1d.md) and D2 the cell
   // second difference with mirror ends (a uniform wall velocity has no short-wave traction).
   // phi_j rather than psi_j: its row reaches V of its own cell only, which keeps the band
-  // of the Newton matrix at stride + 2 below the diagonal instead of 2 stride.
+  // of the Newton matrix at stride + 2 below the diagonal instead of 2 stride - 2.
   int res(const double* y, const double* yp, double* F) {
     if (!unpack(y)) return 1;
     want_velocity = false;  // with the velocity quadrature U is integrated along the steps
