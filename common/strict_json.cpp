@@ -95,8 +95,15 @@ class Builder {
   std::string where() const {
     std::string p;
     for (const auto& f : stack_) {
-      if (f.node->is_object() && !f.key.empty()) p += (p.empty() ? "" : ".") + f.key;
-      if (f.node->is_array()) p += "[" + std::to_string(f.node->size()) + "]";
+      if (f.node->is_object() && !f.key.empty()) {
+        if (!p.empty()) p += '.';
+        p += f.key;
+      }
+      if (f.node->is_array()) {
+        p += '[';
+        p += std::to_string(f.node->size());
+        p += ']';
+      }
     }
     return p.empty() ? what_ : p;
   }

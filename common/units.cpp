@@ -73,7 +73,7 @@ std::pair<double, std::string> split_strict(const std::string& key, const std::s
     mantissa += digits();
   }
   if (mantissa == 0) throw InputError(key, quoted, "no number; expected " + allowed);
-  if (i < t.size() && (t[i] == 'x' || t[i] == 'X') && i == 1 + (t[0] == '+' || t[0] == '-'))
+  if (i < t.size() && (t[i] == 'x' || t[i] == 'X') && i == std::size_t(1 + (t[0] == '+' || t[0] == '-')))
     throw InputError(key, quoted, "hexadecimal numbers are not accepted; expected " + allowed);
   if (i < t.size() && (t[i] == 'e' || t[i] == 'E')) {
     size_t j = i + 1;

@@ -469,11 +469,11 @@ struct ForceModel {
   }
 
   /// Exact Jacobian of rhs() at y (after rhs-equivalent unpack/fluxes): the band part into
-  /// `band(i, j, v)` (|i - j| <= 1) and the rank-1 segment terms into U/V (column-major n x
+  /// `band(i, j, v)` (|i - j| <= 1) and the rank-1 segment terms into Ul/Vt (column-major n x
   /// rank, returns the rank). Entries of D and X with respect to the radii are outside the band
   /// and left out (they do not feed back into the areas).
   template <class Band>
-  int jacobian(const double* y, Band band, std::vector<double>& U, std::vector<double>& Vt) {
+  int jacobian(const double* y, Band band, std::vector<double>& Ul, std::vector<double>& Vt) {
     unpack(y);
     want_velocity = false;
     fluxes(true);
@@ -524,7 +524,7 @@ struct ForceModel {
     }
     // rank-1 terms: d f / d qs_k (per unit segment actuation) times d qs_k / d a
     int rank = 0;
-    U.clear();
+    Ul.clear();
     Vt.clear();
     std::vector<double>& dQ = dQ_;
     dQ.resize(N + 1);
@@ -546,12 +546,12 @@ struct ForceModel {
       }
       if (end0_seg && seg_a[0] == k) dQ[0] += s.Qb0 * (-1.0 / C1);
       if (endL_seg && seg_a[N - 1] == k) dQ[N] += s.QbL * (-1.0 / C1);
-      const std::size_t off = U.size();
-      U.resize(off + n, 0.0);
+      const std::size_t off = Ul.size();
+      Ul.resize(off + n, 0.0);
       Vt.resize(off + n, 0.0);
-      for (int i = std::max(lo - 1, 0); i <= std::min(hi + 1, N - 1); ++i) U[off + 1 + i] = c * (dQ[i] - dQ[i + 1]);
-      U[off + iVr] = dQ[0] / V_s;
-      U[off + iVf] = dQ[N] / V_s;
+      for (int i = std::max(lo - 1, 0); i <= std::min(hi + 1, N - 1); ++i) Ul[off + 1 + i] = c * (dQ[i] - dQ[i + 1]);
+      Ul[off + iVr] = dQ[0] / V_s;
+      Ul[off + iVf] = dQ[N] / V_s;
       for (int i = lo; i <= hi; ++i) Vt[off + 1 + i] = dqs[k] * u(i) / seg_w[k] * 0.5 * R0 * R0 / R[i];
       if (confined) {  // the segment load also moves W and U: d(W, U)/dqs_k = -G^{-1} dg/dqs_k
         double g1 = 0, g2 = 0;
@@ -568,11 +568,11 @@ struct ForceModel {
     if (confined) {
       // Two rank-1 terms df/dW (dW/dy)^T + df/dU (dU/dy)^T; dW/dy and dU/dy are the direct
       // dependence on every radius plus the segment chains d(W, U)/dqs_k times the segment rows.
-      const std::size_t off = U.size();
-      U.resize(off + 2 * std::size_t(n), 0.0);
+      const std::size_t off = Ul.size();
+      Ul.resize(off + 2 * std::size_t(n), 0.0);
       Vt.resize(off + 2 * std::size_t(n), 0.0);
-      std::copy(fq_.begin(), fq_.end(), U.begin() + off);
-      std::copy(fu_.begin(), fu_.end(), U.begin() + off + n);
+      std::copy(fq_.begin(), fq_.end(), Ul.begin() + off);
+      std::copy(fu_.begin(), fu_.end(), Ul.begin() + off + n);
       for (int i = 0; i < N; ++i) {
         const double dRda = 0.5 * R0 * R0 / R[i];
         const double g1 = (s.g1b[i] + s.g1a[i + 1] + dg1pi_[i] * (C1 + dq[i])) * dRda;
@@ -710,7 +710,7 @@ struct ForceModel {
   /// quotients with the segment actuation, the end radii and the confined closure (W, U)
   /// frozen): one per held segment, and with the confined outer flow the two closure terms
   /// dF/dW (dW/dy)^T + dF/dU (dU/dy)^T, d(W, U)/dy = -G^{-1} dg/dy. Same layout as jacobian().
-  int residual_low_rank(const double* y, std::vector<double>& U, std::vector<double>& Vt) {
+  int residual_low_rank(const double* y, std::vector<double>& Ul, std::vector<double>& Vt) {
     unpack(y);
     want_velocity = false;
     fluxes(true);
@@ -726,32 +726,32 @@ struct ForceModel {
       Gi[0][0] = G[1][1] / det, Gi[0][1] = -G[0][1] / det, Gi[1][0] = -G[1][0] / det, Gi[1][1] = G[0][0] / det;
     }
     int rank = 0;
-    U.clear();
+    Ul.clear();
     Vt.clear();
     for (int k = 0; k < nseg; ++k) {
       if (!seg_law[k] || dqs[k] == 0.0) continue;
-      const std::size_t off = U.size();
-      U.resize(off + n, 0.0);
+      const std::size_t off = Ul.size();
+      Ul.resize(off + n, 0.0);
       Vt.resize(off + n, 0.0);
       const int lo = seg_first[k], hi = seg_last[k];
       for (int i = lo; i <= hi; ++i) {
         double u = 0;
         if (seg_a[i] == k) u += frac[i];
         if (seg_b[i] == k && seg_b[i] != seg_a[i]) u += 1.0 - frac[i];
-        U[off + 1 + S * i + 1] = cv * u;  // F_V = [V'] + cv (C1 (R - R0) + q + T - p)
+        Ul[off + 1 + S * i + 1] = cv * u;  // F_V = [V'] + cv (C1 (R - R0) + q + T - p)
         Vt[off + 1 + S * i] = dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
       }
       double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii
       if (endL_seg && seg_a[N - 1] == k) {  // Q_N depends on RbL = R0 - qs/C1
         const double dQN = s.QbL * (-1.0 / C1);
-        U[off + 1 + S * (N - 1) + 2] += cp * dQN / h;
-        U[off + iVf] += -dQN / V_s;
+        Ul[off + 1 + S * (N - 1) + 2] += cp * dQN / h;
+        Ul[off + iVf] += -dQN / V_s;
         if (confined) g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
       }
       if (end0_seg && seg_a[0] == k) {
         const double dQ0 = s.Qb0 * (-1.0 / C1);
-        U[off + 1 + 2] += -cp * dQ0 / h;
-        U[off + iVr] += -dQ0 / V_s;
+        Ul[off + 1 + 2] += -cp * dQ0 / h;
+        Ul[off + iVr] += -dQ0 / V_s;
         if (confined) g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
       }
       if (confined && (g1 != 0.0 || g2 != 0.0))
@@ -760,11 +760,11 @@ struct ForceModel {
     }
     if (confined) {
       // Q_in,j = alpha_j W + beta_j U - gamma_j (outer::ConfinedSystem::transmural)
-      const std::size_t off = U.size();
-      U.resize(off + 2 * std::size_t(n), 0.0);
+      const std::size_t off = Ul.size();
+      Ul.resize(off + 2 * std::size_t(n), 0.0);
       Vt.resize(off + 2 * std::size_t(n), 0.0);
-      double* fw = U.data() + off;
-      double* fu = U.data() + off + n;
+      double* fw = Ul.data() + off;
+      double* fu = Ul.data() + off + n;
       auto al = [&](int j) { return sys->k[j].ra * sys->w[j]; };
       auto be = [&](int j) { return (sys->k[j].c - sys->A_c * sys->k[j].ra) * sys->w[j]; };
       for (int i = 0; i < N; ++i) {

@@ -131,5 +131,7 @@ TEST(SwimRun3d, ACheckpointWriteFailureIsExitThreeNamingTheFile) {
   for (const auto& e : fs::recursive_directory_iterator(d))
     EXPECT_EQ(e.path().filename().string().find(".tmp"), std::string::npos) << e.path();
   std::ifstream in(d + "/summary.json");
-  if (in) EXPECT_EQ(nlohmann::json::parse(in)["status"].get<std::string>().rfind("failed: ", 0), 0u);
+  if (in) {
+    EXPECT_EQ(nlohmann::json::parse(in)["status"].get<std::string>().rfind("failed: ", 0), 0u);
+  }
 }
