@@ -28,13 +28,17 @@ namespace {
 const char* kLock = ".swim.lock";
 const char* kOwner = ".swim-run.json";
 
+// At most `limit` bytes of a file, read in chunks (the string grows with what the file holds,
+// not with the limit: a run folder is opened before every run).
 std::string read_text(const fs::path& p, std::size_t limit = 1 << 20) {
   std::ifstream in(p, std::ios::binary);
   std::string s;
   if (!in) return s;
-  s.resize(limit);
-  in.read(s.data(), static_cast<std::streamsize>(limit));
-  s.resize(static_cast<std::size_t>(in.gcount()));
+  char chunk[1 << 16];
+  while (s.size() < limit && in) {
+    in.read(chunk, static_cast<std::streamsize>(std::min(sizeof chunk, limit - s.size())));
+    s.append(chunk, static_cast<std::size_t>(in.gcount()));
+  }
   return s;
 }
 
