@@ -28,26 +28,23 @@ namespace {
 const char* kLock = ".swim.lock";
 const char* kOwner = ".swim-run.json";
 
-// At most `limit` bytes of a file, read in chunks (the string grows with what the file holds,
-// not with the limit: a run folder is opened before every run).
-std::string read_text(const fs::path& p, std::size_t limit = 1 << 20) {
+// At most `limit` bytes of a small file (the lock's PID).
+std::string read_text(const fs::path& p, std::size_t limit) {
   std::ifstream in(p, std::ios::binary);
-  std::string s;
-  if (!in) return s;
-  char chunk[1 << 16];
-  while (s.size() < limit && in) {
-    in.read(chunk, static_cast<std::streamsize>(std::min(sizeof chunk, limit - s.size())));
-    s.append(chunk, static_cast<std::size_t>(in.gcount()));
-  }
+  std::string s(limit, '\0');
+  if (!in) return {};
+  in.read(s.data(), static_cast<std::streamsize>(limit));
+  s.resize(static_cast<std::size_t>(in.gcount()));
   return s;
 }
 
-// A JSON file of the folder, or null when absent or unreadable.
+// A JSON file of the folder, or null when absent or unreadable (read to its own size, not
+// into a buffer of the size limit: a run folder is opened before every run).
 scene::json read_json(const fs::path& p) {
   try {
     std::error_code ec;
     if (!fs::is_regular_file(p, ec)) return nullptr;
-    return strict_json::parse(read_text(p, 64u << 20), p.filename().string());
+    return strict_json::parse_file(p.string(), p.filename().string());
   } catch (const std::exception&) {
     return nullptr;
   }

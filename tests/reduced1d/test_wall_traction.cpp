@@ -165,8 +165,8 @@ TEST(WallTraction, ErrorTestOnTheDifferentialUnknownsKeepsTheCycleAtFewerSteps) 
   // U(t) between the steps comes from IDA's interpolation of the algebraic unknowns, which
   // are outside the error test: over the cycle its samples stay within 1e-3 (rms) and 1e-2
   // (largest, a sample just after a protocol event) of max |U| of the reference run
-  // (measured 2.0e-4 and 1.6e-3).
-  // (the samples on the output grid; the two runs' event samples fall at slightly different times)
+  // (measured 2.0e-4 and 1.6e-3), compared on the output grid (the two runs' event samples
+  // fall at slightly different times).
   double u_max = 0.0, sq = 0.0, err_max = 0.0;
   std::size_t n = 0;
   for (std::size_t i = 0, j = 0; i < s.size() && j < s_ref.size();) {
