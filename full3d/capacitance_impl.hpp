@@ -59,8 +59,9 @@ struct CapacitanceStokes::Impl {
   // real: rows x nx (x fastest); planes: nx halfcomplex planes of the cross-section,
   // plane r holding Re (r <= nx/2) or Im (r > nx/2) of axial mode min(r, nx - r).
   FftwBuffer real, planes;
-  std::vector<FftwPlan> xfwd, xbwd;  // per thread block of rows
-  std::vector<FftwPlan> xbwd_u;      // the same without the pressure rows (CapacitanceStokes::compute_pressure)
+  std::vector<FftwPlan> xfwd;                      // per thread block of rows
+  std::array<std::vector<FftwPlan>, 4> xbwd;       // per component (u, v, w, p) and thread block
+  std::array<std::vector<std::pair<long, long>>, 4> xbwd_rows;  // the rows [b, e) of each
   bool pressure_wanted = true;
   std::array<FftwPlan, 3> yz_fwd;    // u, v, w (planned on plane 0)
   std::array<FftwPlan, 4> yz_inv;    // u, v, w, p

@@ -63,8 +63,18 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
     }
   };
   plan_x(off[3], true, xfwd);
-  plan_x(off[4], false, xbwd);
-  plan_x(off[3], false, xbwd_u);
+  // the inverse per component and thread block, executed straight into the output arrays
+  for (int c = 0; c < 4; ++c) {
+    const int rows = off[c + 1] - off[c], T = block_count(rows, threads);
+    for (int t = 0; t < T; ++t) {
+      const long b = off[c] + long(rows) * t / T, e = off[c] + long(rows) * (t + 1) / T;
+      const int n[1] = {nx};
+      const fftw_r2r_kind k = FFTW_HC2R;
+      xbwd[c].push_back(plan_many_r2r(1, n, int(e - b), planes.data() + b, nullptr, int(P), 1,
+                                      real.data() + std::size_t(b) * nx, nullptr, 1, nx, &k, fft));
+      xbwd_rows[c].push_back({b, e});
+    }
+  }
 
   // 2D cross-section transforms of one plane (new-array execution on every plane)
   double* p0 = planes.data();
@@ -376,13 +386,23 @@ void CapacitanceStokes::Impl::solve(const VectorField* un, double beta, const Ve
     for (long kx = kb; kx < ke; ++kx) solve_mode(int(kx), fac, alpha, scratch[t]);
   });
   const bool with_p = pressure_wanted;
-  parallel_blocks(with_p ? off[4] : off[3], threads, [&](long rb, long re, int t) {
-    (with_p ? xbwd : xbwd_u)[t].execute();
-    rows_of(rb, re, [&](int c, long lo, long hi) {
-      double* dst = c < 3 ? u.c[c].data() : p.v.data();
-      std::memcpy(dst + std::size_t(lo - off[c]) * nx, real.data() + std::size_t(lo) * nx,
-                  sizeof(double) * std::size_t(hi - lo) * nx);
-    });
+  // Inverse along x from the planes into the output rows (u, v, w, and p when wanted); into
+  // the transform rows and copied when an output array is not aligned like them (FFTW's
+  // new-array execution keeps the planned alignment).
+  parallel_blocks(threads, threads, [&](long tb, long te, int) {
+    for (long t = tb; t < te; ++t)
+      for (int c = 0; c < (with_p ? 4 : 3); ++c) {
+        if (t >= long(xbwd[c].size())) continue;
+        const auto [b, e] = xbwd_rows[c][std::size_t(t)];
+        double* rows = real.data() + std::size_t(b) * nx;
+        double* dst = (c < 3 ? u.c[c].data() : p.v.data()) + std::size_t(b - off[c]) * nx;
+        if (fftw_alignment_of(dst) == fftw_alignment_of(rows)) {
+          xbwd[c][std::size_t(t)].execute_r2r(planes.data() + b, dst);
+        } else {
+          xbwd[c][std::size_t(t)].execute();
+          std::memcpy(dst, rows, sizeof(double) * std::size_t(e - b) * nx);
+        }
+      }
   });
   // Sums and maxima below: per static block, combined in block order (reproducible for a
   // given thread count, parallel.hpp).

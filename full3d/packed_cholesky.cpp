@@ -3,8 +3,6 @@
 extern "C" {
 // LAPACK, Fortran interface (the hidden length of the one-character UPLO argument last)
 void dpptrf_(const char* uplo, const int* n, double* ap, int* info, std::size_t uplo_len);
-void dpptrs_(const char* uplo, const int* n, const int* nrhs, const double* ap, double* b, const int* ldb, int* info,
-             std::size_t uplo_len);
 }
 
 namespace swim::full3d {
@@ -23,11 +21,59 @@ PackedCholesky::PackedCholesky(std::vector<double> packed_lower, int n) : l_(std
   if (info != 0) throw LapackError("dpptrf", info);
 }
 
+// The substitutions run over the packed factor once for a pair of right-hand sides (the two
+// planes of a paired axial mode share one factor): forward L y = b by columns (an axpy per
+// column, as dtpsv), backward L^T x = y by dot products over the same columns, each summed
+// in four interleaved partial sums. Reference dpptrs makes one pass over the factor per
+// right-hand side and direction, and the factors of a capacitance solve (megabytes) do not
+// stay in cache between passes.
+namespace {
+template <int R>
+void substitute(const double* l, int n, double* const* b) {
+  const double* col = l;
+  for (int j = 0; j < n; ++j) {  // forward: L y = b
+    const int len = n - j;
+    double y[R];
+    for (int r = 0; r < R; ++r) y[r] = (b[r][j] /= col[0]);
+    for (int r = 0; r < R; ++r) {
+      double* x = b[r] + j;
+      const double yr = y[r];
+      for (int i = 1; i < len; ++i) x[i] -= col[i] * yr;
+    }
+    col += len;
+  }
+  for (int j = n - 1; j >= 0; --j) {  // backward: L^T x = y
+    const int len = n - j;
+    col -= len;
+    for (int r = 0; r < R; ++r) {
+      const double* x = b[r] + j;
+      double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+      int i = 1;
+      for (; i + 3 < len; i += 4) {
+        s0 += col[i] * x[i];
+        s1 += col[i + 1] * x[i + 1];
+        s2 += col[i + 2] * x[i + 2];
+        s3 += col[i + 3] * x[i + 3];
+      }
+      for (; i < len; ++i) s0 += col[i] * x[i];
+      b[r][j] = (b[r][j] - ((s0 + s1) + (s2 + s3))) / col[0];
+    }
+  }
+}
+}  // namespace
+
 void PackedCholesky::solve(double* b, int nrhs, int ldb) const {
-  if (n_ == 0 || nrhs == 0) return;
-  int info = 0;
-  dpptrs_("L", &n_, &nrhs, l_.data(), b, &ldb, &info, 1);
-  if (info != 0) throw LapackError("dpptrs", info);
+  if (n_ == 0 || nrhs <= 0) return;
+  if (ldb < n_) throw std::invalid_argument("PackedCholesky::solve: leading dimension below the order");
+  int q = 0;
+  for (; q + 1 < nrhs; q += 2) {
+    double* const pair[2] = {b + std::size_t(q) * ldb, b + std::size_t(q + 1) * ldb};
+    substitute<2>(l_.data(), n_, pair);
+  }
+  if (q < nrhs) {
+    double* const one[1] = {b + std::size_t(q) * ldb};
+    substitute<1>(l_.data(), n_, one);
+  }
 }
 
 }  // namespace swim::full3d

@@ -1,7 +1,8 @@
-// Dense symmetric positive definite solves with LAPACK (Debian liblapack-dev): the
-// Cholesky factor L of a matrix of order n in packed lower storage (column j holds
-// L(j..n-1, j), columns concatenated: n (n + 1) / 2 doubles), dpptrf / dpptrs. The one
-// place where LAPACK info codes become exceptions.
+// Dense symmetric positive definite solves: the Cholesky factor L of a matrix of order n in
+// packed lower storage (column j holds L(j..n-1, j), columns concatenated: n (n + 1) / 2
+// doubles), factorised by LAPACK dpptrf (Debian liblapack-dev); the substitutions make one
+// pass over the factor per pair of right-hand sides (dpptrs makes one per right-hand side).
+// The one place where LAPACK info codes become exceptions.
 #pragma once
 
 #include <cstddef>
@@ -33,7 +34,8 @@ class PackedCholesky {
   /// Factorises (dpptrf) the symmetric positive definite matrix of order n whose lower
   /// triangle is given packed. Throws LapackError (info > 0: not positive definite).
   PackedCholesky(std::vector<double> packed_lower, int n);
-  /// In place: the nrhs columns of b (leading dimension ldb >= n) become A^{-1} b (dpptrs).
+  /// In place: the nrhs columns of b (leading dimension ldb >= n) become A^{-1} b (forward
+  /// and backward substitution, two columns per pass over the factor).
   void solve(double* b, int nrhs, int ldb) const;
   int order() const { return n_; }
   std::size_t bytes() const { return l_.size() * sizeof(double); }
