@@ -1,5 +1,7 @@
 #include "full3d/packed_cholesky.hpp"
 
+#include "common/dot.hpp"
+
 extern "C" {
 // LAPACK, Fortran interface (the hidden length of the one-character UPLO argument last)
 void dpptrf_(const char* uplo, const int* n, double* ap, int* info, std::size_t uplo_len);
@@ -23,10 +25,10 @@ PackedCholesky::PackedCholesky(std::vector<double> packed_lower, int n) : l_(std
 
 // The substitutions run over the packed factor once for a pair of right-hand sides (the two
 // planes of a paired axial mode share one factor): forward L y = b by columns (an axpy per
-// column, as dtpsv), backward L^T x = y by dot products over the same columns, each summed
-// in four interleaved partial sums. Reference dpptrs makes one pass over the factor per
-// right-hand side and direction, and the factors of a capacitance solve (megabytes) do not
-// stay in cache between passes.
+// column, as dtpsv), backward L^T x = y by dot products over the same columns (dot4, while
+// the column is in cache). Reference dpptrs makes one pass over the factor per right-hand
+// side and direction, and the factors of a capacitance solve (megabytes) do not stay in
+// cache between passes.
 namespace {
 template <int R>
 void substitute(const double* l, int n, double* const* b) {
@@ -45,19 +47,7 @@ void substitute(const double* l, int n, double* const* b) {
   for (int j = n - 1; j >= 0; --j) {  // backward: L^T x = y
     const int len = n - j;
     col -= len;
-    for (int r = 0; r < R; ++r) {
-      const double* x = b[r] + j;
-      double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-      int i = 1;
-      for (; i + 3 < len; i += 4) {
-        s0 += col[i] * x[i];
-        s1 += col[i + 1] * x[i + 1];
-        s2 += col[i + 2] * x[i + 2];
-        s3 += col[i + 3] * x[i + 3];
-      }
-      for (; i < len; ++i) s0 += col[i] * x[i];
-      b[r][j] = (b[r][j] - ((s0 + s1) + (s2 + s3))) / col[0];
-    }
+    for (int r = 0; r < R; ++r) b[r][j] = (b[r][j] - dot4(col + 1, b[r] + j + 1, len - 1)) / col[0];
   }
 }
 }  // namespace

@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include "common/dot.hpp"
+
 namespace swim::reduced1d::sun {
 
 namespace {
@@ -410,20 +412,6 @@ void small_solve(const std::vector<double>& a, const std::vector<int>& piv, int 
   }
 }
 
-// Dot product with four partial sums (the single-accumulator loop is latency bound).
-double dot4(const double* a, const double* b, long n) {
-  double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-  long i = 0;
-  for (; i + 3 < n; i += 4) {
-    s0 += a[i] * b[i];
-    s1 += a[i + 1] * b[i + 1];
-    s2 += a[i + 2] * b[i + 2];
-    s3 += a[i + 3] * b[i + 3];
-  }
-  for (; i < n; ++i) s0 += a[i] * b[i];
-  return (s0 + s1) + (s2 + s3);
-}
-
 int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   LowRankContent* c = lr(S);
   c->lu.load(A);
@@ -446,11 +434,11 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
     for (int pass = 0; pass < 2; ++pass)
       for (int j = 0; j < k; ++j) {
         const double* qj = Q.data() + n * j;
-        const double d = dot4(qj, qk, n);
+        const double d = swim::dot4(qj, qk, n);
         c->R[std::size_t(k) * r + j] += d;
         for (long i = 0; i < n; ++i) qk[i] -= d * qj[i];
       }
-    const double nrm = std::sqrt(dot4(qk, qk, n));
+    const double nrm = std::sqrt(swim::dot4(qk, qk, n));
     c->R[std::size_t(k) * r + k] = nrm;
     if (nrm > 0) {
       const double inv = 1.0 / nrm;
