@@ -253,6 +253,9 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   // resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
   // with 1 and 2 threads.
   std::printf("== 3D tier ==\n");
+  std::printf("  (per step, ms; bare: the project's pressure-correction FFT solve; floor: 8 raw FFTW transforms\n"
+              "   of the duct's kind, sine/cosine-II across; mac: the same with the staggered grid's own kinds,\n"
+              "   sine-I of the interior faces for v and w; FFTW_MEASURE, same grid and threads)\n");
   std::printf("  %-14s %7s %3s %9s %9s %9s %9s %9s %9s %9s %7s %7s %9s %7s\n", "grid", "nodes", "thr", "step[ms]",
               "fluid", "spread", "interp", "forces", "bare[ms]", "floor[ms]", "st/bare", "st/flr", "mac[ms]", "st/mac");
   scene::json grids = scene::json::array();
