@@ -10,6 +10,7 @@
 #include <string>
 #include <thread>
 #include <utility>
+#include <array>
 #include <vector>
 
 #include "app/app.hpp"
@@ -58,68 +59,28 @@ reduced1d::Params demo_params(const std::vector<std::string>& sets) {
   return reduced1d::read_scene(sc, resolved, data_dir() + "/scenes");
 }
 
-/// The physical floor of one coupled step on an nx x ny x nz grid of the duct's kind (the
-/// cylinder lives inside the same duct grid): 8 transforms (3 velocity components and the
-/// pressure, forward and inverse), each a batched 2D sine / cosine transform over the cross
-/// sections (RODFT10/01 for the velocities, REDFT10/01 for the pressure) and a batched 1D
-/// real transform along x, in a plain C-order layout (x outermost), FFTW_MEASURE, `threads`
-/// FFTW threads. Best of `reps` repetitions, s per step.
-double fft_floor(int nx, int ny, int nz, int threads, int reps) {
-  using namespace swim::full3d;
-  if (threads > 1) fftw_threads_init_once();
-  const FftOptions o{threads, PlanRigor::Measure};
-  const int nxh = nx / 2 + 1, plane = ny * nz;
-  FftwBuffer a(std::size_t(nx) * plane), c(std::size_t(2) * nxh * plane);
-  const int n2[2] = {nz, ny};
-  const fftw_r2r_kind sin_f[2] = {FFTW_RODFT10, FFTW_RODFT10}, sin_b[2] = {FFTW_RODFT01, FFTW_RODFT01};
-  const fftw_r2r_kind cos_f[2] = {FFTW_REDFT10, FFTW_REDFT10}, cos_b[2] = {FFTW_REDFT01, FFTW_REDFT01};
-  FftwPlan yz[4] = {plan_many_r2r(2, n2, nx, a.data(), nullptr, 1, plane, a.data(), nullptr, 1, plane, sin_f, o),
-                    plan_many_r2r(2, n2, nx, a.data(), nullptr, 1, plane, a.data(), nullptr, 1, plane, sin_b, o),
-                    plan_many_r2r(2, n2, nx, a.data(), nullptr, 1, plane, a.data(), nullptr, 1, plane, cos_f, o),
-                    plan_many_r2r(2, n2, nx, a.data(), nullptr, 1, plane, a.data(), nullptr, 1, plane, cos_b, o)};
-  FftwPlan fx = plan_many_r2c_1d(nx, plane, a.data(), plane, 1, c.complex(), plane, 1, o);
-  FftwPlan bx = plan_many_c2r_1d(nx, plane, c.complex(), plane, 1, a.data(), plane, 1, o);
-  for (std::size_t i = 0; i < a.size(); ++i) a[i] = std::sin(0.37 * double(i));
-  double best = 1e300;
-  for (int r = 0; r < reps; ++r) {
-    const auto t0 = std::chrono::steady_clock::now();
-    for (int comp = 0; comp < 4; ++comp) {
-      const int k = comp < 3 ? 0 : 2;
-      yz[k].execute();  // forward: cross sections, then along x
-      fx.execute();
-      bx.execute();     // inverse: along x, then cross sections
-      yz[k + 1].execute();
-    }
-    best = std::min(best, seconds_since(t0));
-  }
-  return best;
-}
+/// One field of an FFTW floor: the {z, y} extents of its transformed cross-section and the
+/// forward and inverse r2r kinds across.
+struct FloorField {
+  std::array<int, 2> n;
+  std::array<fftw_r2r_kind, 2> fwd, inv;
+};
 
-/// The same floor with the transforms the staggered grid itself needs: the face components
-/// normal to a wall vanish on it, so across that direction v and w are DST-I (RODFT00) of the
-/// n - 1 interior faces, u and p DCT-II/III (REDFT10/01) of the n cells, as in the
-/// production solver; 8 transforms, layout, planning and timing as fft_floor. DST-I costs
-/// FFTW about twice a DCT-II of the same length per point, so this floor is the higher one.
-double fft_floor_mac(int nx, int ny, int nz, int threads, int reps) {
+/// 8 transforms, each field forward and inverse: a batched 2D transform over the cross
+/// sections and a batched 1D real transform along x, in a plain C-order layout (x
+/// outermost), FFTW_MEASURE, `threads` FFTW threads. Best of `reps` repetitions, s per step.
+double time_floor(int nx, const std::array<FloorField, 4>& fields, int threads, int reps) {
   using namespace swim::full3d;
   if (threads > 1) fftw_threads_init_once();
   const FftOptions o{threads, PlanRigor::Measure};
-  const int nxh = nx / 2 + 1, plane_max = ny * nz;
-  FftwBuffer a(std::size_t(nx) * plane_max), c(std::size_t(2) * nxh * plane_max);
-  struct Field {
-    std::array<int, 2> n;  // {z, y} extents of the transformed cross-section
-    std::array<fftw_r2r_kind, 2> fwd, inv;
-  };
-  const fftw_r2r_kind C10 = FFTW_REDFT10, C01 = FFTW_REDFT01, S00 = FFTW_RODFT00;
-  const Field fields[4] = {{{nz, ny}, {C10, C10}, {C01, C01}},        // u
-                           {{nz, ny - 1}, {C10, S00}, {C01, S00}},    // v: interior y faces
-                           {{nz - 1, ny}, {S00, C10}, {S00, C01}},    // w: interior z faces
-                           {{nz, ny}, {C10, C10}, {C01, C01}}};       // p
+  int plane_max = 0;
+  for (const FloorField& fd : fields) plane_max = std::max(plane_max, fd.n[0] * fd.n[1]);
+  FftwBuffer a(std::size_t(nx) * plane_max), c(std::size_t(2) * (nx / 2 + 1) * plane_max);
   struct Plans {
     FftwPlan f, i, fx, bx;
   };
   std::vector<Plans> plans;
-  for (const Field& fd : fields) {
+  for (const FloorField& fd : fields) {
     const int plane = fd.n[0] * fd.n[1];
     plans.push_back({plan_many_r2r(2, fd.n.data(), nx, a.data(), nullptr, 1, plane, a.data(), nullptr, 1, plane,
                                    fd.fwd.data(), o),
@@ -141,6 +102,27 @@ double fft_floor_mac(int nx, int ny, int nz, int threads, int reps) {
     best = std::min(best, seconds_since(t0));
   }
   return best;
+}
+
+/// The physical floor of one coupled step on an nx x ny x nz grid of the duct's kind (the
+/// cylinder lives inside the same duct grid): the 3 velocity components and the pressure on
+/// the ny x nz cells, RODFT10/01 across for the velocities, REDFT10/01 for the pressure.
+double fft_floor(int nx, int ny, int nz, int threads, int reps) {
+  const FloorField vel{{nz, ny}, {FFTW_RODFT10, FFTW_RODFT10}, {FFTW_RODFT01, FFTW_RODFT01}};
+  const FloorField pre{{nz, ny}, {FFTW_REDFT10, FFTW_REDFT10}, {FFTW_REDFT01, FFTW_REDFT01}};
+  return time_floor(nx, {vel, vel, vel, pre}, threads, reps);
+}
+
+/// The same floor with the transforms the staggered grid itself needs: the face components
+/// normal to a wall vanish on it, so across that direction v and w are DST-I (RODFT00) of the
+/// n - 1 interior faces, u and p DCT-II/III (REDFT10/01) of the n cells, as in the
+/// production solver. DST-I costs FFTW about twice a DCT-II of the same length per point.
+double fft_floor_staggered(int nx, int ny, int nz, int threads, int reps) {
+  const fftw_r2r_kind C10 = FFTW_REDFT10, C01 = FFTW_REDFT01, S00 = FFTW_RODFT00;
+  const FloorField cells{{nz, ny}, {C10, C10}, {C01, C01}};        // u, p
+  const FloorField vface{{nz, ny - 1}, {C10, S00}, {C01, S00}};    // v: interior y faces
+  const FloorField wface{{nz - 1, ny}, {S00, C10}, {S00, C01}};    // w: interior z faces
+  return time_floor(nx, {cells, vface, wface, cells}, threads, reps);
 }
 
 }  // namespace
@@ -313,7 +295,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       }
       per_step_thr[thr] = per;
       const double floor_per = fft_floor(p.nx, p.ny, p.nz, thr, std::max(3, steps));
-      const double mac_per = fft_floor_mac(p.nx, p.ny, p.nz, thr, std::max(3, steps));
+      const double mac_per = fft_floor_staggered(p.nx, p.ny, p.nz, thr, std::max(3, steps));
       char g[32];
       std::snprintf(g, sizeof g, "%dx%dx%d%s", p.nx, p.ny, p.nz, container == "cylinder" ? " cyl" : "");
       std::printf("  %-14s %7d %3d %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %7.2f %7.2f %9.2f %7.2f\n", g,

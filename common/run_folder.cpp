@@ -31,8 +31,8 @@ const char* kOwner = ".swim-run.json";
 // At most `limit` bytes of a small file (the lock's PID).
 std::string read_text(const fs::path& p, std::size_t limit) {
   std::ifstream in(p, std::ios::binary);
-  std::string s(limit, '\0');
   if (!in) return {};
+  std::string s(limit, '\0');
   in.read(s.data(), static_cast<std::streamsize>(limit));
   s.resize(static_cast<std::size_t>(in.gcount()));
   return s;
