@@ -300,7 +300,7 @@ Eigen::MatrixXd CapacitanceStokes::Impl::capacitance_cyl(int kx, double gx, Scra
     apply_M(s.r.data(), fb, gx, s, syz, false);
     clear_ring_unit(a, s.r.data());
     double* col = C.col(a).data();
-    ring_values(fb, 1.0, col);
+    ring_values(fb, 1.0, col, s.tb.data());
     if (sym_ok)  // C(g b, g a) = sign_g(b) sign_g(a) C(b, a)
       for (int g = 1; g < 4; ++g) {
         const int ga = ring_img[g][a];
@@ -352,16 +352,15 @@ void CapacitanceStokes::Impl::correct_ring(int kx, double* const F[2], int np, d
   double* fb = s.fb.data();
   const double syz = 1.0 / (4.0 * ny * nz), inv_n = syz / nx;
   for (int q = 0; q < np; ++q) {
-    std::copy_n(F[q], std::size_t(off[3]), fb);
     double* w = s.w.col(q).data();
-    ring_values(fb, syz, w);
+    ring_values(F[q], syz, w, s.tb.data());
     if (kx == 0)
       for (int a = 0; a < m; ++a)
         if (ring_c[a] == 0) w[a] = 0.0;
   }
   block_solve(fac.chol[kx], np, s);
   for (int q = 0; q < np; ++q) {
-    ring_forward(s.w.col(q).data(), fb);
+    ring_forward(s.w.col(q).data(), fb, s.tb.data());
     apply_M(fb, F[q], gx, s, inv_n, true);
   }
 }
@@ -370,12 +369,15 @@ void CapacitanceStokes::Impl::correct_ring(int kx, double* const F[2], int np, d
 // inverse along z only at the ring nodes (a dense sum over the z rows); the forward transform
 // of a ring-supported field likewise, the dense half first. About half the work of the three
 // full 2D transforms each (|R| n extra multiply-adds per component against n^2 log n saved).
-void CapacitanceStokes::Impl::ring_values(double* fb, double scale, double* w) const {
-  for (int c = 0; c < 3; ++c) ring_yinv[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
+void CapacitanceStokes::Impl::ring_values(const double* F, double scale, double* w, double* tmp) const {
+  for (int c = 0; c < 3; ++c) {
+    const YzLayout& l = yz[c];
+    l.iy->along(F + yz_at[c], l.row, tmp + yz_at[c], l.row, l.lz);
+  }
   for (int a = 0; a < m; ++a) {
     const int c = ring_c[a], row = c == 1 ? ny + 1 : ny, r = ring[a] - off[c];
     const int j = r % row, k = r / row;
-    const double* t = fb + off[c] + j;  // z row mz of the y-inverted coefficients: t[mz row]
+    const double* t = tmp + off[c] + j;  // z row mz of the y-inverted coefficients: t[mz row]
     double v = 0.0;
     if (c == 2) {  // faces along z: RODFT00 on layers 1..nz-1
       const double* b = dz.sn.data() + k;
@@ -388,12 +390,12 @@ void CapacitanceStokes::Impl::ring_values(double* fb, double scale, double* w) c
   }
 }
 
-void CapacitanceStokes::Impl::ring_forward(const double* z, double* fb) const {
-  std::fill(fb, fb + off[3], 0.0);
+void CapacitanceStokes::Impl::ring_forward(const double* z, double* fb, double* tmp) const {
+  std::fill(tmp, tmp + off[3], 0.0);
   for (int a = 0; a < m; ++a) {
     const int c = ring_c[a], row = c == 1 ? ny + 1 : ny, r = ring[a] - off[c];
     const int j = r % row, k = r / row;
-    double* t = fb + off[c] + std::size_t(k) * row;  // z row k: coefficients along y
+    double* t = tmp + off[c] + std::size_t(k) * row;  // z row k: coefficients along y
     const double za = z[a];
     if (c == 1) {  // faces along y: RODFT00 on faces 1..ny-1
       for (int my = 1; my < ny; ++my) t[my] += za * dy.sn[std::size_t(my) * ny + j];
@@ -401,7 +403,17 @@ void CapacitanceStokes::Impl::ring_forward(const double* z, double* fb) const {
       for (int my = 0; my < ny; ++my) t[my] += za * dy.cf[std::size_t(my) * ny + j];
     }
   }
-  for (int c = 0; c < 3; ++c) ring_zfwd[c].execute_r2r(fb + yz_at[c], fb + yz_at[c]);
+  // the slots no transform writes (v's wall faces, w's wall layers) stay zero
+  for (int k = 0; k < nz; ++k) {
+    fb[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
+    fb[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
+  }
+  std::fill(fb + off[2], fb + off[2] + ny, 0.0);
+  std::fill(fb + off[2] + std::size_t(nz) * ny, fb + off[2] + std::size_t(nz + 1) * ny, 0.0);
+  for (int c = 0; c < 3; ++c) {
+    const YzLayout& l = yz[c];
+    l.fz->across(tmp + yz_at[c], l.row, fb + yz_at[c], l.row, l.ly);
+  }
 }
 
 // Exact axial mean of u on the free faces (masked ones 0) into u (plane 0, real space),

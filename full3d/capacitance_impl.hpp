@@ -21,6 +21,7 @@
 
 #include "common/errors.hpp"
 #include "full3d/capacitance_stokes.hpp"
+#include "full3d/line_transform.hpp"
 #include "full3d/packed_cholesky.hpp"
 
 namespace swim::full3d {
@@ -63,9 +64,20 @@ struct CapacitanceStokes::Impl {
   std::array<std::vector<FftwPlan>, 4> xbwd;       // per component (u, v, w, p) and thread block
   std::array<std::vector<std::pair<long, long>>, 4> xbwd_rows;  // the rows [b, e) of each
   bool pressure_wanted = true;
-  std::array<FftwPlan, 3> yz_fwd;    // u, v, w (planned on plane 0)
-  std::array<FftwPlan, 4> yz_inv;    // u, v, w, p
-  std::array<std::size_t, 4> yz_at{};  // first transformed element of each component in a plane
+  // Cross-section transforms (dense, line_transform.hpp): along y (each z row) then across z.
+  // Per component c (u, v, w, p): the first transformed element of a plane, the lengths along
+  // y and z (v: the ny-1 interior y faces, DST-I; w: the nz-1 interior z layers, DST-I), the
+  // row length, and the transforms each way (REDFT10 forward, REDFT01 inverse, DST-I both).
+  std::array<std::size_t, 4> yz_at{};
+  struct YzLayout {
+    int ly = 0, lz = 0, row = 0;
+    const LineTransform *fy = nullptr, *fz = nullptr, *iy = nullptr, *iz = nullptr;
+  };
+  std::array<YzLayout, 4> yz;
+  LineTransform y10, y01, y00, z10, z01, z00;
+  // 2D transform of component c of plane f in place (tmp: a plane-sized work array).
+  void yz_forward(int c, double* f, double* tmp) const;
+  void yz_inverse(int c, double* f, double* tmp) const;
   int m = 0;  // correction nodes per cross-section (duct: wall nodes; cylinder: ring faces)
   // Symmetry-adapted basis of the correction nodes (shown for the wall nodes; the ring of a
   // symmetric staircase cylinder likewise, setup_cylinder). The duct and both bases are symmetric
@@ -117,7 +129,8 @@ struct CapacitanceStokes::Impl {
     std::vector<double> a0, a1, b0, b1, e;
     std::vector<double> inv_lam, inv_den;  // per (my, mz): 1/|g|^2 (0 at g = 0), 1/(alpha + mu |g|^2)
     Eigen::MatrixXd w;                      // m x 2: wall values U^T y, then z = C^{-1} U^T y
-    FftwBuffer fb;                          // cylinder: one plane, aligned like the planes (FFTW new-array execution)
+    std::vector<double> tb;                 // one plane: the transforms' intermediate (between y and z)
+    std::vector<double> fb;                 // cylinder: one plane of ring-supported coefficients
     Eigen::VectorXd u0b, u0x;               // cylinder: axial-mean x problem on the free u faces
   };
   std::vector<Scratch> scratch;
@@ -139,7 +152,7 @@ struct CapacitanceStokes::Impl {
   // Mode kx's np planes F to the yz spectral (rotated) frame and back (the common first and
   // last stages of the duct's and the cylinder's mode solves).
   void mode_to_spectral(int kx, double* const F[2], int np, Scratch& s);
-  void mode_from_spectral(int kx, double* const F[2], int np, bool pressure);
+  void mode_from_spectral(int kx, double* const F[2], int np, bool pressure, Scratch& s);
   // The whole cross-section solve of axial mode kx on its one or two planes.
   void solve_mode(int kx, const Factors& fac, double alpha, Scratch& s);
   // Rotation of the x component of a paired mode into the real frame, q = i e^{i theta/2} u^
@@ -258,17 +271,15 @@ struct CapacitanceStokes::Impl {
   std::vector<char> cell_fluid;  // per cell k ny + j: has a free face
   std::vector<int> ring;
   std::vector<char> ring_c;
-  // Partial cross-section transforms of the ring (planned on plane 0, new-array execution on
-  // a plane-aligned buffer): per component the inverse along y of every z row (ring values)
-  // and the forward along z of every y column (ring-supported fields); the other halves are
-  // dense sums over the ring nodes only.
-  std::array<FftwPlan, 3> ring_yinv, ring_zfwd;
-  // Values at the ring nodes of the inverse yz transforms of the u, v, w coefficients in fb
-  // (overwritten), times scale, into w (m values).
-  void ring_values(double* fb, double scale, double* w) const;
+  // Partial cross-section transforms of the ring: per component the inverse along y of every
+  // z row (ring values) and the forward along z of every y column (ring-supported fields);
+  // the other halves are dense sums over the ring nodes only.
+  // Values at the ring nodes of the inverse yz transforms of the u, v, w coefficients in F,
+  // times scale, into w (m values); tmp: a plane-sized work array.
+  void ring_values(const double* F, double scale, double* w, double* tmp) const;
   // Forward yz transforms of the field equal to z on the ring nodes and 0 elsewhere into the
-  // u, v, w coefficient slots of fb (all of them written).
-  void ring_forward(const double* z, double* fb) const;
+  // u, v, w coefficient slots of fb (all of them written); tmp: a plane-sized work array.
+  void ring_forward(const double* z, double* fb, double* tmp) const;
   // Null vectors of C(kx): lam = (G q)|_R for q the indicator of a group of cells connected
   // through non-ring y/z faces (real-space G: (q_j - q_{j-1})/h on y faces, g_x q on x faces in
   // the rotated frame). yz: the y/z-face entries; ux: the ring x faces of the group (coefficient g_x).

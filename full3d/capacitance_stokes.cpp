@@ -76,37 +76,24 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
     }
   }
 
-  // 2D cross-section transforms of one plane (new-array execution on every plane)
-  double* p0 = planes.data();
+  // cross-section transforms (dense, applied to every plane)
   yz_at = {std::size_t(off[0]), std::size_t(off[1]) + 1, std::size_t(off[2]) + ny, std::size_t(off[3])};
-  auto plan_yz = [&](int c, bool forward) {
-    const fftw_r2r_kind cosk = forward ? FFTW_REDFT10 : FFTW_REDFT01;
-    int n[2] = {nz, ny}, embed[2] = {nz, ny};
-    fftw_r2r_kind kinds[2] = {cosk, cosk};
-    if (c == 1) {  // v: interior y faces 1..ny-1 of rows of ny+1
-      n[1] = ny - 1;
-      embed[1] = ny + 1;
-      kinds[1] = FFTW_RODFT00;
-    } else if (c == 2) {  // w: interior z faces 1..nz-1 of nz+1 layers
-      n[0] = nz - 1;
-      embed[0] = nz + 1;
-      kinds[0] = FFTW_RODFT00;
-    }
-    double* at = p0 + yz_at[c];
-    return plan_many_r2r(2, n, 1, at, embed, 1, 0, at, embed, 1, 0, kinds, fft);
-  };
-  for (int c = 0; c < 3; ++c) yz_fwd[c] = plan_yz(c, true);
-  for (int c = 0; c < 4; ++c) yz_inv[c] = plan_yz(c, false);
-  if (cylopt)  // the ring's partial transforms: 1D along y of every z row, along z of every y column
-    for (int c = 0; c < 3; ++c) {
-      const int ly = c == 1 ? ny - 1 : ny, lz = c == 2 ? nz - 1 : nz, row = c == 1 ? ny + 1 : ny;
-      const fftw_r2r_kind ky = c == 1 ? FFTW_RODFT00 : FFTW_REDFT01;  // inverse along y
-      const fftw_r2r_kind kz = c == 2 ? FFTW_RODFT00 : FFTW_REDFT10;  // forward along z
-      const int n1[1] = {ly}, n2[1] = {lz};
-      double* at = p0 + yz_at[c];
-      ring_yinv[c] = plan_many_r2r(1, n1, lz, at, nullptr, 1, row, at, nullptr, 1, row, &ky, fft);
-      ring_zfwd[c] = plan_many_r2r(1, n2, ly, at, nullptr, row, 1, at, nullptr, row, 1, &kz, fft);
-    }
+  y10 = LineTransform(R2rKind::Redft10, ny);
+  y01 = LineTransform(R2rKind::Redft01, ny);
+  y00 = LineTransform(R2rKind::Rodft00, ny - 1);
+  z10 = LineTransform(R2rKind::Redft10, nz);
+  z01 = LineTransform(R2rKind::Redft01, nz);
+  z00 = LineTransform(R2rKind::Rodft00, nz - 1);
+  for (int c = 0; c < 4; ++c) {
+    YzLayout& l = yz[c];
+    l.ly = c == 1 ? ny - 1 : ny;
+    l.lz = c == 2 ? nz - 1 : nz;
+    l.row = c == 1 ? ny + 1 : ny;
+    l.fy = c == 1 ? &y00 : &y10;
+    l.iy = c == 1 ? &y00 : &y01;
+    l.fz = c == 2 ? &z00 : &z10;
+    l.iz = c == 2 ? &z00 : &z01;
+  }
   u0 = FftwBuffer(std::size_t(ny) * nz);
   {
     const int n2[2] = {nz, ny};
@@ -136,9 +123,9 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
     s.inv_lam.assign(std::size_t(ny) * nz, 0.0);
     s.inv_den.assign(std::size_t(ny) * nz, 0.0);
     s.w = Eigen::MatrixXd::Zero(m, 2);
+    s.tb.assign(P, 0.0);
     if (cyl) {
-      s.fb = FftwBuffer(P);
-      std::fill(s.fb.data(), s.fb.data() + P, 0.0);
+      s.fb.assign(P, 0.0);
       s.u0b.resize(u0_n);
       s.u0x.resize(u0_n);
     }
@@ -264,7 +251,7 @@ void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alph
     correct_ring(kx, F, np, gx, fac, s);
   else
     correct_walls(kx, F, np, gx, fac, s);
-  mode_from_spectral(kx, F, np, pressure_wanted);
+  mode_from_spectral(kx, F, np, pressure_wanted, s);
   if (kx == 0) {
     if (cyl) {
       mean_x_ring(F[0] + off[0], fac, s);
@@ -280,13 +267,29 @@ void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alph
 void CapacitanceStokes::Impl::mode_to_spectral(int kx, double* const F[2], int np, Scratch& s) {
   if (kx == 0) std::copy_n(F[0] + off[0], std::size_t(ny) * nz, s.y.data());  // b of the axial mean u
   for (int q = 0; q < np; ++q)
-    for (int c = 0; c < 3; ++c) yz_fwd[c].execute_r2r(F[q] + yz_at[c], F[q] + yz_at[c]);
+    for (int c = 0; c < 3; ++c) yz_forward(c, F[q], s.tb.data());
   if (np == 2) rotate(F[0], F[1], kx, +1);
+}
+
+void CapacitanceStokes::Impl::yz_forward(int c, double* f, double* tmp) const {
+  const YzLayout& l = yz[c];
+  double* a = f + yz_at[c];
+  double* t = tmp + yz_at[c];
+  l.fy->along(a, l.row, t, l.row, l.lz);
+  l.fz->across(t, l.row, a, l.row, l.ly);
+}
+
+void CapacitanceStokes::Impl::yz_inverse(int c, double* f, double* tmp) const {
+  const YzLayout& l = yz[c];
+  double* a = f + yz_at[c];
+  double* t = tmp + yz_at[c];
+  l.iy->along(a, l.row, t, l.row, l.lz);
+  l.iz->across(t, l.row, a, l.row, l.ly);
 }
 
 // The way back: rotation of a paired mode, the wall faces (not transformed) set to zero,
 // the inverse yz transforms of u, v, w and (pressure) p.
-void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int np, bool pressure) {
+void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int np, bool pressure, Scratch& s) {
   if (np == 2) rotate(F[0], F[1], kx, -1);
   for (int q = 0; q < np; ++q) {
     double* f = F[q];
@@ -296,7 +299,7 @@ void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int
     }
     std::fill(f + off[2], f + off[2] + ny, 0.0);
     std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
-    for (int c = 0; c < (pressure ? 4 : 3); ++c) yz_inv[c].execute_r2r(f + yz_at[c], f + yz_at[c]);
+    for (int c = 0; c < (pressure ? 4 : 3); ++c) yz_inverse(c, f, s.tb.data());
   }
 }
 
