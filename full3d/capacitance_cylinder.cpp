@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "common/dot.hpp"
 #include "full3d/capacitance_impl.hpp"
 
 namespace swim::full3d {
@@ -365,27 +366,24 @@ void CapacitanceStokes::Impl::correct_ring(int kx, double* const F[2], int np, d
   }
 }
 
-// The 2D transforms are separable: the inverse along y runs over every z row (FFTW), the
-// inverse along z only at the ring nodes (a dense sum over the z rows); the forward transform
-// of a ring-supported field likewise, the dense half first. About half the work of the three
-// full 2D transforms each (|R| n extra multiply-adds per component against n^2 log n saved).
+// The 2D transforms are separable: the inverse across z runs over every y column (dense line
+// transforms), the inverse along y only at the ring nodes (a contiguous dot product along the
+// node's z row); the forward transform of a ring-supported field likewise, the sums along y
+// first. About half the work of the three full 2D transforms each.
 void CapacitanceStokes::Impl::ring_values(const double* F, double scale, double* w, double* tmp) const {
   for (int c = 0; c < 3; ++c) {
     const YzLayout& l = yz[c];
-    l.iy->along(F + yz_at[c], l.row, tmp + yz_at[c], l.row, l.lz);
+    l.iz->across(F + yz_at[c], l.row, tmp + yz_at[c], l.row, l.ly);
   }
   for (int a = 0; a < m; ++a) {
     const int c = ring_c[a], row = c == 1 ? ny + 1 : ny, r = ring[a] - off[c];
     const int j = r % row, k = r / row;
-    const double* t = tmp + off[c] + j;  // z row mz of the y-inverted coefficients: t[mz row]
-    double v = 0.0;
-    if (c == 2) {  // faces along z: RODFT00 on layers 1..nz-1
-      const double* b = dz.sn.data() + k;
-      for (int mz = 1; mz < nz; ++mz) v += t[std::size_t(mz) * row] * b[std::size_t(mz) * nz];
-    } else {  // cells along z: REDFT01
-      const double* b = dz.ci.data() + std::size_t(k) * nz;
-      for (int mz = 0; mz < nz; ++mz) v += t[std::size_t(mz) * row] * b[mz];
-    }
+    const double* t = tmp + off[c] + std::size_t(k) * row;  // z row k: coefficients along y
+    double v;
+    if (c == 1)  // faces along y: RODFT00 on faces 1..ny-1
+      v = dot4(t + 1, dy.sn.data() + std::size_t(j) * ny + 1, ny - 1);
+    else  // cells along y: REDFT01
+      v = dot4(t, dy.ci.data() + std::size_t(j) * ny, ny);
     w[a] = scale * v;
   }
 }
@@ -398,9 +396,11 @@ void CapacitanceStokes::Impl::ring_forward(const double* z, double* fb, double* 
     double* t = tmp + off[c] + std::size_t(k) * row;  // z row k: coefficients along y
     const double za = z[a];
     if (c == 1) {  // faces along y: RODFT00 on faces 1..ny-1
-      for (int my = 1; my < ny; ++my) t[my] += za * dy.sn[std::size_t(my) * ny + j];
+      const double* b = dy.sn.data() + std::size_t(j) * ny;  // symmetric: sn[j ny + my] = sn[my ny + j]
+      for (int my = 1; my < ny; ++my) t[my] += za * b[my];
     } else {  // cells along y: REDFT10
-      for (int my = 0; my < ny; ++my) t[my] += za * dy.cf[std::size_t(my) * ny + j];
+      const double* b = dy.cft.data() + std::size_t(j) * ny;
+      for (int my = 0; my < ny; ++my) t[my] += za * b[my];
     }
   }
   // the slots no transform writes (v's wall faces, w's wall layers) stay zero

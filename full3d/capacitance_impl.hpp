@@ -35,6 +35,7 @@ constexpr double kPi = std::numbers::pi;
 struct Dir1d {
   int n = 0;
   std::vector<double> cf;  // cf[m n + j] = 2 cos(pi m (j+1/2)/n): REDFT10, coefficient m of cell values
+  std::vector<double> cft; // cft[j n + m] = cf[m n + j] (contiguous in m)
   std::vector<double> ci;  // ci[j n + m] = (m ? 2 : 1) cos(pi m (j+1/2)/n): REDFT01, value at cell j
   std::vector<double> sn;  // sn[a n + b] = 2 sin(pi a b/n): RODFT00 on faces 1..n-1 (both directions)
   std::vector<double> g;   // g[m] = -2 sin(pi m/(2n))/h: G maps cos_m onto g_m sin_m, -L = g_m^2
@@ -271,9 +272,9 @@ struct CapacitanceStokes::Impl {
   std::vector<char> cell_fluid;  // per cell k ny + j: has a free face
   std::vector<int> ring;
   std::vector<char> ring_c;
-  // Partial cross-section transforms of the ring: per component the inverse along y of every
-  // z row (ring values) and the forward along z of every y column (ring-supported fields);
-  // the other halves are dense sums over the ring nodes only.
+  // Partial cross-section transforms of the ring: per component the inverse across z of every
+  // y column (ring values) and the forward across z of every y column (ring-supported fields);
+  // the halves along y are dense sums over the ring nodes only, contiguous along y.
   // Values at the ring nodes of the inverse yz transforms of the u, v, w coefficients in F,
   // times scale, into w (m values); tmp: a plane-sized work array.
   void ring_values(const double* F, double scale, double* w, double* tmp) const;

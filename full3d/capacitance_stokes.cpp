@@ -15,11 +15,12 @@ namespace swim::full3d {
 namespace capacitance {
 
 Dir1d::Dir1d(int n_, double h)
-    : n(n_), cf(std::size_t(n_) * n_), ci(std::size_t(n_) * n_), sn(std::size_t(n_) * n_), g(n_) {
+    : n(n_), cf(std::size_t(n_) * n_), cft(std::size_t(n_) * n_), ci(std::size_t(n_) * n_), sn(std::size_t(n_) * n_), g(n_) {
   for (int a = 0; a < n; ++a)
     for (int b = 0; b < n; ++b) {
       const double c = std::cos(kPi * a * (b + 0.5) / n);
       cf[std::size_t(a) * n + b] = 2.0 * c;
+      cft[std::size_t(b) * n + a] = 2.0 * c;
       ci[std::size_t(b) * n + a] = (a ? 2.0 : 1.0) * c;
       sn[std::size_t(a) * n + b] = 2.0 * std::sin(kPi * a * b / n);
     }

@@ -39,8 +39,10 @@ class LineTransform {
 
  private:
   int n_ = 0;
-  std::vector<double> t_;   // T, row-major
-  std::vector<double> tt_;  // T^T, row-major
+  int ne_ = 0, no_ = 0;        // (n + 1) / 2 and n / 2
+  bool output_split_ = false;  // DCT-III: symmetric in the output index, else in the input index
+  std::vector<double> te_, to_;    // the even and odd halves of T (line_transform.cpp), row-major
+  std::vector<double> tet_, tot_;  // their transposes
 };
 
 /// C = A B with row-major A (M x K, leading dimension lda), B (K x N, ldb), C (M x N, ldc);
