@@ -1,7 +1,10 @@
 // Dense 1D real transforms as small matrix products (line_transform.hpp).
 #include "full3d/line_transform.hpp"
 
+#if defined(__x86_64__) || defined(__i386__)
+#define SWIM_LINE_TRANSFORM_AVX2 1
 #include <immintrin.h>
+#endif
 
 #include <algorithm>
 #include <cmath>
@@ -37,104 +40,96 @@ void gemm_generic(int M, int N, int K, const double* A, int lda, int inca, const
   }
 }
 
-// AVX2/FMA kernel: blocks of 4 rows x 8 columns of C in 8 registers, the k loop innermost
-// (one pass over a 4 x K panel of A and a K x 8 panel of B per block); then 4-column blocks,
-// single columns and single rows for the edges.
+#ifdef SWIM_LINE_TRANSFORM_AVX2
+// AVX2/FMA kernel. A block of R rows (R <= 4) and 8 columns of C stays in 2R registers while
+// k runs over a R x K panel of A (broadcast) and a K x 8 panel of B; the column edge is one
+// 4-wide block and a masked block of 1-3 columns, the row edge a block of 1-3 rows, so that
+// every product runs in vector registers (at 36 points the even/odd halves are 18 wide).
+__attribute__((target("avx2,fma"))) inline __m256i tail_mask(int r) {
+  return _mm256_setr_epi64x(r > 0 ? -1 : 0, r > 1 ? -1 : 0, r > 2 ? -1 : 0, 0);
+}
+
+template <int R>
+__attribute__((target("avx2,fma"))) void rows_avx2(int N, int K, const double* A, int lda, int inca,
+                                                     const double* B, int ldb, double* C, int ldc) {
+  const double* a[R];
+  double* c[R];
+  for (int r = 0; r < R; ++r) {
+    a[r] = A + long(r) * lda;
+    c[r] = C + long(r) * ldc;
+  }
+  int j = 0;
+  for (; j + 8 <= N; j += 8) {
+    __m256d s0[R], s1[R];
+    for (int r = 0; r < R; ++r) s0[r] = s1[r] = _mm256_setzero_pd();
+    const double* b = B + j;
+    for (int k = 0; k < K; ++k, b += ldb) {
+      const __m256d b0 = _mm256_loadu_pd(b), b1 = _mm256_loadu_pd(b + 4);
+      for (int r = 0; r < R; ++r) {
+        const __m256d x = _mm256_broadcast_sd(a[r] + long(k) * inca);
+        s0[r] = _mm256_fmadd_pd(x, b0, s0[r]);
+        s1[r] = _mm256_fmadd_pd(x, b1, s1[r]);
+      }
+    }
+    for (int r = 0; r < R; ++r) {
+      _mm256_storeu_pd(c[r] + j, s0[r]);
+      _mm256_storeu_pd(c[r] + j + 4, s1[r]);
+    }
+  }
+  if (j + 4 <= N) {
+    __m256d s0[R];
+    for (int r = 0; r < R; ++r) s0[r] = _mm256_setzero_pd();
+    const double* b = B + j;
+    for (int k = 0; k < K; ++k, b += ldb) {
+      const __m256d b0 = _mm256_loadu_pd(b);
+      for (int r = 0; r < R; ++r) s0[r] = _mm256_fmadd_pd(_mm256_broadcast_sd(a[r] + long(k) * inca), b0, s0[r]);
+    }
+    for (int r = 0; r < R; ++r) _mm256_storeu_pd(c[r] + j, s0[r]);
+    j += 4;
+  }
+  if (j < N) {  // 1-3 columns: masked loads and stores (nothing outside the row is touched)
+    const __m256i mask = tail_mask(N - j);
+    __m256d s0[R];
+    for (int r = 0; r < R; ++r) s0[r] = _mm256_setzero_pd();
+    const double* b = B + j;
+    for (int k = 0; k < K; ++k, b += ldb) {
+      const __m256d b0 = _mm256_maskload_pd(b, mask);
+      for (int r = 0; r < R; ++r) s0[r] = _mm256_fmadd_pd(_mm256_broadcast_sd(a[r] + long(k) * inca), b0, s0[r]);
+    }
+    for (int r = 0; r < R; ++r) _mm256_maskstore_pd(c[r] + j, mask, s0[r]);
+  }
+}
+
 __attribute__((target("avx2,fma"))) void gemm_avx2(int M, int N, int K, const double* A, int lda, int inca,
                                                      const double* B, int ldb, double* C, int ldc) {
   int i = 0;
-  for (; i + 4 <= M; i += 4) {
-    const double* a0 = A + long(i) * lda;
-    const double* a1 = a0 + lda;
-    const double* a2 = a1 + lda;
-    const double* a3 = a2 + lda;
-    double* c0 = C + long(i) * ldc;
-    double* c1 = c0 + ldc;
-    double* c2 = c1 + ldc;
-    double* c3 = c2 + ldc;
-    int j = 0;
-    for (; j + 8 <= N; j += 8) {
-      __m256d s00 = _mm256_setzero_pd(), s01 = s00, s10 = s00, s11 = s00, s20 = s00, s21 = s00, s30 = s00,
-              s31 = s00;
-      const double* b = B + j;
-      for (int k = 0; k < K; ++k, b += ldb) {
-        const __m256d b0 = _mm256_loadu_pd(b), b1 = _mm256_loadu_pd(b + 4);
-        __m256d x = _mm256_broadcast_sd(a0 + long(k) * inca);
-        s00 = _mm256_fmadd_pd(x, b0, s00);
-        s01 = _mm256_fmadd_pd(x, b1, s01);
-        x = _mm256_broadcast_sd(a1 + long(k) * inca);
-        s10 = _mm256_fmadd_pd(x, b0, s10);
-        s11 = _mm256_fmadd_pd(x, b1, s11);
-        x = _mm256_broadcast_sd(a2 + long(k) * inca);
-        s20 = _mm256_fmadd_pd(x, b0, s20);
-        s21 = _mm256_fmadd_pd(x, b1, s21);
-        x = _mm256_broadcast_sd(a3 + long(k) * inca);
-        s30 = _mm256_fmadd_pd(x, b0, s30);
-        s31 = _mm256_fmadd_pd(x, b1, s31);
-      }
-      _mm256_storeu_pd(c0 + j, s00);
-      _mm256_storeu_pd(c0 + j + 4, s01);
-      _mm256_storeu_pd(c1 + j, s10);
-      _mm256_storeu_pd(c1 + j + 4, s11);
-      _mm256_storeu_pd(c2 + j, s20);
-      _mm256_storeu_pd(c2 + j + 4, s21);
-      _mm256_storeu_pd(c3 + j, s30);
-      _mm256_storeu_pd(c3 + j + 4, s31);
-    }
-    for (; j + 4 <= N; j += 4) {
-      __m256d s0 = _mm256_setzero_pd(), s1 = s0, s2 = s0, s3 = s0;
-      const double* b = B + j;
-      for (int k = 0; k < K; ++k, b += ldb) {
-        const __m256d b0 = _mm256_loadu_pd(b);
-        s0 = _mm256_fmadd_pd(_mm256_broadcast_sd(a0 + long(k) * inca), b0, s0);
-        s1 = _mm256_fmadd_pd(_mm256_broadcast_sd(a1 + long(k) * inca), b0, s1);
-        s2 = _mm256_fmadd_pd(_mm256_broadcast_sd(a2 + long(k) * inca), b0, s2);
-        s3 = _mm256_fmadd_pd(_mm256_broadcast_sd(a3 + long(k) * inca), b0, s3);
-      }
-      _mm256_storeu_pd(c0 + j, s0);
-      _mm256_storeu_pd(c1 + j, s1);
-      _mm256_storeu_pd(c2 + j, s2);
-      _mm256_storeu_pd(c3 + j, s3);
-    }
-    for (; j < N; ++j) {
-      double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-      const double* b = B + j;
-      for (int k = 0; k < K; ++k, b += ldb) {
-        s0 = std::fma(a0[long(k) * inca], *b, s0);
-        s1 = std::fma(a1[long(k) * inca], *b, s1);
-        s2 = std::fma(a2[long(k) * inca], *b, s2);
-        s3 = std::fma(a3[long(k) * inca], *b, s3);
-      }
-      c0[j] = s0;
-      c1[j] = s1;
-      c2[j] = s2;
-      c3[j] = s3;
-    }
-  }
-  for (; i < M; ++i) {
-    const double* a = A + long(i) * lda;
-    double* c = C + long(i) * ldc;
-    int j = 0;
-    for (; j + 4 <= N; j += 4) {
-      __m256d s = _mm256_setzero_pd();
-      const double* b = B + j;
-      for (int k = 0; k < K; ++k, b += ldb) s = _mm256_fmadd_pd(_mm256_broadcast_sd(a + long(k) * inca), _mm256_loadu_pd(b), s);
-      _mm256_storeu_pd(c + j, s);
-    }
-    for (; j < N; ++j) {
-      double s = 0;
-      const double* b = B + j;
-      for (int k = 0; k < K; ++k, b += ldb) s = std::fma(a[long(k) * inca], *b, s);
-      c[j] = s;
-    }
+  for (; i + 4 <= M; i += 4) rows_avx2<4>(N, K, A + long(i) * lda, lda, inca, B, ldb, C + long(i) * ldc, ldc);
+  const double* Ai = A + long(i) * lda;
+  double* Ci = C + long(i) * ldc;
+  switch (M - i) {
+    case 3:
+      rows_avx2<3>(N, K, Ai, lda, inca, B, ldb, Ci, ldc);
+      break;
+    case 2:
+      rows_avx2<2>(N, K, Ai, lda, inca, B, ldb, Ci, ldc);
+      break;
+    case 1:
+      rows_avx2<1>(N, K, Ai, lda, inca, B, ldb, Ci, ldc);
+      break;
+    default:
+      break;
   }
 }
+
+#endif  // SWIM_LINE_TRANSFORM_AVX2
 
 using GemmFn = void (*)(int, int, int, const double*, int, int, const double*, int, double*, int);
 
 GemmFn select_gemm() {
+#ifdef SWIM_LINE_TRANSFORM_AVX2
   __builtin_cpu_init();
   if (__builtin_cpu_supports("avx2") && __builtin_cpu_supports("fma")) return gemm_avx2;
+#endif
   return gemm_generic;
 }
 
