@@ -6,6 +6,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "full3d/capacitance_impl.hpp"
 #include "full3d/parallel.hpp"
@@ -135,48 +136,94 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
 
 // 1/|g|^2 and 1/(alpha + mu |g|^2) of every wavevector of mode kx (symbol gx) into s.
 void CapacitanceStokes::Impl::mode_tables(double gx, double alpha, Scratch& s) const {
-  for (int mz = 0; mz < nz; ++mz)
+  // (branch-free, so that the divisions vectorise; |g|^2 = 0 only at gx = my = mz = 0)
+  for (int mz = 0; mz < nz; ++mz) {
+    const double gz2 = gx * gx + dz.g[mz] * dz.g[mz];
+    double* il = s.inv_lam.data() + std::size_t(mz) * ny;
+    double* id = s.inv_den.data() + std::size_t(mz) * ny;
     for (int my = 0; my < ny; ++my) {
-      const double lam = gx * gx + dz.g[mz] * dz.g[mz] + dy.g[my] * dy.g[my];
-      const std::size_t i = std::size_t(mz) * ny + my;
-      s.inv_lam[i] = lam > 0.0 ? 1.0 / lam : 0.0;
-      s.inv_den[i] = 1.0 / (alpha + mu * lam);
+      const double lam = gz2 + dy.g[my] * dy.g[my];
+      il[my] = 1.0 / std::max(lam, std::numeric_limits<double>::min());
+      id[my] = 1.0 / (alpha + mu * lam);
     }
+  }
+  if (!(gx * gx + dz.g[0] * dz.g[0] + dy.g[0] * dy.g[0] > 0.0)) s.inv_lam[0] = 0.0;
 }
 
 // Spectral free-slip projection per wavevector (my, mz), the box formula with a real symbol:
 //   P = g.B/|g|^2 (0 at g = 0),  X = (B - g P)/(alpha + mu |g|^2).
 // B: u, v, w coefficients of a plane-shaped array; X: u, v, w, p coefficients; the tables
 // of mode_tables(gx, alpha). subtract: X = scale (X - M B), else X = scale M B (B may alias X).
+namespace {
+
+// One z row (fixed mz) of apply_M over my = m0 .. ny-1 (m0 = 1: the row without the v
+// coefficient my = 0); with_w: mz > 0 (w has no mz = 0 coefficient). The loop vectorises:
+// X may be B, and each iteration reads and writes only its own index.
+template <bool subtract, bool with_w>
+void apply_M_row(int m0, int ny, const double* bu, const double* bv, const double* bw, double* xu, double* xv,
+                 double* xw, double* xp, const double* gy, double gx, double gz, const double* il,
+                 const double* id, double scale) {
+#pragma omp simd
+  for (int my = m0; my < ny; ++my) {
+    const double cu = bu[my], cv = bv[my], cw = with_w ? bw[my] : 0.0;
+    const double pp = (gx * cu + gy[my] * cv + gz * cw) * il[my];
+    const double inv = id[my];
+    const double ru = (cu - gx * pp) * inv, rv = (cv - gy[my] * pp) * inv, rw = (cw - gz * pp) * inv;
+    if (subtract) {
+      xu[my] = scale * (xu[my] - ru);
+      xp[my] = scale * (xp[my] - pp);
+      xv[my] = scale * (xv[my] - rv);
+      if (with_w) xw[my] = scale * (xw[my] - rw);
+    } else {
+      xu[my] = scale * ru;
+      xp[my] = scale * pp;
+      xv[my] = scale * rv;
+      if (with_w) xw[my] = scale * rw;
+    }
+  }
+}
+
+}  // namespace
+
 void CapacitanceStokes::Impl::apply_M(const double* B, double* X, double gx, const Scratch& s, double scale,
                                       bool subtract) const {
-  const double* Bu = B + off[0];
-  const double* Bv = B + off[1];
-  const double* Bw = B + off[2];
-  double* Xu = X + off[0];
-  double* Xv = X + off[1];
-  double* Xw = X + off[2];
-  double* Xp = X + off[3];
   for (int mz = 0; mz < nz; ++mz) {
     const double gz = dz.g[mz];
-    for (int my = 0; my < ny; ++my) {
-      const double gy = dy.g[my];
-      const std::size_t iu = std::size_t(mz) * ny + my, iv = std::size_t(mz) * (ny + 1) + my;
-      const double cu = Bu[iu], cv = my ? Bv[iv] : 0.0, cw = mz ? Bw[iu] : 0.0;
-      const double pp = (gx * cu + gy * cv + gz * cw) * s.inv_lam[iu];
-      const double inv = s.inv_den[iu];
-      const double xu = (cu - gx * pp) * inv, xv = (cv - gy * pp) * inv, xw = (cw - gz * pp) * inv;
+    const std::size_t iu = std::size_t(mz) * ny, iv = std::size_t(mz) * (ny + 1);
+    const double* Bu = B + off[0] + iu;
+    const double* Bv = B + off[1] + iv;
+    const double* Bw = B + off[2] + iu;
+    double* xu = X + off[0] + iu;
+    double* xv = X + off[1] + iv;
+    double* xw = X + off[2] + iu;
+    double* xp = X + off[3] + iu;
+    const double* il = s.inv_lam.data() + iu;
+    const double* id = s.inv_den.data() + iu;
+    {  // my = 0: no v coefficient
+      const double cu = Bu[0], cw = mz ? Bw[0] : 0.0;
+      const double pp = (gx * cu + gz * cw) * il[0];
+      const double ru = (cu - gx * pp) * id[0], rw = (cw - gz * pp) * id[0];
       if (subtract) {
-        Xu[iu] = scale * (Xu[iu] - xu);
-        Xp[iu] = scale * (Xp[iu] - pp);
-        if (my) Xv[iv] = scale * (Xv[iv] - xv);
-        if (mz) Xw[iu] = scale * (Xw[iu] - xw);
+        xu[0] = scale * (xu[0] - ru);
+        xp[0] = scale * (xp[0] - pp);
+        if (mz) xw[0] = scale * (xw[0] - rw);
       } else {
-        Xu[iu] = scale * xu;
-        Xp[iu] = scale * pp;
-        if (my) Xv[iv] = scale * xv;
-        if (mz) Xw[iu] = scale * xw;
+        xu[0] = scale * ru;
+        xp[0] = scale * pp;
+        if (mz) xw[0] = scale * rw;
       }
+    }
+    const double* gy = dy.g.data();
+    if (subtract) {
+      if (mz)
+        apply_M_row<true, true>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
+      else
+        apply_M_row<true, false>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
+    } else {
+      if (mz)
+        apply_M_row<false, true>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
+      else
+        apply_M_row<false, false>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
     }
   }
 }
