@@ -68,7 +68,9 @@ class Mutator {
         n = &it.value();
       } else {
         n = &(*n)[k];
-        path += "[" + std::to_string(k) + "]";
+        path += '[';  // (appended piecewise: GCC 12 warns falsely on "[" + std::string + "]")
+        path += std::to_string(k);
+        path += ']';
       }
     }
     return n;
