@@ -76,9 +76,9 @@ struct CapacitanceStokes::Impl {
   };
   std::array<YzLayout, 4> yz;
   LineTransform y10, y01, y00, z10, z01, z00;
-  // 2D transform of component c of plane f in place (tmp: a plane-sized work array).
-  void yz_forward(int c, double* f, double* tmp) const;
-  void yz_inverse(int c, double* f, double* tmp) const;
+  // 2D transform (forward or inverse) of component c of plane f in place (tmp: a plane-sized
+  // work array).
+  void yz_transform(int c, double* f, double* tmp, bool inverse) const;
   int m = 0;  // correction nodes per cross-section (duct: wall nodes; cylinder: ring faces)
   // Symmetry-adapted basis of the correction nodes (shown for the wall nodes; the ring of a
   // symmetric staircase cylinder likewise, setup_cylinder). The duct and both bases are symmetric

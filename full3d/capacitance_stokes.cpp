@@ -315,24 +315,16 @@ void CapacitanceStokes::Impl::solve_mode(int kx, const Factors& fac, double alph
 void CapacitanceStokes::Impl::mode_to_spectral(int kx, double* const F[2], int np, Scratch& s) {
   if (kx == 0) std::copy_n(F[0] + off[0], std::size_t(ny) * nz, s.y.data());  // b of the axial mean u
   for (int q = 0; q < np; ++q)
-    for (int c = 0; c < 3; ++c) yz_forward(c, F[q], s.tb.data());
+    for (int c = 0; c < 3; ++c) yz_transform(c, F[q], s.tb.data(), false);
   if (np == 2) rotate(F[0], F[1], kx, +1);
 }
 
-void CapacitanceStokes::Impl::yz_forward(int c, double* f, double* tmp) const {
+void CapacitanceStokes::Impl::yz_transform(int c, double* f, double* tmp, bool inverse) const {
   const YzLayout& l = yz[c];
   double* a = f + yz_at[c];
   double* t = tmp + yz_at[c];
-  l.fy->along(a, l.row, t, l.row, l.lz);
-  l.fz->across(t, l.row, a, l.row, l.ly);
-}
-
-void CapacitanceStokes::Impl::yz_inverse(int c, double* f, double* tmp) const {
-  const YzLayout& l = yz[c];
-  double* a = f + yz_at[c];
-  double* t = tmp + yz_at[c];
-  l.iy->along(a, l.row, t, l.row, l.lz);
-  l.iz->across(t, l.row, a, l.row, l.ly);
+  (inverse ? l.iy : l.fy)->along(a, l.row, t, l.row, l.lz);
+  (inverse ? l.iz : l.fz)->across(t, l.row, a, l.row, l.ly);
 }
 
 // The way back: rotation of a paired mode, the wall faces (not transformed) set to zero,
@@ -347,7 +339,7 @@ void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int
     }
     std::fill(f + off[2], f + off[2] + ny, 0.0);
     std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
-    for (int c = 0; c < (pressure ? 4 : 3); ++c) yz_inverse(c, f, s.tb.data());
+    for (int c = 0; c < (pressure ? 4 : 3); ++c) yz_transform(c, f, s.tb.data(), true);
   }
 }
 
