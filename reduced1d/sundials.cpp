@@ -237,8 +237,19 @@ Vector make_vector(long n, SUNContext ctx) {
   return v;
 }
 
+namespace {
+// SUNMatZero for a band matrix (the integrators zero it before every Jacobian fill): one
+// memset of its storage instead of the distribution's unoptimised element loop.
+int band_zero(SUNMatrix A) {
+  std::memset(SM_DATA_B(A), 0, sizeof(realtype) * std::size_t(SM_LDATA_B(A)));
+  return SUNMAT_SUCCESS;
+}
+}  // namespace
+
 Matrix make_band_matrix(long n, long mu, long ml, SUNContext ctx) {
-  return Matrix(check_ptr(SUNBandMatrix(n, mu, ml, ctx), "SUNBandMatrix"));
+  Matrix A(check_ptr(SUNBandMatrix(n, mu, ml, ctx), "SUNBandMatrix"));
+  A.get()->ops->zero = band_zero;
+  return A;
 }
 
 Matrix make_dense_matrix(long n, SUNContext ctx) {
