@@ -4,13 +4,13 @@
 // of several repetitions) and screening throughput (designs per second) on all cores and on
 // one thread, with the process CPU time per design.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cstdio>
 #include <ctime>
 #include <string>
 #include <thread>
 #include <utility>
-#include <array>
 #include <vector>
 
 #include "app/app.hpp"

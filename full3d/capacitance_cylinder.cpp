@@ -403,13 +403,7 @@ void CapacitanceStokes::Impl::ring_forward(const double* z, double* fb, double* 
       for (int my = 0; my < ny; ++my) t[my] += za * b[my];
     }
   }
-  // the slots no transform writes (v's wall faces, w's wall layers) stay zero
-  for (int k = 0; k < nz; ++k) {
-    fb[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
-    fb[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
-  }
-  std::fill(fb + off[2], fb + off[2] + ny, 0.0);
-  std::fill(fb + off[2] + std::size_t(nz) * ny, fb + off[2] + std::size_t(nz + 1) * ny, 0.0);
+  zero_wall_slots(fb);  // the slots no transform writes
   for (int c = 0; c < 3; ++c) {
     const YzLayout& l = yz[c];
     l.fz->across(tmp + yz_at[c], l.row, fb + yz_at[c], l.row, l.ly);

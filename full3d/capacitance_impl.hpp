@@ -79,6 +79,9 @@ struct CapacitanceStokes::Impl {
   // 2D transform (forward or inverse) of component c of plane f in place (tmp: a plane-sized
   // work array).
   void yz_transform(int c, double* f, double* tmp, bool inverse) const;
+  // Zero the slots of a plane that no cross-section transform writes: v on the wall faces
+  // j = 0, ny, w on the wall layers k = 0, nz.
+  void zero_wall_slots(double* f) const;
   int m = 0;  // correction nodes per cross-section (duct: wall nodes; cylinder: ring faces)
   // Symmetry-adapted basis of the correction nodes (shown for the wall nodes; the ring of a
   // symmetric staircase cylinder likewise, setup_cylinder). The duct and both bases are symmetric

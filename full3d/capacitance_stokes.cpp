@@ -156,75 +156,52 @@ void CapacitanceStokes::Impl::mode_tables(double gx, double alpha, Scratch& s) c
 // of mode_tables(gx, alpha). subtract: X = scale (X - M B), else X = scale M B (B may alias X).
 namespace {
 
-// One z row (fixed mz) of apply_M over my = m0 .. ny-1 (m0 = 1: the row without the v
-// coefficient my = 0); with_w: mz > 0 (w has no mz = 0 coefficient). The loop vectorises:
-// X may be B, and each iteration reads and writes only its own index.
-template <bool subtract, bool with_w>
-void apply_M_row(int m0, int ny, const double* bu, const double* bv, const double* bw, double* xu, double* xv,
+// One z row (fixed mz) of apply_M over my in [m0, m1); with_v: my > 0 (v has no my = 0
+// coefficient), with_w: mz > 0 (nor w an mz = 0 one). The loop vectorises: X may be B, and
+// each iteration reads and writes only its own index.
+template <bool subtract, bool with_v, bool with_w>
+void apply_M_row(int m0, int m1, const double* bu, const double* bv, const double* bw, double* xu, double* xv,
                  double* xw, double* xp, const double* gy, double gx, double gz, const double* il,
                  const double* id, double scale) {
 #pragma omp simd
-  for (int my = m0; my < ny; ++my) {
-    const double cu = bu[my], cv = bv[my], cw = with_w ? bw[my] : 0.0;
+  for (int my = m0; my < m1; ++my) {
+    const double cu = bu[my], cv = with_v ? bv[my] : 0.0, cw = with_w ? bw[my] : 0.0;
     const double pp = (gx * cu + gy[my] * cv + gz * cw) * il[my];
     const double inv = id[my];
     const double ru = (cu - gx * pp) * inv, rv = (cv - gy[my] * pp) * inv, rw = (cw - gz * pp) * inv;
     if (subtract) {
       xu[my] = scale * (xu[my] - ru);
       xp[my] = scale * (xp[my] - pp);
-      xv[my] = scale * (xv[my] - rv);
+      if (with_v) xv[my] = scale * (xv[my] - rv);
       if (with_w) xw[my] = scale * (xw[my] - rw);
     } else {
       xu[my] = scale * ru;
       xp[my] = scale * pp;
-      xv[my] = scale * rv;
+      if (with_v) xv[my] = scale * rv;
       if (with_w) xw[my] = scale * rw;
     }
   }
+}
+
+template <bool subtract, bool with_w>
+void apply_M_z_row(int ny, const double* bu, const double* bv, const double* bw, double* xu, double* xv, double* xw,
+                   double* xp, const double* gy, double gx, double gz, const double* il, const double* id,
+                   double scale) {
+  apply_M_row<subtract, false, with_w>(0, 1, bu, bv, bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
+  apply_M_row<subtract, true, with_w>(1, ny, bu, bv, bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
 }
 
 }  // namespace
 
 void CapacitanceStokes::Impl::apply_M(const double* B, double* X, double gx, const Scratch& s, double scale,
                                       bool subtract) const {
+  auto* row = subtract ? (apply_M_z_row<true, true>) : (apply_M_z_row<false, true>);
+  auto* row0 = subtract ? (apply_M_z_row<true, false>) : (apply_M_z_row<false, false>);
   for (int mz = 0; mz < nz; ++mz) {
-    const double gz = dz.g[mz];
     const std::size_t iu = std::size_t(mz) * ny, iv = std::size_t(mz) * (ny + 1);
-    const double* Bu = B + off[0] + iu;
-    const double* Bv = B + off[1] + iv;
-    const double* Bw = B + off[2] + iu;
-    double* xu = X + off[0] + iu;
-    double* xv = X + off[1] + iv;
-    double* xw = X + off[2] + iu;
-    double* xp = X + off[3] + iu;
-    const double* il = s.inv_lam.data() + iu;
-    const double* id = s.inv_den.data() + iu;
-    {  // my = 0: no v coefficient
-      const double cu = Bu[0], cw = mz ? Bw[0] : 0.0;
-      const double pp = (gx * cu + gz * cw) * il[0];
-      const double ru = (cu - gx * pp) * id[0], rw = (cw - gz * pp) * id[0];
-      if (subtract) {
-        xu[0] = scale * (xu[0] - ru);
-        xp[0] = scale * (xp[0] - pp);
-        if (mz) xw[0] = scale * (xw[0] - rw);
-      } else {
-        xu[0] = scale * ru;
-        xp[0] = scale * pp;
-        if (mz) xw[0] = scale * rw;
-      }
-    }
-    const double* gy = dy.g.data();
-    if (subtract) {
-      if (mz)
-        apply_M_row<true, true>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
-      else
-        apply_M_row<true, false>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
-    } else {
-      if (mz)
-        apply_M_row<false, true>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
-      else
-        apply_M_row<false, false>(1, ny, Bu, Bv, Bw, xu, xv, xw, xp, gy, gx, gz, il, id, scale);
-    }
+    (mz ? row : row0)(ny, B + off[0] + iu, B + off[1] + iv, B + off[2] + iu, X + off[0] + iu, X + off[1] + iv,
+                      X + off[2] + iu, X + off[3] + iu, dy.g.data(), gx, dz.g[mz], s.inv_lam.data() + iu,
+                      s.inv_den.data() + iu, scale);
   }
 }
 
@@ -333,14 +310,18 @@ void CapacitanceStokes::Impl::mode_from_spectral(int kx, double* const F[2], int
   if (np == 2) rotate(F[0], F[1], kx, -1);
   for (int q = 0; q < np; ++q) {
     double* f = F[q];
-    for (int k = 0; k < nz; ++k) {
-      f[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
-      f[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
-    }
-    std::fill(f + off[2], f + off[2] + ny, 0.0);
-    std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
+    zero_wall_slots(f);
     for (int c = 0; c < (pressure ? 4 : 3); ++c) yz_transform(c, f, s.tb.data(), true);
   }
+}
+
+void CapacitanceStokes::Impl::zero_wall_slots(double* f) const {
+  for (int k = 0; k < nz; ++k) {
+    f[off[1] + std::size_t(k) * (ny + 1)] = 0.0;
+    f[off[1] + std::size_t(k) * (ny + 1) + ny] = 0.0;
+  }
+  std::fill(f + off[2], f + off[2] + ny, 0.0);
+  std::fill(f + off[2] + std::size_t(nz) * ny, f + off[2] + std::size_t(nz + 1) * ny, 0.0);
 }
 
 // Rotation of the x component of a paired mode into the real frame, q = i e^{i theta/2} u^

@@ -199,7 +199,7 @@ void LineTransform::along(const double* in, int ld_in, double* out, int ld_out, 
   if (n_ == 0 || lines <= 0) return;
   thread_local std::vector<double> ws;
   const int to_rows = output_split_ ? ne_ : no_;
-  ws.resize(std::size_t(lines) * (2 * ne_ + 2 * to_rows + 2));
+  ws.resize(std::size_t(lines) * (output_split_ ? 2 * ne_ : 2 * (ne_ + no_)));
   double* e = ws.data();                          // lines x ne
   double* o = e + std::size_t(lines) * ne_;        // lines x to_rows
   if (output_split_) {

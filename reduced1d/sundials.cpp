@@ -207,6 +207,12 @@ int dotprodmulti(int nv, N_Vector x, N_Vector* Y, double* out) {
   for (int k = 0; k < nv; ++k) out[k] = dotprod(x, Y[k]);
   return 0;
 }
+// SUNMatZero for a band matrix (the integrators zero it before every Jacobian fill): one
+// memset of its storage instead of the element loop.
+int band_zero(SUNMatrix A) {
+  std::memset(SM_DATA_B(A), 0, sizeof(realtype) * std::size_t(SM_LDATA_B(A)));
+  return SUNMAT_SUCCESS;
+}
 }  // namespace fast
 
 Vector make_vector(long n, SUNContext ctx) {
@@ -237,18 +243,9 @@ Vector make_vector(long n, SUNContext ctx) {
   return v;
 }
 
-namespace {
-// SUNMatZero for a band matrix (the integrators zero it before every Jacobian fill): one
-// memset of its storage instead of the distribution's unoptimised element loop.
-int band_zero(SUNMatrix A) {
-  std::memset(SM_DATA_B(A), 0, sizeof(realtype) * std::size_t(SM_LDATA_B(A)));
-  return SUNMAT_SUCCESS;
-}
-}  // namespace
-
 Matrix make_band_matrix(long n, long mu, long ml, SUNContext ctx) {
   Matrix A(check_ptr(SUNBandMatrix(n, mu, ml, ctx), "SUNBandMatrix"));
-  A.get()->ops->zero = band_zero;
+  A.get()->ops->zero = fast::band_zero;
   return A;
 }
 
