@@ -109,7 +109,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     summary["best_scene"] = sw.design(best);
   }
   output::write_json(out + "/screen.json", summary);
-  std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric};
+  std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name};
   for (const auto& a : sw.axes) plot_args.push_back(a.key);
   plot("plot_screen.py", plot_args);
 

@@ -67,8 +67,10 @@ Axis read_axis(const std::string& key, const json& spec) {
     for (long i = 0; i < n; ++i) {
       const double s = n == 1 ? 0.0 : double(i) / double(n - 1);
       const double v = spacing == "log" ? from * std::pow(to / from, s) : from + (to - from) * s;
+      // The values go into scenes and printouts as written: rounded to 8 significant digits,
+      // so that 0.35 + 0.1 reads 0.45 (not 0.44999999999999996) in designs.csv and screen.json.
       if (unit.empty())
-        a.values.push_back(v);
+        a.values.push_back(std::stod(num(v)));
       else
         a.values.push_back(num(v) + " " + unit);
     }
@@ -134,6 +136,7 @@ Sweep read_sweep(const std::string& path, const std::vector<std::string>& metric
   namespace fs = std::filesystem;
   const json j = scene::load_file(path);
   Sweep sw;
+  sw.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : fs::path(path).stem().string();
   const fs::path dir = fs::path(path).parent_path();
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.key() != "base" && it.key() != "vary" && it.key() != "metric" && it.key() != "goal" &&

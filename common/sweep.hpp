@@ -26,6 +26,7 @@ struct Axis {
 };
 
 struct Sweep {
+  std::string name;          ///< the sweep's "name", or its file name without extension
   json base;                 ///< the base scene
   std::string base_dir;      ///< directory for relative paths inside the base scene
   std::vector<Axis> axes;

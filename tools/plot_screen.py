@@ -1,6 +1,6 @@
 """Plot a design sweep: displacement and mean velocity over the swept keys.
 
-usage: plot_screen.py DESIGNS_CSV OUT_PNG METRIC KEY [KEY ...]
+usage: plot_screen.py DESIGNS_CSV OUT_PNG METRIC SWEEP_NAME KEY [KEY ...]
 Keys with a single value are ignored; with two or more varying keys the first two are
 mapped (others are summarised by the best value over them). Colour scales are logarithmic
 when the positive values span more than a decade; axes and colour bars carry SI-prefixed
@@ -8,7 +8,6 @@ units.
 """
 import csv
 import math
-import os
 import sys
 
 import matplotlib
@@ -58,7 +57,7 @@ def label(name, unit_label):
     return f"{text} [{unit_label}]" if unit_label else text
 
 
-def main(csv_path, png, metric, keys):
+def main(csv_path, png, metric, name, keys):
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
     swept = {}
@@ -70,7 +69,6 @@ def main(csv_path, png, metric, keys):
     varying = list(swept)
     panels = [m for m in ("displacement_m", "mean_velocity_m_per_s") if m != metric] + [metric]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.8 * len(panels), 4.8), squeeze=False)
-    name = os.path.splitext(os.path.basename(os.path.dirname(os.path.abspath(csv_path))))[0]
     fig.suptitle(f"Design sweep {name}: {len(rows)} designs (best by {LABELS.get(metric, (metric,))[0]})")
     for ax, m in zip(axes[0], panels):
         unit = LABELS.get(m, (m, ""))[1]
@@ -106,4 +104,4 @@ def main(csv_path, png, metric, keys):
 
 
 if __name__ == "__main__":
-    main(sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4:])
+    main(sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4], sys.argv[5:])

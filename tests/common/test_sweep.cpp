@@ -47,6 +47,21 @@ TEST(Sweep, LogSpacingIsGeometricAndNullRemovesKeys) {
   EXPECT_FALSE(sw.design(0)["protocol"].contains("total_force"));
 }
 
+TEST(Sweep, NumericRangesReadAsWrittenAndTheSweepKeepsItsName) {
+  // 0.35 + 0.1 * 1 is 0.44999999999999996 in binary; the sweep writes the value a user
+  // would type, so that designs.csv, screen.json and the printed best design read 0.45.
+  json j = {{"name", "ratios"},
+            {"base", json::object()},
+            {"vary", {{"wave.contracted_ratio", {{"from", 0.35}, {"to", 0.85}, {"count", 6}}}}}};
+  const auto sw = swim::sweep::read_sweep(write_tmp(j, "sweep_c.json"), kMetrics);
+  ASSERT_EQ(sw.axes[0].values.size(), 6u);
+  const char* expected[] = {"0.35", "0.45", "0.55", "0.65", "0.75", "0.85"};
+  for (size_t k = 0; k < 6; ++k) EXPECT_EQ(sw.axes[0].values[k].dump(), expected[k]) << k;
+  EXPECT_EQ(sw.name, "ratios");
+  j.erase("name");
+  EXPECT_EQ(swim::sweep::read_sweep(write_tmp(j, "sweep_d.json"), kMetrics).name, "sweep_d");
+}
+
 TEST(Sweep, MalformedSweepsNameTheKey) {
   struct Case {
     json j;
