@@ -20,12 +20,13 @@ struct RunOptions {
 
 int run(const RunOptions& o);
 int demo(const std::string& out, int progress);
-int screen(const std::string& sweep, const std::string& out, int jobs, int progress);
+int screen(const std::string& sweep, const std::string& out, int jobs, int progress, bool overwrite);
 int bench(const std::string& out, bool quick, bool paper_cycle, const std::string& tier = "all");
 int scenes();
 /// swim calibrate: C1 of the 1D tier from 3D uniform loads (validation/calibration.hpp).
 /// wet: also confirm one load with a fluid-coupled 3D run (minutes at the default grid).
-int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out, bool wet);
+int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out, bool wet,
+              bool overwrite);
 
 /// swim validate: the 1D-vs-3D validation suite and its report (validation/suite.hpp).
 /// only: case filter (scene file names); empty: every case.

@@ -7,6 +7,7 @@
 #include "app/app.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/run_folder.hpp"
 #include "common/scene.hpp"
 #include "common/si_format.hpp"
 #include "full3d/scene3d.hpp"
@@ -16,12 +17,16 @@
 namespace swim::app {
 
 int calibrate(const std::string& scene_path, const std::vector<std::string>& sets, const std::string& out_opt,
-              bool wet) {
+              bool wet, bool overwrite) {
   scene::json sc = scene::load_file(scene_path);
   for (const auto& s : sets) scene::apply_override(sc, s);
   scene::json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
   const std::string out = out_opt.empty() ? "out/" + p.name + "-calibration" : out_opt;
+  // The folder belongs to this calibration from the start: a folder in use, or holding another
+  // run's results (without --overwrite), is refused before minutes of 3D runs.
+  output::RunFolder folder(out, {"calibration", {{"scene", resolved}, {"wet", wet}}, overwrite, false, "--out",
+                                 "calibration.json"});
   const auto t0 = std::chrono::steady_clock::now();
   const auto loads = validation::default_loads(p);
   const validation::StaticCalibration c = validation::calibrate_static(p, loads);

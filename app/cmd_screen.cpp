@@ -8,6 +8,7 @@
 #include "common/output.hpp"
 #include "common/si_format.hpp"
 #include "common/progress.hpp"
+#include "common/run_folder.hpp"
 #include "common/sweep.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/screen.hpp"
@@ -34,7 +35,7 @@ std::string csv_field(std::string s) {
 
 }  // namespace
 
-int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, int progress) {
+int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, int progress, bool overwrite) {
   const sweep::Sweep sw = sweep::read_sweep(sweep_path, reduced1d::metric_names());
   // Validate every design before running any of them (exit 2, nothing written).
   std::vector<reduced1d::Params> designs;
@@ -49,7 +50,11 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   }
   const std::string name = fs::path(sweep_path).stem().string();
   const std::string out = out_opt.empty() ? "out/screen-" + name : out_opt;
-  output::make_dir(out);
+  // The folder belongs to this sweep (lock, another run's results refused unless --overwrite,
+  // the same sweep's finished results replaced); the sweep is identified by what it runs.
+  scene::json identity = {{"base", sw.base}, {"metric", sw.metric}, {"goal", sw.maximize ? "max" : "min"}};
+  for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
+  output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json"});
 
   Progress bar("screen " + name, static_cast<double>(designs.size()), progress);
   size_t finished = 0;
@@ -95,7 +100,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   }
   csv_file.commit();
 
-  scene::json summary = {{"sweep", sweep_path},
+  scene::json summary = {{"status", best >= 0 ? "ok" : "failed: every design failed numerically"},
+                         {"sweep", sweep_path},
                          {"designs", results.size()},
                          {"failed", failed},
                          {"metric", sw.metric},
@@ -108,10 +114,10 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     summary["best_metric_value"] = reduced1d::metric_value(results[best].metrics, sw.metric);
     summary["best_scene"] = sw.design(best);
   }
-  output::write_json(out + "/screen.json", summary);
   std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name};
   for (const auto& a : sw.axes) plot_args.push_back(a.key);
   plot("plot_screen.py", plot_args);
+  output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
 
   std::printf("screened %zu designs in %.3g s (%.4g designs/s), %ld failed\n", results.size(), wall,
               summary["designs_per_s"].get<double>(), failed);

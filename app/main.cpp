@@ -1,10 +1,11 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
 //   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
-//   swim screen SWEEP.json [--out DIR] [--jobs N]
+//   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite]
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|all]
 //   swim scenes
-//   swim demo
+//   swim demo [--out DIR]
+//   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--overwrite]
 //
 // Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure or a result
 // file that could not be written (partial results kept, marked failed), 1 anything
@@ -51,6 +52,8 @@ int main(int argc, char** argv) {
   scr->add_option("sweep", sweep, "Sweep file (JSON)")->required();
   scr->add_option("--out", out, "Output directory (default out/screen-<sweep name>)");
   scr->add_option("--jobs", jobs, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+  bool scr_overwrite = false;
+  scr->add_flag("--overwrite", scr_overwrite, "Replace another run's results in the output folder (its files are removed first)");
   add_progress(scr);
 
   bool quick = false;
@@ -73,6 +76,9 @@ int main(int argc, char** argv) {
   cal->add_option("--out", cal_out, "Output directory (default out/<name>-calibration)");
   cal->add_option("--set", cal_sets, "Override a scene value: key.path=value");
   bool cal_wet = false;
+  bool cal_overwrite = false;
+  cal->add_flag("--overwrite", cal_overwrite,
+                "Replace another run's results in the output folder (its files are removed first)");
   cal->add_flag("--wet", cal_wet, "Also confirm the largest fitted load with a fluid-coupled 3D run, the wall held axisymmetric as in the static path (up to 4 000 steps: minutes)");
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
   std::string val_suite, val_out;
@@ -103,10 +109,10 @@ int main(int argc, char** argv) {
       return app::run(ro);
     }
     if (*demo) return app::demo(out, progress);
-    if (*scr) return app::screen(sweep, out, jobs, progress);
+    if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite);
     if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
     if (*sc) return app::scenes();
-    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet);
+    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);
   } catch (const InputError& e) {
     std::fprintf(stderr, "swim: %s\n", e.what());

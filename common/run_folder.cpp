@@ -79,14 +79,17 @@ bool RunFolder::is_result_name(const std::string& rel) {
   static const std::set<std::string> fixed = {"summary.json",  "series.csv",     "radius.csv",  "series.csv.part",
                                               "radius.csv.part", "solver_stats.json",
                                               "scene.resolved.json", "checkpoint.bin", "membrane.pvd", "fluid.pvd",
-                                              "run.png",       "vtk",            kOwner};
+                                              "run.png",       "vtk",            kOwner,
+                                              // swim screen, swim calibrate
+                                              "designs.csv", "screen.json", "screen.png", "calibration.json",
+                                              "calibration.png"};
   if (fixed.count(rel)) return true;
   static const std::regex frames(R"(vtk/(membrane_\d+\.vtp|fluid_\d+\.vti))");
   static const std::regex temps(R"((vtk/)?\.[^/]+\.tmp(-\d+)?)");
   return std::regex_match(rel, frames) || std::regex_match(rel, temps);
 }
 
-RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::move(dir)) {
+RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::move(dir)), summary_(o.summary) {
   const std::string shown = "\"" + dir_ + "\"";
   std::error_code ec;
   if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
@@ -116,7 +119,7 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
   try {
     // 2. What the folder holds.
     std::vector<std::string> results, foreign;
-    const scene::json old_summary = read_json(fs::path(dir_) / "summary.json");
+    const scene::json old_summary = read_json(fs::path(dir_) / o.summary);
     std::set<std::string> listed;
     if (old_summary.is_object() && old_summary.contains("files") && old_summary["files"].is_array())
       for (const auto& f : old_summary["files"])
@@ -167,10 +170,11 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
                          "holds the results of another run (" + (old_tier.empty() ? "" : old_tier + ", ") +
                              (old_status.empty() ? "no summary" : "status \"" + message_text(old_status, 60) + "\"") +
                              ": " + list(results) +
-                             "); give --overwrite to replace them, --resume to continue an interrupted 3D run, or "
-                             "another --out");
+                             "); give --overwrite to replace them, " +
+                             (o.tier == "1d" || o.tier == "3d" ? "--resume to continue an interrupted 3D run, " : "") +
+                             "or another --out");
       // Clear the old run's files: the summary first (it would otherwise claim them).
-      fs::remove(fs::path(dir_) / "summary.json", ec);
+      fs::remove(fs::path(dir_) / o.summary, ec);
       std::sort(results.begin(), results.end(), [](const std::string& a, const std::string& b) { return a > b; });
       for (const auto& r : results) {
         fs::remove(fs::path(dir_) / r, ec);  // files first (reverse order puts vtk/x before vtk)
@@ -196,7 +200,7 @@ RunFolder::~RunFolder() {
 }
 
 bool RunFolder::mark_failed(const std::string& message) noexcept {
-  const fs::path summary = fs::path(dir_) / "summary.json";
+  const fs::path summary = fs::path(dir_) / summary_;
   try {
     scene::json s = read_json(summary);
     if (!s.is_object()) s = scene::json::object();

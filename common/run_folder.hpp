@@ -8,6 +8,8 @@
 //     the old run's files are removed first. Re-running the identical resolved scene on
 //     the same tier replaces a finished run's results (its files are removed first) without
 //     --overwrite; an interrupted (resumable) run is only replaced with --overwrite.
+//   - The same holds for `swim screen` and `swim calibrate` folders (tiers "screen" and
+//     "calibration"; their status is in screen.json and calibration.json).
 //   - Files swim did not write (not a result name, not listed in the old summary.json) are
 //     never removed: such a folder is refused even with --overwrite.
 //   - `resume` continues only a run of the same tier whose folder holds a checkpoint.
@@ -23,11 +25,14 @@
 namespace swim::output {
 
 struct RunFolderOptions {
-  std::string tier;        ///< "1d" or "3d"
-  scene::json resolved;    ///< the resolved scene of this run (its hash identifies the run)
+  std::string tier;        ///< "1d", "3d", "screen" or "calibration"
+  scene::json resolved;    ///< the resolved scene (or sweep) of this run (its hash identifies the run)
   bool overwrite = false;  ///< --overwrite
   bool resume = false;     ///< --resume
   std::string key = "--out";  ///< the flag named in messages
+  /// The file written last, whose "status" says whether the run finished ("summary.json";
+  /// "screen.json" for a sweep, "calibration.json" for a calibration).
+  std::string summary = "summary.json";
 };
 
 class RunFolder {
@@ -40,7 +45,7 @@ class RunFolder {
   RunFolder& operator=(const RunFolder&) = delete;
 
   const std::string& dir() const { return dir_; }
-  /// Best effort, never throws: summary.json's status becomes "failed: <message>" (the
+  /// Best effort, never throws: the summary's status becomes "failed: <message>" (the
   /// file is removed when it cannot be rewritten). Returns false when it had to be removed.
   bool mark_failed(const std::string& message) noexcept;
 
@@ -52,6 +57,7 @@ class RunFolder {
 
  private:
   std::string dir_;
+  std::string summary_;
   int lock_fd_ = -1;
 };
 

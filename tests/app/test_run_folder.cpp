@@ -1,7 +1,8 @@
 // A run folder belongs to one run, and its files never lie: atomic result files, exit 3 on a
 // write failure (injected full disk) with nothing claiming success, the lock against two
 // runs on one folder, stale results from another run refused or cleared with --overwrite,
-// --resume only for the run the folder belongs to, and the output-size limit.
+// --resume only for the run the folder belongs to, the output-size limit, and the same
+// ownership for the folders of swim screen and swim calibrate.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -494,4 +495,73 @@ TEST(CalibrateCli, AFailedHydraulicMeasurementKeepsTheMeasuredStiffness) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("hydraulic"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "run"));
+}
+
+// swim screen and swim calibrate own their output folders like swim run: a folder holding
+// another run's results is refused (exit 2, nothing touched) unless --overwrite, the same
+// sweep's finished results are replaced, files swim did not write are never removed.
+TEST(ScreenCli, AnotherSweepsResultsAreRefusedOrReplacedWithOverwrite) {
+  const fs::path d = tmpdir("screen");
+  const fs::path out = d / "sweep";
+  auto sweep_file = [&](const std::string& name, const json& lengths) {
+    const json j = {{"name", name},
+                    {"base", kDemo},
+                    {"vary", {{"wave.kind", {"step"}}, {"protocol", {nullptr}}, {"swimmer.length", lengths}}}};
+    const fs::path p = d / (name + ".json");
+    std::ofstream(p) << j.dump();
+    return p.string();
+  };
+  const std::string a = sweep_file("a", {"0.3 um", "0.4 um"}), b = sweep_file("b", {"0.5 um"});
+  auto screen = [&](const std::string& sweep, const fs::path& dir, const std::string& flags = "") {
+    return swim_cli("screen \"" + sweep + "\" --jobs 1 --out \"" + dir.string() + "\"" + flags, d);
+  };
+  Cli c = screen(a, out);
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_EQ(json::parse(slurp(out / "screen.json"))["status"], "ok");
+  EXPECT_EQ(json::parse(slurp(out / ".swim-run.json"))["tier"], "screen");
+  EXPECT_EQ(screen(a, out).code, 0);  // the same sweep replaces its own results
+  const std::string before = slurp(out / "screen.json"), designs = slurp(out / "designs.csv");
+  c = screen(b, out);  // another sweep
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("--overwrite"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("--resume"), std::string::npos) << c.err;  // not a 3D run to continue
+  EXPECT_EQ(slurp(out / "screen.json"), before);
+  EXPECT_EQ(slurp(out / "designs.csv"), designs);
+  c = swim_cli("run \"" + kDemo + "\" --out \"" + out.string() + "\"", d);  // a 1D run into the sweep's folder
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_EQ(slurp(out / "designs.csv"), designs);
+  c = screen(b, out, " --overwrite");
+  ASSERT_EQ(c.code, 0) << c.err;
+  EXPECT_NE(slurp(out / "designs.csv").find("0.5 um"), std::string::npos);
+  EXPECT_EQ(slurp(out / "designs.csv").find("0.3 um"), std::string::npos);
+  // a run folder and a folder with a file of the user's are refused, even with --overwrite
+  const fs::path run = d / "run";
+  ASSERT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + run.string() + "\"", d).code, 0);
+  const std::string run_summary = slurp(run / "summary.json");
+  EXPECT_EQ(screen(a, run).code, 2);
+  EXPECT_EQ(slurp(run / "summary.json"), run_summary);
+  EXPECT_FALSE(fs::exists(run / "designs.csv"));
+  const fs::path mine = d / "mine";
+  fs::create_directories(mine);
+  std::ofstream(mine / "notes.txt") << "mine";
+  c = screen(a, mine, " --overwrite");
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("notes.txt"), std::string::npos) << c.err;
+  EXPECT_EQ(slurp(mine / "notes.txt"), "mine");
+  EXPECT_FALSE(fs::exists(mine / "designs.csv"));
+  fs::remove_all(d);
+}
+
+TEST(CalibrateCli, AFolderHoldingAnotherRunsResultsIsRefused) {
+  const fs::path d = tmpdir("calibrate_guard");
+  const fs::path run = d / "run";
+  ASSERT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + run.string() + "\"", d).code, 0);
+  const std::string run_summary = slurp(run / "summary.json");
+  const Cli c = swim_cli("calibrate \"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json\" --out \"" + run.string() + "\"",
+                         d, "", false);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("--overwrite"), std::string::npos) << c.err;
+  EXPECT_EQ(slurp(run / "summary.json"), run_summary);
+  EXPECT_FALSE(fs::exists(run / "calibration.json"));
+  fs::remove_all(d);
 }
