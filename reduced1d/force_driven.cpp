@@ -1182,7 +1182,10 @@ class IdaBackend final : public Backend {
     sun::check(IDASetId(mem, id_.get()), "IDASetId");
     A_ = sun::make_band_matrix(M.n, M.band_mu, M.band_ml, ctx_.get());
     pb.low_rank.scale = nullptr;  // IDA: J = dF/dy + cj dF/dy', the segment terms are in dF/dy
-    LS_ = sun::make_low_rank_band_solver(y_.get(), A_.get(), &pb.low_rank, ctx_.get());
+    // The Newton matrix is block tridiagonal over the cells (stride unknowns each) with the
+    // swimmer integrals as a border: factored by blocks (docs/performance-1d.md).
+    LS_ = sun::make_low_rank_block_solver(y_.get(), A_.get(), &pb.low_rank, sun::CellBlocks{1, M.stride, M.N},
+                                          ctx_.get());
     sun::check(IDASetLinearSolver(mem, LS_.get(), A_.get()), "IDASetLinearSolver");
     sun::check(IDASetJacFn(mem, &IdaBackend::jac), "IDASetJacFn");
     sun::check(IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn");

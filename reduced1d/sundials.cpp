@@ -369,28 +369,6 @@ struct BandLU {
   }
 };
 
-struct LowRankContent {
-  BandLU lu;
-  LowRankTerm* term = nullptr;
-  int rank = 0;     // rank used at the last setup
-  double s = 1.0;   // scale at the last setup
-  long n = 0;
-  std::vector<double> Qc;  // Q, column-major n x rank (U = Q R, Q orthonormal); setup workspace
-  std::vector<double> Z;   // M^{-1} Q, row-major n x rank
-  std::vector<double> W;   // V R^T, row-major n x rank: U V^T = Q W^T
-  std::vector<double> R;   // rank x rank, column-major
-  std::vector<double> S;   // I + s W^T Z, LU-factored in place (rank x rank)
-  std::vector<int> piv;
-  std::vector<double> w;   // rank workspace
-  int last = 0;
-};
-LowRankContent* lr(SUNLinearSolver S) { return static_cast<LowRankContent*>(S->content); }
-
-SUNLinearSolver_Type lr_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
-SUNLinearSolver_ID lr_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
-int lr_init(SUNLinearSolver) { return 0; }
-sunindextype lr_lastflag(SUNLinearSolver S) { return lr(S)->last; }
-
 // LU with partial pivoting of a small dense column-major matrix; returns false if singular.
 bool small_lu(std::vector<double>& a, std::vector<int>& piv, int r) {
   for (int k = 0; k < r; ++k) {
@@ -420,10 +398,314 @@ void small_solve(const std::vector<double>& a, const std::vector<int>& piv, int 
   }
 }
 
+// Block LU of a band matrix whose cells form a block tridiagonal matrix (CellBlocks), with a
+// border of unknowns that no cell row references: A = [T 0; F G]. T = Lt Ut with Lt block
+// lower bidiagonal (diagonal blocks D_k, subdiagonal blocks the matrix's own L_k) and Ut unit
+// block upper bidiagonal (Up_k = D_k^{-1} U_k); D_k = A_kk - L_k Up_{k-1} is inverted
+// explicitly (Gauss-Jordan with partial pivoting), so that both sweeps of a solve are dense
+// S x S products per cell, independent across rows. The border follows from G x_B = b_B - F x_T.
+struct BlockTri {
+  long n = 0, o = 0, N = 0;
+  int S = 0, nb = 0;
+  std::vector<int> bpos;          // unknown -> position in the border, or -1
+  std::vector<long> border;       // border unknowns
+  // per cell, S x S column-major (entry (r, c) at [c S + r]): L_k (columns of cell k - 1),
+  // D_k^{-1}, Up_k = D_k^{-1} U_k
+  std::vector<double> Lw, Dinv, Up;
+  struct Entry {
+    int row;
+    long col;
+    double v;
+  };
+  std::vector<Entry> F;       // the border rows' entries in cell columns
+  std::vector<double> G;      // nb x nb, column-major, LU-factored in place
+  std::vector<int> gpiv;
+  std::vector<double> bt;  // workspace
+  double growth = 0;          // largest ||D_k||_max ||D_k^{-1}||_max S of the last factor()
+
+  /// Block sizes with a compiled kernel (3: wall inertia alone; 3 + J with the traction's J
+  /// fields, J = 5 to 10 from the |k| quadrature).
+  static bool supported(int s) { return s >= 3 && s <= 14; }
+
+  void resize(long n_, const CellBlocks& c) {
+    n = n_, o = c.offset, S = c.block, N = c.count;
+    bpos.assign(n, -1);
+    border.clear();
+    for (long i = 0; i < n; ++i)
+      if (i < o || i >= o + S * N) bpos[i] = int(border.size()), border.push_back(i);
+    nb = int(border.size());
+    const std::size_t blk = std::size_t(S) * S * N;
+    Lw.assign(blk, 0.0), Dinv.assign(blk, 0.0), Up.assign(blk, 0.0);
+    G.assign(std::size_t(nb) * nb, 0.0);
+    gpiv.assign(nb, 0);
+    bt.assign(nb, 0.0);
+  }
+
+  /// Band entry (i, j), zero outside the band.
+  static double band_at(SUNMatrix M, long i, long j) {
+    const long d = i - j;
+    return (d > SM_LBAND_B(M) || -d > SM_UBAND_B(M)) ? 0.0 : SM_COLUMN_B(M, j)[d];
+  }
+
+  /// Rows [r0, r0 + s) of band column j into dst (zero outside the band): a contiguous run
+  /// of the column's storage.
+  template <int s>
+  static void column_run(SUNMatrix M, long j, long r0, double* dst) {
+    const long mu = SM_UBAND_B(M), ml = SM_LBAND_B(M);
+    const double* col = SM_COLUMN_B(M, j);
+    // rows r with -mu <= r0 + r - j <= ml; the others are zero (a fixed-length loop with a
+    // clamped index: no library copy with its start-up cost for 3 to 14 entries)
+    for (int r = 0; r < s; ++r) {
+      const long d = r0 + r - j;
+      const double v = col[std::clamp(d, -mu, ml)];
+      dst[r] = (d >= -mu && d <= ml) ? v : 0.0;
+    }
+  }
+
+  /// Copy the three blocks of cell k's rows (columns of cells k - 1, k, k + 1) into L, A, U
+  /// (column-major); false if a band entry of these rows lies outside them.
+  template <int s>
+  bool gather(SUNMatrix M, long k, double* L, double* A, double* Uk) const {
+    const long e = o + s * N, r0 = o + s * k;
+    for (int c = 0; c < s; ++c) {
+      if (k > 0)
+        column_run<s>(M, r0 - s + c, r0, L + c * s);
+      else
+        std::fill(L + c * s, L + c * s + s, 0.0);
+      if (s - 1 <= SM_UBAND_B(M) && s - 1 <= SM_LBAND_B(M)) {  // the diagonal block lies inside the band
+        const double* col = SM_COLUMN_B(M, r0 + c) - c;
+        for (int r = 0; r < s; ++r) A[c * s + r] = col[r];
+      } else {
+        column_run<s>(M, r0 + c, r0, A + c * s);
+      }
+      if (k + 1 < N)
+        column_run<s>(M, r0 + s + c, r0, Uk + c * s);
+      else
+        std::fill(Uk + c * s, Uk + c * s + s, 0.0);
+    }
+    // the rest of these rows' band must be zero: columns left of cell k - 1 (or of the
+    // cells) and right of cell k + 1 (or of the cells) that the band reaches
+    const long lo = std::max(o, r0 - (k > 0 ? s : 0)), hi = std::min(e, r0 + (k + 1 < N ? 2 * s : s));
+    double run[s];
+    for (long j = std::max(0L, r0 - long(SM_LBAND_B(M))); j < lo; ++j) {
+      column_run<s>(M, j, r0, run);
+      for (int r = 0; r < s; ++r)
+        if (run[r] != 0.0) return false;
+    }
+    for (long j = hi; j <= std::min(n - 1, r0 + s - 1 + long(SM_UBAND_B(M))); ++j) {
+      column_run<s>(M, j, r0, run);
+      for (int r = 0; r < s; ++r)
+        if (run[r] != 0.0) return false;
+    }
+    return true;
+  }
+
+  /// Gauss-Jordan inverse with partial pivoting of the column-major s x s matrix Dm (destroyed)
+  /// into Di. Row-major elimination on a column-major buffer inverts the transpose, whose
+  /// inverse read column-major is D^{-1}; its pivots are D's columns.
+  template <int s>
+  static bool invert(double* Dm, double* Di) {
+    for (int r = 0; r < s; ++r)
+      for (int c = 0; c < s; ++c) Di[r * s + c] = r == c ? 1.0 : 0.0;
+    for (int k = 0; k < s; ++k) {
+      int p = k;
+      for (int r = k + 1; r < s; ++r)
+        if (std::abs(Dm[r * s + k]) > std::abs(Dm[p * s + k])) p = r;
+      if (Dm[p * s + k] == 0.0) return false;
+      if (p != k)
+        for (int c = 0; c < s; ++c) std::swap(Dm[k * s + c], Dm[p * s + c]), std::swap(Di[k * s + c], Di[p * s + c]);
+      // the pivot row, scaled, in local copies: the row updates then read memory they do not
+      // write, and vectorise
+      alignas(32) double pd[s], pi[s];
+      const double inv = 1.0 / Dm[k * s + k];
+      for (int c = 0; c < s; ++c) pd[c] = Dm[k * s + c] * inv, pi[c] = Di[k * s + c] * inv;
+      for (int r = 0; r < s; ++r) {
+        const double f = r == k ? 0.0 : Dm[r * s + k];
+        for (int c = 0; c < s; ++c) Dm[r * s + c] -= f * pd[c];
+        for (int c = 0; c < s; ++c) Di[r * s + c] -= f * pi[c];
+      }
+      for (int c = 0; c < s; ++c) Dm[k * s + c] = pd[c], Di[k * s + c] = pi[c];
+    }
+    return true;
+  }
+
+  /// Largest |x_e| of m entries, in four independent chains.
+  template <std::size_t m>
+  static double max_abs(const double* x) {
+    double a[4] = {0, 0, 0, 0};
+    for (std::size_t e = 0; e < m; ++e) a[e & 3] = std::max(a[e & 3], std::abs(x[e]));
+    return std::max(std::max(a[0], a[1]), std::max(a[2], a[3]));
+  }
+
+  template <int s>
+  bool factor_cells(SUNMatrix M) {
+    constexpr std::size_t SS = std::size_t(s) * s;
+    growth = 0;
+    // local copies: the compiler sees that they do not alias, and vectorises the updates
+    alignas(32) double L[SS], Dm[SS], Uk[SS], Di[SS], P[SS], Pp[SS] = {};
+    for (long k = 0; k < N; ++k) {
+      if (!gather<s>(M, k, L, Dm, Uk)) return false;
+      std::copy(L, L + SS, Lw.data() + k * SS);
+      if (k > 0)  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
+        for (int c = 0; c < s; ++c)
+          for (int r = 0; r < s; ++r) {
+            const double l = L[c * s + r];
+            if (l == 0.0) continue;
+            for (int q = 0; q < s; ++q) Dm[q * s + r] -= l * Pp[q * s + c];
+          }
+      const double dmax = max_abs<SS>(Dm);
+      if (!invert<s>(Dm, Di)) return false;
+      growth = std::max(growth, dmax * max_abs<SS>(Di) * s);
+      std::copy(Di, Di + SS, Dinv.data() + k * SS);
+      if (k + 1 < N) {  // Up_k = D_k^{-1} U_k: column c takes D^{-1}'s column r times U(r, c)
+        std::fill(P, P + SS, 0.0);
+        for (int c = 0; c < s; ++c)
+          for (int r = 0; r < s; ++r) {
+            const double u = Uk[c * s + r];
+            if (u == 0.0) continue;
+            for (int q = 0; q < s; ++q) P[c * s + q] += Di[r * s + q] * u;
+          }
+        std::copy(P, P + SS, Up.data() + k * SS);
+        std::copy(P, P + SS, Pp);
+      }
+    }
+    return true;
+  }
+
+  /// Factor; false if the matrix leaves the block structure or a diagonal block is singular.
+  bool factor(SUNMatrix M) {
+    // border rows: G (border columns) and F (cell columns)
+    std::fill(G.begin(), G.end(), 0.0);
+    F.clear();
+    for (int q = 0; q < nb; ++q) {
+      const long i = border[q];
+      for (long j = std::max(0L, i - long(SM_LBAND_B(M))); j <= std::min(n - 1, i + long(SM_UBAND_B(M))); ++j) {
+        const double v = band_at(M, i, j);
+        if (v == 0.0) continue;
+        if (bpos[j] >= 0)
+          G[std::size_t(bpos[j]) * nb + q] = v;
+        else
+          F.push_back({q, j, v});
+      }
+    }
+    bool ok = false;
+    switch (S) {
+#define SWIM_BLOCK_CASE(s) \
+  case s:                  \
+    ok = factor_cells<s>(M); \
+    break;
+      SWIM_BLOCK_CASE(3) SWIM_BLOCK_CASE(4) SWIM_BLOCK_CASE(5) SWIM_BLOCK_CASE(6) SWIM_BLOCK_CASE(7)
+      SWIM_BLOCK_CASE(8) SWIM_BLOCK_CASE(9) SWIM_BLOCK_CASE(10) SWIM_BLOCK_CASE(11) SWIM_BLOCK_CASE(12)
+      SWIM_BLOCK_CASE(13) SWIM_BLOCK_CASE(14)
+#undef SWIM_BLOCK_CASE
+      default:
+        return false;
+    }
+    return ok && (nb == 0 || small_lu(G, gpiv, nb));
+  }
+
+  template <int s>
+  void solve_cells(double* b) {
+    constexpr std::size_t SS = std::size_t(s) * s;
+    alignas(32) double T[s], y[s], x[s];
+    for (int i = 0; i < s; ++i) y[i] = 0.0;
+    for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} (b_k - L_k y_{k-1})
+      double* bk = b + o + k * s;
+      for (int i = 0; i < s; ++i) T[i] = bk[i];
+      if (k > 0) {
+        const double* L = Lw.data() + k * SS;
+        for (int c = 0; c < s; ++c)
+          for (int i = 0; i < s; ++i) T[i] -= L[c * s + i] * y[c];
+      }
+      const double* Di = Dinv.data() + k * SS;
+      for (int i = 0; i < s; ++i) y[i] = 0.0;
+      for (int c = 0; c < s; ++c)
+        for (int i = 0; i < s; ++i) y[i] += Di[c * s + i] * T[c];
+      for (int i = 0; i < s; ++i) bk[i] = y[i];
+    }
+    for (int i = 0; i < s; ++i) x[i] = y[i];  // x_{N-1} = y_{N-1}
+    for (long k = N - 2; k >= 0; --k) {       // x_k = y_k - Up_k x_{k+1}
+      double* xk = b + o + k * s;
+      const double* P = Up.data() + k * SS;
+      for (int i = 0; i < s; ++i) T[i] = xk[i];
+      for (int c = 0; c < s; ++c)
+        for (int i = 0; i < s; ++i) T[i] -= P[c * s + i] * x[c];
+      for (int i = 0; i < s; ++i) x[i] = T[i], xk[i] = T[i];
+    }
+  }
+
+  /// One right-hand side: per cell, dense s x s products as column updates (vectorised
+  /// across the block's rows).
+  void solve(double* b) {
+    switch (S) {
+#define SWIM_BLOCK_CASE(s) \
+  case s:                  \
+    solve_cells<s>(b);     \
+    break;
+      SWIM_BLOCK_CASE(3) SWIM_BLOCK_CASE(4) SWIM_BLOCK_CASE(5) SWIM_BLOCK_CASE(6) SWIM_BLOCK_CASE(7)
+      SWIM_BLOCK_CASE(8) SWIM_BLOCK_CASE(9) SWIM_BLOCK_CASE(10) SWIM_BLOCK_CASE(11) SWIM_BLOCK_CASE(12)
+      SWIM_BLOCK_CASE(13) SWIM_BLOCK_CASE(14)
+#undef SWIM_BLOCK_CASE
+      default:
+        break;
+    }
+    if (nb == 0) return;
+    for (int q = 0; q < nb; ++q) bt[q] = b[border[q]];  // G x_B = b_B - F x_T
+    for (const Entry& e : F) bt[e.row] -= e.v * b[e.col];
+    small_solve(G, gpiv, nb, bt.data());
+    for (int q = 0; q < nb; ++q) b[border[q]] = bt[q];
+  }
+
+  /// r right-hand sides stored row-major (row m: B[m r .. m r + r)), the set-up's low-rank
+  /// columns: one right-hand side at a time through a strided copy.
+  void solve_rows(double* B, int r) {
+    std::vector<double>& x = rows_;
+    x.resize(n);
+    for (int m = 0; m < r; ++m) {
+      for (long i = 0; i < n; ++i) x[i] = B[std::size_t(i) * r + m];
+      solve(x.data());
+      for (long i = 0; i < n; ++i) B[std::size_t(i) * r + m] = x[i];
+    }
+  }
+  std::vector<double> rows_;
+};
+
+// Above this bound on a diagonal block's condition (max-norm estimate), a setup factors the
+// band with partial pivoting across cells instead.
+constexpr double kBlockGrowthLimit = 1e14;
+
+struct LowRankContent {
+  BandLU lu;
+  BlockTri bt;
+  bool blocks = false;     // the block structure is known (make_low_rank_block_solver)
+  bool block_now = false;  // the last setup factored by blocks
+  LowRankTerm* term = nullptr;
+  int rank = 0;     // rank used at the last setup
+  double s = 1.0;   // scale at the last setup
+  long n = 0;
+  std::vector<double> Qc;  // Q, column-major n x rank (U = Q R, Q orthonormal); setup workspace
+  std::vector<double> Z;   // M^{-1} Q, row-major n x rank
+  std::vector<double> W;   // V R^T, row-major n x rank: U V^T = Q W^T
+  std::vector<double> R;   // rank x rank, column-major
+  std::vector<double> S;   // I + s W^T Z, LU-factored in place (rank x rank)
+  std::vector<int> piv;
+  std::vector<double> w;   // rank workspace
+  int last = 0;
+};
+LowRankContent* lr(SUNLinearSolver S) { return static_cast<LowRankContent*>(S->content); }
+
+SUNLinearSolver_Type lr_type(SUNLinearSolver) { return SUNLINEARSOLVER_DIRECT; }
+SUNLinearSolver_ID lr_id(SUNLinearSolver) { return SUNLINEARSOLVER_CUSTOM; }
+int lr_init(SUNLinearSolver) { return 0; }
+sunindextype lr_lastflag(SUNLinearSolver S) { return lr(S)->last; }
+
 int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   LowRankContent* c = lr(S);
-  c->lu.load(A);
-  if (!c->lu.factor()) return c->last = SUNLS_LUFACT_FAIL;
+  c->block_now = c->blocks && c->bt.factor(A) && c->bt.growth < kBlockGrowthLimit;
+  if (!c->block_now) {
+    c->lu.load(A);
+    if (!c->lu.factor()) return c->last = SUNLS_LUFACT_FAIL;
+  }
   c->last = 0;
   const LowRankTerm& t = *c->term;
   c->rank = t.rank;
@@ -467,7 +749,10 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
       Wm[i] = w;
     }
   }
-  c->lu.solve_rows(c->Z.data(), r);
+  if (c->block_now)
+    c->bt.solve_rows(c->Z.data(), r);
+  else
+    c->lu.solve_rows(c->Z.data(), r);
   // S = I + s W^T Z, accumulated row by row (r^2 independent sums).
   c->S.assign(std::size_t(r) * r, 0.0);
   for (long m = 0; m < n; ++m) {
@@ -494,7 +779,10 @@ int lr_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   double* xd = N_VGetArrayPointer(x);
   const double* bd = N_VGetArrayPointer(b);
   if (xd != bd) std::copy(bd, bd + n, xd);
-  c->lu.solve(xd);
+  if (c->block_now)
+    c->bt.solve(xd);
+  else
+    c->lu.solve(xd);
   c->last = 0;
   if (c->rank == 0) return 0;
   const int r = c->rank;
@@ -528,6 +816,20 @@ int lr_free(SUNLinearSolver S) {
   return 0;
 }
 }  // namespace
+
+bool factored_by_blocks(SUNLinearSolver S) { return S->content && lr(S)->block_now; }
+
+LinearSolver make_low_rank_block_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, const CellBlocks& cells,
+                                        SUNContext ctx) {
+  LinearSolver S = make_low_rank_band_solver(y, A, term, ctx);
+  LowRankContent* c = lr(S.get());
+  if (BlockTri::supported(cells.block) && cells.count > 0 && cells.offset >= 0 &&
+      cells.offset + cells.block * cells.count <= c->n) {
+    c->bt.resize(c->n, cells);
+    c->blocks = true;
+  }
+  return S;
+}
 
 LinearSolver make_low_rank_band_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, SUNContext ctx) {
   SUNLinearSolver S = check_ptr(SUNLinSolNewEmpty(ctx), "SUNLinSolNewEmpty");

@@ -107,6 +107,26 @@ struct LowRankTerm {
 /// solver. A must be a SUNBandMatrix with the bandwidths used later.
 LinearSolver make_low_rank_band_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, SUNContext ctx);
 
+/// Block structure of a band matrix whose unknowns are grouped in cells: unknowns
+/// [offset, offset + block * count) are `count` cells of `block` unknowns each; a cell's rows
+/// reach only its own and its two neighbouring cells; the unknowns before and after the cells
+/// (the border) appear in no cell's row.
+struct CellBlocks {
+  long offset = 0;
+  int block = 0;
+  long count = 0;
+};
+
+/// The same solver for a band matrix with the structure of `cells`: the cells are factored
+/// by block LU (block tridiagonal, each diagonal block inverted with partial pivoting), the
+/// border by a small dense LU after them. A setup whose matrix leaves that structure, or
+/// whose diagonal blocks are singular or too ill-conditioned for block elimination, falls
+/// back to the band LU.
+LinearSolver make_low_rank_block_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, const CellBlocks& cells,
+                                        SUNContext ctx);
+/// Whether the last set-up of a solver made by make_low_rank_block_solver factored by blocks.
+bool factored_by_blocks(SUNLinearSolver S);
+
 /// Raw data pointer of a serial vector.
 inline double* data(N_Vector v) { return N_VGetArrayPointer(v); }
 

@@ -1,7 +1,7 @@
 // The project's own SUNDIALS kernels against references: the optimised serial N_Vector
 // operations (installed on every vector of sun::make_vector) against the distribution's
 // serial implementations, and the band + low-rank (Woodbury) linear solver against a dense
-// LU solve of the same matrix.
+// LU solve of the same matrix, also when the band is factored by cell blocks.
 #include <gtest/gtest.h>
 
 #include <Eigen/Dense>
@@ -218,4 +218,76 @@ TEST(SundialsKernels, LowRankBandSolverPivotsTheCapacitanceMatrix) {
       for (long i = 0; i < n; ++i)
         EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-12 * scale) << "n=" << n << " rank=" << rank << " i=" << i;
     }
+}
+
+namespace {
+// A Newton-like matrix with the 1D tier's layout: one border unknown, `cells` cells of `S`
+// unknowns, five border unknowns after them; band mu = S, ml = S + 2. Cell rows reach their
+// own and the neighbouring cells (entries outside the band are left zero), border rows reach
+// anything in the band. Some diagonal entries are small, so that the diagonal blocks must
+// pivot. Returns the same matrix dense.
+Eigen::MatrixXd fill_cells(SUNMatrix A, long cells, int S, Rng& rng) {
+  const long o = 1, n = o + cells * S + 5, mu = S, ml = S + 2;
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(n, n);
+  auto cell = [&](long i) { return (i < o || i >= o + cells * S) ? -1L : (i - o) / S; };
+  for (long i = 0; i < n; ++i)
+    for (long j = std::max(0L, i - ml); j <= std::min(n - 1, i + mu); ++j) {
+      const long ci = cell(i), cj = cell(j);
+      if (ci >= 0 && (cj < 0 || std::abs(ci - cj) > 1)) continue;
+      double v = rng();
+      if (i == j) v = (i % 3 == 0 ? 1e-3 : 4.0) + 0.5 * rng();
+      SM_ELEMENT_B(A, i, j) = v;
+      D(i, j) = v;
+    }
+  return D;
+}
+}  // namespace
+
+// The block-tridiagonal factorisation of the 1D tier's Newton matrix (cells of 9 unknowns,
+// the traction model at N = 200; 3, wall inertia alone; 14, the largest compiled block)
+// against a dense LU of the assembled matrix, with and without the low-rank term; a matrix
+// that leaves the cell structure (an entry in a border column of a cell row) is factored by
+// the band LU instead, with the same answer.
+TEST(SundialsKernels, LowRankBlockSolverMatchesADenseSolve) {
+  auto ctx = sun::make_context();
+  Rng rng{37};
+  for (int S : {3, 9, 14})
+    for (long cells : {1L, 2L, 40L})
+      for (int rank : {0, 3})
+        for (bool foreign : {false, true}) {
+          const long n = 1 + cells * S + 5;
+          auto y = sun::make_vector(n, ctx.get());
+          sun::Matrix A(SUNBandMatrix(n, S, S + 2, ctx.get()));
+          sun::LowRankTerm term;
+          auto solver =
+              sun::make_low_rank_block_solver(y.get(), A.get(), &term, sun::CellBlocks{1, S, cells}, ctx.get());
+          Eigen::MatrixXd D = fill_cells(A.get(), cells, S, rng);
+          if (foreign) {  // cell 0's first row reaches the leading border unknown
+            SM_ELEMENT_B(A.get(), 1, 0) = 0.7;
+            D(1, 0) = 0.7;
+          }
+          term.rank = rank;
+          term.U.assign(std::size_t(n) * rank, 0.0);
+          term.V.assign(std::size_t(n) * rank, 0.0);
+          for (int k = 0; k < rank; ++k)
+            for (long i = 0; i < n; ++i) {
+              term.U[std::size_t(k) * n + i] = rng();
+              term.V[std::size_t(k) * n + i] = 0.1 * rng();
+            }
+          for (int k = 0; k < rank; ++k)
+            for (long i = 0; i < n; ++i)
+              for (long j = 0; j < n; ++j) D(i, j) += term.U[std::size_t(k) * n + i] * term.V[std::size_t(k) * n + j];
+          ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
+          EXPECT_EQ(sun::factored_by_blocks(solver.get()), !foreign) << "S=" << S << " cells=" << cells;
+          auto b = sun::make_vector(n, ctx.get()), x = sun::make_vector(n, ctx.get());
+          Eigen::VectorXd bb(n);
+          for (long i = 0; i < n; ++i) bb(i) = sun::data(b.get())[i] = rng();
+          ASSERT_EQ(SUNLinSolSolve(solver.get(), A.get(), x.get(), b.get(), 0.0), 0);
+          const auto lu = D.partialPivLu();
+          const Eigen::VectorXd ref = lu.solve(bb);
+          const double scale = ref.cwiseAbs().maxCoeff(), cond = 1.0 / lu.rcond();
+          for (long i = 0; i < n; ++i)
+            EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-15 * cond * scale + 1e-13 * scale)
+                << "S=" << S << " cells=" << cells << " rank=" << rank << " foreign=" << foreign << " i=" << i;
+        }
 }
