@@ -339,34 +339,6 @@ struct BandLU {
       for (long i = std::max(0L, j - kv); i < j; ++i) b[i] -= at(i, j) * bj;
     }
   }
-  /// Solve for r right-hand sides at once, stored row-major (row m: B[m * r .. m * r + r)):
-  /// the r substitution chains are independent, so they overlap instead of each waiting on
-  /// its own latency.
-  void solve_rows(double* B, int r) const {
-    for (long j = 0; j < n; ++j) {
-      const long km = std::min<long>(kl, n - 1 - j);
-      double* bj = B + std::size_t(j) * r;
-      if (piv[j] != j) {
-        double* bp = B + std::size_t(piv[j]) * r;
-        for (int k = 0; k < r; ++k) std::swap(bj[k], bp[k]);
-      }
-      for (long q = 1; q <= km; ++q) {
-        const double l = at(j + q, j);
-        double* bq = B + std::size_t(j + q) * r;
-        for (int k = 0; k < r; ++k) bq[k] -= l * bj[k];
-      }
-    }
-    for (long j = n - 1; j >= 0; --j) {
-      double* bj = B + std::size_t(j) * r;
-      const double d = dinv[j];
-      for (int k = 0; k < r; ++k) bj[k] *= d;
-      for (long i = std::max(0L, j - kv); i < j; ++i) {
-        const double u = at(i, j);
-        double* bi = B + std::size_t(i) * r;
-        for (int k = 0; k < r; ++k) bi[k] -= u * bj[k];
-      }
-    }
-  }
 };
 
 // LU with partial pivoting of a small dense column-major matrix; returns false if singular.
@@ -655,19 +627,6 @@ struct BlockTri {
     small_solve(G, gpiv, nb, bt.data());
     for (int q = 0; q < nb; ++q) b[border[q]] = bt[q];
   }
-
-  /// r right-hand sides stored row-major (row m: B[m r .. m r + r)), the set-up's low-rank
-  /// columns: one right-hand side at a time through a strided copy.
-  void solve_rows(double* B, int r) {
-    std::vector<double>& x = rows_;
-    x.resize(n);
-    for (int m = 0; m < r; ++m) {
-      for (long i = 0; i < n; ++i) x[i] = B[std::size_t(i) * r + m];
-      solve(x.data());
-      for (long i = 0; i < n; ++i) B[std::size_t(i) * r + m] = x[i];
-    }
-  }
-  std::vector<double> rows_;
 };
 
 // Above this bound on a diagonal block's condition (max-norm estimate), a setup factors the
@@ -684,8 +643,8 @@ struct LowRankContent {
   double s = 1.0;   // scale at the last setup
   long n = 0;
   std::vector<double> Qc;  // Q, column-major n x rank (U = Q R, Q orthonormal); setup workspace
-  std::vector<double> Z;   // M^{-1} Q, row-major n x rank
-  std::vector<double> W;   // V R^T, row-major n x rank: U V^T = Q W^T
+  std::vector<double> Z;   // M^{-1} Q, column-major n x rank
+  std::vector<double> W;   // V R^T, column-major n x rank: U V^T = Q W^T
   std::vector<double> R;   // rank x rank, column-major
   std::vector<double> S;   // I + s W^T Z, LU-factored in place (rank x rank)
   std::vector<int> piv;
@@ -735,36 +694,30 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
       for (long i = 0; i < n; ++i) qk[i] *= inv;
     }
   }
-  // Z = M^{-1} Q and W = V R^T, both row-major (n x r, row m holds the r entries of cell m)
-  // for the fused loops of lr_solve; the r solves run together.
-  c->Z.assign(std::size_t(n) * r, 0.0);
+  // Z = M^{-1} Q and W = V R^T, column-major (n x r): the passes of lr_solve are then r
+  // contiguous dot products and r contiguous updates.
+  c->Z.assign(Q.begin(), Q.begin() + n * r);
   c->W.assign(std::size_t(n) * r, 0.0);
-  for (long m = 0; m < n; ++m) {
-    double* Wm = c->W.data() + std::size_t(m) * r;
-    double* Zm = c->Z.data() + std::size_t(m) * r;
-    for (int i = 0; i < r; ++i) {
-      Zm[i] = Q[std::size_t(i) * n + m];
-      double w = 0;  // W(m, i) = sum_{k >= i} V(m, k) R(i, k)
-      for (int k = i; k < r; ++k) w += t.V[std::size_t(k) * n + m] * c->R[std::size_t(k) * r + i];
-      Wm[i] = w;
+  for (int i = 0; i < r; ++i) {  // W(:, i) = sum_{k >= i} V(:, k) R(i, k)
+    double* Wi = c->W.data() + std::size_t(i) * n;
+    for (int k = i; k < r; ++k) {
+      const double f = c->R[std::size_t(k) * r + i];
+      const double* Vk = t.V.data() + std::size_t(k) * n;
+      for (long m = 0; m < n; ++m) Wi[m] += Vk[m] * f;
     }
   }
-  if (c->block_now)
-    c->bt.solve_rows(c->Z.data(), r);
-  else
-    c->lu.solve_rows(c->Z.data(), r);
-  // S = I + s W^T Z, accumulated row by row (r^2 independent sums).
+  for (int i = 0; i < r; ++i) {
+    double* Zi = c->Z.data() + std::size_t(i) * n;
+    if (c->block_now)
+      c->bt.solve(Zi);
+    else
+      c->lu.solve(Zi);
+  }
+  // S = I + s W^T Z
   c->S.assign(std::size_t(r) * r, 0.0);
-  for (long m = 0; m < n; ++m) {
-    const double* Wm = c->W.data() + std::size_t(m) * r;
-    const double* Zm = c->Z.data() + std::size_t(m) * r;
-    for (int j = 0; j < r; ++j) {
-      const double z = Zm[j];
-      if (z == 0.0) continue;
-      double* Sj = c->S.data() + std::size_t(j) * r;
-      for (int i = 0; i < r; ++i) Sj[i] += Wm[i] * z;
-    }
-  }
+  for (int j = 0; j < r; ++j)
+    for (int i = 0; i < r; ++i)
+      c->S[std::size_t(j) * r + i] = swim::dot4(c->W.data() + std::size_t(i) * n, c->Z.data() + std::size_t(j) * n, n);
   for (int i = 0; i < r * r; ++i) c->S[i] *= c->s;
   for (int i = 0; i < r; ++i) c->S[std::size_t(i) * r + i] += 1.0;
   c->piv.assign(r, 0);
@@ -786,22 +739,14 @@ int lr_solve(SUNLinearSolver S, SUNMatrix, N_Vector x, N_Vector b, realtype) {
   c->last = 0;
   if (c->rank == 0) return 0;
   const int r = c->rank;
-  // x <- x - Z (I + s W^T Z)^{-1} s W^T x, one pass for W^T x (r independent sums) and one
-  // for the update.
+  // x <- x - Z (I + s W^T Z)^{-1} s W^T x: r dot products, then r updates
   double* w = c->w.data();
-  std::fill(w, w + r, 0.0);
-  for (long m = 0; m < n; ++m) {
-    const double* Wm = c->W.data() + std::size_t(m) * r;
-    const double xm = xd[m];
-    for (int i = 0; i < r; ++i) w[i] += Wm[i] * xm;
-  }
-  for (int i = 0; i < r; ++i) w[i] *= c->s;
+  for (int i = 0; i < r; ++i) w[i] = c->s * swim::dot4(c->W.data() + std::size_t(i) * n, xd, n);
   small_solve(c->S, c->piv, r, w);
-  for (long m = 0; m < n; ++m) {
-    const double* Zm = c->Z.data() + std::size_t(m) * r;
-    double v = 0;
-    for (int j = 0; j < r; ++j) v += Zm[j] * w[j];
-    xd[m] -= v;
+  for (int j = 0; j < r; ++j) {
+    const double* Zj = c->Z.data() + std::size_t(j) * n;
+    const double wj = w[j];
+    for (long m = 0; m < n; ++m) xd[m] -= Zj[m] * wj;
   }
   return 0;
 }
