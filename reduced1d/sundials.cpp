@@ -504,9 +504,15 @@ struct BlockTri {
   /// Largest |x_e| of m entries, in four independent chains.
   template <std::size_t m>
   static double max_abs(const double* x) {
-    double a[4] = {0, 0, 0, 0};
-    for (std::size_t e = 0; e < m; ++e) a[e & 3] = std::max(a[e & 3], std::abs(x[e]));
-    return std::max(std::max(a[0], a[1]), std::max(a[2], a[3]));
+    double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+    std::size_t e = 0;
+    for (; e + 4 <= m; e += 4) {
+      a0 = std::max(a0, std::abs(x[e])), a1 = std::max(a1, std::abs(x[e + 1]));
+      a2 = std::max(a2, std::abs(x[e + 2])), a3 = std::max(a3, std::abs(x[e + 3]));
+    }
+    if constexpr (m % 4 != 0)
+      for (; e < m; ++e) a0 = std::max(a0, std::abs(x[e]));
+    return std::max(std::max(a0, a1), std::max(a2, a3));
   }
 
   template <int s>
