@@ -381,9 +381,12 @@ struct BlockTri {
   int S = 0, nb = 0;
   std::vector<int> bpos;          // unknown -> position in the border, or -1
   std::vector<long> border;       // border unknowns
-  // per cell, S x S column-major (entry (r, c) at [c S + r]): L_k (columns of cell k - 1),
-  // D_k^{-1}, Up_k = D_k^{-1} U_k
-  std::vector<double> Lw, Dinv, Up;
+  // per cell, S x S column-major (entry (r, c) at [c S + r]): D_k^{-1}, Up_k = D_k^{-1} U_k
+  std::vector<double> Dinv, Up;
+  // the nonzeros of each L_k (about one per column): position r + c s and value, cell k's
+  // from lbeg[k] to lbeg[k + 1]
+  std::vector<int> lpos, lbeg;
+  std::vector<double> lval;
   struct Entry {
     int row;
     long col;
@@ -407,7 +410,8 @@ struct BlockTri {
       if (i < o || i >= o + S * N) bpos[i] = int(border.size()), border.push_back(i);
     nb = int(border.size());
     const std::size_t blk = std::size_t(S) * S * N;
-    Lw.assign(blk, 0.0), Dinv.assign(blk, 0.0), Up.assign(blk, 0.0);
+    Dinv.assign(blk, 0.0), Up.assign(blk, 0.0);
+    lpos.clear(), lval.clear(), lbeg.assign(N + 1, 0);
     G.assign(std::size_t(nb) * nb, 0.0);
     gpiv.assign(nb, 0);
     bt.assign(nb, 0.0);
@@ -521,9 +525,12 @@ struct BlockTri {
     growth = 0;
     // local copies: the compiler sees that they do not alias, and vectorises the updates
     alignas(32) double L[SS], Dm[SS], Uk[SS], Di[SS], P[SS], Pp[SS] = {};
+    lpos.clear(), lval.clear();
     for (long k = 0; k < N; ++k) {
       if (!gather<s>(M, k, L, Dm, Uk)) return false;
-      std::copy(L, L + SS, Lw.data() + k * SS);
+      lbeg[k] = int(lpos.size());
+      for (int e = 0; e < int(SS); ++e)
+        if (L[e] != 0.0) lpos.push_back(e), lval.push_back(L[e]);
       if (k > 0)  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
         for (int c = 0; c < s; ++c)
           for (int r = 0; r < s; ++r) {
@@ -535,6 +542,7 @@ struct BlockTri {
       if (!invert<s>(Dm, Di)) return false;
       growth = std::max(growth, dmax * max_abs<SS>(Di) * s);
       std::copy(Di, Di + SS, Dinv.data() + k * SS);
+      lbeg[k + 1] = int(lpos.size());
       if (k + 1 < N) {  // Up_k = D_k^{-1} U_k: column c takes D^{-1}'s column r times U(r, c)
         std::fill(P, P + SS, 0.0);
         for (int c = 0; c < s; ++c)
@@ -582,33 +590,36 @@ struct BlockTri {
     return ok && (nb == 0 || small_lu(G, gpiv, nb));
   }
 
+  /// y = A x for the column-major s x s matrix A, in two independent chains of column updates.
+  template <int s>
+  static void matvec(const double* A, const double* x, double* y) {
+    alignas(32) double y0[s] = {}, y1[s] = {};
+    int c = 0;
+    for (; c + 1 < s; c += 2)
+      for (int i = 0; i < s; ++i) y0[i] += A[c * s + i] * x[c], y1[i] += A[(c + 1) * s + i] * x[c + 1];
+    if constexpr (s % 2 == 1)
+      for (int i = 0; i < s; ++i) y0[i] += A[(s - 1) * s + i] * x[s - 1];
+    for (int i = 0; i < s; ++i) y[i] = y0[i] + y1[i];
+  }
+
   template <int s>
   void solve_cells(double* b) {
     constexpr std::size_t SS = std::size_t(s) * s;
-    alignas(32) double T[s], y[s], x[s];
-    for (int i = 0; i < s; ++i) y[i] = 0.0;
+    alignas(32) double T[s], y[s] = {}, x[s];
+    const int* lp = lpos.data();
+    const double* lv = lval.data();
     for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} (b_k - L_k y_{k-1})
       double* bk = b + o + k * s;
       for (int i = 0; i < s; ++i) T[i] = bk[i];
-      if (k > 0) {
-        const double* L = Lw.data() + k * SS;
-        for (int c = 0; c < s; ++c)
-          for (int i = 0; i < s; ++i) T[i] -= L[c * s + i] * y[c];
-      }
-      const double* Di = Dinv.data() + k * SS;
-      for (int i = 0; i < s; ++i) y[i] = 0.0;
-      for (int c = 0; c < s; ++c)
-        for (int i = 0; i < s; ++i) y[i] += Di[c * s + i] * T[c];
+      for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) T[lp[e] % s] -= lv[e] * y[lp[e] / s];
+      matvec<s>(Dinv.data() + k * SS, T, y);
       for (int i = 0; i < s; ++i) bk[i] = y[i];
     }
     for (int i = 0; i < s; ++i) x[i] = y[i];  // x_{N-1} = y_{N-1}
     for (long k = N - 2; k >= 0; --k) {       // x_k = y_k - Up_k x_{k+1}
       double* xk = b + o + k * s;
-      const double* P = Up.data() + k * SS;
-      for (int i = 0; i < s; ++i) T[i] = xk[i];
-      for (int c = 0; c < s; ++c)
-        for (int i = 0; i < s; ++i) T[i] -= P[c * s + i] * x[c];
-      for (int i = 0; i < s; ++i) x[i] = T[i], xk[i] = T[i];
+      matvec<s>(Up.data() + k * SS, x, T);
+      for (int i = 0; i < s; ++i) x[i] = xk[i] - T[i], xk[i] = x[i];
     }
   }
 
