@@ -439,36 +439,44 @@ struct BlockTri {
   }
 
   /// Copy the three blocks of cell k's rows (columns of cells k - 1, k, k + 1) into L, A, U
-  /// (column-major); false if a band entry of these rows lies outside them.
+  /// (column-major); false if a band entry of these rows lies outside them. The entries of L
+  /// and U outside the band are never written: the caller zeroes them once.
   template <int s>
   bool gather(SUNMatrix M, long k, double* L, double* A, double* Uk) const {
+    const long mu = SM_UBAND_B(M), ml = SM_LBAND_B(M);
     const long e = o + s * N, r0 = o + s * k;
     for (int c = 0; c < s; ++c) {
-      if (k > 0)
-        column_run<s>(M, r0 - s + c, r0, L + c * s);
-      else
-        std::fill(L + c * s, L + c * s + s, 0.0);
-      if (s - 1 <= SM_UBAND_B(M) && s - 1 <= SM_LBAND_B(M)) {  // the diagonal block lies inside the band
+      // block column c of L (band column r0 - s + c) holds rows r with s + r - c <= ml;
+      // of A, all rows when s - 1 <= min(mu, ml); of U (column r0 + s + c), rows with
+      // s + c - r <= mu
+      if (k > 0) {
+        const double* col = SM_COLUMN_B(M, r0 - s + c) + (s - c);
+        const int hi = int(std::min<long>(s, ml - s + c + 1));
+        for (int r = 0; r < hi; ++r) L[c * s + r] = col[r];
+      }
+      if (s - 1 <= mu && s - 1 <= ml) {
         const double* col = SM_COLUMN_B(M, r0 + c) - c;
         for (int r = 0; r < s; ++r) A[c * s + r] = col[r];
       } else {
         column_run<s>(M, r0 + c, r0, A + c * s);
       }
-      if (k + 1 < N)
-        column_run<s>(M, r0 + s + c, r0, Uk + c * s);
-      else
+      if (k + 1 < N) {
+        const double* col = SM_COLUMN_B(M, r0 + s + c) - (s + c);
+        for (int r = int(std::max<long>(0, s + c - mu)); r < s; ++r) Uk[c * s + r] = col[r];
+      } else {
         std::fill(Uk + c * s, Uk + c * s + s, 0.0);
+      }
     }
     // the rest of these rows' band must be zero: columns left of cell k - 1 (or of the
     // cells) and right of cell k + 1 (or of the cells) that the band reaches
     const long lo = std::max(o, r0 - (k > 0 ? s : 0)), hi = std::min(e, r0 + (k + 1 < N ? 2 * s : s));
     double run[s];
-    for (long j = std::max(0L, r0 - long(SM_LBAND_B(M))); j < lo; ++j) {
+    for (long j = std::max(0L, r0 - ml); j < lo; ++j) {
       column_run<s>(M, j, r0, run);
       for (int r = 0; r < s; ++r)
         if (run[r] != 0.0) return false;
     }
-    for (long j = hi; j <= std::min(n - 1, r0 + s - 1 + long(SM_UBAND_B(M))); ++j) {
+    for (long j = hi; j <= std::min(n - 1, r0 + s - 1 + mu); ++j) {
       column_run<s>(M, j, r0, run);
       for (int r = 0; r < s; ++r)
         if (run[r] != 0.0) return false;
@@ -524,7 +532,7 @@ struct BlockTri {
     constexpr std::size_t SS = std::size_t(s) * s;
     growth = 0;
     // local copies: the compiler sees that they do not alias, and vectorises the updates
-    alignas(32) double L[SS], Dm[SS], Uk[SS], Di[SS], P[SS], Pp[SS] = {};
+    alignas(32) double L[SS] = {}, Dm[SS], Uk[SS] = {}, Di[SS], P[SS], Pp[SS] = {};
     lpos.clear(), lval.clear();
     for (long k = 0; k < N; ++k) {
       if (!gather<s>(M, k, L, Dm, Uk)) return false;
