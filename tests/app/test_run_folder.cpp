@@ -391,6 +391,7 @@ TEST(RunFolderCli, BothTiersWriteTheSameKeysAndColumns) {
   EXPECT_EQ(rows(d / "b" / "series.csv"), b["series_rows"].get<long>());
   expect_consistent_folder(d / "a");
   expect_consistent_folder(d / "b");
+  fs::remove_all(d);
 }
 
 // A run without a size estimate (a force-driven run until its cycles complete) is bounded
@@ -412,6 +413,7 @@ TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
   expect_consistent_folder(out);
   // the same run with the default limit completes
   EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "full").string() + "\"", d).code, 0);
+  fs::remove_all(d);
 }
 
 // The VTK frames count toward the same limit while the run goes: a 3D run with an auto duration
@@ -495,6 +497,7 @@ TEST(CalibrateCli, AFailedHydraulicMeasurementKeepsTheMeasuredStiffness) {
   EXPECT_EQ(r.code, 2) << r.err;
   EXPECT_NE(r.err.find("hydraulic"), std::string::npos) << r.err;
   EXPECT_FALSE(fs::exists(d / "run"));
+  fs::remove_all(d);
 }
 
 // swim screen and swim calibrate own their output folders like swim run: a folder holding
