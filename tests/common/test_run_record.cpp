@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <vector>
 
 #include "common/checksum.hpp"
 #include "common/errors.hpp"
@@ -25,10 +26,21 @@ using namespace swim::record;
 
 namespace {
 
+// Scratch folders, removed when the test process ends.
+struct Scratch {
+  std::vector<fs::path> dirs;
+  ~Scratch() {
+    std::error_code ec;
+    for (const auto& d : dirs) fs::remove_all(d, ec);
+  }
+};
+Scratch scratch;
+
 std::string fresh_dir(const std::string& name) {
   const fs::path d = fs::temp_directory_path() / ("swim_record_" + name + "_" + std::to_string(::getpid()));
   fs::remove_all(d);
   fs::create_directories(d);
+  scratch.dirs.push_back(d);
   return d.string();
 }
 
