@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <type_traits>
 #include <utility>
 #include <vector>
 
@@ -400,7 +401,21 @@ struct BlockTri {
 
   /// Block sizes with a compiled kernel (3: wall inertia alone; 3 + J with the traction's J
   /// fields, J = 5 to 10 from the |k| quadrature).
-  static bool supported(int s) { return s >= 3 && s <= 14; }
+  static constexpr int kMinBlock = 3, kMaxBlock = 14;
+  static bool supported(int s) { return s >= kMinBlock && s <= kMaxBlock; }
+  /// Calls f(std::integral_constant<int, S>) for a supported S; false otherwise.
+  template <int s = kMinBlock, class F>
+  static bool with_block_size(int S_, F&& f) {
+    if constexpr (s > kMaxBlock) {
+      return false;
+    } else {
+      if (S_ == s) {
+        f(std::integral_constant<int, s>{});
+        return true;
+      }
+      return with_block_size<s + 1>(S_, f);
+    }
+  }
 
   void resize(long n_, const CellBlocks& c) {
     n = n_, o = c.offset, S = c.block, N = c.count;
@@ -583,18 +598,7 @@ struct BlockTri {
       }
     }
     bool ok = false;
-    switch (S) {
-#define SWIM_BLOCK_CASE(s) \
-  case s:                  \
-    ok = factor_cells<s>(M); \
-    break;
-      SWIM_BLOCK_CASE(3) SWIM_BLOCK_CASE(4) SWIM_BLOCK_CASE(5) SWIM_BLOCK_CASE(6) SWIM_BLOCK_CASE(7)
-      SWIM_BLOCK_CASE(8) SWIM_BLOCK_CASE(9) SWIM_BLOCK_CASE(10) SWIM_BLOCK_CASE(11) SWIM_BLOCK_CASE(12)
-      SWIM_BLOCK_CASE(13) SWIM_BLOCK_CASE(14)
-#undef SWIM_BLOCK_CASE
-      default:
-        return false;
-    }
+    if (!with_block_size(S, [&](auto c) { ok = factor_cells<decltype(c)::value>(M); })) return false;
     return ok && (nb == 0 || small_lu(G, gpiv, nb));
   }
 
@@ -634,18 +638,7 @@ struct BlockTri {
   /// One right-hand side: per cell, dense s x s products as column updates (vectorised
   /// across the block's rows).
   void solve(double* b) {
-    switch (S) {
-#define SWIM_BLOCK_CASE(s) \
-  case s:                  \
-    solve_cells<s>(b);     \
-    break;
-      SWIM_BLOCK_CASE(3) SWIM_BLOCK_CASE(4) SWIM_BLOCK_CASE(5) SWIM_BLOCK_CASE(6) SWIM_BLOCK_CASE(7)
-      SWIM_BLOCK_CASE(8) SWIM_BLOCK_CASE(9) SWIM_BLOCK_CASE(10) SWIM_BLOCK_CASE(11) SWIM_BLOCK_CASE(12)
-      SWIM_BLOCK_CASE(13) SWIM_BLOCK_CASE(14)
-#undef SWIM_BLOCK_CASE
-      default:
-        break;
-    }
+    with_block_size(S, [&](auto c) { solve_cells<decltype(c)::value>(b); });
     if (nb == 0) return;
     for (int q = 0; q < nb; ++q) bt[q] = b[border[q]];  // G x_B = b_B - F x_T
     for (const Entry& e : F) bt[e.row] -= e.v * b[e.col];
