@@ -417,6 +417,11 @@ struct BlockTri {
     }
   }
 
+  /// Leading dimension of a block of size s: s rounded up to whole 4-wide vectors. Blocks are
+  /// stored column-major with this stride and zero padding rows, so that every column update
+  /// and every Gauss-Jordan row operation is whole vectors.
+  static constexpr int lead(int s) { return (s + 3) / 4 * 4; }
+
   void resize(long n_, const CellBlocks& c) {
     n = n_, o = c.offset, S = c.block, N = c.count;
     bpos.assign(n, -1);
@@ -424,7 +429,7 @@ struct BlockTri {
     for (long i = 0; i < n; ++i)
       if (i < o || i >= o + S * N) bpos[i] = int(border.size()), border.push_back(i);
     nb = int(border.size());
-    const std::size_t blk = std::size_t(S) * S * N;
+    const std::size_t blk = std::size_t(S) * lead(S) * N;
     Dinv.assign(blk, 0.0), Up.assign(blk, 0.0);
     lpos.clear(), lval.clear(), lbeg.assign(N + 1, 0);
     G.assign(std::size_t(nb) * nb, 0.0);
@@ -454,10 +459,12 @@ struct BlockTri {
   }
 
   /// Copy the three blocks of cell k's rows (columns of cells k - 1, k, k + 1) into L, A, U
-  /// (column-major); false if a band entry of these rows lies outside them. The entries of L
-  /// and U outside the band are never written: the caller zeroes them once.
+  /// (column-major, stride lead(s)); false if a band entry of these rows lies outside them.
+  /// The entries of L and U outside the band and the padding rows are never written: the
+  /// caller zeroes them once.
   template <int s>
   bool gather(SUNMatrix M, long k, double* L, double* A, double* Uk) const {
+    constexpr int ld = lead(s);
     const long mu = SM_UBAND_B(M), ml = SM_LBAND_B(M);
     const long e = o + s * N, r0 = o + s * k;
     for (int c = 0; c < s; ++c) {
@@ -467,19 +474,19 @@ struct BlockTri {
       if (k > 0) {
         const double* col = SM_COLUMN_B(M, r0 - s + c) + (s - c);
         const int hi = int(std::min<long>(s, ml - s + c + 1));
-        for (int r = 0; r < hi; ++r) L[c * s + r] = col[r];
+        for (int r = 0; r < hi; ++r) L[c * ld + r] = col[r];
       }
       if (s - 1 <= mu && s - 1 <= ml) {
         const double* col = SM_COLUMN_B(M, r0 + c) - c;
-        for (int r = 0; r < s; ++r) A[c * s + r] = col[r];
+        for (int r = 0; r < s; ++r) A[c * ld + r] = col[r];
       } else {
-        column_run<s>(M, r0 + c, r0, A + c * s);
+        column_run<s>(M, r0 + c, r0, A + c * ld);
       }
       if (k + 1 < N) {
         const double* col = SM_COLUMN_B(M, r0 + s + c) - (s + c);
-        for (int r = int(std::max<long>(0, s + c - mu)); r < s; ++r) Uk[c * s + r] = col[r];
+        for (int r = int(std::max<long>(0, s + c - mu)); r < s; ++r) Uk[c * ld + r] = col[r];
       } else {
-        std::fill(Uk + c * s, Uk + c * s + s, 0.0);
+        std::fill(Uk + c * ld, Uk + c * ld + s, 0.0);
       }
     }
     // the rest of these rows' band must be zero: columns left of cell k - 1 (or of the
@@ -499,32 +506,41 @@ struct BlockTri {
     return true;
   }
 
-  /// Gauss-Jordan inverse with partial pivoting of the column-major s x s matrix Dm (destroyed)
-  /// into Di. Row-major elimination on a column-major buffer inverts the transpose, whose
-  /// inverse read column-major is D^{-1}; its pivots are D's columns.
+  /// Gauss-Jordan inverse with partial pivoting, in place, of the column-major s x s matrix
+  /// Dm (stride lead(s), padding rows zero). Row-major elimination on a column-major buffer
+  /// inverts the transpose, whose inverse read column-major is D^{-1}; its pivots are D's
+  /// columns. In place: each step leaves the inverse's column k where the eliminated column
+  /// was (s^3 multiply-adds instead of 2 s^3 with a separate identity), and the row
+  /// interchanges are undone as column interchanges at the end.
   template <int s>
-  static bool invert(double* Dm, double* Di) {
-    for (int r = 0; r < s; ++r)
-      for (int c = 0; c < s; ++c) Di[r * s + c] = r == c ? 1.0 : 0.0;
+  static bool invert(double* Dm) {
+    constexpr int ld = lead(s);
+    int perm[s];
     for (int k = 0; k < s; ++k) {
       int p = k;
       for (int r = k + 1; r < s; ++r)
-        if (std::abs(Dm[r * s + k]) > std::abs(Dm[p * s + k])) p = r;
-      if (Dm[p * s + k] == 0.0) return false;
-      if (p != k)
-        for (int c = 0; c < s; ++c) std::swap(Dm[k * s + c], Dm[p * s + c]), std::swap(Di[k * s + c], Di[p * s + c]);
-      // the pivot row, scaled, in local copies: the row updates then read memory they do not
+        if (std::abs(Dm[r * ld + k]) > std::abs(Dm[p * ld + k])) p = r;
+      perm[k] = p;
+      if (Dm[p * ld + k] == 0.0) return false;
+      // the pivot row, scaled, in a local copy: the row updates then read memory they do not
       // write, and vectorise
-      alignas(32) double pd[s], pi[s];
-      const double inv = 1.0 / Dm[k * s + k];
-      for (int c = 0; c < s; ++c) pd[c] = Dm[k * s + c] * inv, pi[c] = Di[k * s + c] * inv;
+      alignas(32) double pk[ld];
+      const double inv = 1.0 / Dm[p * ld + k];
+      for (int c = 0; c < ld; ++c) pk[c] = Dm[p * ld + c] * inv;
+      pk[k] = inv;
+      if (p != k)
+        for (int c = 0; c < ld; ++c) Dm[p * ld + c] = Dm[k * ld + c];
       for (int r = 0; r < s; ++r) {
-        const double f = r == k ? 0.0 : Dm[r * s + k];
-        for (int c = 0; c < s; ++c) Dm[r * s + c] -= f * pd[c];
-        for (int c = 0; c < s; ++c) Di[r * s + c] -= f * pi[c];
+        if (r == k) continue;
+        const double f = Dm[r * ld + k];
+        Dm[r * ld + k] = 0.0;
+        for (int c = 0; c < ld; ++c) Dm[r * ld + c] -= f * pk[c];
       }
-      for (int c = 0; c < s; ++c) Dm[k * s + c] = pd[c], Di[k * s + c] = pi[c];
+      for (int c = 0; c < ld; ++c) Dm[k * ld + c] = pk[c];
     }
+    for (int k = s - 1; k >= 0; --k)
+      if (perm[k] != k)
+        for (int r = 0; r < s; ++r) std::swap(Dm[r * ld + k], Dm[r * ld + perm[k]]);
     return true;
   }
 
@@ -544,10 +560,11 @@ struct BlockTri {
 
   template <int s>
   bool factor_cells(SUNMatrix M) {
-    constexpr std::size_t SS = std::size_t(s) * s;
+    constexpr int ld = lead(s);
+    constexpr std::size_t SS = std::size_t(s) * ld;
     growth = 0;
     // local copies: the compiler sees that they do not alias, and vectorises the updates
-    alignas(32) double L[SS] = {}, Dm[SS], Uk[SS] = {}, Di[SS], P[SS], Pp[SS] = {};
+    alignas(32) double L[SS] = {}, Dm[SS] = {}, Uk[SS] = {}, Di[SS], P[SS] = {}, Pp[SS] = {};
     lpos.clear(), lval.clear();
     for (long k = 0; k < N; ++k) {
       if (!gather<s>(M, k, L, Dm, Uk)) return false;
@@ -555,14 +572,14 @@ struct BlockTri {
       for (int e = 0; e < int(SS); ++e)
         if (L[e] != 0.0) lpos.push_back(e), lval.push_back(L[e]);
       if (k > 0)  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
-        for (int c = 0; c < s; ++c)
-          for (int r = 0; r < s; ++r) {
-            const double l = L[c * s + r];
-            if (l == 0.0) continue;
-            for (int q = 0; q < s; ++q) Dm[q * s + r] -= l * Pp[q * s + c];
-          }
+        for (int e = lbeg[k]; e < int(lpos.size()); ++e) {
+          const int r = lpos[e] % ld, c = lpos[e] / ld;
+          const double l = lval[e];
+          for (int q = 0; q < s; ++q) Dm[q * ld + r] -= l * Pp[q * ld + c];
+        }
       const double dmax = max_abs<SS>(Dm);
-      if (!invert<s>(Dm, Di)) return false;
+      std::copy(Dm, Dm + SS, Di);
+      if (!invert<s>(Di)) return false;
       growth = std::max(growth, dmax * max_abs<SS>(Di) * s);
       std::copy(Di, Di + SS, Dinv.data() + k * SS);
       lbeg[k + 1] = int(lpos.size());
@@ -570,9 +587,9 @@ struct BlockTri {
         std::fill(P, P + SS, 0.0);
         for (int c = 0; c < s; ++c)
           for (int r = 0; r < s; ++r) {
-            const double u = Uk[c * s + r];
+            const double u = Uk[c * ld + r];
             if (u == 0.0) continue;
-            for (int q = 0; q < s; ++q) P[c * s + q] += Di[r * s + q] * u;
+            for (int q = 0; q < ld; ++q) P[c * ld + q] += Di[r * ld + q] * u;
           }
         std::copy(P, P + SS, Up.data() + k * SS);
         std::copy(P, P + SS, Pp);
@@ -602,33 +619,36 @@ struct BlockTri {
     return ok && (nb == 0 || small_lu(G, gpiv, nb));
   }
 
-  /// y = A x for the column-major s x s matrix A, in two independent chains of column updates.
+  /// y = A x for the column-major s x s matrix A (stride ld, padding rows zero), in two
+  /// independent chains of whole-vector column updates.
   template <int s>
   static void matvec(const double* A, const double* x, double* y) {
-    alignas(32) double y0[s] = {}, y1[s] = {};
+    constexpr int ld = lead(s);
+    alignas(32) double y0[ld] = {}, y1[ld] = {};
     int c = 0;
     for (; c + 1 < s; c += 2)
-      for (int i = 0; i < s; ++i) y0[i] += A[c * s + i] * x[c], y1[i] += A[(c + 1) * s + i] * x[c + 1];
+      for (int i = 0; i < ld; ++i) y0[i] += A[c * ld + i] * x[c], y1[i] += A[(c + 1) * ld + i] * x[c + 1];
     if constexpr (s % 2 == 1)
-      for (int i = 0; i < s; ++i) y0[i] += A[(s - 1) * s + i] * x[s - 1];
-    for (int i = 0; i < s; ++i) y[i] = y0[i] + y1[i];
+      for (int i = 0; i < ld; ++i) y0[i] += A[(s - 1) * ld + i] * x[s - 1];
+    for (int i = 0; i < ld; ++i) y[i] = y0[i] + y1[i];
   }
 
   template <int s>
   void solve_cells(double* b) {
-    constexpr std::size_t SS = std::size_t(s) * s;
-    alignas(32) double T[s], y[s] = {}, x[s];
+    constexpr int ld = lead(s);
+    constexpr std::size_t SS = std::size_t(s) * ld;
+    alignas(32) double T[ld] = {}, y[ld] = {}, x[ld] = {};
     const int* lp = lpos.data();
     const double* lv = lval.data();
     for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} (b_k - L_k y_{k-1})
       double* bk = b + o + k * s;
       for (int i = 0; i < s; ++i) T[i] = bk[i];
-      for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) T[lp[e] % s] -= lv[e] * y[lp[e] / s];
+      for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) T[lp[e] % ld] -= lv[e] * y[lp[e] / ld];
       matvec<s>(Dinv.data() + k * SS, T, y);
       for (int i = 0; i < s; ++i) bk[i] = y[i];
     }
-    for (int i = 0; i < s; ++i) x[i] = y[i];  // x_{N-1} = y_{N-1}
-    for (long k = N - 2; k >= 0; --k) {       // x_k = y_k - Up_k x_{k+1}
+    for (int i = 0; i < ld; ++i) x[i] = y[i];  // x_{N-1} = y_{N-1}
+    for (long k = N - 2; k >= 0; --k) {        // x_k = y_k - Up_k x_{k+1}
       double* xk = b + o + k * s;
       matvec<s>(Up.data() + k * SS, x, T);
       for (int i = 0; i < s; ++i) x[i] = xk[i] - T[i], xk[i] = x[i];
