@@ -564,26 +564,29 @@ struct BlockTri {
     constexpr std::size_t SS = std::size_t(s) * ld;
     growth = 0;
     // local copies: the compiler sees that they do not alias, and vectorises the updates
-    alignas(32) double L[SS] = {}, Dm[SS] = {}, Uk[SS] = {}, Di[SS], P[SS] = {}, Pp[SS] = {};
+    alignas(32) double L[SS] = {}, Dm[SS] = {}, Uk[SS] = {}, Di[SS];
     lpos.clear(), lval.clear();
     for (long k = 0; k < N; ++k) {
       if (!gather<s>(M, k, L, Dm, Uk)) return false;
       lbeg[k] = int(lpos.size());
       for (int e = 0; e < int(SS); ++e)
         if (L[e] != 0.0) lpos.push_back(e), lval.push_back(L[e]);
-      if (k > 0)  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
-        for (int e = lbeg[k]; e < int(lpos.size()); ++e) {
+      lbeg[k + 1] = int(lpos.size());
+      if (k > 0) {  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
+        const double* Pp = Up.data() + (k - 1) * SS;
+        for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) {
           const int r = lpos[e] % ld, c = lpos[e] / ld;
           const double l = lval[e];
           for (int q = 0; q < s; ++q) Dm[q * ld + r] -= l * Pp[q * ld + c];
         }
+      }
       const double dmax = max_abs<SS>(Dm);
       std::copy(Dm, Dm + SS, Di);
       if (!invert<s>(Di)) return false;
       growth = std::max(growth, dmax * max_abs<SS>(Di) * s);
       std::copy(Di, Di + SS, Dinv.data() + k * SS);
-      lbeg[k + 1] = int(lpos.size());
       if (k + 1 < N) {  // Up_k = D_k^{-1} U_k: column c takes D^{-1}'s column r times U(r, c)
+        double* P = Up.data() + k * SS;
         std::fill(P, P + SS, 0.0);
         for (int c = 0; c < s; ++c)
           for (int r = 0; r < s; ++r) {
@@ -591,8 +594,6 @@ struct BlockTri {
             if (u == 0.0) continue;
             for (int q = 0; q < ld; ++q) P[c * ld + q] += Di[r * ld + q] * u;
           }
-        std::copy(P, P + SS, Up.data() + k * SS);
-        std::copy(P, P + SS, Pp);
       }
     }
     return true;
