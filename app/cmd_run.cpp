@@ -6,6 +6,8 @@
 
 #include "app/app.hpp"
 #include "app/scene_checks.hpp"
+#include "axi/run_axi.hpp"
+#include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/run_folder.hpp"
@@ -140,6 +142,45 @@ int run3d(const RunOptions& o, const scene::json& sc) {
   return 0;
 }
 
+// The axisymmetric reference tier: read and validate, run (axi/run_axi.hpp), report.
+int run_axi(const RunOptions& o, const scene::json& sc) {
+  if (!o.resume.empty()) throw InputError("--resume", o.resume, "only the 3D tier writes checkpoints; add --tier 3d");
+  scene::json resolved;
+  const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+  check_other_tier(sc, "axi");
+  const std::string out = o.out.empty() ? "out/" + p.name() + "-axi" : o.out;
+  output::RunFolder folder(out, {"axi", resolved, o.overwrite, false, "--out"});
+  axi::RunControlAxi ctl;
+  ctl.progress = o.progress;
+  ctl.max_output_bytes = static_cast<std::uintmax_t>(scene::output_limits(sc).max_bytes);
+  axi::RunOutcomeAxi r;
+  try {
+    r = axi::run_axi(p, resolved, out, ctl);
+  } catch (const std::exception& e) {
+    fail_run(folder, e);
+  }
+  const auto& s = r.summary;
+  std::string per_cycle = "no cycle completed";
+  if (s["mean_velocity_per_cycle_m_per_s"].is_number())
+    per_cycle = si(s["displacement_per_cycle_m"].get<double>(), "m") + " per cycle in " +
+                si(s["cycle_times_s"].back().get<double>(), "s") + ", " +
+                si(s["mean_velocity_per_cycle_m_per_s"].get<double>(), "m/s");
+  std::printf("%s (axi): displacement %s; %s; %d cycle(s); pumped %s; %ld steps on %d x %d cells (h = %s); wall time %s\n"
+              "  -> %s/summary.json\n",
+              p.name().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(), per_cycle.c_str(),
+              s["cycles_completed"].get<int>(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps, p.nr,
+              p.nx, si(p.h, "m").c_str(), si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
+  std::fflush(stdout);
+  for (const auto& w : s["implausible_because"])
+    std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
+  if (o.plot) plot("plot_run.py", {out});
+  if (r.failed) {
+    std::fprintf(stderr, "swim: %s\n  partial results kept in %s\n", r.message.c_str(), out.c_str());
+    return 3;
+  }
+  return 0;
+}
+
 }  // namespace
 
 int run(const RunOptions& o) {
@@ -147,6 +188,7 @@ int run(const RunOptions& o) {
   scene::json sc = scene::load_file(o.scene);
   for (const auto& s : o.sets) scene::apply_override(sc, s);
   if (o.tier == "3d") return run3d(o, sc);
+  if (o.tier == "axi") return run_axi(o, sc);
   if (!o.resume.empty()) throw InputError("--resume", o.resume, "only the 3D tier writes checkpoints; add --tier 3d");
   scene::json resolved;
   const std::string scene_dir = fs::path(o.scene).parent_path().string();

@@ -1,6 +1,6 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
-//   swim run SCENE.json [--tier 1d|3d] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
+//   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
 //   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite]
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|all]
 //   swim scenes
@@ -32,7 +32,7 @@ int main(int argc, char** argv) {
 
   CLI::App* run = cli.add_subcommand("run", "Run one scene on one tier");
   run->add_option("scene", ro.scene, "Scene file (JSON with unit strings)")->required();
-  run->add_option("--tier", ro.tier, "Model tier: 1d (default; the force-free lubrication model, milliseconds to a second) or 3d (immersed boundary, minutes)")->check(CLI::IsMember({"1d", "3d"}));
+  run->add_option("--tier", ro.tier, "Model tier: 1d (default; the force-free lubrication model, milliseconds to a second), 3d (immersed boundary, minutes) or axi (the axisymmetric reference of round-wall scenes)")->check(CLI::IsMember({"1d", "3d", "axi"}));
   run->add_option("--out", ro.out, "Output directory (default out/<scene name>-<tier>)");
   run->add_option("--set", ro.sets, "Override a scene value: key.path=value (same unit syntax as the file)");
   run->add_flag("--plot", ro.plot, "Also write plots (PNG) of the run");

@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "full3d/scene3d_keys.hpp"
 #include "reduced1d/scene1d_keys.hpp"
@@ -26,6 +27,7 @@ std::string human(double bytes) {
 
 void check_other_tier(const scene::json& sc, const std::string& tier) {
   if (!sc.is_object()) return;
+  if (tier != "axi" && sc.contains("axi")) scene::check_section(sc.at("axi"), "axi", axi::section_keys().at("axi"));
   if (tier == "1d") {
     if (sc.contains("full3d")) scene::check_section(sc.at("full3d"), "full3d", full3d::section_keys());
     return;

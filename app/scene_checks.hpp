@@ -13,7 +13,8 @@
 namespace swim::app {
 
 /// Throws InputError naming the key when a section of the tier that is not running
-/// (`running_tier` "1d": full3d; "3d": model1d and numerics1d) is malformed.
+/// (`running_tier` "1d": full3d and axi; "3d": model1d, numerics1d and axi; "axi": model1d and
+/// numerics1d; the full3d section is read by the axisymmetric tier itself) is malformed.
 void check_other_tier(const scene::json& scene, const std::string& running_tier);
 
 /// Estimated bytes a run writes (series, radius samples, VTK frames), and the key whose

@@ -96,6 +96,7 @@ Params3d read_scene3d(const json& scene, json& resolved) {
   }
   top.pass_through("model1d");
   top.pass_through("numerics1d");
+  top.pass_through("axi");  // the axisymmetric tier's numerics (axi/scene_axi.hpp)
   {
     Reader t = top.child("time");
     const json& tn = scene.contains("time") ? scene["time"] : json::object();

@@ -247,6 +247,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     t.finish();
   }
   top.pass_through("full3d");
+  top.pass_through("axi");  // the axisymmetric tier's numerics (axi/scene_axi.hpp)
   scene::read_output(top);
   top.finish();
   return p;

@@ -1,0 +1,393 @@
+#include "axi/run_axi.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <optional>
+
+#include "axi/grid_axi.hpp"
+#include "axi/ib_axi.hpp"
+#include "axi/stokes_axi.hpp"
+#include "axi/wall_axi.hpp"
+#include "common/errors.hpp"
+#include "common/progress.hpp"
+#include "full3d/protocol3d.hpp"
+
+namespace swim::axi {
+
+using scene::json;
+
+const std::vector<std::string>& series_columns() {
+  static const std::vector<std::string> c = [] {
+    std::vector<std::string> v = record::common_series_columns();
+    for (const char* k : {"elastic_energy_J", "bending_energy_J", "active_segment", "cycles_completed", "cfl",
+                          "max_spacing_m", "dt_s"})
+      v.push_back(k);
+    return v;
+  }();
+  return c;
+}
+
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point t0) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.4g", v);
+  return b;
+}
+
+/// The protocol's view of the wall: a "mesh" of one node per ring (n_theta = 1), with the
+/// rings' reference positions and areas, so that the 3D tier's protocol (segments, relays,
+/// events, recovery end) drives the rings unchanged.
+full3d::CylinderMesh ring_mesh(const AxiWall& wall, double R0, double L, double x_start) {
+  full3d::CylinderMesh m;
+  m.radius = R0;
+  m.length = L;
+  m.n_theta = 1;
+  m.n_rings = wall.nodes();
+  m.ring_spacing = wall.ds0();
+  m.axis_start = Eigen::Vector3d(x_start, 0.0, 0.0);
+  m.X0 = wall.reference();
+  m.X0.row(0).array() += x_start;
+  m.node_area = wall.node_area();
+  return m;
+}
+
+class Runner {
+ public:
+  Runner(const ParamsAxi& p, const json& resolved, const std::string& out, const RunControlAxi& ctl)
+      : p_(p), b_(p.base), resolved_(resolved), out_(out), ctl_(ctl), grid_{p.nr, p.nx, p.h},
+        stokes_(grid_, b_.fluid.mu), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes}),
+        mesh_(ring_mesh(wall_, b_.R0, b_.L, p.x_start())), e_ref_(wall_.uniform_energy(b_.protocol.R_f)),
+        protocol_(effective(), mesh_, e_ref_),
+        rec_("axi", "axisymmetric_immersed_boundary", b_.L, series_columns(), reference_z()) {
+    rec_.keep(ctl.keep_rows);
+    X_ = mesh_.X0;
+    U_ = Eigen::Matrix3Xd::Zero(3, X_.cols());
+    const double q_static = b_.c1_estimate() * (b_.R0 - b_.protocol.R_f);
+    e_cap_ = b_.energy_growth * e_ref_ * std::max(1.0, std::pow(b_.protocol.q / q_static, 2));
+    t_end_ = b_.duration > 0 ? b_.duration : p_.time_limit;
+  }
+
+  RunOutcomeAxi run() {
+    RunOutcomeAxi res;
+    const auto t0 = std::chrono::steady_clock::now();
+    stream_ = std::make_unique<record::RunStream>(out_, series_columns());
+    stream_->limit(ctl_.max_output_bytes);
+    rec_.attach(stream_.get());
+    Progress progress("axi " + p_.name() + (b_.duration > 0 ? "" : " (auto: until " + std::to_string(b_.protocol.cycles) +
+                                                                  " cycle(s), progress against axi.time_limit)"),
+                      t_end_, ctl_.progress);
+    std::optional<NumericalError> failure;
+    try {
+      x_center0_ = X_.row(0).mean();
+      protocol_.start(0.0, X_);
+      events();
+      evaluate(X_, U_, &energy_);
+      fluxes(0.0);
+      record();
+      next_out_ = b_.output_interval;
+      dt_ = p_.event_dt;
+      while (!finished()) {
+        step();
+        progress.update(t_);
+        const bool event = events();
+        if (event || t_ >= next_out_ - 1e-12 * b_.output_interval || finished()) {
+          record();
+          while (next_out_ <= t_ + 1e-12 * b_.output_interval) next_out_ += b_.output_interval;
+        }
+      }
+    } catch (const NumericalError& e) {
+      failure = e;
+      if (last_recorded_ != steps_ && X_.allFinite() && U_.allFinite()) {
+        try {
+          record();
+        } catch (const NumericalError&) {
+        }
+      }
+    }
+    progress.done();
+    res.failed = failure.has_value();
+    res.message = failure ? failure->what() : "";
+    events();
+    fill(failure ? "failed: " + std::string(failure->what()) : "ok", seconds_since(t0));
+    res.summary = record::write_run(out_, rec_, resolved_);
+    res.steps = steps_;
+    rec_.attach(nullptr);
+    res.record = std::move(rec_);
+    return res;
+  }
+
+ private:
+  full3d::ProtocolParams effective() const {
+    full3d::ProtocolParams q = b_.protocol;
+    q.end_energy = b_.recovery_end == "dead_band" ? wall_.uniform_energy(b_.R0 - b_.protocol.delta) : 0.0;
+    return q;
+  }
+
+  std::vector<double> reference_z() const {
+    std::vector<double> z(wall_.nodes());
+    for (int k = 0; k < wall_.nodes(); ++k) z[k] = k * wall_.ds0();
+    return z;
+  }
+
+  bool finished() const {
+    if (b_.duration > 0) return t_ >= b_.duration * (1.0 - 1e-12) || protocol_.finished();
+    return protocol_.finished();
+  }
+
+  /// Ring velocities at positions X for the current protocol state; the wall energies of X.
+  void evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd& U, std::array<double, 2>* energy) {
+    auto t = std::chrono::steady_clock::now();
+    Eigen::Matrix3Xd F = wall_.forces(X, energy);
+    F += protocol_.force(X);
+    if (!F.allFinite()) throw NumericalError("non-finite wall force", "reduce axi.tolerance", t_);
+    split_forces_ += seconds_since(t);
+    t = std::chrono::steady_clock::now();
+    spread(grid_, X, F, fr_, fx_);
+    split_spread_ += seconds_since(t);
+    t = std::chrono::steady_clock::now();
+    u_.resize(grid_.u_size());
+    w_.resize(grid_.w_size());
+    stokes_.solve(fr_.data(), fx_.data(), u_.data(), w_.data());
+    split_fluid_ += seconds_since(t);
+    t = std::chrono::steady_clock::now();
+    interpolate(grid_, X, u_.data(), w_.data(), U);
+    split_interp_ += seconds_since(t);
+    ++solves_;
+    if (!U.allFinite()) throw NumericalError("non-finite wall velocity", "reduce axi.tolerance", t_);
+  }
+
+  double max_spacing(const Eigen::Matrix3Xd& X) const {
+    double m = 0;
+    for (Eigen::Index k = 0; k + 1 < X.cols(); ++k) m = std::max(m, (X.col(k + 1) - X.col(k)).head<2>().norm());
+    return m;
+  }
+
+  /// The step size bound of the next contraction event: the active segment's radius
+  /// extrapolated linearly to R_f.
+  double event_bound() const {
+    const full3d::ProtocolState& st = protocol_.state();
+    if (st.phase != 0) return p_.dt_max;
+    const int a = st.active;
+    double R = 0, V = 0;
+    int n = 0;
+    for (int k = 0; k < wall_.nodes(); ++k)
+      if (protocol_.segment_of(k) == a) R += X_(1, k), V += U_(1, k), ++n;
+    R /= n, V /= n;
+    const double gap = R - b_.protocol.R_f;
+    if (!(V < 0.0) || gap <= 0.0) return p_.dt_max;
+    return std::max(p_.event_dt, 1.02 * gap / -V);
+  }
+
+  /// One accepted step of the trapezoidal rule (retried with smaller steps until its local
+  /// error estimate passes).
+  void step() {
+    const double h = p_.h, tol = p_.tolerance * h;
+    double umax = 0;
+    for (Eigen::Index k = 0; k < U_.cols(); ++k) umax = std::max(umax, U_.col(k).head<2>().norm());
+    dt_ = std::min({dt_, p_.dt_max, event_bound()});
+    if (umax > 0) dt_ = std::min(dt_, kCfl * h / umax);
+    if (b_.duration > 0) dt_ = std::min(dt_, b_.duration - t_);
+    for (;;) {
+      if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
+        throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s",
+                             "loosen axi.tolerance or lower axi.dt_min", t_);
+      X1_ = X_ + dt_ * U_;
+      std::array<double, 2> e1{};
+      evaluate(X1_, U1_, &e1);
+      const double err = 0.5 * dt_ * (U1_ - U_).cwiseAbs().maxCoeff();
+      double u1max = 0;
+      for (Eigen::Index k = 0; k < U1_.cols(); ++k) u1max = std::max(u1max, U1_.col(k).head<2>().norm());
+      const double cfl = std::max(umax, u1max) * dt_ / h;
+      if (err <= tol && cfl <= kMaxCfl) {
+        Xn_ = X_ + (0.5 * dt_) * (U_ + U1_);
+        const double dt_done = dt_;
+        const double grow = err > 0 ? 0.9 * std::sqrt(tol / err) : 2.0;
+        accept(dt_done);
+        dt_ = dt_done * std::clamp(grow, 0.2, 2.0);
+        return;
+      }
+      ++rejected_;
+      const double shrink = err > tol ? 0.9 * std::sqrt(tol / err) : 0.5;
+      dt_ *= std::clamp(shrink, 0.1, 0.5);
+    }
+  }
+
+  void accept(double dt) {
+    X_.swap(Xn_);
+    t_ += dt;
+    ++steps_;
+    dt_last_ = dt;
+    dt_min_taken_ = steps_ == 1 ? dt : std::min(dt_min_taken_, dt);
+    dt_max_taken_ = std::max(dt_max_taken_, dt);
+    evaluate(X_, U_, &energy_);
+    fluxes(dt);
+    const double e = energy_[0] + energy_[1];
+    if (!std::isfinite(e) || e > e_cap_)
+      throw NumericalError("the wall energy grew to " + num(e) + " J, " + num(e / e_ref_) +
+                               " times that of the tube uniformly at R_f",
+                           "reduce axi.tolerance, or raise full3d.energy_growth_limit if the load is meant", t_);
+    const double sp = max_spacing(X_);
+    if (!(sp < 0.5 * p_.h))
+      throw NumericalError("two wall rings moved " + num(sp) + " m apart, half a cell or more (h = " + num(p_.h) +
+                               " m): fluid would leak through the wall",
+                           "lower axi.spacing_factor", t_);
+    const int sw = protocol_.update(t_, X_, e);
+    if (sw > 0) {
+      evaluate(X_, U_, &energy_);  // the actuation changed
+      dt_ = p_.event_dt;
+      event_pending_ = true;
+    }
+    if (b_.duration <= 0 && t_ >= p_.time_limit && !protocol_.finished())
+      throw NumericalError("the protocol did not finish within axi.time_limit = " + num(p_.time_limit) + " s",
+                           "raise axi.time_limit (the cycle may be slow to recover: see full3d.recovery_end)", t_);
+  }
+
+  /// Volume fluxes through the end discs (relative to the end ring's axial velocity, positive
+  /// towards +x), integrated in time by the trapezoidal rule.
+  void fluxes(double dt) {
+    const int last = wall_.nodes() - 1;
+    const double qr = disc_flux(grid_, w_.data(), X_(0, 0), X_(1, 0), U_(0, 0), kDiscPoints);
+    const double qf = disc_flux(grid_, w_.data(), X_(0, last), X_(1, last), U_(0, last), kDiscPoints);
+    if (dt > 0) {
+      vol_rear_ += 0.5 * dt * (q_rear_ + qr);
+      vol_front_ += 0.5 * dt * (q_front_ + qf);
+    }
+    q_rear_ = qr;
+    q_front_ = qf;
+  }
+
+  bool events() {
+    const full3d::ProtocolState& st = protocol_.state();
+    auto& e = rec_.events;
+    bool any = event_pending_;
+    event_pending_ = false;
+    while (e.cycle_start_s.size() < st.cycle_start.size()) rec_.cycle_started(st.cycle_start[e.cycle_start_s.size()]), any = true;
+    while (e.cycle_end_s.size() < st.cycle_end.size()) rec_.cycle_ended(st.cycle_end[e.cycle_end_s.size()]), any = true;
+    return any;
+  }
+
+  void record() {
+    const int n = wall_.nodes();
+    double vol = 0;
+    for (int k = 0; k + 1 < n; ++k)
+      vol += 0.5 * M_PI * (X_(1, k) * X_(1, k) + X_(1, k + 1) * X_(1, k + 1)) * (X_(0, k + 1) - X_(0, k));
+    double umax = 0;
+    for (Eigen::Index k = 0; k < U_.cols(); ++k) umax = std::max(umax, U_.col(k).head<2>().norm());
+    const full3d::ProtocolState& st = protocol_.state();
+    const double row[] = {t_,
+                          X_.row(0).mean() - x_center0_,
+                          U_.row(0).mean(),
+                          energy_[0] + energy_[1],
+                          X_.row(1).minCoeff(),
+                          X_.row(1).maxCoeff(),
+                          q_rear_,
+                          q_front_,
+                          vol_rear_,
+                          vol_front_,
+                          vol,
+                          double(st.phase),
+                          energy_[0],
+                          energy_[1],
+                          double(st.active),
+                          double(st.cycles_completed),
+                          umax * dt_last_ / p_.h,
+                          max_spacing(X_),
+                          steps_ > 0 ? dt_last_ : 0.0};
+    last_recorded_ = steps_;
+    const std::size_t rows = rec_.series.count();
+    std::vector<double> radius(n);
+    for (int k = 0; k < n; ++k) radius[k] = X_(1, k);
+    try {
+      rec_.add_row(row);
+    } catch (const NumericalError&) {
+      if (rec_.series.count() > rows) rec_.add_radius(t_, radius);
+      throw;
+    }
+    rec_.add_radius(t_, radius);
+  }
+
+  void fill(const std::string& status, double wall) {
+    rec_.status = status;
+    rec_.wall_time_s = wall;
+    rec_.derived = {{"C1_Pa_per_m", b_.c1_estimate()},
+                    {"aspect_ratio_R0_over_L", b_.R0 / b_.L},
+                    {"contracted_ratio", b_.protocol.R_f / b_.R0},
+                    {"actuation_pressure_Pa", b_.protocol.q},
+                    {"reference_energy_J", e_ref_},
+                    {"recovery_end_energy_J", protocol_.end_threshold()},
+                    {"cell_size_m", p_.h},
+                    {"grid", {p_.nr, p_.nx}},
+                    {"wall_nodes", wall_.nodes()},
+                    {"wall_node_spacing_m", wall_.ds0()},
+                    {"spring_constant_N_per_m", p_.ks},
+                    {"stretching_modulus_N_per_m", 2.0 * p_.ks / std::sqrt(3.0)},
+                    {"bending_rigidity_J", p_.D},
+                    {"bending_rigidity_from", p_.bending_source},
+                    {"segment_boundaries_m", protocol_.boundaries()}};
+    const int cycles = protocol_.state().cycles_completed;
+    const long per_cycle = cycles > 0 ? steps_ / cycles : 0;
+    rec_.extras = {{"steps", steps_},
+                   {"steps_per_cycle", per_cycle},
+                   {"max_spacing_over_h", rec_.series.count() ? rec_.series.max("max_spacing_m") / p_.h : 0.0}};
+    record::check_plausible(rec_);
+    rec_.events.switches = protocol_.state().switches;
+    rec_.events.segment_reached_s = protocol_.state().segment_reached;
+    rec_.stats = {{"steps", steps_},
+                  {"rejected_steps", rejected_},
+                  {"stokes_solves", solves_},
+                  {"steps_per_cycle", per_cycle},
+                  {"dt_min_taken_s", dt_min_taken_},
+                  {"dt_max_taken_s", dt_max_taken_},
+                  {"dt_mean_s", steps_ > 0 ? t_ / double(steps_) : 0.0},
+                  {"protocol_switches", protocol_.state().switches},
+                  {"wall_time_s", wall},
+                  {"wall_time_split_s",
+                   {{"wall_forces", split_forces_},
+                    {"spread", split_spread_},
+                    {"fluid", split_fluid_},
+                    {"interp", split_interp_}}}};
+  }
+
+  static constexpr double kCfl = 0.25, kMaxCfl = 0.5;
+  static constexpr int kDiscPoints = 32;
+
+  const ParamsAxi& p_;
+  const full3d::Params3d& b_;
+  const json& resolved_;
+  std::string out_;
+  RunControlAxi ctl_;
+  AxiGrid grid_;
+  AxiStokes stokes_;
+  AxiWall wall_;
+  full3d::CylinderMesh mesh_;
+  double e_ref_;
+  full3d::Protocol3d protocol_;
+  record::RunRecord rec_;
+  std::unique_ptr<record::RunStream> stream_;
+
+  Eigen::Matrix3Xd X_, U_, X1_, U1_, Xn_;
+  std::vector<double> fr_, fx_, u_, w_;
+  std::array<double, 2> energy_{};
+  double t_ = 0, dt_ = 0, dt_last_ = 0, dt_min_taken_ = 0, dt_max_taken_ = 0, t_end_ = 0, next_out_ = 0;
+  double e_cap_ = 0, x_center0_ = 0;
+  double q_rear_ = 0, q_front_ = 0, vol_rear_ = 0, vol_front_ = 0;
+  long steps_ = 0, rejected_ = 0, solves_ = 0, last_recorded_ = -1;
+  bool event_pending_ = false;
+  double split_forces_ = 0, split_spread_ = 0, split_fluid_ = 0, split_interp_ = 0;
+};
+
+}  // namespace
+
+RunOutcomeAxi run_axi(const ParamsAxi& p, const json& resolved, const std::string& out_dir, const RunControlAxi& ctl) {
+  Runner r(p, resolved, out_dir, ctl);
+  return r.run();
+}
+
+}  // namespace swim::axi

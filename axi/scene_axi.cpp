@@ -1,0 +1,140 @@
+#include "axi/scene_axi.hpp"
+
+#include <cmath>
+
+#include "common/errors.hpp"
+#include "common/scene_shared.hpp"
+#include "full3d/membrane.hpp"
+
+namespace swim::axi {
+
+using scene::json;
+using scene::Range;
+using scene::Reader;
+
+namespace {
+
+std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
+
+bool multiple_of(double a, double h) {
+  const double n = std::round(a / h);
+  return n >= 1 && std::abs(a - n * h) <= 1e-9 * a;
+}
+
+const json& section_or_empty(const json& sc, const char* key) {
+  static const json empty = json::object();
+  return sc.is_object() && sc.contains(key) ? sc.at(key) : empty;
+}
+
+}  // namespace
+
+const json& section_keys() {
+  static const json keys = {{"axi",
+                             {{"grid", {{"cells_across", "integer"}, {"cell_size", "quantity:m"}}},
+                              {"spacing_factor", "number"},
+                              {"tolerance", "number"},
+                              {"dt_max", "quantity:s"},
+                              {"dt_min", "quantity:s"},
+                              {"event_dt", "quantity:s"},
+                              {"time_limit", "quantity:s"}}}};
+  return keys;
+}
+
+ParamsAxi read_scene_axi(const json& sc, json& resolved) {
+  ParamsAxi p;
+  // 1. The shared physics, read by the 3D tier's reader (the axi section is passed through).
+  p.base = full3d::read_scene3d(sc, resolved);
+  const full3d::Params3d& b = p.base;
+  const json& f3 = section_or_empty(sc, "full3d");
+  const json& mem = section_or_empty(f3, "membrane");
+  if (!b.axisymmetric_wall)
+    throw InputError("full3d.membrane.axisymmetric", mem.contains("axisymmetric") ? scene::show(mem["axisymmetric"]) : "false (default)",
+                     "--tier axi solves round-wall scenes only: set full3d.membrane.axisymmetric = true (the 3D tier "
+                     "then holds the same wall round), or run the buckling wall with --tier 3d");
+  if (b.container != "cylinder")
+    throw InputError("container.kind", "\"" + b.container + "\"",
+                     "the axisymmetric tier models the rigid circular cylinder only (\"cylinder\"); a box or square "
+                     "duct is not axisymmetric: run it with --tier 3d");
+  if (b.navier_stokes)
+    throw InputError("full3d.navier_stokes", "true", "the axisymmetric tier solves Stokes flow: set it to false");
+  if (b.wall_inertia)
+    throw InputError("full3d.wall_inertia", "true",
+                     "the axisymmetric tier models the force-free wall of creeping flow (no wall inertia): set it to false");
+  if (b.dry) throw InputError("full3d.dry", "true", "the dry swimmer is a 3D test of the protocol: run it with --tier 3d");
+  if (b.membrane.bending != full3d::BendingForm::ReferenceAngle)
+    throw InputError("full3d.membrane.bending_form", "\"printed\"",
+                     "the axisymmetric wall measures bending from the reference shape (\"reference_angle\")");
+
+  // 2. The wall's moduli: the network's spring constant and the bending rigidity D the 3D
+  // tier's wall has on the scene's 3D mesh (equal to full3d.membrane.bending_rigidity when given).
+  p.ks = b.membrane.ks;
+  {
+    const full3d::CylinderMesh mesh = full3d::make_mesh(b);
+    p.D = b.membrane.kb * full3d::bending_rigidity_per_kb(mesh, b.membrane.bending);
+    p.bending_source = b.bending_rigidity > 0 ? "full3d.membrane.bending_rigidity"
+                                              : "full3d.membrane.bending_constant " + fmt(b.membrane.kb, "N") +
+                                                    " on the 3D mesh of full3d.grid (n_theta " +
+                                                    std::to_string(mesh.n_theta) + ")";
+  }
+
+  // 3. The axi section.
+  json& res_axi = resolved["axi"];
+  res_axi = json::object();
+  Reader a(section_or_empty(sc, "axi"), "axi", res_axi);
+  const double Rc = b.container_radius, width = 2.0 * Rc;
+  {
+    Reader g = a.child("grid");
+    if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
+      p.h = g.quantity("cell_size", "m", "", Range::positive());
+      if (!multiple_of(Rc, p.h))
+        throw InputError(g.path("cell_size"), fmt(p.h, "m"), "must divide the container radius " + fmt(Rc, "m"));
+    } else {
+      const long n = g.integer("cells_across", 64, 8, 8192);
+      if (n % 2 != 0)
+        throw InputError(g.path("cells_across"), std::to_string(n),
+                         "an even number (cells across the container's diameter; the axisymmetric grid spans its radius)");
+      p.h = width / double(n);
+    }
+    if (!multiple_of(b.period, p.h))
+      throw InputError("container.period", fmt(b.period, "m"), "must be a multiple of the cell size " + fmt(p.h, "m"));
+    p.nr = int(std::lround(Rc / p.h));
+    p.nx = int(std::lround(b.period / p.h));
+    if (p.nx % 2 != 0)
+      throw InputError("container.period", fmt(b.period, "m"),
+                       "must hold an even number of cells (" + std::to_string(p.nx) + " of " + fmt(p.h, "m") + ")");
+    g.finish();
+  }
+  p.spacing_factor = a.number("spacing_factor", 0.5, Range::open(0.0, 1.0));
+  p.tolerance = a.number("tolerance", 2e-4, Range::open(0.0, 1.0));
+  p.dt_max = a.quantity("dt_max", "s", "8 ms", Range::positive());
+  p.dt_min = a.quantity("dt_min", "s", "10 ns", Range::positive());
+  p.event_dt = a.quantity("event_dt", "s", "0.1 ms", Range::positive());
+  if (!(p.dt_min <= p.event_dt && p.event_dt <= p.dt_max))
+    throw InputError(a.path("event_dt"), fmt(p.event_dt, "s"),
+                     "must lie between axi.dt_min = " + fmt(p.dt_min, "s") + " and axi.dt_max = " + fmt(p.dt_max, "s"));
+  p.time_limit = a.quantity("time_limit", "s", fmt(b.time_limit, "s"), Range::positive());
+  a.finish();
+
+  // 4. Consistency.
+  const double R0 = b.R0, L = b.L;
+  if (!(R0 + 2.0 * p.h < Rc))
+    throw InputError("container.radius", fmt(Rc, "m"),
+                     "the swimmer must fit: swimmer.radius + 2 h (kernel support) = " + fmt(R0 + 2.0 * p.h, "m") +
+                         " must be below the container radius (h = " + fmt(p.h, "m") + ")");
+  if (!(b.protocol.R_f > 2.0 * p.h))
+    throw InputError("axi.grid.cells_across", "",
+                     "the contracted wall (R_f = " + fmt(b.protocol.R_f, "m") +
+                         ") must stay more than 2 cells from the axis: refine the grid (h = " + fmt(p.h, "m") + ")");
+  if (!(L + 4.0 * p.h < b.period))
+    throw InputError("container.period", fmt(b.period, "m"),
+                     "must exceed swimmer.length + 4 h = " + fmt(L + 4.0 * p.h, "m"));
+  if (double(p.nr) * p.nx > 4.0e7)
+    throw InputError("axi.grid", std::to_string(p.nr) + "x" + std::to_string(p.nx), "more than 4e7 cells; use a coarser grid");
+  const double spacing = p.spacing_factor * 0.5 * p.h;
+  p.wall_nodes = int(std::ceil(L / spacing)) + 1;
+  if (p.wall_nodes > 200000)
+    throw InputError("axi.spacing_factor", fmt(p.spacing_factor, ""), "gives more than 2e5 wall nodes");
+  return p;
+}
+
+}  // namespace swim::axi

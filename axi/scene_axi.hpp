@@ -1,0 +1,48 @@
+// Scene -> parameters of the axisymmetric reference tier (`swim run SCENE --tier axi`).
+//
+// The tier solves the same scene as the 3D tier's round wall: the shared sections (swimmer,
+// fluid, wall, wave, protocol, time, container) and the wall's network keys are read by the
+// 3D tier's own reader (full3d/scene3d.hpp), with the same keys, defaults and rules, so
+// that both tiers run the same physics; the `axi` section holds this tier's numerics
+// (docs/axi.md, docs/scenes.md "The axi section"). Model only what the scene asks for:
+//   - the wall must be held round: full3d.membrane.axisymmetric = true;
+//   - the container must be the rigid cylinder (container.kind = "cylinder");
+//   - Stokes flow, no wall inertia, no dry swimmer (full3d.navier_stokes, full3d.wall_inertia,
+//     full3d.dry must be false), the reference-angle bending form.
+// Anything else is an InputError (exit 2) naming the key, before anything is written.
+#pragma once
+
+#include <string>
+
+#include "common/scene.hpp"
+#include "full3d/scene3d.hpp"
+
+namespace swim::axi {
+
+struct ParamsAxi {
+  full3d::Params3d base;       ///< the shared physics, as the 3D tier reads it
+  // grid
+  int nr = 32, nx = 256;       ///< radial and axial cells
+  double h = 0.0;              ///< m
+  // wall
+  double spacing_factor = 0.5; ///< meridional node spacing <= spacing_factor * h / 2
+  int wall_nodes = 0;
+  double ks = 0.0;             ///< N/m, the network's spring constant
+  double D = 0.0;              ///< J, the wall's bending rigidity
+  std::string bending_source;  ///< "full3d.membrane.bending_rigidity" or the k_b mapping used
+  // time stepping (explicit trapezoidal rule with an embedded Euler error estimate)
+  double tolerance = 2e-4;     ///< local position error per step, in cells (h)
+  double dt_max = 8e-3, dt_min = 1e-8, event_dt = 1e-4;  ///< s
+  double time_limit = 2.0;     ///< s; run cap when the duration is auto
+
+  const std::string& name() const { return base.name; }
+  double x_start() const { return 0.5 * (nx * h - base.L); }  ///< axial position of the rear end
+};
+
+/// Throws swim::InputError naming the key, the value and what is allowed.
+ParamsAxi read_scene_axi(const scene::json& scene, scene::json& resolved);
+
+/// The keys of the `axi` section (for the other tiers' pass-through check).
+const scene::json& section_keys();
+
+}  // namespace swim::axi
