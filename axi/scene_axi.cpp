@@ -12,14 +12,11 @@ using scene::json;
 using scene::Range;
 using scene::Reader;
 
+using scene::multiple_of;
+
 namespace {
 
 std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
-
-bool multiple_of(double a, double h) {
-  const double n = std::round(a / h);
-  return n >= 1 && std::abs(a - n * h) <= 1e-9 * a;
-}
 
 const json& section_or_empty(const json& sc, const char* key) {
   static const json empty = json::object();

@@ -1,8 +1,9 @@
 #include "axi/wall_axi.hpp"
 
-#include <Eigen/Sparse>
-#include <Eigen/SparseLU>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <numbers>
 #include <string>
 #include <vector>
 
@@ -11,34 +12,94 @@
 namespace swim::axi {
 
 namespace {
+constexpr double kPi = std::numbers::pi;
 constexpr double kSqrt3 = 1.7320508075688772935;
+// 2-point Gauss on [0, 1]
+constexpr double kXi1 = 0.5 - 0.5 / kSqrt3, kXi2 = 0.5 + 0.5 / kSqrt3;
+
+std::string num(double v) {
+  char b[32];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
 }
+
+/// Band matrix (kl sub-, ku super-diagonals) with room for the fill of partial pivoting;
+/// row i stores columns i - kl .. i + ku + kl.
+class BandLU {
+ public:
+  BandLU(int n, int kl, int ku) : n_(n), kl_(kl), ku_(ku), w_(2 * kl + ku + 1), a_(size_t(n) * w_, 0.0) {}
+  double& at(int i, int j) { return a_[size_t(i) * w_ + (j - i + kl_)]; }
+  /// Solves A x = b in place (A is destroyed). False on a zero pivot.
+  bool solve(Eigen::VectorXd& b) {
+    const int up = ku_ + kl_;
+    for (int k = 0; k < n_; ++k) {
+      const int last = std::min(n_ - 1, k + kl_);
+      int p = k;
+      for (int i = k + 1; i <= last; ++i)
+        if (std::abs(at(i, k)) > std::abs(at(p, k))) p = i;
+      if (!(at(p, k) != 0.0) || !std::isfinite(at(p, k))) return false;
+      const int jmax = std::min(n_ - 1, k + up);
+      if (p != k) {
+        for (int j = k; j <= jmax; ++j) std::swap(at(k, j), at(p, j));
+        std::swap(b[k], b[p]);
+      }
+      const double piv = at(k, k);
+      for (int i = k + 1; i <= last; ++i) {
+        const double m = at(i, k) / piv;
+        if (m == 0.0) continue;
+        for (int j = k + 1; j <= jmax; ++j) at(i, j) -= m * at(k, j);
+        b[i] -= m * b[k];
+      }
+    }
+    for (int k = n_ - 1; k >= 0; --k) {
+      double s = b[k];
+      const int jmax = std::min(n_ - 1, k + up);
+      for (int j = k + 1; j <= jmax; ++j) s -= at(k, j) * b[j];
+      b[k] = s / at(k, k);
+    }
+    return b.allFinite();
+  }
+
+ private:
+  int n_, kl_, ku_, w_;
+  std::vector<double> a_;
+};
+}  // namespace
 
 double stretching_density(double ks, double ls, double lt, double* dW_dls, double* dW_dlt) {
   const double c = ks / kSqrt3;
   const double q = std::sqrt(0.25 * lt * lt + 0.75 * ls * ls);
-  const double a = lt - 1.0, b = q - 1.0;
-  if (dW_dls) *dW_dls = 3.0 * c * b * ls / q;
-  if (dW_dlt) *dW_dlt = c * (2.0 * a + b * lt / q);
-  return c * (a * a + 2.0 * b * b);
+  const double et = lt - 1.0, eq = q - 1.0;
+  if (dW_dls || dW_dlt) {
+    const double f = eq / q;  // d(q-1)^2/dq / (2 q)
+    if (dW_dls) *dW_dls = 3.0 * c * f * ls;
+    if (dW_dlt) *dW_dlt = c * (2.0 * et + f * lt);
+  }
+  return c * (et * et + 2.0 * eq * eq);
 }
 
 AxiWall::AxiWall(const AxiWallParams& p) : p_(p) {
-  const auto bad = [](double v) { return !std::isfinite(v); };
-  if (bad(p.R0) || !(p.R0 > 0)) throw InputError("swimmer.radius", std::to_string(p.R0), "must be > 0");
-  if (bad(p.L) || !(p.L > 0)) throw InputError("swimmer.length", std::to_string(p.L), "must be > 0");
-  if (p.nodes < 3) throw InputError("axi.spacing_factor", std::to_string(p.nodes), "the wall needs at least 3 nodes");
-  if (bad(p.ks) || !(p.ks > 0)) throw InputError("wall.spring_constant", std::to_string(p.ks), "must be > 0");
-  if (bad(p.D) || !(p.D >= 0)) throw InputError("full3d.membrane.bending_rigidity", std::to_string(p.D), "must be >= 0");
+  if (!(p.R0 > 0.0) || !std::isfinite(p.R0)) throw InputError("swimmer.R0", num(p.R0), "a positive radius in m");
+  if (!(p.L > 0.0) || !std::isfinite(p.L)) throw InputError("swimmer.L", num(p.L), "a positive length in m");
+  if (p.nodes < 3)
+    throw InputError("axi wall nodes", std::to_string(p.nodes), "an integer >= 3 (meridian nodes of the wall)");
+  if (!(p.ks > 0.0) || !std::isfinite(p.ks))
+    throw InputError("axi wall spring constant ks", num(p.ks), "a positive spring constant in N/m");
+  if (!(p.D >= 0.0) || !std::isfinite(p.D))
+    throw InputError("axi wall bending rigidity D", num(p.D), "a non-negative bending rigidity in J");
   n_ = p.nodes;
   h_ = p.L / (n_ - 1);
-  X0_ = Eigen::Matrix3Xd::Zero(3, n_);
+  X0_.setZero(3, n_);
   A_.resize(n_);
   for (int k = 0; k < n_; ++k) {
-    X0_(0, k) = k * h_;
+    X0_(0, k) = k == n_ - 1 ? p.L : k * h_;
     X0_(1, k) = p.R0;
-    A_[k] = 2.0 * M_PI * p.R0 * h_ * (k == 0 || k == n_ - 1 ? 0.5 : 1.0);
+    A_[k] = 2.0 * kPi * p.R0 * h_ * (k == 0 || k == n_ - 1 ? 0.5 : 1.0);
   }
+}
+
+double AxiWall::uniform_energy(double R) const {
+  return 2.0 * kPi * p_.R0 * p_.L * stretching_density(p_.ks, 1.0, R / p_.R0);
 }
 
 std::array<double, 2> AxiWall::energies(const Eigen::Matrix3Xd& X) const {
@@ -48,84 +109,89 @@ std::array<double, 2> AxiWall::energies(const Eigen::Matrix3Xd& X) const {
 }
 
 Eigen::Matrix3Xd AxiWall::forces(const Eigen::Matrix3Xd& X, std::array<double, 2>* energy) const {
-  Eigen::Matrix3Xd F = Eigen::Matrix3Xd::Zero(3, n_);
-  std::array<double, 2> e{};
-  evaluate(X, &F, &e);
-  if (energy) *energy = e;
+  Eigen::Matrix3Xd F(3, n_);
+  evaluate(X, &F, energy);
   return F;
 }
 
-double AxiWall::uniform_energy(double R) const {
-  return 2.0 * M_PI * p_.R0 * p_.L * stretching_density(p_.ks, 1.0, R / p_.R0);
-}
-
 double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::array<double, 2>* energy) const {
-  if (X.cols() != n_) throw InputError("wall", std::to_string(X.cols()), "positions must have one column per wall node");
-  const double R0 = p_.R0, h = h_, a = 2.0 * M_PI * R0, D = p_.D, nu = kWallPoisson;
-  const int ne = n_ - 1;
-  // per segment: vector, length, hoop bending strain and its gradient
-  std::vector<double> dx(ne), dr(ne), l2(ne), kt(ne), gkt(ne, 0.0);
-  double Es = 0.0, Eb = 0.0;
-  const double g1 = 0.5 - 0.5 / kSqrt3, g2 = 0.5 + 0.5 / kSqrt3;
+  if (X.cols() != n_)
+    throw InputError("axi wall positions", std::to_string(X.cols()) + " columns",
+                     "3 x " + std::to_string(n_) + " (one column per wall node)");
+  const int n = n_, ne = n - 1;
+  const double h = h_, R0 = p_.R0, ks = p_.ks, D = p_.D, nu = kWallPoisson;
+  const double inv_R0 = 1.0 / R0;
+  const double ws = kPi * R0 * h;  // 2 pi R0 h * (1/2): the Gauss weight of a segment
+  const double G = kPi * R0 * D;   // 2 pi R0 * D/2
   const bool grad = F != nullptr;
-  // gradient accumulated as dE/dX (F = -G at the end)
-  auto add = [&](int k, double gx, double gr) {
-    (*F)(0, k) -= gx;
-    (*F)(1, k) -= gr;
-  };
+  if (grad) F->setZero();
+
+  // per segment: unit tangent (c, s) = (cos psi, sin psi), length l, k_t, dE/dk_t, dE/dpsi
+  Eigen::Matrix<double, 6, Eigen::Dynamic> S(6, ne);
+  double Es = 0.0;
   for (int e = 0; e < ne; ++e) {
-    dx[e] = X(0, e + 1) - X(0, e);
-    dr[e] = X(1, e + 1) - X(1, e);
-    l2[e] = dx[e] * dx[e] + dr[e] * dr[e];
-    const double l = std::sqrt(l2[e]);
+    const double dx = X(0, e + 1) - X(0, e), dr = X(1, e + 1) - X(1, e);
+    const double l = std::sqrt(dx * dx + dr * dr), il = 1.0 / l;
+    const double c = dx * il, s = dr * il;
+    S(0, e) = c;
+    S(1, e) = s;
+    S(2, e) = l;
+    S(3, e) = (c - 1.0) * inv_R0;
+    S(4, e) = 0.0;
+    S(5, e) = 0.0;
+    // stretching
     const double ls = l / h;
-    double Wls[2], Wlt[2];
-    const double lt1 = (X(1, e) + g1 * dr[e]) / R0, lt2 = (X(1, e) + g2 * dr[e]) / R0;
-    Es += 0.5 * a * h * (stretching_density(p_.ks, ls, lt1, &Wls[0], &Wlt[0]) +
-                         stretching_density(p_.ks, ls, lt2, &Wls[1], &Wlt[1]));
-    kt[e] = (dx[e] / l - 1.0) / R0;
+    const double ra = X(1, e), rb = X(1, e + 1);
+    const double lt1 = ((1.0 - kXi1) * ra + kXi1 * rb) * inv_R0, lt2 = ((1.0 - kXi2) * ra + kXi2 * rb) * inv_R0;
     if (grad) {
-      const double dEdls = 0.5 * a * h * (Wls[0] + Wls[1]);
-      const double sx = dEdls * dx[e] / (l * h), sr = dEdls * dr[e] / (l * h);
-      const double c1 = 0.5 * a * h * Wlt[0] / R0, c2 = 0.5 * a * h * Wlt[1] / R0;
-      add(e + 1, sx, sr + c1 * g1 + c2 * g2);
-      add(e, -sx, -sr + c1 * (1.0 - g1) + c2 * (1.0 - g2));
+      double ds1, dt1, ds2, dt2;
+      Es += ws * (stretching_density(ks, ls, lt1, &ds1, &dt1) + stretching_density(ks, ls, lt2, &ds2, &dt2));
+      const double dEdl = ws * (ds1 + ds2) / h;  // dE/dl
+      const double fx = dEdl * c, fr = dEdl * s;  // dE/dX_{e+1} along the tangent
+      (*F)(0, e) += fx;
+      (*F)(1, e) += fr;
+      (*F)(0, e + 1) -= fx;
+      (*F)(1, e + 1) -= fr;
+      const double g1 = ws * dt1 * inv_R0, g2 = ws * dt2 * inv_R0;  // dE/dr at the Gauss points
+      (*F)(1, e) -= g1 * (1.0 - kXi1) + g2 * (1.0 - kXi2);
+      (*F)(1, e + 1) -= g1 * kXi1 + g2 * kXi2;
+    } else {
+      Es += ws * (stretching_density(ks, ls, lt1) + stretching_density(ks, ls, lt2));
     }
   }
+
+  double Eb = 0.0;
   if (D > 0.0) {
-    const double cb = 0.5 * a * D;
+    // hoop term, midpoint rule per segment
     for (int e = 0; e < ne; ++e) {
-      Eb += cb * h * kt[e] * kt[e];
-      gkt[e] += cb * 2.0 * h * kt[e];
+      const double kt = S(3, e);
+      Eb += G * h * kt * kt;
+      S(4, e) += 2.0 * G * h * kt;
     }
-    for (int k = 1; k + 1 < n_; ++k) {
-      const double w = n_ == 3 ? 2.0 * h : (k == 1 || k == n_ - 2) ? 1.5 * h : h;
-      const int ea = k - 1, eb = k;
-      const double cross = dx[ea] * dr[eb] - dr[ea] * dx[eb], dot = dx[ea] * dx[eb] + dr[ea] * dr[eb];
-      const double th = std::atan2(cross, dot);
-      const double ks = th / h, kbar = 0.5 * (kt[ea] + kt[eb]);
-      Eb += cb * w * (ks * ks + 2.0 * nu * ks * kbar);
-      if (grad) {
-        const double dks = cb * w * (2.0 * ks + 2.0 * nu * kbar);
-        const double dkbar = cb * w * 2.0 * nu * ks;
-        gkt[ea] += 0.5 * dkbar;
-        gkt[eb] += 0.5 * dkbar;
-        // d theta / d(segment a) = (a_r, -a_x)/|a|^2, d theta / d(segment b) = (-b_r, b_x)/|b|^2
-        const double s = dks / h;
-        const double ax = s * dr[ea] / l2[ea], ar = -s * dx[ea] / l2[ea];
-        const double bx = -s * dr[eb] / l2[eb], br = s * dx[eb] / l2[eb];
-        add(k, ax, ar);
-        add(k - 1, -ax, -ar);
-        add(k + 1, bx, br);
-        add(k, -bx, -br);
-      }
+    // meridional and mixed terms at the interior nodes
+    for (int k = 1; k <= n - 2; ++k) {
+      const double w = n == 3 ? 2.0 * h : (k == 1 || k == n - 2) ? 1.5 * h : h;
+      const double c0 = S(0, k - 1), s0 = S(1, k - 1), c1 = S(0, k), s1 = S(1, k);
+      const double dpsi = std::atan2(c0 * s1 - s0 * c1, c0 * c1 + s0 * s1);
+      const double kap = dpsi / h, ktm = 0.5 * (S(3, k - 1) + S(3, k));
+      Eb += G * w * (kap * kap + 2.0 * nu * kap * ktm);
+      const double dEdpsi = G * w * (2.0 * kap + 2.0 * nu * ktm) / h;
+      S(5, k) += dEdpsi;
+      S(5, k - 1) -= dEdpsi;
+      const double dEdkt = G * w * nu * kap;  // on each of the two segments (d ktm / d kt = 1/2)
+      S(4, k - 1) += dEdkt;
+      S(4, k) += dEdkt;
     }
     if (grad)
       for (int e = 0; e < ne; ++e) {
-        const double l3 = l2[e] * std::sqrt(l2[e]);
-        const double gx = gkt[e] * dr[e] * dr[e] / (l3 * R0), gr = -gkt[e] * dx[e] * dr[e] / (l3 * R0);
-        add(e + 1, gx, gr);
-        add(e, -gx, -gr);
+        // d k_t / d psi = -sin psi / R0;  d psi / d X_{e+1} = (-sin psi, cos psi) / l
+        const double c = S(0, e), s = S(1, e), l = S(2, e);
+        const double g = (S(5, e) - S(4, e) * s * inv_R0) / l;
+        const double gx = -g * s, gr = g * c;  // dE/dX_{e+1}
+        (*F)(0, e) += gx;
+        (*F)(1, e) += gr;
+        (*F)(0, e + 1) -= gx;
+        (*F)(1, e + 1) -= gr;
       }
   }
   if (energy) *energy = {Es, Eb};
@@ -133,80 +199,98 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
 }
 
 AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double tol_force, int max_iterations) {
-  if (!std::isfinite(P) || P == 0.0) throw InputError("pressure", std::to_string(P), "must be finite and non-zero");
-  if (max_iterations < 1) throw InputError("max_iterations", std::to_string(max_iterations), "must be >= 1");
-  const int n = wall.nodes();
+  if (!(P != 0.0) || !std::isfinite(P))
+    throw InputError("pressure", num(P), "a non-zero finite pressure in Pa (C1 = P / (R0 - R_mid))");
+  if (max_iterations < 1)
+    throw InputError("max_iterations", std::to_string(max_iterations), "an integer >= 1");
+  const int n = wall.nodes(), nu = 2 * n - 1;
   const Eigen::VectorXd& A = wall.node_area();
-  if (!(tol_force > 0)) tol_force = 1e-9 * std::abs(P) * A.maxCoeff();
-  // unknowns: x_1..x_{n-1} (index k-1), r_0..r_{n-1} (index n-1+k)
-  const int m = 2 * n - 1;
-  auto residual = [&](const Eigen::Matrix3Xd& X) {
-    const Eigen::Matrix3Xd F = wall.forces(X);
-    Eigen::VectorXd g(m);
-    for (int k = 1; k < n; ++k) g[k - 1] = -F(0, k);
-    for (int k = 0; k < n; ++k) g[n - 1 + k] = -F(1, k) + P * A[k];
+  const double R0 = wall.params().R0;
+  if (!(tol_force > 0.0)) tol_force = 1e-9 * std::abs(P) * A.maxCoeff();
+  // unknowns: r_k -> 2k, x_k -> 2k - 1 (k >= 1); x_0 held
+  auto dof = [](int k, int comp) { return comp == 1 ? 2 * k : 2 * k - 1; };
+
+  // gradient g = -F + P A e_r of E + P sum A r (3 x n; row 2 unused)
+  auto gradient = [&](const Eigen::Matrix3Xd& X) {
+    Eigen::Matrix3Xd g = -wall.forces(X);
+    g.row(1) += P * A.transpose();
     return g;
   };
-  auto apply = [&](Eigen::Matrix3Xd& X, const Eigen::VectorXd& d, double s) {
-    for (int k = 1; k < n; ++k) X(0, k) += s * d[k - 1];
-    for (int k = 0; k < n; ++k) X(1, k) += s * d[n - 1 + k];
+  auto reduced = [&](const Eigen::Matrix3Xd& g) {
+    Eigen::VectorXd v(nu);
+    for (int k = 0; k < n; ++k) {
+      v[dof(k, 1)] = g(1, k);
+      if (k > 0) v[dof(k, 0)] = g(0, k);
+    }
+    return v;
   };
-  AxiPressureResponse res;
-  res.X = wall.reference();
-  Eigen::VectorXd g = residual(res.X);
-  const double eps = 1e-7 * wall.params().R0;
-  for (int it = 0;; ++it) {
-    res.max_residual_force = g.cwiseAbs().maxCoeff();
-    res.iterations = it;
-    if (res.max_residual_force < tol_force) break;
-    if (it >= max_iterations)
-      throw NumericalError("the static wall did not reach equilibrium under " + std::to_string(P) + " Pa in " +
-                               std::to_string(max_iterations) + " Newton steps",
-                           "lower the load");
-    // banded Jacobian by central differences, 5 colours per coordinate (a node couples to
-    // at most 2 neighbours each side)
-    std::vector<Eigen::Triplet<double>> trip;
+  auto max_node_force = [&](const Eigen::Matrix3Xd& g) { return g.topRows<2>().colwise().norm().maxCoeff(); };
+
+  Eigen::Matrix3Xd X = wall.reference();
+  Eigen::Matrix3Xd g = gradient(X);
+  Eigen::VectorXd res = reduced(g);
+  const double eps = 1e-6 * R0;
+  int it = 0;
+  for (; it < max_iterations && !(max_node_force(g) <= tol_force); ++it) {
+    // banded Jacobian dg/du by central differences, nodes k = colour mod 5 together
+    BandLU J(nu, 5, 5);
     for (int comp = 0; comp < 2; ++comp)
       for (int colour = 0; colour < 5; ++colour) {
-        Eigen::Matrix3Xd Xp = res.X, Xm = res.X;
+        Eigen::Matrix3Xd Xp = X, Xm = X;
+        bool any = false;
         for (int k = colour; k < n; k += 5) {
           if (comp == 0 && k == 0) continue;
+          any = true;
           Xp(comp, k) += eps;
           Xm(comp, k) -= eps;
         }
-        const Eigen::VectorXd d = (residual(Xp) - residual(Xm)) / (2.0 * eps);
+        if (!any) continue;
+        const Eigen::Matrix3Xd d = (wall.forces(Xm) - wall.forces(Xp)) / (2.0 * eps);  // = dg
         for (int k = colour; k < n; k += 5) {
           if (comp == 0 && k == 0) continue;
-          const int col = comp == 0 ? k - 1 : n - 1 + k;
+          const int col = dof(k, comp);
           for (int j = std::max(0, k - 2); j <= std::min(n - 1, k + 2); ++j) {
-            if (j >= 1 && d[j - 1] != 0.0) trip.emplace_back(j - 1, col, d[j - 1]);
-            if (d[n - 1 + j] != 0.0) trip.emplace_back(n - 1 + j, col, d[n - 1 + j]);
+            J.at(dof(j, 1), col) = d(1, j);
+            if (j > 0) J.at(dof(j, 0), col) = d(0, j);
           }
         }
       }
-    Eigen::SparseMatrix<double> J(m, m);
-    J.setFromTriplets(trip.begin(), trip.end());
-    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
-    lu.compute(J);
-    if (lu.info() != Eigen::Success) throw NumericalError("singular Jacobian of the static wall", "lower the load");
-    const Eigen::VectorXd d = lu.solve(-g);
-    double s = 1.0;
-    const double norm0 = g.norm();
-    for (int back = 0;; ++back) {
-      Eigen::Matrix3Xd Xt = res.X;
-      apply(Xt, d, s);
-      const Eigen::VectorXd gt = residual(Xt);
-      if ((gt.allFinite() && gt.norm() < norm0) || back >= 20) {
-        res.X = Xt;
-        g = gt;
+    Eigen::VectorXd step = -res;
+    if (!J.solve(step)) break;
+    // backtracking on the residual norm
+    double t = 1.0;
+    bool accepted = false;
+    for (int ls = 0; ls < 30; ++ls, t *= 0.5) {
+      Eigen::Matrix3Xd Xn = X;
+      for (int k = 0; k < n; ++k) {
+        Xn(1, k) += t * step[dof(k, 1)];
+        if (k > 0) Xn(0, k) += t * step[dof(k, 0)];
+      }
+      if (!(Xn.row(1).minCoeff() > 0.0)) continue;
+      const Eigen::Matrix3Xd gn = gradient(Xn);
+      const Eigen::VectorXd rn = reduced(gn);
+      if (rn.allFinite() && (rn.norm() < res.norm() || max_node_force(gn) <= tol_force)) {
+        X = Xn;
+        g = gn;
+        res = rn;
+        accepted = true;
         break;
       }
-      s *= 0.5;
     }
+    if (!accepted) break;
   }
-  res.mid_radius = n % 2 ? res.X(1, n / 2) : 0.5 * (res.X(1, n / 2 - 1) + res.X(1, n / 2));
-  res.c1 = P / (wall.params().R0 - res.mid_radius);
-  return res;
+  AxiPressureResponse out;
+  out.X = X;
+  out.iterations = it;
+  out.max_residual_force = max_node_force(g);
+  if (!(out.max_residual_force <= tol_force))
+    throw NumericalError("axisymmetric wall static relaxation stalled at residual force " +
+                             num(out.max_residual_force) + " N (tolerance " + num(tol_force) + " N) after " +
+                             std::to_string(it) + " Newton iterations",
+                         "reduce the applied pressure (protocol.pressure sets the scale of the calibration loads)");
+  out.mid_radius = 0.5 * (X(1, (n - 1) / 2) + X(1, n / 2));
+  out.c1 = P / (R0 - out.mid_radius);
+  return out;
 }
 
 }  // namespace swim::axi

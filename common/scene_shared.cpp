@@ -27,6 +27,11 @@ std::string format_quantity(double v, const char* unit) {
   return b;
 }
 
+bool multiple_of(double a, double h) {
+  const double n = std::round(a / h);
+  return n >= 1 && std::abs(a - n * h) <= 1e-9 * a;
+}
+
 Body read_body(Reader& top) {
   Body b;
   {

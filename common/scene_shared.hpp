@@ -17,6 +17,10 @@ std::string one_of(const Reader& r, const std::vector<std::string>& keys, const 
 /// "1.25e-07 m": a value and its unit for messages and defaults.
 std::string format_quantity(double v, const char* unit);
 
+/// True when a is a whole number n >= 1 of cells h (to 1e-9 relative): grid rules of the
+/// 3D and axisymmetric tiers.
+bool multiple_of(double a, double h);
+
 struct Body {
   double R0 = 0, L = 0;     ///< swimmer.radius, swimmer.length [m]
   double mu = 0, rho = 0;   ///< fluid.viscosity [Pa s], fluid.density [kg/m^3]

@@ -13,14 +13,11 @@ using scene::json;
 using scene::Range;
 using scene::Reader;
 
+using scene::multiple_of;
+
 namespace {
 
 std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
-
-bool multiple_of(double a, double h) {
-  const double n = std::round(a / h);
-  return n >= 1 && std::abs(a - n * h) <= 1e-9 * a;
-}
 
 }  // namespace
 

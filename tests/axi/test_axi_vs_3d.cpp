@@ -15,6 +15,7 @@
 #include <unistd.h>
 
 #include "axi/run_axi.hpp"
+#include "axi_test_support.hpp"
 #include "axi/scene_axi.hpp"
 #include "common/scene.hpp"
 #include "full3d/run3d.hpp"
@@ -24,14 +25,7 @@ namespace {
 namespace fs = std::filesystem;
 using swim::scene::json;
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) : path(fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using swim::axi::testing::TempDir;
 }  // namespace
 
 TEST(AxiAgainst3d, RoundWallCycleAgreesWithThe3dTierAtTheSameCellSizeWithinTheFirstOrderError) {

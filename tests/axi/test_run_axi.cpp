@@ -10,6 +10,7 @@
 #include "axi/grid_axi.hpp"
 #include "axi/ib_axi.hpp"
 #include "axi/run_axi.hpp"
+#include "axi_test_support.hpp"
 #include "axi/scene_axi.hpp"
 #include "axi/stokes_axi.hpp"
 #include "axi/wall_axi.hpp"
@@ -39,14 +40,7 @@ std::string input_error_key(const json& sc) {
   return "(accepted)";
 }
 
-struct TempDir {
-  fs::path path;
-  explicit TempDir(const std::string& name) : path(fs::temp_directory_path() / (name + "-" + std::to_string(::getpid()))) {
-    fs::remove_all(path);
-    fs::create_directories(path);
-  }
-  ~TempDir() { fs::remove_all(path); }
-};
+using swim::axi::testing::TempDir;
 
 }  // namespace
 
