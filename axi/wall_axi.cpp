@@ -64,6 +64,13 @@ class BandLU {
   int n_, kl_, ku_, w_;
   std::vector<double> a_;
 };
+/// Sum of squares, NaN-propagating (a plain loop: GCC 12 flags Eigen's AVX-512 reductions of
+/// dynamic vectors as maybe-uninitialised).
+double sum_sq(const Eigen::VectorXd& v) {
+  double s = 0.0;
+  for (Eigen::Index i = 0; i < v.size(); ++i) s += v[i] * v[i];
+  return s;
+}
 }  // namespace
 
 double stretching_density(double ks, double ls, double lt, double* dW_dls, double* dW_dlt) {
@@ -96,6 +103,8 @@ AxiWall::AxiWall(const AxiWallParams& p) : p_(p) {
     X0_(1, k) = p.R0;
     A_[k] = 2.0 * kPi * p.R0 * h_ * (k == 0 || k == n_ - 1 ? 0.5 : 1.0);
   }
+  h0_.resize(n_ - 1);
+  for (int e = 0; e + 1 < n_; ++e) h0_[e] = X0_(0, e + 1) - X0_(0, e);
 }
 
 double AxiWall::uniform_energy(double R) const {
@@ -131,22 +140,23 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
   double Es = 0.0;
   for (int e = 0; e < ne; ++e) {
     const double dx = X(0, e + 1) - X(0, e), dr = X(1, e + 1) - X(1, e);
-    const double l = std::sqrt(dx * dx + dr * dr), il = 1.0 / l;
-    const double c = dx * il, s = dr * il;
+    // (divisions, not a reciprocal: cos psi = 1 and lambda_s = 1 exactly on the reference)
+    const double l = std::sqrt(dx * dx + dr * dr);
+    const double c = dx / l, s = dr / l;
     S(0, e) = c;
     S(1, e) = s;
     S(2, e) = l;
-    S(3, e) = (c - 1.0) * inv_R0;
+    S(3, e) = (c - 1.0) / R0;
     S(4, e) = 0.0;
     S(5, e) = 0.0;
     // stretching
-    const double ls = l / h;
+    const double ls = l / h0_[e];
     const double ra = X(1, e), rb = X(1, e + 1);
-    const double lt1 = ((1.0 - kXi1) * ra + kXi1 * rb) * inv_R0, lt2 = ((1.0 - kXi2) * ra + kXi2 * rb) * inv_R0;
+    const double lt1 = (ra + kXi1 * dr) / R0, lt2 = (ra + kXi2 * dr) / R0;
     if (grad) {
       double ds1, dt1, ds2, dt2;
       Es += ws * (stretching_density(ks, ls, lt1, &ds1, &dt1) + stretching_density(ks, ls, lt2, &ds2, &dt2));
-      const double dEdl = ws * (ds1 + ds2) / h;  // dE/dl
+      const double dEdl = ws * (ds1 + ds2) / h0_[e];  // dE/dl
       const double fx = dEdl * c, fr = dEdl * s;  // dE/dX_{e+1} along the tangent
       (*F)(0, e) += fx;
       (*F)(1, e) += fr;
@@ -206,7 +216,9 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
   const int n = wall.nodes(), nu = 2 * n - 1;
   const Eigen::VectorXd& A = wall.node_area();
   const double R0 = wall.params().R0;
-  if (!(tol_force > 0.0)) tol_force = 1e-9 * std::abs(P) * A.maxCoeff();
+  // (plain loops for the reductions here: see sum_sq)
+  const double a_max = *std::max_element(A.data(), A.data() + n);
+  if (!(tol_force > 0.0)) tol_force = 1e-9 * std::abs(P) * a_max;
   // unknowns: r_k -> 2k, x_k -> 2k - 1 (k >= 1); x_0 held
   auto dof = [](int k, int comp) { return comp == 1 ? 2 * k : 2 * k - 1; };
 
@@ -224,7 +236,14 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
     }
     return v;
   };
-  auto max_node_force = [&](const Eigen::Matrix3Xd& g) { return g.topRows<2>().colwise().norm().maxCoeff(); };
+  auto max_node_force = [&](const Eigen::Matrix3Xd& gr) {
+    double m = 0.0;
+    for (int k = 0; k < n; ++k) {
+      const double f = std::hypot(gr(0, k), gr(1, k));
+      if (!(f <= m)) m = f;  // NaN propagates
+    }
+    return m;
+  };
 
   Eigen::Matrix3Xd X = wall.reference();
   Eigen::Matrix3Xd g = gradient(X);
@@ -266,10 +285,12 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
         Xn(1, k) += t * step[dof(k, 1)];
         if (k > 0) Xn(0, k) += t * step[dof(k, 0)];
       }
-      if (!(Xn.row(1).minCoeff() > 0.0)) continue;
+      bool positive = true;
+      for (int k = 0; k < n; ++k) positive = positive && Xn(1, k) > 0.0;
+      if (!positive) continue;
       const Eigen::Matrix3Xd gn = gradient(Xn);
       const Eigen::VectorXd rn = reduced(gn);
-      if (rn.allFinite() && (rn.norm() < res.norm() || max_node_force(gn) <= tol_force)) {
+      if (rn.allFinite() && (sum_sq(rn) < sum_sq(res) || max_node_force(gn) <= tol_force)) {
         X = Xn;
         g = gn;
         res = rn;

@@ -24,7 +24,9 @@
 //
 // Discretisation: n nodes X_k = (x_k, r_k) at s0_k = k h, h = L/(n-1), linear segments
 // e = (k, k+1) between them.
-//   Stretching, per segment: lambda_s,e = |X_{k+1} - X_k| / h (constant on the segment),
+//   Stretching, per segment: lambda_s,e = |X_{k+1} - X_k| / h_e (constant on the segment;
+//     h_e = x0_{k+1} - x0_k of reference(), h up to round-off, so that the reference shape
+//     is exactly stress free),
 //     lambda_t linear along it, integrated by 2-point Gauss:
 //       E_s = 2 pi R0 h sum_e (1/2) sum_{g=1,2} W_s(lambda_s,e, lambda_t(xi_g)),
 //       xi_g = 1/2 -+ 1/(2 sqrt 3).
@@ -110,6 +112,7 @@ class AxiWall {
   double h_ = 0.0;
   Eigen::Matrix3Xd X0_;
   Eigen::VectorXd A_;
+  Eigen::VectorXd h0_;  ///< reference segment lengths h_e
 };
 
 /// Static equilibrium of the wall under a uniform inward pressure P (Pa).
