@@ -151,7 +151,7 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
     S(5, e) = 0.0;
     // stretching
     const double ls = l / h0_[e];
-    const double ra = X(1, e), rb = X(1, e + 1);
+    const double ra = X(1, e);
     const double lt1 = (ra + kXi1 * dr) / R0, lt2 = (ra + kXi2 * dr) / R0;
     if (grad) {
       double ds1, dt1, ds2, dt2;

@@ -35,6 +35,26 @@ Eigen::Matrix3Xd perturbed(const AxiWall& w, double amp, unsigned seed) {
   return X;
 }
 
+/// Sum and maximum of the node areas (plain loops: GCC 12 flags Eigen's AVX-512 reductions of
+/// dynamic vectors as maybe-uninitialised).
+double area_sum(const AxiWall& w) {
+  double s = 0;
+  for (int k = 0; k < w.nodes(); ++k) s += w.node_area()[k];
+  return s;
+}
+double area_max(const AxiWall& w) {
+  double m = 0;
+  for (int k = 0; k < w.nodes(); ++k) m = std::max(m, w.node_area()[k]);
+  return m;
+}
+
+/// Largest |entry| (a plain loop, as above).
+double max_abs(const Eigen::Matrix3Xd& M) {
+  double m = 0;
+  for (Eigen::Index i = 0; i < M.size(); ++i) m = std::max(m, std::abs(M.data()[i]));
+  return m;
+}
+
 double total(const AxiWall& w, const Eigen::Matrix3Xd& X) {
   const auto e = w.energies(X);
   return e[0] + e[1];
@@ -54,7 +74,7 @@ std::pair<double, double> gradient_error(const AxiWall& w, const Eigen::Matrix3X
       const double fd = -(energy(Xp) - energy(Xm)) / (2.0 * eps);
       worst = std::max(worst, std::abs(fd - F(c, k)));
     }
-  return {worst, F.cwiseAbs().maxCoeff()};
+  return {worst, max_abs(F)};
 }
 
 }  // namespace
@@ -68,7 +88,7 @@ TEST(AxiWall, ForcesEqualCentralDifferencesOfTheEnergyOnAPerturbedShape) {
       const Eigen::Matrix3Xd X = perturbed(w, 0.05, seed);
       std::array<double, 2> e{};
       const Eigen::Matrix3Xd F = w.forces(X, &e);
-      EXPECT_EQ(F.row(2).cwiseAbs().maxCoeff(), 0.0);
+      EXPECT_EQ(F.row(2).cwiseAbs().sum(), 0.0);
       const auto [err, scale] = gradient_error(w, X, F, [&](const Eigen::Matrix3Xd& Y) { return total(w, Y); });
       EXPECT_LT(err, 1e-7 * scale) << "D = " << D << ", seed " << seed;
       // the energies of the same pass are those of energies()
@@ -95,16 +115,16 @@ TEST(AxiWall, TheReferenceCylinderHasZeroEnergyAndZeroForce) {
     // lambda_s is measured against the stored reference differences: exactly 1 there
     EXPECT_EQ(e[0], 0.0) << n;
     EXPECT_EQ(e[1], 0.0) << n;
-    EXPECT_EQ(F.cwiseAbs().maxCoeff(), 0.0) << n;
+    EXPECT_EQ(max_abs(F), 0.0) << n;
     // shifted along the axis, x_{k+1} - x_k rounds differently: strains up to
     // 2 ulp(x) / h, ring forces up to ~ 2 pi R0 (Y / (1 - nu^2)) = 2 pi R0 1.3 ks times that
     Eigen::Matrix3Xd X = w.reference();
     X.row(0).array() += 0.3e-6;
     const double strain = 2 * std::numeric_limits<double>::epsilon() * (0.3e-6 + kL) / w.ds0();
     const Eigen::Matrix3Xd Fs = w.forces(X, &e);
-    EXPECT_LT(Fs.cwiseAbs().maxCoeff(), 2 * 2 * kPi * kR0 * 1.3 * kKs * strain) << n;
+    EXPECT_LT(max_abs(Fs), 2 * 2 * kPi * kR0 * 1.3 * kKs * strain) << n;
     EXPECT_LT(e[0] + e[1], 2 * kPi * kR0 * kL * kKs * strain * strain) << n;
-    EXPECT_NEAR(w.node_area().sum(), 2 * kPi * kR0 * kL, 1e-14 * kR0 * kL);
+    EXPECT_NEAR(area_sum(w), 2 * kPi * kR0 * kL, 1e-13 * 2 * kPi * kR0 * kL);
     EXPECT_DOUBLE_EQ(w.reference()(0, n - 1), kL);
     EXPECT_DOUBLE_EQ(w.ds0(), kL / (n - 1));
   }
@@ -118,8 +138,8 @@ TEST(AxiWall, RigidAxialTranslationChangesNothingAndTheTotalAxialForceVanishes) 
     Y.row(0).array() += 0.37e-6;
     std::array<double, 2> ex{}, ey{};
     const Eigen::Matrix3Xd FX = w.forces(X, &ex), FY = w.forces(Y, &ey);
-    const double scale = FX.cwiseAbs().maxCoeff();
-    EXPECT_LT((FX - FY).cwiseAbs().maxCoeff(), 1e-9 * scale);  // x differences lose ~1e-10 at the shift
+    const double scale = max_abs(FX);
+    EXPECT_LT(max_abs(FX - FY), 1e-9 * scale);  // x differences lose ~1e-10 at the shift
     EXPECT_NEAR(ex[0], ey[0], 1e-9 * ex[0]);
     EXPECT_NEAR(ex[1], ey[1], 1e-9 * ex[1]);
     EXPECT_LT(std::abs(FX.row(0).sum()), 1e-13 * scale);
@@ -137,7 +157,7 @@ TEST(AxiWall, MirroringTheShapeMirrorsTheForces) {
   double worst = 0;
   for (int k = 0; k < n; ++k)
     worst = std::max({worst, std::abs(G(0, k) + F(0, n - 1 - k)), std::abs(G(1, k) - F(1, n - 1 - k))});
-  EXPECT_LT(worst, 1e-10 * F.cwiseAbs().maxCoeff());
+  EXPECT_LT(worst, 1e-10 * max_abs(F));
   EXPECT_NEAR(eg[0], ef[0], 1e-12 * ef[0]);
   EXPECT_NEAR(eg[1], ef[1], 1e-12 * ef[1]);
 }
@@ -181,11 +201,12 @@ TEST(AxiWall, TheLinearisedStretchingLawIsIsotropicWithYEqualToTwoKsOverRootThre
 
 TEST(AxiWall, SmallUniformPressureGivesC1EqualToYOverR0SquaredInTheMiddleAndALinearResponse) {
   // With free ends and the reference-area load the uniform state (no axial tension,
-  // dW/dlambda_t = -P R0) is an exact equilibrium of the discrete wall too, so the only error
-  // is Newton's stopping residual (1e-9 of the largest nodal load): about 1e-9 relative in
-  // R0 - R. 1e-6 leaves three decades of margin; the 0.5 % an end-effect estimate would allow
-  // would hide a missing end-node load factor (a 1/2 error at the end nodes changes C1 by
-  // much more than that: see the large-load test's uniformity check).
+  // dW/dlambda_t = -P R0) is an exact equilibrium of the discrete wall too, so there is no
+  // end effect and the only error is Newton's stopping residual (1e-9 of the largest nodal
+  // load): measured 2e-11 relative in R0 - R. 1e-6 leaves four decades of margin. The middle
+  // of this 8 R0 tube is insensitive to the ends by design (full end-node areas A_0 = 2 pi R0 h
+  // instead of half would move its C1 by only 2e-7), so the whole tube's uniformity is
+  // checked as well (the same fault moves the end rings by half the deflection).
   const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kD, 65});
   const double C1 = swim::axi::young_modulus_2d(kKs) / (kR0 * kR0);
   const double P = 1e-3 * C1 * kR0;  // R0 - R = 1e-3 R0
@@ -193,7 +214,9 @@ TEST(AxiWall, SmallUniformPressureGivesC1EqualToYOverR0SquaredInTheMiddleAndALin
   const auto b = swim::axi::relax_under_pressure(w, 2 * P);
   EXPECT_NEAR(a.c1, C1, 1e-6 * C1);
   EXPECT_NEAR(b.c1 / a.c1, 1.0, 1e-6);
-  EXPECT_LE(a.max_residual_force, 1e-9 * P * w.node_area().maxCoeff());
+  for (int k = 0; k < w.nodes(); ++k)
+    EXPECT_NEAR(kR0 - a.X(1, k), kR0 - a.mid_radius, 1e-6 * (kR0 - a.mid_radius)) << "ring " << k;
+  EXPECT_LE(a.max_residual_force, 1e-9 * P * area_max(w));
   EXPECT_GE(a.iterations, 1);
   EXPECT_LT(a.iterations, 10);
 }
@@ -280,7 +303,7 @@ TEST(AxiWall, AUniformContractionCostsNoBendingEnergy) {
   EXPECT_GT(e[0], 0.0);
   // and no bending force: the forces are those of the wall without bending
   const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, 33});
-  EXPECT_LT((w.forces(X) - w0.forces(X)).cwiseAbs().maxCoeff(), 1e-15 * w0.forces(X).cwiseAbs().maxCoeff());
+  EXPECT_LT(max_abs(w.forces(X) - w0.forces(X)), 1e-15 * max_abs(w0.forces(X)));
 }
 
 TEST(AxiWall, AGentleAxialUndulationConvergesToTheContinuumIntegralAtSecondOrder) {
