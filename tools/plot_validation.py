@@ -63,6 +63,63 @@ def evidence_value(key, v):
     return f"{v}"
 
 
+def unit_of(quantity):
+    """The SI unit of a report key: *_m_per_s, *_m, *_s."""
+    for suffix, unit in (("_m_per_s", "m/s"), ("_m", "m"), ("_s", "s")):
+        if quantity.endswith(suffix):
+            return unit
+    return ""
+
+
+def value_pm(v, e, quantity):
+    """'22.3 ± 4.07 nm/s'; a dash for a value the suite could not compute."""
+    if v is None:
+        return "—"
+    if quantity == "body_lengths_per_s":
+        return f"{v:.3g} ± {'—' if e is None else f'{e:.2g}'} body lengths/s"
+    unit = unit_of(quantity)
+    if not unit:
+        return f"{v:.3g} ± {'—' if e is None else f'{e:.3g}'}"
+    return f"{si(v, unit)} ± {si(e, unit)}"
+
+
+def finding_values(f):
+    """A finding's values with their errors, and the differences it rests on."""
+    parts = []
+    for e in f["evidence"]:
+        if "quantity" in e:
+            sweep = [f"{k} = {e[k]}" for k in ("L_um", "R_f_over_R0") if k in e]
+            text = f"{e['case']}{' (' + sweep[0] + ')' if sweep else ''}: {value_pm(e['value'], e['error'], e['quantity'])}"
+            if "band" in e:
+                text += f" (paper {e['paper']}, band {e['band'][0]:.3g}–{e['band'][1]:.3g})"
+        elif "relative_difference" in e:
+            rd, er = e["relative_difference"], e["reference_error_relative"]
+            text = (f"{e['case']}, {e['model']}{' (default)' if e.get('default_model') else ''}: "
+                    f"1D − 3D = {pct(rd)} ± {'—' if er is None else f'{100 * er:.1f} %'} "
+                    f"(tolerance ±{100 * e['tolerance']:.0f} %): {e['verdict']}")
+        elif "correlation" in e:
+            c, ce = e["correlation"], e["correlation_error"]
+            text = (f"{e['case']}, {e['model']}{' (default)' if e.get('default_model') else ''}: "
+                    f"correlation {'—' if c is None else f'{c:.2f}'} ± {'—' if ce is None else f'{ce:.2f}'} "
+                    f"(threshold {e['threshold']}): {e['verdict']}")
+        else:
+            text = ", ".join(f"{k} = {evidence_value(k, v)}" for k, v in e.items())
+        if e.get("note"):
+            text += f" ({e['note']})"
+        parts.append(text)
+    unit = unit_of((f["evidence"][0].get("quantity") or "") if f["evidence"] else "")
+    for c in f.get("comparisons", []):
+        parts.append(f"{c['expected_larger']} − {c['expected_smaller']} = {si(c['difference'], unit) if unit else c['difference']} "
+                     f"against e₁ + e₂ = {si(c['combined_uncertainty'], unit) if unit else c['combined_uncertainty']}: "
+                     f"{c['outcome']}")
+    return "; ".join(parts) or "the suite has no cases for it"
+
+
+def cell(text):
+    """Text for a Markdown table cell: its pipes escaped (|a − b| stays readable)."""
+    return text.replace("|", "\\|")
+
+
 def legend_right(ax):
     """Legend beside the axes, off the data."""
     ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
@@ -132,9 +189,17 @@ def convergence_figure(case, path):
     ax.plot(h, d, "ko-", label="3D runs")
     ref = case["reference3d"].get("displacement_per_cycle_m")
     if ref:
+        rng = case["reference3d"].get("order_range")
+        rng_text = f"[{rng[0]:g}, {rng[1]:g}]" if rng else "the scheme's range"
+        obs = ref.get("observed_order")
+        if ref["asymptotic"]:
+            what = f" (order {ref['order']:.2f}, accepted in {rng_text})" if ref["order"] else ""
+        else:
+            what = (" (not asymptotic: finest ± spread" +
+                    (f"; observed order {obs:.2f} outside {rng_text}" if obs is not None and
+                     not (rng and rng[0] <= obs <= rng[1]) else "") + ")")
         ax.errorbar([0], [ref["value"] * 1e9], yerr=[ref["error"] * 1e9], fmt="rs", capsize=4,
-                    label="extrapolated h → 0" + (f" (order {ref['order']:.2f})" if ref["asymptotic"] else
-                                                  " (not asymptotic: finest)"))
+                    label="3D reference h → 0 ± error" + what)
     for k, m in enumerate(case["models1d"]):
         if m.get("has_cycle") and ref and abs(m["displacement_per_cycle_m"]) < 20 * abs(ref["value"]):
             ax.axhline(m["displacement_per_cycle_m"] * 1e9, color=f"C{k + 1}", ls="--", lw=1, label=f"1D: {m['label']}")
@@ -361,12 +426,20 @@ def markdown(report, figs):
            f"±{100 * th['displacement_per_cycle_relative']:.0f} %, cycle time ±{100 * th['cycle_time_relative']:.0f} %, "
            f"mean velocity per cycle ±{100 * th['mean_velocity_per_cycle_relative']:.0f} % (1D against the "
            f"extrapolated 3D reference); U(t) phase correlation ≥ {th['velocity_phase_correlation']} "
-           "(against the finest 3D run).", "", "## The paper's conclusions", "",
-           "| claim | status | evidence |", "|---|---|---|"]
+           "(against the finest 3D run); each verdict against the 3D reference's error bar.", "",
+           "## The paper's conclusions", "",
+           "Every value carries the error of its 3D reference (the extrapolation's, or the spread of the grids "
+           "when they are not in the asymptotic range). Two values differ when |a − b| exceeds e_a + e_b (their "
+           "error bars do not overlap); a status is *inconclusive* when the error bars cannot decide it, with what "
+           "would settle it.", "",
+           "| claim | status | values (± error) | rule |", "|---|---|---|---|"]
     for f in report["findings"]:
-        ev = "; ".join(", ".join(f"{k} = {evidence_value(k, v)}" for k, v in e.items())
-                       for e in f["evidence"]) or "the suite has no cases for it"
-        out.append(f"| {f['claim']} | **{f['status']}** | {ev} |")
+        status = f"**{f['status']}**"
+        if f.get("to_settle"):
+            status += f": {f['to_settle']}"
+        elif f.get("reason"):
+            status += f": {f['reason']}"
+        out.append(f"| {cell(f['claim'])} | {cell(status)} | {cell(finding_values(f))} | {cell(f.get('rule', ''))} |")
     ex = report.get("extremes3d") or []
     if ex:
         n_ok = sum(1 for e in ex if e["as_expected"])
@@ -399,7 +472,9 @@ def markdown(report, figs):
                     "lobes whose pattern follows the grid, and the 1D tier, which assumes a round tube, "
                     "cannot represent them (docs/full3d.md, \"Wall wrinkling\")."]
         ref = c["reference3d"]
-        out += ["", "Extrapolated 3D reference (h → 0):", ""]
+        rng = ref.get("order_range")
+        out += ["", "Extrapolated 3D reference (h → 0"
+                + (f"; observed orders accepted in [{rng[0]:g}, {rng[1]:g}]" if rng else "") + "):", ""]
         for key, unit in (("displacement_per_cycle_m", "m"), ("cycle_time_s", "s"),
                           ("mean_velocity_per_cycle_m_per_s", "m/s")):
             if key in ref:
@@ -432,6 +507,9 @@ def markdown(report, figs):
         else:
             out.append(f"Not available: {cal.get('status', 'unknown')}")
         out += ["", "### 1D models", "",
+                "vs ref: the relative difference from the 3D reference ± the reference's relative error; U(t) phase "
+                "correlation ± its spread over the 3D grids. A verdict passes when the whole interval lies inside the "
+                "tolerance, fails when it lies wholly outside, and is inconclusive otherwise.", "",
                 "| model | displacement / cycle | vs ref | cycle time | vs ref | mean velocity / cycle | vs ref | "
                 "U(t) phase corr. | verdicts | wall time |", "|---|---|---|---|---|---|---|---|---|---|"]
         for m in c["models1d"]:
@@ -440,13 +518,20 @@ def markdown(report, figs):
                            "| | | | | | | | |")
                 continue
             e = m.get("relative_error_vs_reference", {})
+            re_ = m.get("reference_error_relative", {})
             v = m.get("velocity_vs_finest3d", {})
             verd = ", ".join(f"{k}: {w}" for k, w in m.get("verdicts", {}).items())
             corr = v.get("phase_correlation")
-            out.append(f"| {m['label']} | {si(m['displacement_per_cycle_m'], 'm')} | {pct(e.get('displacement_per_cycle'))} | "
-                       f"{si(m['cycle_time_s'], 's')} | {pct(e.get('cycle_time'))} | "
-                       f"{si(m['mean_velocity_per_cycle_m_per_s'], 'm/s')} | {pct(e.get('mean_velocity_per_cycle'))} | "
-                       f"{'—' if corr is None else f'{corr:.2f}'} | {verd} | {si(m['wall_time_s'], 's')} |")
+            spread = v.get("phase_correlation_grid_spread")
+
+            def vs(k):
+                err = re_.get(k)
+                return pct(e.get(k)) + ("" if err is None or e.get(k) is None else f" ± {100 * err:.0f} %")
+            out.append(f"| {m['label']} | {si(m['displacement_per_cycle_m'], 'm')} | {vs('displacement_per_cycle')} | "
+                       f"{si(m['cycle_time_s'], 's')} | {vs('cycle_time')} | "
+                       f"{si(m['mean_velocity_per_cycle_m_per_s'], 'm/s')} | {vs('mean_velocity_per_cycle')} | "
+                       f"{'—' if corr is None else f'{corr:.2f}'}{'' if spread is None else f' ± {spread:.2f}'} | "
+                       f"{verd} | {si(m['wall_time_s'], 's')} |")
         if "wall_time_ratio_3d_over_1d" in c:
             out += ["", f"Wall time, 3D run at the calibration grid against the first 1D model: "
                         f"{c['wall_time_ratio_3d_over_1d']:.3g} ×."]
@@ -462,7 +547,8 @@ def to_html(md, d):
     body, table = [], False
     for line in md.splitlines():
         if line.startswith("|"):
-            cells = [c.strip() for c in line.strip("|").split("|")]
+            # cells split on the unescaped pipes; an escaped one (\|) is text
+            cells = [c.strip().replace("\\|", "|") for c in re.split(r"(?<!\\)\|", line.strip()[1:-1])]
             if all(set(c) <= set("-") for c in cells):
                 continue
             if not table:

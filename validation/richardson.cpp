@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <cstdio>
+#include <cstdlib>
 #include <numeric>
 
 #include <gsl/gsl_errno.h>
@@ -32,9 +33,20 @@ double bracketed_root(const std::function<double(double)>& f, double lo, double 
   return gsl_root_fsolver_root(s.get());
 }
 
-Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order) {
+std::string OrderRange::text() const {
+  char b[64];
+  std::snprintf(b, sizeof b, "[%g, %g]", lo, hi);
+  return b;
+}
+
+Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order, OrderRange range) {
   if (h.size() != f.size() || h.size() < 2)
     throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
+  if (!(range.lo > 0 && range.hi > range.lo && range.hi <= kOrderSearchMax))
+    throw InputError("order range", range.text(),
+                     "0 < lo < hi <= " + std::to_string(int(kOrderSearchMax)) + " (the orders the scheme can show)");
+  if (!(assumed_order >= range.lo && assumed_order <= range.hi))
+    throw InputError("assumed order", std::to_string(assumed_order), "inside the order range " + range.text());
   std::vector<std::size_t> idx(h.size());
   std::iota(idx.begin(), idx.end(), 0);
   std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return h[a] > h[b]; });
@@ -63,7 +75,8 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
     }
     e.order = assumed_order;
     e.value = v;
-    e.error = std::abs(e.value - f3);
+    // the order is assumed, not observed: the error is at least the difference of the two
+    e.error = std::max(std::abs(e.value - f3), std::abs(f3 - f2));
     e.asymptotic = true;
     char b[32];
     std::snprintf(b, sizeof b, "%g", assumed_order);
@@ -89,17 +102,47 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
   }
   if (!(d12 * d23 > 0)) return not_asymptotic("the differences change sign");
   const double ratio = d12 / d23;
-  auto g = [&](double p) {
-    return (std::pow(h1, p) - std::pow(h2, p)) / (std::pow(h2, p) - std::pow(h3, p)) - ratio;
-  };
-  if (g(0.25) * g(8.0) > 0) return not_asymptotic("observed order outside [0.25, 8]");
-  const double order = bracketed_root(g, 0.25, 8.0);
+  // spacings relative to the finest, so that h^p neither under- nor overflows
+  const double a = h1 / h3, b = h2 / h3;
+  auto g = [&](double p) { return (std::pow(a, p) - std::pow(b, p)) / (std::pow(b, p) - 1.0) - ratio; };
+  char buf[160];
+  // g grows with p: below the bracket's g the order is lower than its low end, above it higher
+  if (g(kOrderSearchMin) > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "observed order below %g (the differences do not shrink as h falls), outside the range %s of the "
+                  "scheme",
+                  kOrderSearchMin, range.text().c_str());
+    return not_asymptotic(buf);
+  }
+  if (g(kOrderSearchMax) < 0) {
+    std::snprintf(buf, sizeof buf, "observed order above %g, outside the range %s of the scheme", kOrderSearchMax,
+                  range.text().c_str());
+    return not_asymptotic(buf);
+  }
+  const double order = bracketed_root(g, kOrderSearchMin, kOrderSearchMax);
+  e.observed_order = order;
+  // round-off of the root (1e-14 relative) does not take an order on the range's end out of it
+  const double slack = 1e-9 * range.hi;
+  if (order < range.lo - slack || order > range.hi + slack) {
+    // enough digits to show the order outside the range (2.005, not 2)
+    int digits = 3;
+    for (; digits < 8; ++digits) {
+      std::snprintf(buf, sizeof buf, "%.*g", digits, order);
+      const double shown = std::atof(buf);
+      if (shown < range.lo || shown > range.hi) break;
+    }
+    std::snprintf(buf, sizeof buf, "observed order %.*g, outside the range %s of the scheme", digits, order,
+                  range.text().c_str());
+    return not_asymptotic(buf);
+  }
   if (too_large(extrapolate(order))) return not_asymptotic("the extrapolation would change the finest value by more than half");
   e.order = order;
   e.value = extrapolate(e.order);
   e.error = std::abs(e.value - f3);
   e.asymptotic = true;
-  e.note = "Richardson with the observed order";
+  std::snprintf(buf, sizeof buf, "Richardson with the observed order (inside the range %s of the scheme)",
+                range.text().c_str());
+  e.note = buf;
   return e;
 }
 

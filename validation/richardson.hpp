@@ -2,14 +2,20 @@
 //
 // With three grids h1 > h2 > h3 and f(h) = f0 + C h^p + o(h^p), the observed order p solves
 //   (f1 - f2) / (f2 - f3) = (h1^p - h2^p) / (h2^p - h3^p)
-// (bisection on p in [0.25, 8]; for a constant refinement ratio r it is ln(ratio)/ln(r)), and
+// (Brent on p in [kOrderSearchMin, kOrderSearchMax]; for a constant refinement ratio r it is
+// ln(ratio)/ln(r)), and
 //   f0 = f3 + (f3 - f2) / ((h2 / h3)^p - 1),   error estimate |f0 - f3|.
-// When the two differences have opposite signs, or p leaves [0.25, 8], the sequence is not in
-// its asymptotic range: the finest value is returned with the spread of the three as its
-// error, and `asymptotic` is false. With two grids the order must be given (`assumed_order`).
+// The sequence is not in its asymptotic range when the two differences have opposite signs,
+// when p lies outside the range of orders the discretisation can show (OrderRange: an
+// immersed-boundary method is first order at best), or when the correction would exceed half
+// the finest value: the finest value is then returned with the spread of the three as its
+// error, and `asymptotic` is false. With two grids the order must be given (`assumed_order`,
+// inside the range); the error is then the larger of the correction and the difference of
+// the two values.
 #pragma once
 
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -18,10 +24,31 @@ namespace swim::validation {
 /// Largest accepted correction of an extrapolation, as a fraction of the finest value.
 constexpr double kMaxCorrection = 0.5;
 
+/// Observed orders are searched on this bracket; outside it the note says "below"/"above".
+constexpr double kOrderSearchMin = 0.01;
+constexpr double kOrderSearchMax = 20.0;
+
+/// The observed orders a discretisation can show. An observed order outside it says the grids
+/// are not in the asymptotic range (or that something else than h changes between them).
+struct OrderRange {
+  double lo = 0.5;
+  double hi = 2.0;
+  /// "[0.5, 2]"
+  std::string text() const;
+};
+
+/// Immersed-boundary methods (the 3D tier, the axisymmetric IB tier): first order at best.
+constexpr OrderRange kImmersedBoundaryOrders{0.5, 2.0};
+/// A sharp-interface method of second order.
+constexpr OrderRange kSharpInterfaceOrders{1.0, 3.5};
+
 struct Extrapolation {
   double value = 0;      ///< extrapolated f0 (or the finest value when not asymptotic)
   double error = 0;      ///< estimated error of `value`
-  double order = 0;      ///< observed (or assumed) order p; 0 when not asymptotic
+  double order = 0;      ///< observed (or assumed) order p used; 0 when not asymptotic
+  /// order the three grids show, also when it is rejected; NaN when there is none (two grids,
+  /// differences of opposite sign, or an order beyond the search bracket)
+  double observed_order = std::numeric_limits<double>::quiet_NaN();
   bool asymptotic = false;
   std::string note;      ///< how the value was obtained
 };
@@ -30,8 +57,11 @@ struct Extrapolation {
 /// Throws NumericalError when the solver fails.
 double bracketed_root(const std::function<double(double)>& f, double lo, double hi);
 
-/// h: grid spacings (any order), f: the figure on each. Throws InputError for fewer than two
-/// grids, repeated spacings, or mismatched sizes.
-Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order = 1.0);
+/// h: grid spacings (any order), f: the figure on each; `range`: the orders the scheme can
+/// show (default: immersed boundary, [0.5, 2]). Throws InputError for fewer than two grids,
+/// repeated spacings, mismatched sizes, an empty or non-positive range, or an assumed order
+/// outside the range.
+Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order = 1.0,
+                         OrderRange range = kImmersedBoundaryOrders);
 
 }  // namespace swim::validation

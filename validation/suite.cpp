@@ -23,6 +23,7 @@
 #include "validation/compare.hpp"
 #include "validation/hydraulic.hpp"
 #include "validation/richardson.hpp"
+#include "validation/verdicts.hpp"
 
 namespace fs = std::filesystem;
 
@@ -385,126 +386,6 @@ json relative(double value, double ref) {
   return (value - ref) / std::abs(ref);
 }
 
-json verdict(const json& rel, double threshold) {
-  if (rel.is_null()) return "not assessed";
-  return std::abs(rel.get<double>()) <= threshold ? "pass" : "fail";
-}
-
-// The paper's conclusions, judged on the 3D reference (extrapolated where available, else the
-// finest grid) of the cases of each sweep group.
-double reference_value(const json& c, const std::string& key) {
-  const json& ref = c["reference3d"];
-  if (ref.contains(key)) return ref[key]["value"].get<double>();
-  for (auto it = c["runs3d"].rbegin(); it != c["runs3d"].rend(); ++it)
-    if (it->contains(key)) return (*it)[key].get<double>();
-  return std::nan("");
-}
-
-/// A figure for the report: null when it could not be computed (a case whose 3D runs all failed).
-json finite_or_null(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
-
-json findings(const json& cases, double th_d) {
-  auto group = [&](const std::string& g) {
-    std::vector<const json*> v;
-    for (const auto& c : cases)
-      if (c["group"] == g && c["sweep_value"].is_number()) v.push_back(&c);
-    std::sort(v.begin(), v.end(), [](const json* a, const json* b) { return (*a)["sweep_value"] < (*b)["sweep_value"]; });
-    return v;
-  };
-  auto finding = [](const std::string& claim, const std::string& status, const json& evidence) {
-    return json{{"claim", claim}, {"status", status}, {"evidence", evidence}};
-  };
-  json out = json::array();
-  auto monotone = [&](const std::vector<const json*>& v, const std::string& key, bool increasing, json& ev) {
-    bool ok = true;
-    double prev = std::nan("");
-    for (const json* c : v) {
-      const double x = reference_value(*c, key);
-      ev.push_back({{"case", (*c)["name"]}, {"sweep_value", (*c)["sweep_value"]}, {key, finite_or_null(x)}});
-      if (!std::isfinite(x)) return std::string("not assessed");
-      if (std::isfinite(prev) && (increasing ? x <= prev : x >= prev)) ok = false;
-      prev = x;
-    }
-    return std::string(ok ? "reproduced" : "refuted");
-  };
-  {
-    const auto a = group("aspect"), m = group("amplitude");
-    json ev = json::array(), ev2 = json::array();
-    const std::string s1 = a.size() >= 2 ? monotone(a, "displacement_per_cycle_m", true, ev) : "not assessed";
-    // amplitude sweep_value is R_f / R0: deformation grows as it falls
-    const std::string s2 = m.size() >= 2 ? monotone(m, "displacement_per_cycle_m", false, ev2) : "not assessed";
-    out.push_back(finding("distance per cycle grows with the swimmer length L", s1, ev));
-    out.push_back(finding("distance per cycle grows with the deformation amplitude", s2, ev2));
-  }
-  // index of the case with the largest reference mean velocity per cycle (evidence appended)
-  auto fastest = [&](const std::vector<const json*>& v, const char* sweep_name, json& ev) {
-    // -1: a case has no 3D value, so the largest is not known
-    long best = 0;
-    double bv = -1e300;
-    for (std::size_t i = 0; i < v.size(); ++i) {
-      const double x = reference_value(*v[i], "mean_velocity_per_cycle_m_per_s");
-      ev.push_back({{"case", (*v[i])["name"]}, {sweep_name, (*v[i])["sweep_value"]},
-                    {"mean_velocity_per_cycle_m_per_s", finite_or_null(x)}});
-      if (!std::isfinite(x)) best = -1;
-      if (best >= 0 && x > bv) bv = x, best = long(i);
-    }
-    return best;
-  };
-  {
-    const auto a = group("aspect");
-    json ev = json::array();
-    const long best = a.size() < 2 ? -1 : fastest(a, "L_um", ev);
-    const std::string st = best < 0 ? "not assessed" : best == 0 ? "reproduced" : "refuted";
-    out.push_back(finding("mean velocity per cycle is largest for the shortest swimmer", st, ev));
-  }
-  {
-    const auto m = group("amplitude");
-    json ev = json::array();
-    std::string st = "not assessed";
-    if (m.size() >= 2) {
-      if (const long best = fastest(m, "R_f_over_R0", ev); best >= 0) {
-        const double rf = (*m[std::size_t(best)])["sweep_value"];
-        st = std::abs(rf - 0.5) <= 0.1 ? "reproduced" : "refuted";
-      }
-    }
-    out.push_back(finding("mean velocity per cycle is largest at about 50 % deformation", st, ev));
-  }
-  {
-    const auto m = group("amplitude");
-    json ev = json::array();
-    std::string st = "not assessed";
-    bool any = false, all = true;
-    for (const json* c : m) {
-      if ((*c)["sweep_value"].get<double>() < 0.5) continue;
-      for (const auto& md : (*c)["models1d"]) {
-        if (!md.contains("verdicts") || !md["verdicts"].contains("displacement_per_cycle")) continue;
-        any = true;
-        ev.push_back({{"case", (*c)["name"]}, {"model", md["label"]}, {"verdict", md["verdicts"]["displacement_per_cycle"]},
-                      {"relative_error", md["relative_error_vs_reference"]["displacement_per_cycle"]}});
-      }
-      const auto& md0 = (*c)["models1d"][0];
-      if (!(md0.contains("verdicts") && md0["verdicts"].value("displacement_per_cycle", "") == "pass")) all = false;
-    }
-    if (any) st = all ? "reproduced" : "refuted";
-    out.push_back(finding("1D agrees with 3D up to 50 % deformation (displacement per cycle within " +
-                              std::to_string(int(std::lround(100 * th_d))) + " %, the suite's default 1D model)",
-                          st, ev));
-  }
-  {
-    const auto o = group("optimal");
-    json ev = json::array();
-    std::string st = "not assessed";
-    for (const json* c : o) {
-      const double v = reference_value(*c, "mean_velocity_per_cycle_m_per_s"), L = (*c)["length_m"];
-      const double bl = v / L;
-      ev.push_back({{"case", (*c)["name"]}, {"body_lengths_per_s", finite_or_null(bl)}, {"paper_body_lengths_per_s", 1.5}});
-      st = std::isfinite(bl) && std::abs(bl / 1.5 - 1.0) <= 0.2 ? "reproduced" : "refuted";
-    }
-    out.push_back(finding("the optimal swimmer makes 1.5 body lengths/s (within 20 %)", st, ev));
-  }
-  return out;
-}
-
 }  // namespace
 
 json load_suite(const std::string& path) {
@@ -523,6 +404,7 @@ json load_suite(const std::string& path) {
         throw InputError(at + ".calibration_grid", scene::show(c),
                          "an index into grids, 0 to " + std::to_string(g.size() - 1));
     }
+    if (cases[i].contains("order_range")) parse_order_range(cases[i]["order_range"], at + ".order_range");
     if (cases[i].contains("time_variants3d")) {
       const json& v = cases[i]["time_variants3d"];
       bool ok = v.is_array();
@@ -533,6 +415,7 @@ json load_suite(const std::string& path) {
                          "an array of {\"label\": text, \"set\": {\"dotted.key\": value}} (3D time-step variants)");
     }
   }
+  if (s.contains("order_range")) parse_order_range(s["order_range"], "suite.order_range");
   if (s.contains("extremes3d")) {
     const json& ex = s["extremes3d"];
     bool ok = ex.is_array();
@@ -560,8 +443,6 @@ json run_suite(const SuiteOptions& o) {
   const json suite = load_suite(o.suite);
   const std::string suite_dir = fs::path(o.suite).parent_path().string();
   const json& th = suite["thresholds"];
-  const double th_d = th["displacement_per_cycle_relative"], th_T = th["cycle_time_relative"],
-               th_v = th["mean_velocity_per_cycle_relative"], th_c = th["velocity_phase_correlation"];
   const std::string runs_dir = o.out_dir + "/runs", cal_dir = o.out_dir + "/calibrations";
   fs::create_directories(runs_dir);
   fs::create_directories(cal_dir);
@@ -633,19 +514,32 @@ json run_suite(const SuiteOptions& o) {
     json ref = json::object();
     Extrapolation ed, eT, ev;
     const bool have_ref = hs.size() >= 2;
+    // the observed orders the 3D scheme can show: the case's, else the suite's, else the
+    // immersed boundary's
+    const OrderRange orders = cs.contains("order_range")      ? parse_order_range(cs["order_range"], "order_range")
+                              : suite.contains("order_range") ? parse_order_range(suite["order_range"], "order_range")
+                                                              : kImmersedBoundaryOrders;
     if (have_ref) {
-      ed = richardson(hs, fd);
-      eT = richardson(hs, fT);
-      // the mean velocity of the reference is its displacement over its cycle time
+      // two grids: first order, or the range's nearest end when first order lies outside it
+      const double assumed = std::clamp(1.0, orders.lo, orders.hi);
+      ed = richardson(hs, fd, assumed, orders);
+      eT = richardson(hs, fT, assumed, orders);
+      // the mean velocity of the reference is its displacement over its cycle time; the
+      // relative errors add (bounds, as everywhere in the verdicts: verdicts.hpp)
       ev.value = ed.value / eT.value;
-      ev.error = std::abs(ev.value) * std::hypot(ed.error / ed.value, eT.error / eT.value);
+      ev.error = std::abs(ev.value) * (std::abs(ed.error / ed.value) + std::abs(eT.error / eT.value));
       ev.asymptotic = ed.asymptotic && eT.asymptotic;
-      ev.note = "extrapolated displacement per cycle / extrapolated cycle time";
+      ev.note = "extrapolated displacement per cycle / extrapolated cycle time (relative errors added)";
       auto ej = [](const Extrapolation& e) {
-        return json{{"value", e.value}, {"error", e.error}, {"order", e.order}, {"asymptotic", e.asymptotic},
+        return json{{"value", e.value},
+                    {"error", e.error},
+                    {"order", e.order},
+                    {"observed_order", std::isfinite(e.observed_order) ? json(e.observed_order) : json(nullptr)},
+                    {"asymptotic", e.asymptotic},
                     {"note", e.note}};
       };
       ref = {{"grids_used", hs.size()},
+             {"order_range", {orders.lo, orders.hi}},
              {"displacement_per_cycle_m", ej(ed)},
              {"cycle_time_s", ej(eT)},
              {"mean_velocity_per_cycle_m_per_s", ej(ev)}};
@@ -743,6 +637,15 @@ json run_suite(const SuiteOptions& o) {
               relative(r.cyc.mean_velocity_per_cycle_m_per_s, at_cal.cyc.mean_velocity_per_cycle_m_per_s);
         }
         entry["relative_error_vs_reference"] = vs_ref;
+        // the reference's error relative to its value: the width of the verdicts' interval
+        json ref_err = json::object();
+        if (have_ref)
+          for (const auto& [k, e] : {std::pair<const char*, const Extrapolation*>{"displacement_per_cycle", &ed},
+                                     {"cycle_time", &eT},
+                                     {"mean_velocity_per_cycle", &ev}})
+            ref_err[k] = std::abs(e->value) > 0 && std::isfinite(e->error / e->value) ? json(std::abs(e->error / e->value))
+                                                                                       : json(nullptr);
+        entry["reference_error_relative"] = ref_err;
         entry["relative_error_vs_calibration_grid"] = vs_cal;
         if (finest.cyc.has_cycle && r.series.t.size() > 1 && finest.series.t.size() > 1) {
           const SeriesComparison ph = compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, finest.series.t,
@@ -753,13 +656,22 @@ json run_suite(const SuiteOptions& o) {
                                           {"phase_correlation", ph.correlation},
                                           {"time_l2_relative", ab.l2_relative},
                                           {"time_correlation", ab.correlation}};
-          entry["verdicts"]["velocity_phase_correlation"] = ph.correlation >= th_c ? "pass" : "fail";
+          // the uncertainty of the correlation: its spread against the (up to) three finest
+          // grids that completed a cycle, as the spread of a reference that is not asymptotic
+          std::vector<double> corr;
+          for (auto it = runs.rbegin(); it != runs.rend() && corr.size() < 3; ++it)
+            if (it->cyc.has_cycle && it->series.t.size() > 1)
+              corr.push_back(compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, it->series.t, it->series.u,
+                                            it->cyc.cycle_time_s, true)
+                                 .correlation);
+          if (corr.size() >= 2) {
+            const double spread = *std::max_element(corr.begin(), corr.end()) - *std::min_element(corr.begin(), corr.end());
+            entry["velocity_vs_finest3d"]["phase_correlation_grid_spread"] = spread;
+            entry["velocity_vs_finest3d"]["phase_correlation_grids"] = corr.size();
+          }
         }
-        if (have_ref) {
-          entry["verdicts"]["displacement_per_cycle"] = verdict(vs_ref["displacement_per_cycle"], th_d);
-          entry["verdicts"]["cycle_time"] = verdict(vs_ref["cycle_time"], th_T);
-          entry["verdicts"]["mean_velocity_per_cycle"] = verdict(vs_ref["mean_velocity_per_cycle"], th_v);
-        }
+        // pass, fail or inconclusive against the reference's error bar (verdicts.hpp)
+        if (const json v = model_verdicts(entry, th); !v.empty()) entry["verdicts"] = v;
         if (at_cal.record.value("pumped_volume_m3", 0.0) != 0.0)
           entry["pumped_volume_relative_vs_calibration_grid"] =
               relative(r.record.value("pumped_volume_m3", 0.0), at_cal.record["pumped_volume_m3"].get<double>());
@@ -831,7 +743,7 @@ json run_suite(const SuiteOptions& o) {
       cr["wall_time_ratio_3d_over_1d"] = at_cal.wall / models_j[0]["wall_time_s"].get<double>();
     report["cases"].push_back(cr);
   }
-  report["findings"] = findings(report["cases"], th_d);
+  report["findings"] = findings(report["cases"], th);
 
   // 3D at the extremes: each case's outcome against the one the suite states for it
   json extremes = json::array();

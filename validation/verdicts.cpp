@@ -1,0 +1,398 @@
+#include "validation/verdicts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <utility>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "common/si_format.hpp"
+
+namespace swim::validation {
+
+using scene::json;
+
+namespace {
+
+constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// A number for the report: null when it is not finite (never NaN in a file).
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+std::string fmt(const char* f, double x) {
+  char b[64];
+  std::snprintf(b, sizeof b, f, x);
+  return b;
+}
+
+std::string percent(double x) { return fmt("%.3g %%", 100 * x); }
+
+std::string show(double x, const std::string& unit) { return unit.empty() ? fmt("%.3g", x) : si(x, unit); }
+
+/// A case's 3D reference value with its error; `missing` says why there is none.
+struct Valued {
+  double value = kNaN, error = kNaN;
+  std::string missing;
+};
+
+Valued reference_of(const json& c, const std::string& key) {
+  Valued v;
+  const json& ref = c.contains("reference3d") ? c["reference3d"] : json::object();
+  if (ref.contains(key) && ref[key].contains("value") && ref[key]["value"].is_number() && ref[key].contains("error") &&
+      ref[key]["error"].is_number()) {
+    v.value = ref[key]["value"].get<double>();
+    v.error = std::abs(ref[key]["error"].get<double>());
+    if (std::isfinite(v.value) && std::isfinite(v.error)) return v;
+  }
+  bool one = false;
+  if (c.contains("runs3d"))
+    for (const auto& r : c["runs3d"]) one = one || (r.contains(key) && r[key].is_number());
+  v.value = v.error = kNaN;
+  v.missing = one ? "fewer than two grids completed a cycle: a value without an error bar" : "no 3D value";
+  return v;
+}
+
+const char* kTrendRule =
+    "each difference the claim rests on is compared with the combined uncertainty of its two values, "
+    "|a − b| > e_a + e_b (their error bars do not overlap): reproduced when every difference exceeds it in the "
+    "claimed direction, refuted when one exceeds it in the opposite direction, inconclusive otherwise";
+
+const char* kSettleSuffix = ": finer grids or the converged reference";
+
+struct Point {
+  const json* c = nullptr;
+  Valued v;
+  std::string name() const { return (*c)["name"].get<std::string>(); }
+};
+
+/// The reference values of the cases of a claim, with the evidence; `missing` gets the first
+/// case without a value (or without an error bar).
+std::vector<Point> points(const std::vector<const json*>& cases, const std::string& key, const char* sweep_name,
+                          json& ev, std::string& missing) {
+  std::vector<Point> p;
+  for (const json* c : cases) {
+    Point q{c, reference_of(*c, key)};
+    json e = {{"case", (*c)["name"]}, {sweep_name, (*c)["sweep_value"]}, {"quantity", key},
+              {"value", num(q.v.value)}, {"error", num(q.v.error)}};
+    if (!q.v.missing.empty()) {
+      e["note"] = q.v.missing;
+      if (missing.empty()) missing = q.name() + ": " + q.v.missing;
+    }
+    ev.push_back(e);
+    p.push_back(q);
+  }
+  return p;
+}
+
+/// "a exceeds b" against the combined uncertainty: +1 beyond it, -1 beyond it the other way,
+/// 0 within it (then what would settle it goes to `undecided`).
+int exceeds(const Point& a, const Point& b, const std::string& unit, json& comps, std::vector<std::string>& undecided) {
+  const double d = a.v.value - b.v.value, u = a.v.error + b.v.error;
+  const int o = d > u ? 1 : -d > u ? -1 : 0;
+  comps.push_back({{"expected_larger", a.name()},
+                   {"expected_smaller", b.name()},
+                   {"difference", num(d)},
+                   {"combined_uncertainty", num(u)},
+                   {"outcome", o > 0 ? "supports" : o < 0 ? "contradicts" : "within the uncertainty"}});
+  if (o == 0)
+    undecided.push_back(d == 0 ? a.name() + " and " + b.name() + " are equal: no error bar separates them"
+                               : "needs error bars below " + show(std::abs(d) / 2, unit) + " on both " + a.name() +
+                                     " and " + b.name() + " (now ± " + show(a.v.error, unit) + " and ± " +
+                                     show(b.v.error, unit) + ")");
+  return o;
+}
+
+std::string join(const std::vector<std::string>& v, const std::string& sep) {
+  std::string s;
+  for (std::size_t i = 0; i < v.size(); ++i) s += (i ? sep : "") + v[i];
+  return s;
+}
+
+json finding(const std::string& claim, const std::string& rule, const json& ev) {
+  return json{{"claim", claim}, {"status", "not assessed"}, {"rule", rule}, {"evidence", ev}};
+}
+
+/// A claim that values[a] > values[b] for each (a, b) in `pairs`.
+json trend(const std::string& claim, const std::vector<Point>& p, const std::string& missing, const json& ev,
+           const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::string& unit) {
+  json f = finding(claim, kTrendRule, ev);
+  if (p.size() < 2) {
+    f["reason"] = "the suite has fewer than two cases for it";
+    return f;
+  }
+  if (!missing.empty()) {
+    f["reason"] = missing;
+    return f;
+  }
+  json comps = json::array();
+  std::vector<std::string> undecided;
+  bool all = true, against = false;
+  for (const auto& [a, b] : pairs) {
+    const int o = exceeds(p[a], p[b], unit, comps, undecided);
+    all = all && o > 0;
+    against = against || o < 0;
+  }
+  f["comparisons"] = comps;
+  f["status"] = against ? "refuted" : all ? "reproduced" : "inconclusive";
+  if (!against && !all) f["to_settle"] = join(undecided, "; ") + kSettleSuffix;
+  return f;
+}
+
+/// Combined status of a claim over cases: refuted > not assessed > inconclusive > reproduced.
+std::string combine(const std::vector<std::string>& st) {
+  if (st.empty()) return "not assessed";
+  for (const char* s : {"refuted", "not assessed", "inconclusive"})
+    if (std::find(st.begin(), st.end(), s) != st.end()) return s;
+  return "reproduced";
+}
+
+}  // namespace
+
+OrderRange parse_order_range(const json& v, const std::string& key) {
+  if (v.is_string()) {
+    if (v == "immersed_boundary") return kImmersedBoundaryOrders;
+    if (v == "sharp_interface") return kSharpInterfaceOrders;
+  } else if (v.is_array() && v.size() == 2 && v[0].is_number() && v[1].is_number()) {
+    const OrderRange r{v[0].get<double>(), v[1].get<double>()};
+    if (r.lo > 0 && r.hi > r.lo && r.hi <= kOrderSearchMax) return r;
+  }
+  throw InputError(key, scene::show(v),
+                   "\"immersed_boundary\" (orders [0.5, 2]), \"sharp_interface\" ([1, 3.5]) or [lo, hi] with "
+                   "0 < lo < hi <= 20: the observed orders the 3D scheme can show");
+}
+
+std::string tolerance_verdict(double rel, double rel_error, double tolerance) {
+  if (!std::isfinite(rel) || !std::isfinite(rel_error)) return "not assessed";
+  const double d = std::abs(rel), e = std::abs(rel_error);
+  if (d + e <= tolerance) return "pass";
+  if (d - e > tolerance) return "fail";
+  return "inconclusive";
+}
+
+std::string correlation_verdict(double corr, double error, double threshold) {
+  if (!std::isfinite(corr) || !std::isfinite(error)) return "not assessed";
+  const double e = std::abs(error);
+  if (corr - e >= threshold) return "pass";
+  if (corr + e < threshold) return "fail";
+  return "inconclusive";
+}
+
+json model_verdicts(const json& entry, const json& th) {
+  json v = json::object();
+  auto number = [](const json& j, const char* k) {
+    return j.is_object() && j.contains(k) && j[k].is_number() ? j[k].get<double>() : kNaN;
+  };
+  const json& rel = entry.contains("relative_error_vs_reference") ? entry["relative_error_vs_reference"] : json::object();
+  const json& err = entry.contains("reference_error_relative") ? entry["reference_error_relative"] : json::object();
+  for (const auto& [k, t] : {std::pair<const char*, const char*>{"displacement_per_cycle", "displacement_per_cycle_relative"},
+                             {"cycle_time", "cycle_time_relative"},
+                             {"mean_velocity_per_cycle", "mean_velocity_per_cycle_relative"}})
+    if (rel.is_object() && rel.contains(k)) v[k] = tolerance_verdict(number(rel, k), number(err, k), th.at(t).get<double>());
+  const json& u = entry.contains("velocity_vs_finest3d") ? entry["velocity_vs_finest3d"] : json::object();
+  if (u.is_object() && u.contains("phase_correlation_grid_spread"))
+    v["velocity_phase_correlation"] =
+        correlation_verdict(number(u, "phase_correlation"), number(u, "phase_correlation_grid_spread"),
+                            th.at("velocity_phase_correlation").get<double>());
+  return v;
+}
+
+json findings(const json& cases, const json& th) {
+  auto group = [&](const std::string& g) {
+    std::vector<const json*> v;
+    for (const auto& c : cases)
+      if (c.value("group", json()) == g && c.value("sweep_value", json()).is_number()) v.push_back(&c);
+    std::sort(v.begin(), v.end(), [](const json* a, const json* b) { return (*a)["sweep_value"] < (*b)["sweep_value"]; });
+    return v;
+  };
+  json out = json::array();
+  const std::string kd = "displacement_per_cycle_m", kv = "mean_velocity_per_cycle_m_per_s";
+  const auto aspect = group("aspect"), amplitude = group("amplitude");
+
+  // distance per cycle grows with L: each L against the next
+  {
+    json ev = json::array();
+    std::string missing;
+    const auto p = points(aspect, kd, "L_um", ev, missing);
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i + 1, i);
+    out.push_back(trend("distance per cycle grows with the swimmer length L", p, missing, ev, pairs, "m"));
+  }
+  // ... and with the amplitude: the sweep value is R_f / R0, the deformation grows as it falls
+  {
+    json ev = json::array();
+    std::string missing;
+    const auto p = points(amplitude, kd, "R_f_over_R0", ev, missing);
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i, i + 1);
+    out.push_back(trend("distance per cycle grows with the deformation amplitude", p, missing, ev, pairs, "m"));
+  }
+  // the shortest swimmer against every other
+  {
+    json ev = json::array();
+    std::string missing;
+    const auto p = points(aspect, kv, "L_um", ev, missing);
+    std::vector<std::pair<std::size_t, std::size_t>> pairs;
+    for (std::size_t j = 1; j < p.size(); ++j) pairs.emplace_back(0, j);
+    out.push_back(trend("mean velocity per cycle is largest for the shortest swimmer", p, missing, ev, pairs, "m/s"));
+  }
+  // largest at about 50 % deformation (R_f / R0 within 0.1 of 0.5): some case there exceeds
+  // every case away from it
+  {
+    json ev = json::array();
+    std::string missing;
+    const auto p = points(amplitude, kv, "R_f_over_R0", ev, missing);
+    json f = finding("mean velocity per cycle is largest at about 50 % deformation (R_f/R0 within 0.1 of 0.5)",
+                     std::string(kTrendRule) + "; a case at about 50 % must exceed every case away from it", ev);
+    std::vector<std::size_t> at, away;
+    for (std::size_t i = 0; i < p.size(); ++i)
+      (std::abs((*p[i].c)["sweep_value"].get<double>() - 0.5) <= 0.1 ? at : away).push_back(i);
+    if (p.size() < 2) f["reason"] = "the suite has fewer than two cases for it";
+    else if (!missing.empty()) f["reason"] = missing;
+    else if (at.empty()) f["reason"] = "the sweep has no case at about 50 % deformation";
+    else if (away.empty()) f["reason"] = "the sweep has no case away from 50 % deformation";
+    else {
+      json comps = json::array();
+      std::vector<std::string> undecided;
+      std::vector<std::vector<int>> o(at.size(), std::vector<int>(away.size()));
+      for (std::size_t i = 0; i < at.size(); ++i)
+        for (std::size_t j = 0; j < away.size(); ++j) o[i][j] = exceeds(p[at[i]], p[away[j]], "m/s", comps, undecided);
+      bool reproduced = false, refuted = false;
+      for (std::size_t i = 0; i < at.size(); ++i)
+        reproduced = reproduced || std::all_of(o[i].begin(), o[i].end(), [](int x) { return x > 0; });
+      for (std::size_t j = 0; j < away.size(); ++j) {
+        bool beats_all = true;
+        for (std::size_t i = 0; i < at.size(); ++i) beats_all = beats_all && o[i][j] < 0;
+        refuted = refuted || beats_all;
+      }
+      f["comparisons"] = comps;
+      f["status"] = reproduced ? "reproduced" : refuted ? "refuted" : "inconclusive";
+      if (!reproduced && !refuted) f["to_settle"] = join(undecided, "; ") + kSettleSuffix;
+    }
+    out.push_back(f);
+  }
+  // 1D against 3D up to 50 % deformation (R_f / R0 >= 0.5), one finding per figure, judged on
+  // the suite's default 1D model (the first); every model is evidence
+  {
+    struct Figure {
+      const char* key;
+      const char* what;
+      const char* threshold_key;
+      bool correlation;
+    };
+    for (const Figure& fig : {Figure{"displacement_per_cycle", "displacement per cycle", "displacement_per_cycle_relative", false},
+                              Figure{"cycle_time", "cycle time", "cycle_time_relative", false},
+                              Figure{"mean_velocity_per_cycle", "mean velocity per cycle", "mean_velocity_per_cycle_relative", false},
+                              Figure{"velocity_phase_correlation", "U(t) against the cycle phase", "velocity_phase_correlation", true}}) {
+      const double tol = th.at(fig.threshold_key).get<double>();
+      const std::string claim =
+          std::string("1D agrees with 3D up to 50 % deformation: ") + fig.what +
+          (fig.correlation ? " (correlation with the finest 3D run at least " + fmt("%g", tol)
+                           : " (within " + fmt("%g", 100 * tol) + " % of the 3D reference") +
+          ", the suite's default 1D model)";
+      const std::string rule =
+          fig.correlation
+              ? "pass when the correlation minus its uncertainty (its spread over the 3D grids) reaches the threshold, "
+                "fail when the correlation plus its uncertainty stays below it, inconclusive otherwise"
+              : "pass when |1D − ref| / |ref| plus the reference's relative error e_ref is within the tolerance (the "
+                "whole interval inside the band), fail when |1D − ref| / |ref| − e_ref exceeds it, inconclusive "
+                "otherwise (a difference within the reference's error bar cannot fail)";
+      json ev = json::array();
+      std::vector<std::string> st, settle, reasons;
+      for (const json* c : amplitude) {
+        if ((*c)["sweep_value"].get<double>() < 0.5) continue;
+        const std::string name = (*c)["name"];
+        const json& models = c->contains("models1d") ? (*c)["models1d"] : json::array();
+        for (std::size_t k = 0; k < models.size(); ++k) {
+          const json& md = models[k];
+          const bool has = md.contains("verdicts") && md["verdicts"].contains(fig.key);
+          json e = {{"case", name}, {"model", md.value("label", std::string())}, {"default_model", k == 0},
+                    {"verdict", has ? md["verdicts"][fig.key] : json("not assessed")}};
+          double x = kNaN, err = kNaN;
+          if (fig.correlation) {
+            const json& v = md.contains("velocity_vs_finest3d") ? md["velocity_vs_finest3d"] : json::object();
+            if (v.contains("phase_correlation") && v["phase_correlation"].is_number()) x = v["phase_correlation"];
+            if (v.contains("phase_correlation_grid_spread") && v["phase_correlation_grid_spread"].is_number())
+              err = v["phase_correlation_grid_spread"];
+            e["correlation"] = num(x);
+            e["correlation_error"] = num(err);
+            e["threshold"] = tol;
+          } else {
+            const json& r = md.contains("relative_error_vs_reference") ? md["relative_error_vs_reference"] : json::object();
+            const json& re = md.contains("reference_error_relative") ? md["reference_error_relative"] : json::object();
+            if (r.contains(fig.key) && r[fig.key].is_number()) x = r[fig.key];
+            if (re.contains(fig.key) && re[fig.key].is_number()) err = re[fig.key];
+            e["relative_difference"] = num(x);
+            e["reference_error_relative"] = num(err);
+            e["tolerance"] = tol;
+          }
+          ev.push_back(e);
+          if (k != 0) continue;
+          const std::string v = has ? md["verdicts"][fig.key].get<std::string>() : "not assessed";
+          st.push_back(v == "pass" ? "reproduced" : v == "fail" ? "refuted" : v == "inconclusive" ? "inconclusive"
+                                                                                                   : "not assessed");
+          if (v == "inconclusive") {
+            const double need = fig.correlation ? std::abs(x - tol) : std::abs(std::abs(x) - tol);
+            settle.push_back(fig.correlation
+                                 ? "needs the correlation's grid spread below " + fmt("%.2g", need) + " on " + name +
+                                       " (now " + fmt("%.2g", err) + ")"
+                                 : "needs the 3D reference's error below " + percent(need) + " of it on " + name +
+                                       " (now " + percent(err) + ")");
+          } else if (!has) {
+            reasons.push_back(name + ": the default 1D model has no verdict (" + md.value("status", std::string("no cycle")) + ")");
+          }
+        }
+        if (models.empty()) {
+          st.push_back("not assessed");
+          reasons.push_back(name + ": no 1D model");
+        }
+      }
+      json f = finding(claim, rule, ev);
+      f["status"] = combine(st);
+      if (st.empty()) f["reason"] = "the suite has no amplitude case with R_f/R0 >= 0.5";
+      else if (f["status"] == "not assessed") f["reason"] = join(reasons, "; ");
+      else if (f["status"] == "inconclusive") f["to_settle"] = join(settle, "; ") + kSettleSuffix;
+      out.push_back(f);
+    }
+  }
+  // the optimal swimmer's speed against the paper's 1.5 body lengths/s
+  {
+    const double paper = 1.5, tol = 0.2, lo = paper * (1 - tol), hi = paper * (1 + tol);
+    json ev = json::array();
+    std::vector<std::string> st, settle, reasons;
+    for (const json* c : group("optimal")) {
+      const Valued v = reference_of(*c, kv);
+      const double L = c->contains("length_m") && (*c)["length_m"].is_number() ? (*c)["length_m"].get<double>() : kNaN;
+      const double bl = v.value / L, e = v.error / L;
+      const std::string name = (*c)["name"];
+      ev.push_back({{"case", name}, {"quantity", "body_lengths_per_s"}, {"value", num(bl)}, {"error", num(e)},
+                    {"paper", paper}, {"band", {lo, hi}}});
+      if (!std::isfinite(bl) || !std::isfinite(e)) {
+        st.push_back("not assessed");
+        reasons.push_back(name + ": " + (v.missing.empty() ? "no swimmer length" : v.missing));
+      } else if (bl - e >= lo && bl + e <= hi) {
+        st.push_back("reproduced");
+      } else if (bl + e < lo || bl - e > hi) {
+        st.push_back("refuted");
+      } else {
+        st.push_back("inconclusive");
+        const double need = bl < lo ? lo - bl : bl > hi ? bl - hi : std::min(bl - lo, hi - bl);
+        settle.push_back("needs an error bar below " + fmt("%.2g", need) + " body lengths/s on " + name + " (now ± " +
+                         fmt("%.2g", e) + ")");
+      }
+    }
+    json f = finding("the optimal swimmer makes 1.5 body lengths/s (within 20 %)",
+                     "reproduced when the whole interval value ± error lies inside [1.2, 1.8] body lengths/s, refuted "
+                     "when it lies wholly outside, inconclusive otherwise",
+                     ev);
+    f["status"] = combine(st);
+    if (st.empty()) f["reason"] = "the suite has no case for it";
+    else if (f["status"] == "not assessed") f["reason"] = join(reasons, "; ");
+    else if (f["status"] == "inconclusive") f["to_settle"] = join(settle, "; ") + kSettleSuffix;
+    out.push_back(f);
+  }
+  return out;
+}
+
+}  // namespace swim::validation

@@ -1,0 +1,59 @@
+// Verdicts of the validation suite, judged with the error bars of the 3D reference.
+//
+// Every reference value carries an error (richardson.hpp: the extrapolation's error, or the
+// spread of the grids when they are not in the asymptotic range). Error estimates of this
+// kind are bounds on a discretisation error, not independent random deviations, so they are
+// combined linearly: two values a ± ea and b ± eb differ beyond their uncertainty when
+// |a - b| > ea + eb, i.e. when their error bars do not overlap.
+//
+//   trend claim (grows with L, largest for the shortest swimmer, ...): reproduced when every
+//     difference it rests on exceeds the combined uncertainty in the claimed direction;
+//     refuted when one difference exceeds it in the opposite direction; inconclusive
+//     otherwise (with the error bars that would settle it);
+//   claim against a number (1.5 body lengths/s within 20 %): reproduced when the whole
+//     interval value ± error lies inside the tolerance band, refuted when it lies wholly
+//     outside, inconclusive otherwise;
+//   1D against 3D (each figure): pass when |difference| + reference error <= tolerance (the
+//     whole interval inside the band), fail when |difference| - reference error > tolerance,
+//     inconclusive otherwise; a difference within the reference's error bar cannot fail.
+//   A claim over several cases is refuted when one case refutes it, not assessed when a case
+//   lacks its data, reproduced when every case reproduces it, inconclusive otherwise.
+#pragma once
+
+#include <string>
+
+#include "common/scene.hpp"
+#include "validation/richardson.hpp"
+
+namespace swim::validation {
+
+/// The order range of a suite file's `order_range` key (at the top, or per case): a name,
+/// "immersed_boundary" ([0.5, 2]) or "sharp_interface" ([1, 3.5]), or [lo, hi] with
+/// 0 < lo < hi <= 20. Throws InputError naming `key`, the value and what is allowed.
+OrderRange parse_order_range(const scene::json& value, const std::string& key);
+
+/// 1D against the 3D reference: rel = (1D - ref) / |ref|, rel_error = reference error / |ref|,
+/// tolerance relative. "pass", "fail" or "inconclusive"; "not assessed" when rel or
+/// rel_error is not finite.
+std::string tolerance_verdict(double rel, double rel_error, double tolerance);
+
+/// U(t) correlation with the finest 3D run, its uncertainty (the spread of the correlation
+/// over the grids) and the smallest passing correlation: "pass" when corr - error >=
+/// threshold, "fail" when corr + error < threshold, else "inconclusive".
+std::string correlation_verdict(double corr, double error, double threshold);
+
+/// The verdicts of one 1D model of a report from its `relative_error_vs_reference`,
+/// `reference_error_relative` (thresholds: displacement_per_cycle_relative, ...) and
+/// `velocity_vs_finest3d` (`phase_correlation`, `phase_correlation_grid_spread`;
+/// velocity_phase_correlation): {"displacement_per_cycle": "pass", ...}. A figure whose
+/// numbers the entry lacks is left out; one whose numbers are null is "not assessed".
+scene::json model_verdicts(const scene::json& entry, const scene::json& thresholds);
+
+/// The paper's conclusions judged on the cases of a report (each with `group`,
+/// `sweep_value`, `name`, `reference3d`, `runs3d`, `models1d` with `verdicts`, `length_m`);
+/// `thresholds` as in the suite file. Each finding: claim, status ("reproduced", "refuted",
+/// "inconclusive", "not assessed"), rule, evidence (values with their errors), comparisons
+/// (for trends), and to_settle (inconclusive) or reason (not assessed). Never NaN.
+scene::json findings(const scene::json& cases, const scene::json& thresholds);
+
+}  // namespace swim::validation
