@@ -19,7 +19,7 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   if (!fs::is_regular_file(suite))
     throw InputError("suite", "\"" + suite + "\"", "a suite file (shipped: data/validation/default.json, quick.json)");
   if (threads < 1 || threads > 64) throw InputError("--threads", std::to_string(threads), "an integer from 1 to 64");
-  const scene::json s = validation::load_suite(suite);  // bad input stops here, before anything is written
+  const scene::json s = validation::load_suite(suite, data_dir());  // bad input stops here, before anything is written
   for (const auto& n : only) {
     bool found = false;
     for (const auto& cs : s["cases"]) {
@@ -38,6 +38,7 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   o.threads = threads;
   o.only = only;
   if (progress != 0) o.progress = [](const std::string& line) { std::fprintf(stderr, "validate: %s\n", line.c_str()); };
+  o.run_progress = progress;
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);
   const bool plotted = plot("plot_validation.py", {out});
@@ -49,6 +50,10 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   std::printf("validation suite %s: %zu case(s), %d verdicts pass, %d fail; wall time %s\n  -> %s/report.json%s\n",
               name.c_str(), report["cases"].size(), pass, fail, si(report["wall_time_s"].get<double>(), "s").c_str(),
               out.c_str(), plotted ? ", report.md, report.html and figures" : "");
+  for (const auto& c : report["cases"])
+    if (c.contains("reference") && c["reference"].contains("statement"))
+      std::printf("  %s: axisymmetric reference %s\n", c["name"].get<std::string>().c_str(),
+                  c["reference"]["statement"].get<std::string>().c_str());
   for (const auto& f : report["findings"])
     std::printf("  %-13s %s\n", f["status"].get<std::string>().c_str(), f["claim"].get<std::string>().c_str());
   return 0;

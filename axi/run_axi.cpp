@@ -6,6 +6,9 @@
 #include <memory>
 #include <optional>
 
+#include <Eigen/Sparse>
+
+#include "axi/fe_stokes_axi.hpp"
 #include "axi/grid_axi.hpp"
 #include "axi/ib_axi.hpp"
 #include "axi/stokes_axi.hpp"
@@ -62,11 +65,19 @@ class Runner {
  public:
   Runner(const ParamsAxi& p, const json& resolved, const std::string& out, const RunControlAxi& ctl)
       : p_(p), b_(p.base), resolved_(resolved), out_(out), ctl_(ctl), grid_{p.nr, p.nx, p.h},
-        stokes_(grid_, b_.fluid.mu), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes}),
+        fitted_(p.method == AxiMethod::Fitted), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes}),
         mesh_(ring_mesh(wall_, b_.R0, b_.L, p.x_start())), e_ref_(wall_.uniform_energy(b_.protocol.R_f)),
         protocol_(effective(), mesh_, e_ref_),
-        rec_("axi", "axisymmetric_immersed_boundary", b_.L, series_columns(), reference_z()) {
+        rec_("axi", fitted_ ? "axisymmetric_fitted_finite_elements" : "axisymmetric_immersed_boundary", b_.L,
+             series_columns(), reference_z()) {
     rec_.keep(ctl.keep_rows);
+    if (fitted_) {
+      const FittedMeshParams mp = fitted_mesh_params();
+      stage_ = std::make_unique<FittedStokes>(mp, b_.fluid.mu, wall_.nodes());
+      flow_ = std::make_unique<FittedStokes>(mp, b_.fluid.mu, wall_.nodes());
+    } else {
+      stokes_ = std::make_unique<AxiStokes>(grid_, b_.fluid.mu);
+    }
     X_ = mesh_.X0;
     U_ = Eigen::Matrix3Xd::Zero(3, X_.cols());
     const double q_static = b_.c1_estimate() * (b_.R0 - b_.protocol.R_f);
@@ -85,7 +96,7 @@ class Runner {
                       t_end_, ctl_.progress);
     std::optional<NumericalError> failure;
     try {
-      x_center0_ = X_.row(0).mean();
+      x_center0_ = center(X_);
       protocol_.start(0.0, X_);
       events();
       evaluate(X_, U_, &energy_);
@@ -127,6 +138,7 @@ class Runner {
   full3d::ProtocolParams effective() const {
     full3d::ProtocolParams q = b_.protocol;
     q.end_energy = b_.recovery_end == "dead_band" ? wall_.uniform_energy(b_.R0 - b_.protocol.delta) : 0.0;
+    q.dual_cell_segments = p_.method == AxiMethod::Fitted;
     return q;
   }
 
@@ -148,13 +160,20 @@ class Runner {
     F += protocol_.force(X);
     if (!F.allFinite()) throw NumericalError("non-finite wall force", "reduce axi.tolerance", t_);
     split_forces_ += seconds_since(t);
+    if (fitted_) {
+      flow_->factor(X);
+      flow_->solve(F, U);
+      ++solves_;
+      if (!U.allFinite()) throw NumericalError("non-finite wall velocity", "reduce axi.tolerance", t_);
+      return;
+    }
     t = std::chrono::steady_clock::now();
     spread(grid_, X, F, fr_, fx_);
     split_spread_ += seconds_since(t);
     t = std::chrono::steady_clock::now();
     u_.resize(grid_.u_size());
     w_.resize(grid_.w_size());
-    stokes_.solve(fr_.data(), fx_.data(), u_.data(), w_.data());
+    stokes_->solve(fr_.data(), fx_.data(), u_.data(), w_.data());
     split_fluid_ += seconds_since(t);
     t = std::chrono::steady_clock::now();
     interpolate(grid_, X, u_.data(), w_.data(), U);
@@ -169,6 +188,14 @@ class Runner {
     return m;
   }
 
+  /// The swimmer's axial position: the fitted method's wall is a discretised surface, so its
+  /// centre is the area-weighted mean of the rings (the continuum mean over the tube); the
+  /// immersed boundary keeps the plain ring mean, as the 3D tier's node mean.
+  double center(const Eigen::Matrix3Xd& X) const {
+    if (!fitted_) return X.row(0).mean();
+    return X.row(0).dot(wall_.node_area().transpose()) / wall_.node_area().sum();
+  }
+
   /// The step size bound of the next contraction event: the active segment's radius
   /// extrapolated linearly to R_f.
   double event_bound() const {
@@ -176,18 +203,175 @@ class Runner {
     if (st.phase != 0) return p_.dt_max;
     const int a = st.active;
     double R = 0, V = 0;
-    int n = 0;
-    for (int k = 0; k < wall_.nodes(); ++k)
-      if (protocol_.segment_of(k) == a) R += X_(1, k), V += U_(1, k), ++n;
-    R /= n, V /= n;
+    if (fitted_) {  // the protocol's own segment radius (linear in the ring radii)
+      constexpr double tau = 1e-6;  // s
+      R = protocol_.segment_radii(X_)[a];
+      V = (protocol_.segment_radii(X_ + tau * U_)[a] - R) / tau;
+    } else {
+      int n = 0;
+      for (int k = 0; k < wall_.nodes(); ++k)
+        if (protocol_.segment_of(k) == a) R += X_(1, k), V += U_(1, k), ++n;
+      R /= n, V /= n;
+    }
     const double gap = R - b_.protocol.R_f;
     if (!(V < 0.0) || gap <= 0.0) return p_.dt_max;
     return std::max(p_.event_dt, 1.02 * gap / -V);
   }
 
+  /// The fitted mesh's parameters (axi/scene_axi.cpp derives them from h).
+  FittedMeshParams fitted_mesh_params() const {
+    FittedMeshParams mp;
+    mp.Rc = b_.container_radius;
+    mp.period = b_.period;
+    mp.cells_inner = p_.cells_inner;
+    mp.cells_outer = p_.cells_outer;
+    mp.gap_columns = p_.gap_columns;
+    mp.gap_growth = 4.0;  // the column count is chosen for a ratio near 1 + 5 ds / Rc (scene_axi.cpp)
+    return mp;
+  }
+
+  /// Wall and actuation forces at X for the current protocol state; throws on non-finite ones.
+  Eigen::Matrix3Xd total_force(const Eigen::Matrix3Xd& X, std::array<double, 2>* energy = nullptr) {
+    const auto t = std::chrono::steady_clock::now();
+    Eigen::Matrix3Xd F = wall_.forces(X, energy);
+    F += protocol_.force(X);
+    split_forces_ += seconds_since(t);
+    if (!F.allFinite()) throw NumericalError("non-finite wall force", "reduce axi.tolerance", t_);
+    return F;
+  }
+
+  void step() {
+    if (fitted_)
+      step_ros2();
+    else
+      step_heun();
+  }
+
+  /// The protocol's next event as a function of the shape, zero at the event and positive
+  /// before it: the active segment's radius minus R_f while contracting; during the recovery
+  /// the largest deviation of a ring's radius from R0 or of its axial position from its
+  /// reference (mean translation removed) minus delta (full3d.recovery_end = shape), or the wall
+  /// energy's excess over the end threshold relative to it (the energy ends). eps: how far past
+  /// zero a located event may land.
+  struct EventValue {
+    bool active = false;
+    double g = 0.0, eps = 0.0;
+  };
+  EventValue event_value(const Eigen::Matrix3Xd& X) const {
+    const full3d::ProtocolState& st = protocol_.state();
+    const full3d::ProtocolParams& q = protocol_.params();
+    EventValue v;
+    if (st.phase == 0) {
+      v.active = true;
+      v.g = protocol_.segment_radii(X)[st.active] - q.R_f;
+      v.eps = 1e-3 * q.delta;
+    } else if (st.phase == 1 && q.shape_end) {
+      const int n = wall_.nodes();
+      const double shift = X.row(0).mean() - mesh_.X0.row(0).mean();
+      double m = 0.0;
+      for (int k = 0; k < n; ++k)
+        m = std::max({m, std::abs(X(1, k) - b_.R0), std::abs(X(0, k) - mesh_.X0(0, k) - shift)});
+      v.active = true;
+      v.g = m - q.delta;
+      v.eps = 1e-3 * q.delta;
+    } else if (st.phase == 1) {
+      const std::array<double, 2> e = wall_.energies(X);
+      const double thr = protocol_.end_threshold();
+      v.active = thr > 0.0;
+      v.g = (e[0] + e[1] - thr) / thr;
+      v.eps = 1e-4;
+    }
+    return v;
+  }
+
+  /// One accepted step of the two-stage Rosenbrock method ROS2 (Verwer et al. 1999; order 2
+  /// for any approximation W of the Jacobian, L-stable with gamma = 1 + 1/sqrt 2):
+  ///   (I - gamma dt W) k1 = f(X),  (I - gamma dt W) k2 = f(X + dt k1) - 2 k1,
+  ///   X+ = X + dt (3/2 k1 + 1/2 k2),  error estimate |X+ - (X + dt k1)| = dt/2 |k1 + k2|.
+  /// f(X) = M(X) F(X), M the fluid's mobility on the mesh fitted to X, W = -M(X) K with K the
+  /// wall's stiffness -dF_wall/dX at X (the actuation's relays and the mobility's dependence on
+  /// the shape are left to the error control). With M^-1 the Schur complement of the
+  /// finite-element system on the wall's velocity unknowns, (I + gamma dt M K) k = M F is the
+  /// fitted system with gamma dt K added on the wall's unknowns, and
+  ///   k2 = g - gamma dt (M^-1 + gamma dt K)^-1 K g,   g = f(X + dt k1) - 2 k1,
+  /// reuses the stage's factorisation.
+  void step_ros2() {
+    const double tol = p_.tolerance * p_.h;
+    constexpr double gamma = 1.0 + 0.70710678118654752440;
+    dt_ = std::min({dt_, p_.dt_max, event_bound()});
+    if (b_.duration > 0) dt_ = std::min(dt_, b_.duration - t_);
+    auto tk = std::chrono::steady_clock::now();
+    const Eigen::SparseMatrix<double> K = wall_.stiffness(X_, 1e-6 * b_.R0);
+    split_stiffness_ += seconds_since(tk);
+    const Eigen::Matrix3Xd F0 = total_force(X_);
+    const int n = wall_.nodes();
+    for (;;) {
+      if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
+        throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s",
+                             "loosen axi.tolerance or lower axi.dt_min", t_);
+      bool valid = true;
+      double err = 0;
+      try {
+        const int last = n - 1;
+        stage_->factor(X_, &K, gamma * dt_);
+        stage_->solve(F0, k1_);
+        const double a_rear = stage_->end_disc_flux(0, k1_(0, 0)), a_front = stage_->end_disc_flux(1, k1_(0, last));
+        X1_ = X_ + dt_ * k1_;
+        const Eigen::Matrix3Xd F1 = total_force(X1_);
+        flow_->factor(X1_);
+        flow_->solve(F1, U1_);
+        const double b_rear = flow_->end_disc_flux(0, U1_(0, 0)), b_front = flow_->end_disc_flux(1, U1_(0, last));
+        solves_ += 2;
+        Eigen::Matrix3Xd g = U1_ - 2.0 * k1_;
+        Eigen::VectorXd gv(2 * n);
+        for (int k = 0; k < n; ++k) gv(2 * k) = g(0, k), gv(2 * k + 1) = g(1, k);
+        const Eigen::VectorXd Kg = K * gv;
+        Eigen::Matrix3Xd KgF = Eigen::Matrix3Xd::Zero(3, n);
+        for (int k = 0; k < n; ++k) KgF(0, k) = Kg(2 * k), KgF(1, k) = Kg(2 * k + 1);
+        stage_->solve(KgF, k2_);
+        ++solves_;
+        const double c_rear = stage_->end_disc_flux(0, k2_(0, 0)), c_front = stage_->end_disc_flux(1, k2_(0, last));
+        k2_ = g - (gamma * dt_) * k2_;
+        // The end-disc fluxes are linear in the stage fields (each on its own mesh and disc), so
+        // the step's mean flux is the same combination as the step's mean velocity.
+        step_q_rear_ = 1.5 * a_rear + 0.5 * (b_rear - 2.0 * a_rear - gamma * dt_ * c_rear);
+        step_q_front_ = 1.5 * a_front + 0.5 * (b_front - 2.0 * a_front - gamma * dt_ * c_front);
+        if (!k1_.allFinite() || !k2_.allFinite()) throw NumericalError("non-finite stage", "reduce axi.tolerance", t_);
+        err = 0.5 * dt_ * (k1_ + k2_).cwiseAbs().maxCoeff();
+      } catch (const NumericalError&) {
+        // a stage shape the fitted mesh cannot follow (folded or outside the container): retry smaller
+        valid = false;
+      }
+      if (valid && err <= tol) {
+        Xn_ = X_ + dt_ * (1.5 * k1_ + 0.5 * k2_);
+        // Protocol events are located, not just detected: a step that carries the event
+        // function g (protocol::event_value) past zero by more than its tolerance is taken again,
+        // shorter, by the secant through g's values at its two ends.
+        if (const EventValue g0 = event_value(X_); g0.active && g0.g > 0.0 && event_tries_ < kEventTries) {
+          const EventValue g1 = event_value(Xn_);
+          if (g1.g < -g1.eps) {
+            ++event_tries_;
+            ++event_retakes_;
+            dt_ *= std::clamp((g0.g + 0.5 * g1.eps) / (g0.g - g1.g), 0.05, 0.999);
+            continue;
+          }
+        }
+        event_tries_ = 0;
+        const double dt_done = dt_;
+        const double grow = err > 0 ? 0.9 * std::sqrt(tol / err) : 2.0;
+        accept(dt_done);
+        dt_ = dt_done * std::clamp(grow, 0.2, 2.0);
+        return;
+      }
+      ++rejected_;
+      const double shrink = valid && err > tol ? 0.9 * std::sqrt(tol / err) : 0.25;
+      dt_ *= std::clamp(shrink, 0.1, 0.5);
+    }
+  }
+
   /// One accepted step of the trapezoidal rule (retried with smaller steps until its local
   /// error estimate passes).
-  void step() {
+  void step_heun() {
     const double h = p_.h, tol = p_.tolerance * h;
     double umax = 0;
     for (Eigen::Index k = 0; k < U_.cols(); ++k) umax = std::max(umax, U_.col(k).head<2>().norm());
@@ -226,15 +410,26 @@ class Runner {
     dt_last_ = dt;
     dt_min_taken_ = steps_ == 1 ? dt : std::min(dt_min_taken_, dt);
     dt_max_taken_ = std::max(dt_max_taken_, dt);
-    evaluate(X_, U_, &energy_);
-    fluxes(dt);
+    if (fitted_) {
+      // the step's mean wall velocity and end fluxes (ROS2's combination of its stages): no
+      // further solve at the new shape
+      U_ = 1.5 * k1_ + 0.5 * k2_;
+      energy_ = wall_.energies(X_);
+      vol_rear_ += dt * step_q_rear_;
+      vol_front_ += dt * step_q_front_;
+      q_rear_ = step_q_rear_;
+      q_front_ = step_q_front_;
+    } else {
+      evaluate(X_, U_, &energy_);
+      fluxes(dt);
+    }
     const double e = energy_[0] + energy_[1];
     if (!std::isfinite(e) || e > e_cap_)
       throw NumericalError("the wall energy grew to " + num(e) + " J, " + num(e / e_ref_) +
                                " times that of the tube uniformly at R_f",
                            "reduce axi.tolerance, or raise full3d.energy_growth_limit if the load is meant", t_);
     const double sp = max_spacing(X_);
-    if (!(sp < 0.5 * p_.h))
+    if (!fitted_ && !(sp < 0.5 * p_.h))
       throw NumericalError("two wall rings moved " + num(sp) + " m apart, half a cell or more (h = " + num(p_.h) +
                                " m): fluid would leak through the wall",
                            "lower axi.spacing_factor", t_);
@@ -253,8 +448,10 @@ class Runner {
   /// towards +x), integrated in time by the trapezoidal rule.
   void fluxes(double dt) {
     const int last = wall_.nodes() - 1;
-    const double qr = disc_flux(grid_, w_.data(), X_(0, 0), X_(1, 0), U_(0, 0), kDiscPoints);
-    const double qf = disc_flux(grid_, w_.data(), X_(0, last), X_(1, last), U_(0, last), kDiscPoints);
+    const double qr = fitted_ ? flow_->end_disc_flux(0, U_(0, 0))
+                              : disc_flux(grid_, w_.data(), X_(0, 0), X_(1, 0), U_(0, 0), kDiscPoints);
+    const double qf = fitted_ ? flow_->end_disc_flux(1, U_(0, last))
+                              : disc_flux(grid_, w_.data(), X_(0, last), X_(1, last), U_(0, last), kDiscPoints);
     if (dt > 0) {
       vol_rear_ += 0.5 * dt * (q_rear_ + qr);
       vol_front_ += 0.5 * dt * (q_front_ + qf);
@@ -282,7 +479,7 @@ class Runner {
     for (Eigen::Index k = 0; k < U_.cols(); ++k) umax = std::max(umax, U_.col(k).head<2>().norm());
     const full3d::ProtocolState& st = protocol_.state();
     const double row[] = {t_,
-                          X_.row(0).mean() - x_center0_,
+                          center(X_) - x_center0_,
                           U_.row(0).mean(),
                           energy_[0] + energy_[1],
                           X_.row(1).minCoeff(),
@@ -323,7 +520,12 @@ class Runner {
                     {"reference_energy_J", e_ref_},
                     {"recovery_end_energy_J", protocol_.end_threshold()},
                     {"cell_size_m", p_.h},
-                    {"grid", {p_.nr, p_.nx}},
+                    {"method", p_.method_name()},
+                    {"grid", fitted_ ? json{p_.cells_inner, p_.cells_outer, wall_.nodes() - 1, p_.gap_columns}
+                                     : json{p_.nr, p_.nx}},
+                    {"grid_is", fitted_ ? "element rows inside and outside the wall, element columns along the tube and "
+                                          "across the gap"
+                                        : "cells across the radius and along the axis"},
                     {"wall_nodes", wall_.nodes()},
                     {"wall_node_spacing_m", wall_.ds0()},
                     {"spring_constant_N_per_m", p_.ks},
@@ -341,6 +543,7 @@ class Runner {
     rec_.events.segment_reached_s = protocol_.state().segment_reached;
     rec_.stats = {{"steps", steps_},
                   {"rejected_steps", rejected_},
+                  {"event_retakes", event_retakes_},
                   {"stokes_solves", solves_},
                   {"steps_per_cycle", per_cycle},
                   {"dt_min_taken_s", dt_min_taken_},
@@ -348,11 +551,23 @@ class Runner {
                   {"dt_mean_s", steps_ > 0 ? t_ / double(steps_) : 0.0},
                   {"protocol_switches", protocol_.state().switches},
                   {"wall_time_s", wall},
-                  {"wall_time_split_s",
-                   {{"wall_forces", split_forces_},
-                    {"spread", split_spread_},
-                    {"fluid", split_fluid_},
-                    {"interp", split_interp_}}}};
+                  {"wall_time_split_s", split_json()}};
+    if (fitted_) rec_.stats["fitted_unknowns"] = flow_->unknowns(), rec_.stats["fitted_nonzeros"] = flow_->nonzeros();
+  }
+
+  json split_json() const {
+    if (!fitted_)
+      return {{"wall_forces", split_forces_}, {"spread", split_spread_}, {"fluid", split_fluid_}, {"interp", split_interp_}};
+    const FittedStokes::Timing& a = stage_->timing();
+    const FittedStokes::Timing& b = flow_->timing();
+    return {{"wall_forces", split_forces_},
+            {"wall_stiffness", split_stiffness_},
+            {"assembly", a.assemble + b.assemble},
+            {"factorisation", a.factor + b.factor},
+            {"solves", a.solve + b.solve},
+            {"factorisations", a.factorisations + b.factorisations},
+            {"solves_on_an_earlier_factorisation", a.reused + b.reused},
+            {"gmres_iterations", a.krylov_iterations + b.krylov_iterations}};
   }
 
   static constexpr double kCfl = 0.25, kMaxCfl = 0.5;
@@ -364,7 +579,10 @@ class Runner {
   std::string out_;
   RunControlAxi ctl_;
   AxiGrid grid_;
-  AxiStokes stokes_;
+  bool fitted_;
+  std::unique_ptr<AxiStokes> stokes_;       ///< immersed boundary: the MAC solver
+  std::unique_ptr<FittedStokes> stage_;     ///< fitted: the Rosenbrock stages' system (with gamma dt K)
+  std::unique_ptr<FittedStokes> flow_;      ///< fitted: the plain fluid solve (velocities, end fluxes)
   AxiWall wall_;
   full3d::CylinderMesh mesh_;
   double e_ref_;
@@ -372,15 +590,17 @@ class Runner {
   record::RunRecord rec_;
   std::unique_ptr<record::RunStream> stream_;
 
-  Eigen::Matrix3Xd X_, U_, X1_, U1_, Xn_;
+  Eigen::Matrix3Xd X_, U_, X1_, U1_, Xn_, k1_, k2_;
   std::vector<double> fr_, fx_, u_, w_;
   std::array<double, 2> energy_{};
   double t_ = 0, dt_ = 0, dt_last_ = 0, dt_min_taken_ = 0, dt_max_taken_ = 0, t_end_ = 0, next_out_ = 0;
   double e_cap_ = 0, x_center0_ = 0;
-  double q_rear_ = 0, q_front_ = 0, vol_rear_ = 0, vol_front_ = 0;
-  long steps_ = 0, rejected_ = 0, solves_ = 0, last_recorded_ = -1;
+  double q_rear_ = 0, q_front_ = 0, vol_rear_ = 0, vol_front_ = 0, step_q_rear_ = 0, step_q_front_ = 0;
+  long steps_ = 0, rejected_ = 0, solves_ = 0, last_recorded_ = -1, event_retakes_ = 0;
+  int event_tries_ = 0;
+  static constexpr int kEventTries = 12;
   bool event_pending_ = false;
-  double split_forces_ = 0, split_spread_ = 0, split_fluid_ = 0, split_interp_ = 0;
+  double split_forces_ = 0, split_spread_ = 0, split_fluid_ = 0, split_interp_ = 0, split_stiffness_ = 0;
 };
 
 }  // namespace

@@ -27,7 +27,8 @@ const json& section_or_empty(const json& sc, const char* key) {
 
 const json& section_keys() {
   static const json keys = {{"axi",
-                             {{"grid", {{"cells_across", "integer"}, {"cell_size", "quantity:m"}}},
+                             {{"method", "choice:fitted|immersed_boundary"},
+                              {"grid", {{"cells_across", "integer"}, {"cell_size", "quantity:m"}}},
                               {"spacing_factor", "number"},
                               {"tolerance", "number"},
                               {"dt_max", "quantity:s"},
@@ -79,6 +80,9 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   res_axi = json::object();
   Reader a(section_or_empty(sc, "axi"), "axi", res_axi);
   const double Rc = b.container_radius, width = 2.0 * Rc;
+  p.method = a.choice("method", "fitted", {"fitted", "immersed_boundary"}) == "fitted" ? AxiMethod::Fitted
+                                                                                     : AxiMethod::ImmersedBoundary;
+  const bool ib = p.method == AxiMethod::ImmersedBoundary;
   {
     Reader g = a.child("grid");
     if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
@@ -86,23 +90,30 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
       if (!multiple_of(Rc, p.h))
         throw InputError(g.path("cell_size"), fmt(p.h, "m"), "must divide the container radius " + fmt(Rc, "m"));
     } else {
-      const long n = g.integer("cells_across", 64, 8, 8192);
+      const long n = g.integer("cells_across", ib ? 64 : 32, 8, 8192);
       if (n % 2 != 0)
         throw InputError(g.path("cells_across"), std::to_string(n),
                          "an even number (cells across the container's diameter; the axisymmetric grid spans its radius)");
       p.h = width / double(n);
     }
-    if (!multiple_of(b.period, p.h))
+    if (ib && !multiple_of(b.period, p.h))
       throw InputError("container.period", fmt(b.period, "m"), "must be a multiple of the cell size " + fmt(p.h, "m"));
     p.nr = int(std::lround(Rc / p.h));
     p.nx = int(std::lround(b.period / p.h));
-    if (p.nx % 2 != 0)
+    if (ib && p.nx % 2 != 0)
       throw InputError("container.period", fmt(b.period, "m"),
                        "must hold an even number of cells (" + std::to_string(p.nx) + " of " + fmt(p.h, "m") + ")");
     g.finish();
   }
-  p.spacing_factor = a.number("spacing_factor", 0.5, Range::open(0.0, 1.0));
-  p.tolerance = a.number("tolerance", 2e-4, Range::open(0.0, 1.0));
+  // meridional wall node spacing <= spacing_factor * h / 2: the immersed boundary needs several
+  // nodes per cell (default 4); the fitted mesh has one element column per wall segment
+  // (default 2 per h: the wall's bending boundary layers are shorter than the fluid's scales)
+  p.spacing_factor = ib ? a.number("spacing_factor", 0.5, Range::open(0.0, 1.0))
+                        : a.number("spacing_factor", 1.0, Range::open(0.0, 2.0 + 1e-12));
+  // local position error per step in cells: the explicit immersed boundary's steps are bounded
+  // by its stability anyway; the fitted method's Rosenbrock steps by the tolerance alone (at
+  // 2e-3 h its time error is 1e-5 of the displacement and 1e-3 of the cycle time, docs/axi.md)
+  p.tolerance = a.number("tolerance", ib ? 2e-4 : 2e-3, Range::open(0.0, 1.0));
   p.dt_max = a.quantity("dt_max", "s", "8 ms", Range::positive());
   p.dt_min = a.quantity("dt_min", "s", "10 ns", Range::positive());
   p.event_dt = a.quantity("event_dt", "s", "0.1 ms", Range::positive());
@@ -114,23 +125,50 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
 
   // 4. Consistency.
   const double R0 = b.R0, L = b.L;
-  if (!(R0 + 2.0 * p.h < Rc))
-    throw InputError("container.radius", fmt(Rc, "m"),
-                     "the swimmer must fit: swimmer.radius + 2 h (kernel support) = " + fmt(R0 + 2.0 * p.h, "m") +
-                         " must be below the container radius (h = " + fmt(p.h, "m") + ")");
-  if (!(b.protocol.R_f > 2.0 * p.h))
-    throw InputError("axi.grid.cells_across", "",
-                     "the contracted wall (R_f = " + fmt(b.protocol.R_f, "m") +
-                         ") must stay more than 2 cells from the axis: refine the grid (h = " + fmt(p.h, "m") + ")");
-  if (!(L + 4.0 * p.h < b.period))
-    throw InputError("container.period", fmt(b.period, "m"),
-                     "must exceed swimmer.length + 4 h = " + fmt(L + 4.0 * p.h, "m"));
-  if (double(p.nr) * p.nx > 4.0e7)
-    throw InputError("axi.grid", std::to_string(p.nr) + "x" + std::to_string(p.nx), "more than 4e7 cells; use a coarser grid");
-  const double spacing = p.spacing_factor * 0.5 * p.h;
-  p.wall_nodes = int(std::ceil(L / spacing)) + 1;
-  if (p.wall_nodes > 200000)
-    throw InputError("axi.spacing_factor", fmt(p.spacing_factor, ""), "gives more than 2e5 wall nodes");
+  if (ib) {
+    if (!(R0 + 2.0 * p.h < Rc))
+      throw InputError("container.radius", fmt(Rc, "m"),
+                       "the swimmer must fit: swimmer.radius + 2 h (kernel support) = " + fmt(R0 + 2.0 * p.h, "m") +
+                           " must be below the container radius (h = " + fmt(p.h, "m") + ")");
+    if (!(b.protocol.R_f > 2.0 * p.h))
+      throw InputError("axi.grid.cells_across", "",
+                       "the contracted wall (R_f = " + fmt(b.protocol.R_f, "m") +
+                           ") must stay more than 2 cells from the axis: refine the grid (h = " + fmt(p.h, "m") + ")");
+    if (!(L + 4.0 * p.h < b.period))
+      throw InputError("container.period", fmt(b.period, "m"),
+                       "must exceed swimmer.length + 4 h = " + fmt(L + 4.0 * p.h, "m"));
+    if (double(p.nr) * p.nx > 4.0e7)
+      throw InputError("axi.grid", std::to_string(p.nr) + "x" + std::to_string(p.nx), "more than 4e7 cells; use a coarser grid");
+    const double spacing = p.spacing_factor * 0.5 * p.h;
+    p.wall_nodes = int(std::ceil(L / spacing)) + 1;
+    if (p.wall_nodes > 200000)
+      throw InputError("axi.spacing_factor", fmt(p.spacing_factor, ""), "gives more than 2e5 wall nodes");
+  } else {
+    // The fitted mesh: element rows of about h between the axis and the wall and between the wall
+    // and the container, one element column per wall segment, and graded columns across the gap
+    // between the tube's ends.
+    if (!(R0 + p.h <= Rc))
+      throw InputError("container.radius", fmt(Rc, "m"),
+                       "the swimmer must fit with one element row outside it: swimmer.radius + h = " + fmt(R0 + p.h, "m") +
+                           " must not exceed the container radius (h = " + fmt(p.h, "m") + ")");
+    if (!(L + 2.0 * p.h < b.period))
+      throw InputError("container.period", fmt(b.period, "m"),
+                       "must exceed swimmer.length + 2 h = " + fmt(L + 2.0 * p.h, "m"));
+    p.cells_inner = std::max(2, int(std::lround(R0 / p.h)));
+    p.cells_outer = std::max(2, int(std::lround((Rc - R0) / p.h)));
+    p.wall_nodes = std::max(5, int(std::ceil(L / (p.spacing_factor * 0.5 * p.h) - 1e-9)) + 1);
+    // Gap columns: widths growing geometrically from the wall's spacing ds at both ends with the
+    // ratio q = 1 + 5 ds / Rc (so that halving ds splits every column: q -> sqrt(q) to first
+    // order), as many as fill the gap G: 2 ceil(ln(1 + G (q - 1) / (2 ds)) / ln q).
+    {
+      const double ds = L / (p.wall_nodes - 1), G = b.period - L, q = 1.0 + 5.0 * ds / Rc;
+      const int half = int(std::ceil(std::log(1.0 + G * (q - 1.0) / (2.0 * ds)) / std::log(q)));
+      p.gap_columns = std::max(8, 2 * half);
+    }
+    const double elements = double(p.cells_inner + p.cells_outer) * (p.wall_nodes - 1 + p.gap_columns);
+    if (elements > 2.0e6)
+      throw InputError("axi.grid", fmt(p.h, "m"), "gives more than 2e6 fitted elements; use a coarser grid");
+  }
   return p;
 }
 

@@ -19,23 +19,34 @@
 
 namespace swim::axi {
 
+/// How the wall is coupled to the fluid (axi.method).
+enum class AxiMethod {
+  ImmersedBoundary,  ///< MAC grid, FFT along the axis, Peskin kernel: the 3D tier's family, first order
+  Fitted,            ///< finite elements on a mesh fitted to the wall (sharp interface), implicit wall steps
+};
+
 struct ParamsAxi {
   full3d::Params3d base;       ///< the shared physics, as the 3D tier reads it
+  AxiMethod method = AxiMethod::Fitted;
+  // fitted mesh (method Fitted): element rows and gap columns from h (docs/axi.md)
+  int cells_inner = 0, cells_outer = 0, gap_columns = 0;
   // grid
   int nr = 32, nx = 256;       ///< radial and axial cells
   double h = 0.0;              ///< m
   // wall
-  double spacing_factor = 0.5; ///< meridional node spacing <= spacing_factor * h / 2
+  double spacing_factor = 0.5; ///< meridional node spacing <= spacing_factor * h / 2 (immersed boundary), <= h (fitted)
   int wall_nodes = 0;
   double ks = 0.0;             ///< N/m, the network's spring constant
   double D = 0.0;              ///< J, the wall's bending rigidity
   std::string bending_source;  ///< "full3d.membrane.bending_rigidity" or the k_b mapping used
-  // time stepping (explicit trapezoidal rule with an embedded Euler error estimate)
+  // time stepping (immersed boundary: explicit trapezoidal rule with an embedded Euler error
+  // estimate; fitted: the two-stage Rosenbrock method ROS2 with its embedded first-order step)
   double tolerance = 2e-4;     ///< local position error per step, in cells (h)
   double dt_max = 8e-3, dt_min = 1e-8, event_dt = 1e-4;  ///< s
   double time_limit = 2.0;     ///< s; run cap when the duration is auto
 
   const std::string& name() const { return base.name; }
+  const char* method_name() const { return method == AxiMethod::Fitted ? "fitted" : "immersed_boundary"; }
   double x_start() const { return 0.5 * (nx * h - base.L); }  ///< axial position of the rear end
 };
 

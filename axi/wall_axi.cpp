@@ -314,4 +314,25 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
   return out;
 }
 
+Eigen::SparseMatrix<double> AxiWall::stiffness(const Eigen::Matrix3Xd& X, double eps) const {
+  const int n = n_;
+  std::vector<Eigen::Triplet<double>> trip;
+  trip.reserve(std::size_t(n) * 40);
+  Eigen::Matrix3Xd Xp, Xm;
+  for (int comp = 0; comp < 2; ++comp)
+    for (int colour = 0; colour < 5; ++colour) {
+      Xp = X;
+      Xm = X;
+      for (int k = colour; k < n; k += 5) Xp(comp, k) += eps, Xm(comp, k) -= eps;
+      const Eigen::Matrix3Xd dF = (forces(Xp) - forces(Xm)) / (2.0 * eps);
+      for (int k = colour; k < n; k += 5)
+        for (int l = std::max(0, k - 2); l <= std::min(n - 1, k + 2); ++l)
+          for (int c = 0; c < 2; ++c) trip.emplace_back(2 * l + c, 2 * k + comp, -dF(c, l));
+    }
+  Eigen::SparseMatrix<double> K(2 * n, 2 * n);
+  K.setFromTriplets(trip.begin(), trip.end());
+  const Eigen::SparseMatrix<double> Kt = K.transpose();
+  return 0.5 * (K + Kt);
+}
+
 }  // namespace swim::axi

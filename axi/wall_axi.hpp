@@ -57,6 +57,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 #include <array>
 
 namespace swim::axi {
@@ -103,6 +104,10 @@ class AxiWall {
   Eigen::Matrix3Xd forces(const Eigen::Matrix3Xd& X, std::array<double, 2>* energy = nullptr) const;
   /// Energy of the wall uniformly at radius R (all x at reference): 2 pi R0 L W_s(1, R/R0), J.
   double uniform_energy(double R) const;
+  /// The stiffness K = -dF/dX at X (2n x 2n, unknowns [x_0, r_0, x_1, r_1, ...], N/m): central
+  /// differences of forces() with step eps (m), five colours per component (a ring's force
+  /// depends on the rings at most 2 away), symmetrised (the exact K is the energy's Hessian).
+  Eigen::SparseMatrix<double> stiffness(const Eigen::Matrix3Xd& X, double eps) const;
 
  private:
   double evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::array<double, 2>* energy) const;

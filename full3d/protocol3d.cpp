@@ -53,6 +53,17 @@ Protocol3d::Protocol3d(const ProtocolParams& p, const CylinderMesh& mesh, double
                            std::to_string(mesh.ring_spacing) + " m); use fewer segments, a larger "
                            "protocol.first_segment_ratio or a finer full3d.grid");
   if (!(e_ref_ > 0.0)) throw InputError("wave.contracted_ratio", "", "the reference energy of the contracted tube must be > 0");
+  if (p_.dual_cell_segments) {
+    ring_share_.assign(mesh.n_rings, {});
+    const double ds = mesh.ring_spacing;
+    for (int r = 0; r < mesh.n_rings; ++r) {
+      const double a = std::max(0.0, (r - 0.5) * ds), b = std::min(L, (r + 0.5) * ds);
+      for (int k = 0; k < n; ++k) {
+        const double o = std::min(b, bounds_[k + 1]) - std::max(a, bounds_[k]);
+        if (o > 1e-12 * L) ring_share_[r].emplace_back(k, o / (b - a));
+      }
+    }
+  }
 }
 
 void Protocol3d::start(double t, const Eigen::Matrix3Xd& X) {
@@ -65,6 +76,18 @@ void Protocol3d::start(double t, const Eigen::Matrix3Xd& X) {
 Eigen::VectorXd Protocol3d::segment_radii(const Eigen::Matrix3Xd& X) const {
   const Eigen::VectorXd r = node_radii(*mesh_, X);
   Eigen::VectorXd R = Eigen::VectorXd::Zero(p_.segments);
+  if (p_.dual_cell_segments) {
+    Eigen::VectorXd W = Eigen::VectorXd::Zero(p_.segments);
+    for (int ring = 0; ring < mesh_->n_rings; ++ring)
+      for (int i = 0; i < mesh_->n_theta; ++i) {
+        const int node = mesh_->node(ring, i);
+        for (const auto& [k, f] : ring_share_[ring]) {
+          R[k] += f * mesh_->node_area[node] * r[node];
+          W[k] += f * mesh_->node_area[node];
+        }
+      }
+    return R.cwiseQuotient(W);
+  }
   for (int i = 0; i < int(r.size()); ++i) R[seg_[i]] += r[i];
   for (int k = 0; k < p_.segments; ++k) R[k] /= seg_count_[k];
   return R;
@@ -81,13 +104,44 @@ Eigen::VectorXd Protocol3d::levels(const Eigen::Matrix3Xd& X) const {
     Eigen::VectorXd seg_level(p_.segments);
     for (int k = 0; k < p_.segments; ++k)
       seg_level[k] = k < st_.active ? 0.0 : k == st_.active ? 1.0 : relay(R[k], thr, lev, 2, eps);
-    for (int i = 0; i < nn; ++i) s[i] = seg_level[seg_[i]];
+    if (p_.dual_cell_segments) {
+      for (int ring = 0; ring < mesh_->n_rings; ++ring) {
+        double v = 0.0;
+        for (const auto& [k, f] : ring_share_[ring]) v += f * seg_level[k];
+        for (int i = 0; i < mesh_->n_theta; ++i) s[mesh_->node(ring, i)] = v;
+      }
+    } else {
+      for (int i = 0; i < nn; ++i) s[i] = seg_level[seg_[i]];
+    }
   } else if (st_.phase == 1) {
     const double R0 = mesh_->radius;
-    const Eigen::VectorXd r = node_radii(*mesh_, X);
     const double thr[4] = {0.5 * R0, 0.8 * R0, R0 - p_.delta, R0 + p_.delta};
     const double lev[5] = {-1.0, -0.5, -0.1, 0.0, 0.1};
-    for (int i = 0; i < nn; ++i) s[i] = relay(r[i], thr, lev, 4, eps);
+    if (p_.dual_cell_segments) {
+      // the five-band law at every point of the wall, averaged over each ring's cell with the
+      // radius interpolated linearly between the rings: the bands' thresholds cross the wall as
+      // fronts narrower than a cell, which a per-ring evaluation would sample irregularly
+      const Eigen::VectorXd rr = ring_radii(*mesh_, X);
+      const int nr = mesh_->n_rings;
+      constexpr int kSub = 16;  // samples per half-cell (midpoint rule)
+      for (int ring = 0; ring < nr; ++ring) {
+        double v = 0.0;
+        int count = 0;
+        for (int side : {-1, 1}) {
+          const int nb = ring + side;
+          if (nb < 0 || nb >= nr) continue;
+          for (int j = 0; j < kSub; ++j) {
+            const double w = 0.5 * (j + 0.5) / kSub;  // distance from the ring, in ring spacings
+            v += relay((1.0 - w) * rr[ring] + w * rr[nb], thr, lev, 4, eps);
+            ++count;
+          }
+        }
+        for (int i = 0; i < mesh_->n_theta; ++i) s[mesh_->node(ring, i)] = v / count;
+      }
+    } else {
+      const Eigen::VectorXd r = node_radii(*mesh_, X);
+      for (int i = 0; i < nn; ++i) s[i] = relay(r[i], thr, lev, 4, eps);
+    }
   }
   return s;
 }

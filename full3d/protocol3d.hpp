@@ -61,6 +61,17 @@ struct ProtocolParams {
   /// within delta of R0 and every ring's mean axial position is within delta of its reference
   /// position (after removing the mean axial translation), whatever the energy.
   bool shape_end = false;
+  /// false (the 3D tier): a ring belongs to the segment its reference position lies in, and a
+  /// segment's radius is the plain mean of its nodes' radii. true (the axisymmetric fitted
+  /// method): each ring's reference cell, [s - ds/2, s + ds/2] cut at the tube's ends, is shared
+  /// among the segments it overlaps; a ring's level is the overlap-weighted mean of their
+  /// levels and a segment's radius is the mean over its length, sum f A r / sum f A (f the
+  /// overlap fraction, A the ring's area); during the recovery a ring's level is the five-band
+  /// law averaged over its cell (the radius interpolated linearly between the rings). The
+  /// actuation is then the integral of the load over each ring's cell, and the discrete
+  /// protocol converges to the continuum one instead of jumping as rings cross segment
+  /// boundaries or band thresholds.
+  bool dual_cell_segments = false;
 };
 
 /// Discrete protocol state (checkpointed).
@@ -110,6 +121,8 @@ class Protocol3d {
   double e_ref_;
   std::vector<int> seg_;
   std::vector<int> seg_count_;
+  /// dual_cell_segments: per ring, (segment, fraction of the ring's cell) pairs
+  std::vector<std::vector<std::pair<int, double>>> ring_share_;
   std::vector<double> bounds_;
   ProtocolState st_;
 };

@@ -11,6 +11,7 @@ import os
 import re
 import struct
 import sys
+import textwrap
 
 import matplotlib
 
@@ -90,6 +91,8 @@ def finding_values(f):
         if "quantity" in e:
             sweep = [f"{k} = {e[k]}" for k in ("L_um", "R_f_over_R0") if k in e]
             text = f"{e['case']}{' (' + sweep[0] + ')' if sweep else ''}: {value_pm(e['value'], e['error'], e['quantity'])}"
+            if e.get("reference") == "axisymmetric reference":
+                text += " (axisymmetric reference)"
             if "band" in e:
                 text += f" (paper {e['paper']}, band {e['band'][0]:.3g}–{e['band'][1]:.3g})"
         elif "relative_difference" in e:
@@ -179,7 +182,70 @@ def velocity_figure(case, path):
     plt.close(fig)
 
 
+FIGURE_PANELS = (("displacement_per_cycle_m", "displacement per cycle [nm]", 1e9),
+                 ("cycle_time_s", "cycle time [s]", 1.0),
+                 ("max_displacement_m", "maximum centre displacement [nm]", 1e9))
+
+
+def order_text(e):
+    """'observed order 0.82' / 'not asymptotic' for an extrapolation's legend entry."""
+    if e is None:
+        return "no extrapolation"
+    obs = e.get("observed_order")
+    if e.get("asymptotic") and e.get("order"):
+        return f"order {e['order']:.2f}" + ("" if obs is not None else " (assumed)")
+    return "not asymptotic" + (f", observed order {obs:.2f}" if obs is not None else "")
+
+
+def reference_convergence_figure(case, path):
+    """Both grid series of a case with an axisymmetric reference against h: each figure on its
+    own panel, the 3D runs and the axi runs, both extrapolations at h = 0 with their error bars
+    (fitted orders in the legend), the paper's value where the case has one."""
+    ref = case["reference"]
+    r3 = [r for r in case["runs3d"] if r.get("has_cycle")]
+    ra = [r for r in ref.get("runs", []) if r.get("has_cycle")]
+    if not r3 and not ra:
+        return False
+    paper = (case.get("paper") or {}).get("max_displacement_m")
+    panels = [p for p in FIGURE_PANELS if p[0] != "max_displacement_m" or paper]
+    fig, axes = plt.subplots(1, len(panels), figsize=(5.4 * len(panels), 6.0))
+    hmax = max([r["cell_size_m"] * 1e9 for r in r3 + ra] or [1.0])
+    for ax, (key, ylabel, scale) in zip(axes, panels):
+        p3 = [(r["cell_size_m"] * 1e9, r[key] * scale) for r in r3 if r.get(key) is not None]
+        pa = [(r["cell_size_m"] * 1e9, r[key] * scale) for r in ra if r.get(key) is not None]
+        e3 = case["reference3d"].get(key)
+        ea = ref.get(key)
+        if p3:
+            ax.plot(*zip(*p3), "ko-", ms=5, label=f"3D runs: {order_text(e3)}")
+        if pa:
+            ax.plot(*zip(*pa), "s-", color="tab:blue", ms=5,
+                    label=f"axisymmetric runs ({ref.get('method', 'axi')}): {order_text(ea)}")
+        if e3 and e3.get("value") is not None:
+            ax.errorbar([-0.015 * hmax], [e3["value"] * scale], yerr=[(e3["error"] or 0) * scale], fmt="o", mfc="white",
+                        color="k", capsize=4, label="3D extrapolation h → 0 ± error")
+        if ea and ea.get("value") is not None:
+            conv = "converged" if ea.get("converged") else "not converged"
+            ax.errorbar([0.015 * hmax], [ea["value"] * scale], yerr=[(ea["error"] or 0) * scale], fmt="s",
+                        color="tab:blue", capsize=4, label=f"axisymmetric reference h → 0 ± error ({conv})")
+        if key == "max_displacement_m" and paper:
+            ax.axhline(paper * 1e9, color="tab:red", ls=":", lw=1.4, label="paper: maximum displacement over the cycle")
+        ax.set_xlim(-0.06 * hmax, 1.06 * hmax)
+        ax.set(xlabel="cell size h [nm]", ylabel=ylabel)
+        ax.grid(alpha=0.3)
+        # each panel's legend below it, off the data: the orders differ from figure to figure
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize="small", frameon=False)
+    statement = "\n".join(textwrap.wrap(ref.get("statement", ""), 150))
+    fig.suptitle(f"{case['name']}: grid convergence of the 3D tier and the axisymmetric reference\n{statement}",
+                 fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
 def convergence_figure(case, path):
+    if case.get("reference"):
+        return reference_convergence_figure(case, path)
     runs = [r for r in case["runs3d"] if r.get("has_cycle")]
     if not runs:
         return False
@@ -272,11 +338,21 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title, logx=Fa
     fig, ax = plt.subplots(figsize=(9, 4.6))
     x = [c["sweep_value"] for c in cases]
     y, e = [], []
+    axi = [bool(c.get("reference")) for c in cases]
     for c in cases:
-        ref = c["reference3d"].get(key)
-        y.append(ref["value"] * scale if ref else float("nan"))
-        e.append(ref["error"] * scale if ref else 0)
-    ax.errorbar(x, y, yerr=e, fmt="ks-", capsize=4, label="3D reference (h → 0, or finest grid)")
+        ref = (c.get("reference") or c["reference3d"]).get(key)
+        y.append(ref["value"] * scale if ref and ref.get("value") is not None else float("nan"))
+        e.append(ref["error"] * scale if ref and ref.get("error") is not None else 0)
+    label = ("axisymmetric reference (h → 0)" if all(axi) else "3D reference (h → 0, or finest grid)" if not any(axi)
+             else "reference (axisymmetric where the case has one, else 3D)")
+    ax.errorbar(x, y, yerr=e, fmt="ks-", capsize=4, label=label)
+    if any(axi):
+        y3, e3 = [], []
+        for c in cases:
+            ref = c["reference3d"].get(key)
+            y3.append(ref["value"] * scale if ref and ref.get("value") is not None else float("nan"))
+            e3.append(ref["error"] * scale if ref and ref.get("error") is not None else 0)
+        ax.errorbar(x, y3, yerr=e3, fmt="o--", color="0.5", mfc="white", capsize=3, label="3D extrapolation (h → 0)")
     labels = [m["label"] for m in cases[0]["models1d"]]
     for k, lab in enumerate(labels):
         v = []
@@ -416,6 +492,17 @@ def suite_wall_time(report):
     return text
 
 
+def ref_words(report):
+    """Which reference the cases are judged against."""
+    axi = [c["name"] for c in report["cases"] if c.get("reference")]
+    if not axi:
+        return "the extrapolated 3D reference"
+    if len(axi) == len(report["cases"]):
+        return "the extrapolated axisymmetric reference (`--tier axi`)"
+    return ("the extrapolated axisymmetric reference for " + ", ".join(axi) +
+            ", the extrapolated 3D reference for the others")
+
+
 def markdown(report, figs):
     th = report["thresholds"]
     sel = report.get("cases_selected") or []
@@ -425,8 +512,8 @@ def markdown(report, figs):
            f"Wall time of the suite: {suite_wall_time(report)}. Thresholds: displacement per cycle "
            f"±{100 * th['displacement_per_cycle_relative']:.0f} %, cycle time ±{100 * th['cycle_time_relative']:.0f} %, "
            f"mean velocity per cycle ±{100 * th['mean_velocity_per_cycle_relative']:.0f} % (1D against the "
-           f"extrapolated 3D reference); U(t) phase correlation ≥ {th['velocity_phase_correlation']} "
-           "(against the finest 3D run); each verdict against the 3D reference's error bar.", "",
+           f"case's reference: {ref_words(report)}); U(t) phase correlation ≥ {th['velocity_phase_correlation']} "
+           "(against the finest 3D run); each verdict against the reference's error bar.", "",
            "## The paper's conclusions", "",
            "Every value carries the error of its 3D reference (the extrapolation's, or the spread of the grids "
            "when they are not in the asymptotic range). Two values differ when |a − b| exceeds e_a + e_b (their "
@@ -484,6 +571,8 @@ def markdown(report, figs):
                            + (f", order {e['order']:.2f}" if e["asymptotic"] and e["order"] else ""))
         if "note" in ref:
             out.append(f"- {ref['note']}")
+        if c.get("reference"):
+            out += reference_markdown(c)
         if c.get("paper"):
             p = c["paper"]
             out += ["", f"Paper: maximum displacement {si(p.get('max_displacement_m'), 'm')} ({p.get('source', '')}); "
@@ -507,7 +596,8 @@ def markdown(report, figs):
         else:
             out.append(f"Not available: {cal.get('status', 'unknown')}")
         out += ["", "### 1D models", "",
-                "vs ref: the relative difference from the 3D reference ± the reference's relative error; U(t) phase "
+                f"vs ref: the relative difference from the {'axisymmetric' if c.get('reference') else '3D'} reference "
+                "± the reference's relative error; U(t) phase "
                 "correlation ± its spread over the 3D grids. A verdict passes when the whole interval lies inside the "
                 "tolerance, fails when it lies wholly outside, and is inconclusive otherwise.", "",
                 "| model | displacement / cycle | vs ref | cycle time | vs ref | mean velocity / cycle | vs ref | "
@@ -540,6 +630,57 @@ def markdown(report, figs):
     for f in figs.get("", []):
         out += ["", f"![{f}]({f})"]
     return "\n".join(out) + "\n"
+
+
+
+FIGURE_WORDS = (("displacement_per_cycle_m", "displacement per cycle", "m"), ("cycle_time_s", "cycle time", "s"),
+                ("mean_velocity_per_cycle_m_per_s", "mean velocity per cycle", "m/s"),
+                ("max_displacement_m", "maximum displacement", "m"))
+
+
+def reference_markdown(c):
+    """The axisymmetric reference of a case: its runs, its extrapolated figures with the
+    convergence statement, and the 3D extrapolation against it."""
+    ref = c["reference"]
+    rng = ref.get("order_range")
+    out = ["", "### Axisymmetric reference (the reference of this case's 1D verdicts and findings)", "",
+           f"**{ref.get('statement', '')}** "
+           f"(target ±{100 * ref.get('target_relative', 0.01):g} %; {ref.get('method', '')} method, "
+           f"`{ref.get('grid_key', '')}` = {json.dumps(ref.get('grids'))}"
+           + (f", observed orders accepted in [{rng[0]:g}, {rng[1]:g}]" if rng else "") + ").", "",
+           "| grid | h | status | displacement / cycle | cycle time | mean velocity / cycle | max displacement | steps | wall time |",
+           "|---|---|---|---|---|---|---|---|---|"]
+    for r in ref.get("runs", []):
+        out.append(f"| {json.dumps(r.get('grid_value'))} | {si(r['cell_size_m'], 'm')} | {r['status'][:60]} | "
+                   f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
+                   f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {si(r.get('max_displacement_m'), 'm')} | "
+                   f"{r.get('steps', '')} | {si(r.get('wall_time_s'), 's')}{' (cached)' if r.get('cached') else ''} |")
+    out.append("")
+    for key, words, unit in FIGURE_WORDS:
+        e = ref.get(key)
+        if not e:
+            continue
+        rel = e.get("relative_error")
+        out.append(f"- {words}: {si(e['value'], unit)} ± {si(e['error'], unit)}"
+                   f"{'' if rel is None else f' (± {100 * rel:.2g} %)'}; {order_text(e)}; "
+                   f"{'converged' if e.get('converged') else 'not converged'}; {e.get('note', '')}")
+    cmp = c.get("comparison_3d_vs_reference") or {}
+    if cmp:
+        out += ["", "3D extrapolation against the axisymmetric reference (agree when |Δ| ≤ e_3d + e_ref):", "",
+                "| figure | 3D (h → 0) | 3D order | axisymmetric reference | Δ = 3D − ref | e_3d + e_ref | verdict | finest 3D grid vs ref |",
+                "|---|---|---|---|---|---|---|---|"]
+        for key, words, unit in FIGURE_WORDS:
+            e = cmp.get(key)
+            if not e:
+                continue
+            obs = e.get("observed_order_3d")
+            fr = e.get("finest_3d_relative_error")
+            out.append(f"| {words} | {si(e['value_3d'], unit)} ± {si(e['error_3d'], unit)} | "
+                       f"{'—' if obs is None else f'{obs:.2f}'}{'' if e.get('asymptotic_3d') else ' (not asymptotic)'} | "
+                       f"{si(e['value_reference'], unit)} ± {si(e['error_reference'], unit)} | "
+                       f"{si(e['difference'], unit)} | {si(e['combined_uncertainty'], unit)} | **{e['verdict']}** | "
+                       f"{pct(fr)} (h = {si(e.get('finest_3d_cell_size_m'), 'm')}) |")
+    return out
 
 
 def to_html(md, d):

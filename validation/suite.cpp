@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 #include <map>
 #include <optional>
 #include <sstream>
@@ -14,6 +15,8 @@
 #include "common/run_record.hpp"
 #include "common/run_folder.hpp"
 #include "common/units.hpp"
+#include "axi/run_axi.hpp"
+#include "axi/scene_axi.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/report.hpp"
@@ -120,6 +123,7 @@ struct Run3d {
   Series series;
   CycleFigures cyc;
   double h = 0, wall = 0, length = 0;
+  double max_displacement = std::numeric_limits<double>::quiet_NaN();  ///< m, over the run
   bool ok = false;
 };
 
@@ -149,37 +153,46 @@ json same_swimmer(json resolved) {
   return resolved;
 }
 
-/// A run folder's scene.resolved.json resolved again by the current scene reader: keys the
-/// reader gained since the run was written appear with their defaults, so a run stays found
-/// as long as its physics is what the scene would resolve to today. null when the reader
-/// no longer accepts it.
-json current_resolution(const json& written) {
+/// A run folder's scene.resolved.json resolved again by the current scene reader (the 3D
+/// tier's, or with axi_tier the axisymmetric tier's): keys the reader gained since the run was
+/// written appear with their defaults, so a run stays found as long as its physics is what
+/// the scene would resolve to today. null when the reader no longer accepts it.
+json current_resolution(const json& written, bool axi_tier = false) {
   try {
     json again;
-    full3d::read_scene3d(written, again);
+    if (axi_tier) axi::read_scene_axi(written, again);
+    else full3d::read_scene3d(written, again);
     return again;
   } catch (const std::exception&) {
     return nullptr;
   }
 }
 
+/// The cache key of an axi run: its physics (same_swimmer) tagged with the tier, so that an
+/// axi run is never taken for a 3D one.
+std::string axi_key(const json& resolved) { return output::json_hash({"axi", same_swimmer(resolved)}); }
+
 /// json_hash(same_swimmer(current_resolution(...))) of a run folder's scene.resolved.json or
-/// of a calibration file's "scene" (member), "" when unreadable. Resolving a scene again costs
-/// tens of ms and every cache lookup scans every folder, so the key is kept per file and its
-/// modification time for the life of the process.
-std::string swimmer_key(const fs::path& file, const char* member) {
+/// of a calibration file's "scene" (member), "" when unreadable; with axi_tier, axi_key of the
+/// axisymmetric tier's resolution. Resolving a scene again costs tens of ms and every cache
+/// lookup scans every folder, so the key is kept per file and its modification time for the
+/// life of the process.
+std::string swimmer_key(const fs::path& file, const char* member, bool axi_tier = false) {
   static std::map<std::string, std::pair<fs::file_time_type, std::string>> memo;
   std::error_code ec;
   const auto mtime = fs::last_write_time(file, ec);
   if (ec) return {};
   std::string id = file.string();
   if (member) id.append("#").append(member);
+  if (axi_tier) id.append("#axi");
   if (auto it = memo.find(id); it != memo.end() && it->second.first == mtime) return it->second.second;
   std::ifstream in(file);
   json j = json::parse(in, nullptr, false);
   std::string key;
-  if (!j.is_discarded() && (!member || j.contains(member)))
-    key = output::json_hash(same_swimmer(current_resolution(member ? j[member] : j)));
+  if (!j.is_discarded() && (!member || j.contains(member))) {
+    const json again = current_resolution(member ? j[member] : j, axi_tier);
+    if (!again.is_null()) key = axi_tier ? axi_key(again) : output::json_hash(same_swimmer(again));
+  }
   memo[id] = {mtime, key};
   return key;
 }
@@ -230,7 +243,8 @@ bool interrupted_run(const std::string& dir) {
 }
 
 /// frame_interval > 0: membrane frames (VTK) at that interval, for the side-view figure.
-Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached, double frame_interval = 0) {
+Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached, double frame_interval = 0,
+             int progress = 0) {
   json s = sc;
   set_key(s, "full3d.threads", threads);
   set_key(s, "full3d.output.vtk", frame_interval > 0);
@@ -254,6 +268,8 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
     for (const auto& e : fs::directory_iterator(runs_dir)) {
       if (swimmer_key(e.path() / "scene.resolved.json", nullptr) != key) continue;
       summary = finished_summary(e.path().string());
+      // an axi run of the same scene resolves to the same 3D physics: only a 3D run is one
+      if (!summary.is_null() && summary.value("tier", std::string("3d")) != "3d") summary = nullptr;
       if (!summary.is_null()) {
         dir = e.path().string();
         break;
@@ -278,7 +294,7 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   record::RunRecord rec;
   if (!*cached) {
     full3d::RunControl ctl;
-    ctl.progress = 0;
+    ctl.progress = progress;
     ctl.quiet_vtk = frame_interval <= 0;
     ctl.keep_rows = true;
     ctl.resume = resume;
@@ -317,6 +333,10 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   // existed have none)
   for (const char* k : {"max_wrinkle_m", "max_wrinkle_over_h"})
     if (summary.contains(k) && summary[k].is_number()) r.record[k] = summary[k];
+  if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number()) {
+    r.max_displacement = summary["max_displacement_m"].get<double>();
+    r.record["max_displacement_m"] = r.max_displacement;
+  }
   if (r.cyc.has_cycle) {
     r.record["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
     r.record["cycle_time_s"] = r.cyc.cycle_time_s;
@@ -325,6 +345,87 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   // the first cycle of a one-cycle scene; the whole run of a multi-cycle one (Figure 14)
   const double t_end = r.series.t.empty() ? 0.0 : r.series.t.back();
   r.record["series"] = downsample(r.series, r.cyc.has_cycle && p.protocol.cycles == 1 ? r.cyc.cycle_time_s : t_end);
+  return r;
+}
+
+// ---- one axi run (cached) ------------------------------------------------------------
+
+struct RunAxi {
+  json record;  ///< report entry
+  CycleFigures cyc;
+  double h = 0, wall = 0;
+  double max_displacement = std::numeric_limits<double>::quiet_NaN();  ///< m, over the run
+  bool ok = false;
+};
+
+/// One run of the axisymmetric tier, cached in runs_dir like the 3D runs: a finished run
+/// whose physics (its scene resolved again by the current reader) is this scene's is reused,
+/// found by its folder name or by its own scene.resolved.json; any other change reruns it.
+RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress, bool* cached) {
+  json resolved;
+  const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+  const std::string key = axi_key(resolved);
+  std::string dir = runs_dir + "/" + p.name() + "-axi-" + key;
+  json summary = finished_summary(dir);
+  // the summary's own scene must still resolve to this physics
+  if (!summary.is_null() && swimmer_key(fs::path(dir) / "scene.resolved.json", nullptr, true) != key) summary = nullptr;
+  if (summary.is_null())
+    for (const auto& e : fs::directory_iterator(runs_dir)) {
+      if (swimmer_key(e.path() / "scene.resolved.json", nullptr, true) != key) continue;
+      summary = finished_summary(e.path().string());
+      if (!summary.is_null() && summary.value("tier", std::string()) != "axi") summary = nullptr;
+      if (!summary.is_null()) {
+        dir = e.path().string();
+        break;
+      }
+    }
+  *cached = !summary.is_null();
+  record::RunRecord rec;
+  if (!*cached) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+    axi::RunControlAxi ctl;
+    ctl.progress = progress;
+    ctl.keep_rows = true;
+    axi::RunOutcomeAxi out = axi::run_axi(p, resolved, dir, ctl);
+    summary = out.summary;
+    rec = std::move(out.record);
+  } else {
+    rec = record::read_run(dir);
+  }
+  RunAxi r;
+  r.h = p.h;
+  const std::string status = summary.value("status", std::string("unknown"));
+  r.ok = status == "ok";
+  r.wall = summary.value("wall_time_s", 0.0);
+  r.cyc = record::cycle_figures(rec);
+  // the run's own figures at full precision (a cached series.csv carries 10 digits)
+  if (summary.contains("displacement_per_cycle_m") && summary["displacement_per_cycle_m"].is_number() &&
+      summary.contains("cycle_time_s") && summary["cycle_time_s"].is_number()) {
+    r.cyc.displacement_per_cycle_m = summary["displacement_per_cycle_m"].get<double>();
+    r.cyc.cycle_time_s = summary["cycle_time_s"].get<double>();
+    r.cyc.mean_velocity_per_cycle_m_per_s = summary["mean_velocity_per_cycle_m_per_s"].get<double>();
+  }
+  if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number())
+    r.max_displacement = summary["max_displacement_m"].get<double>();
+  r.record = {{"cell_size_m", p.h},
+              {"grid", {p.nr, p.nx}},
+              {"method", p.method_name()},
+              {"status", status},
+              {"cached", *cached},
+              {"folder", dir},
+              {"wall_time_s", r.wall},
+              {"steps", summary.value("steps", 0L)},
+              {"cycles_completed", summary.value("cycles_completed", 0)},
+              {"has_cycle", r.cyc.has_cycle}};
+  if (std::isfinite(r.max_displacement)) r.record["max_displacement_m"] = r.max_displacement;
+  if (r.cyc.has_cycle) {
+    r.record["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
+    r.record["cycle_time_s"] = r.cyc.cycle_time_s;
+    r.record["mean_velocity_per_cycle_m_per_s"] = r.cyc.mean_velocity_per_cycle_m_per_s;
+  } else {
+    r.record["no_cycle_reason"] = r.cyc.absent_because;
+  }
   return r;
 }
 
@@ -386,9 +487,177 @@ json relative(double value, double ref) {
   return (value - ref) / std::abs(ref);
 }
 
+/// A number for the report: null when it is not finite (never NaN in a file).
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json extrapolation_json(const Extrapolation& e) {
+  return json{{"value", num(e.value)},         {"error", num(e.error)},
+              {"order", num(e.order)},         {"observed_order", num(e.observed_order)},
+              {"asymptotic", e.asymptotic},    {"note", e.note}};
+}
+
+std::string percent_text(double x) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.2g %%", 100.0 * x);
+  return b;
+}
+
+/// The axisymmetric reference from its runs: each headline figure (and the largest centre
+/// displacement when the paper gives it) extrapolated to h -> 0 with the reference's order
+/// range over the grids that completed a cycle; each figure converged when it is asymptotic,
+/// has an observed order (three grids) and its relative error is at most `target`; the
+/// reference converged when every figure is. `statement` says so with the figures reached.
+json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target) {
+  std::vector<double> h, d, T, v, hm, m;
+  for (const auto& r : runs)
+    if (r.cyc.has_cycle) {
+      h.push_back(r.h);
+      d.push_back(r.cyc.displacement_per_cycle_m);
+      T.push_back(r.cyc.cycle_time_s);
+      v.push_back(r.cyc.mean_velocity_per_cycle_m_per_s);
+      if (std::isfinite(r.max_displacement)) {
+        hm.push_back(r.h);
+        m.push_back(r.max_displacement);
+      }
+    }
+  json ref = {{"grids_used", h.size()}, {"order_range", {orders.lo, orders.hi}}, {"target_relative", target}};
+  const std::string target_text = percent_text(target);
+  if (h.size() < 2) {
+    ref["converged"] = false;
+    ref["statement"] = "not converged to " + target_text + ": fewer than two of the reference's grids completed a cycle, "
+                       "so it has no extrapolated value";
+    ref["note"] = "fewer than two grids completed a cycle: no extrapolated reference";
+    return ref;
+  }
+  const double assumed = std::clamp(1.0, orders.lo, orders.hi);
+  struct Fig {
+    const char* key;
+    const char* words;
+    const std::vector<double>* hh;
+    const std::vector<double>* f;
+  };
+  std::vector<Fig> figs = {{"displacement_per_cycle_m", "displacement per cycle", &h, &d},
+                           {"cycle_time_s", "cycle time", &h, &T},
+                           {"mean_velocity_per_cycle_m_per_s", "mean velocity per cycle", &h, &v}};
+  if (with_max && hm.size() >= 2) figs.push_back({"max_displacement_m", "maximum displacement", &hm, &m});
+  bool all = true;
+  std::string parts;
+  for (const Fig& f : figs) {
+    const Extrapolation e = richardson(*f.hh, *f.f, assumed, orders);
+    json j = extrapolation_json(e);
+    const double rel = std::abs(e.value) > 0 ? std::abs(e.error / e.value) : std::numeric_limits<double>::quiet_NaN();
+    const bool ok = e.asymptotic && std::isfinite(e.observed_order) && std::isfinite(rel) && rel <= target;
+    j["relative_error"] = num(rel);
+    j["converged"] = ok;
+    ref[f.key] = j;
+    all = all && ok;
+    std::string why;
+    if (!e.asymptotic) why = " (not in the asymptotic range)";
+    else if (!std::isfinite(e.observed_order)) why = " (two grids: no observed order)";
+    parts += std::string(parts.empty() ? "" : ", ") + f.words + " ± " +
+             (std::isfinite(rel) ? percent_text(rel) : std::string("—")) + why;
+  }
+  ref["converged"] = all;
+  ref["statement"] = std::string(all ? "converged to " : "not converged to ") + target_text + ": " + parts;
+  return ref;
+}
+
+/// The 3D extrapolation against the axisymmetric reference, figure by figure: both values
+/// with their errors, the difference, e_3d + e_ref, agree / disagree (verdicts.hpp), the 3D
+/// series' observed order, and the finest 3D grid's relative error against the reference.
+json compare_3d_with_reference(const json& ref3d, const json& ref, const std::vector<const Run3d*>& runs) {
+  json out = json::object();
+  const Run3d* finest = nullptr;
+  for (const Run3d* r : runs)
+    if (!finest || r->h < finest->h) finest = r;
+  for (const char* key : {"displacement_per_cycle_m", "cycle_time_s", "mean_velocity_per_cycle_m_per_s", "max_displacement_m"}) {
+    const bool in3d = ref3d.contains(key) && ref3d[key].is_object(), inref = ref.contains(key) && ref[key].is_object();
+    if (!inref) continue;
+    auto get = [](const json& j, const char* k) {
+      return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::numeric_limits<double>::quiet_NaN();
+    };
+    const double a = in3d ? get(ref3d[key], "value") : std::numeric_limits<double>::quiet_NaN();
+    const double ea = in3d ? std::abs(get(ref3d[key], "error")) : std::numeric_limits<double>::quiet_NaN();
+    const double b = get(ref[key], "value"), eb = std::abs(get(ref[key], "error"));
+    json c = {{"value_3d", num(a)},
+              {"error_3d", num(ea)},
+              {"order_3d", in3d ? ref3d[key]["order"] : json(nullptr)},
+              {"observed_order_3d", in3d ? ref3d[key]["observed_order"] : json(nullptr)},
+              {"asymptotic_3d", in3d ? ref3d[key]["asymptotic"] : json(nullptr)},
+              {"value_reference", num(b)},
+              {"error_reference", num(eb)},
+              {"difference", num(a - b)},
+              {"combined_uncertainty", num(ea + eb)},
+              {"verdict", agreement_verdict(a, ea, b, eb)}};
+    if (!in3d) c["note"] = "fewer than two 3D grids completed a cycle: no 3D extrapolation";
+    double f = std::numeric_limits<double>::quiet_NaN();
+    if (finest) {
+      const std::string k = key;
+      f = k == "displacement_per_cycle_m" ? finest->cyc.displacement_per_cycle_m
+          : k == "cycle_time_s"           ? finest->cyc.cycle_time_s
+          : k == "mean_velocity_per_cycle_m_per_s" ? finest->cyc.mean_velocity_per_cycle_m_per_s
+                                                   : finest->max_displacement;
+      c["finest_3d_cell_size_m"] = finest->h;
+    }
+    c["finest_3d_value"] = num(f);
+    c["finest_3d_relative_error"] = std::abs(b) > 0 ? num((f - b) / std::abs(b)) : json(nullptr);
+    out[key] = c;
+  }
+  return out;
+}
+
+/// The reference's order range: its `order_range`, else the axi method's own (the fitted
+/// method is a sharp-interface one, the immersed boundary first order at best).
+OrderRange reference_orders(const json& ref, const axi::ParamsAxi& p) {
+  if (ref.contains("order_range")) return parse_order_range(ref["order_range"], "reference.order_range");
+  return p.method == axi::AxiMethod::Fitted ? kSharpInterfaceOrders : kImmersedBoundaryOrders;
+}
+
+/// The scene of one reference grid: the case's scene (after its own set), the reference's
+/// set, the grid.
+json reference_scene(const json& base, const json& ref, const json& grid) {
+  json s = base;
+  apply_sets(s, ref.value("set", json()));
+  set_key(s, ref.value("grid_key", std::string("axi.grid.cells_across")), grid);
+  return s;
+}
+
+/// A case's `reference` read strictly (InputError naming the key, the value and what is
+/// allowed).
+void check_reference(const json& ref, const std::string& at) {
+  if (!ref.is_object())
+    throw InputError(at, scene::show(ref),
+                     "an object {\"tier\": \"axi\", \"grid_key\": \"axi.grid.cells_across\", \"grids\": [64, 128, 256], "
+                     "\"order_range\": ..., \"set\": {...}}: the converged reference of the case");
+  for (const auto& [k, v] : ref.items())
+    if (k != "tier" && k != "grid_key" && k != "grids" && k != "order_range" && k != "set")
+      throw InputError(at + "." + k, scene::show(v), "not a key of a reference: tier, grid_key, grids, order_range, set");
+  const json& tier = member(ref, "tier", at);
+  if (tier != "axi")
+    throw InputError(at + ".tier", scene::show(tier),
+                     "\"axi\" (the axisymmetric tier, --tier axi, the converged reference of round-wall scenes)");
+  if (ref.contains("grid_key")) {
+    const json& k = ref["grid_key"];
+    if (!k.is_string() || k.get<std::string>().rfind("axi.grid", 0) != 0)
+      throw InputError(at + ".grid_key", scene::show(k),
+                       "a dotted key of the axi tier's grid: \"axi.grid.cells_across\" (default), \"axi.grid.cell_size\" "
+                       "or \"axi.grid\"");
+  }
+  const json& g = member(ref, "grids", at);
+  bool distinct = g.is_array() && g.size() >= 3;
+  for (std::size_t i = 0; distinct && i < g.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j) distinct = distinct && g[i] != g[j];
+  if (!distinct)
+    throw InputError(at + ".grids", scene::show(g),
+                     "three or more distinct grid values (an observed order needs three grids), coarse to fine");
+  if (ref.contains("order_range")) parse_order_range(ref["order_range"], at + ".order_range");
+  if (ref.contains("set") && !ref["set"].is_object())
+    throw InputError(at + ".set", scene::show(ref["set"]), "an object {\"dotted.key\": value} applied to the axi runs");
+}
+
 }  // namespace
 
-json load_suite(const std::string& path) {
+json load_suite(const std::string& path, const std::string& data_dir) {
   const json s = scene::load_file(path);
   if (!s.is_object()) throw InputError("suite", path, "a JSON object with \"cases\" and \"models1d\"");
   const json& cases = member(s, "cases", "suite");
@@ -405,6 +674,7 @@ json load_suite(const std::string& path) {
                          "an index into grids, 0 to " + std::to_string(g.size() - 1));
     }
     if (cases[i].contains("order_range")) parse_order_range(cases[i]["order_range"], at + ".order_range");
+    if (cases[i].contains("reference")) check_reference(cases[i]["reference"], at + ".reference");
     if (cases[i].contains("time_variants3d")) {
       const json& v = cases[i]["time_variants3d"];
       bool ok = v.is_array();
@@ -416,6 +686,13 @@ json load_suite(const std::string& path) {
     }
   }
   if (s.contains("order_range")) parse_order_range(s["order_range"], "suite.order_range");
+  if (s.contains("reference_target_relative")) {
+    const json& t = s["reference_target_relative"];
+    if (!t.is_number() || !(t.get<double>() > 0 && t.get<double>() < 1))
+      throw InputError("suite.reference_target_relative", scene::show(t),
+                       "a number between 0 and 1 (exclusive): the relative error below which a reference counts as "
+                       "converged (default 0.01)");
+  }
   if (s.contains("extremes3d")) {
     const json& ex = s["extremes3d"];
     bool ok = ex.is_array();
@@ -436,11 +713,42 @@ json load_suite(const std::string& path) {
   for (const char* k : {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative",
                         "velocity_phase_correlation"})
     if (!member(th, k, "suite.thresholds").is_number()) throw InputError(std::string("suite.thresholds.") + k, scene::show(th[k]), "a number");
+  // the scene of every case with a reference must be one the axi tier runs, on every grid:
+  // refused here, before anything runs
+  const std::string suite_dir = fs::path(path).parent_path().string();
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    if (!cases[i].contains("reference")) continue;
+    const std::string at = "suite.cases[" + std::to_string(i) + "].reference";
+    const json& ref = cases[i]["reference"];
+    const std::string scene_name = cases[i]["scene"].is_string() ? cases[i]["scene"].get<std::string>() : "";
+    std::string scene_path;
+    for (const fs::path& q : {fs::path(scene_name), fs::path(suite_dir) / scene_name,
+                              data_dir.empty() ? fs::path() : fs::path(data_dir) / "scenes" / scene_name})
+      if (!scene_name.empty() && !q.empty() && fs::is_regular_file(q)) {
+        scene_path = q.string();
+        break;
+      }
+    if (scene_path.empty())
+      throw InputError("suite.cases[" + std::to_string(i) + "].scene", scene::show(cases[i]["scene"]),
+                       "a scene file (tried as given, beside the suite file and in the shipped data/scenes/)");
+    json base = scene::load_file(scene_path);
+    apply_sets(base, cases[i].value("set", json()));
+    for (const json& g : ref["grids"]) {
+      try {
+        json resolved;
+        axi::read_scene_axi(reference_scene(base, ref, g), resolved);
+      } catch (const InputError& e) {
+        throw InputError(at, scene_name + " at " + ref.value("grid_key", std::string("axi.grid.cells_across")) + " = " +
+                                 g.dump(),
+                         std::string("a scene the axisymmetric tier (--tier axi) runs; it refuses this one: ") + e.what());
+      }
+    }
+  }
   return s;
 }
 
 json run_suite(const SuiteOptions& o) {
-  const json suite = load_suite(o.suite);
+  const json suite = load_suite(o.suite, o.data_dir);
   const std::string suite_dir = fs::path(o.suite).parent_path().string();
   const json& th = suite["thresholds"];
   const std::string runs_dir = o.out_dir + "/runs", cal_dir = o.out_dir + "/calibrations";
@@ -495,7 +803,7 @@ json run_suite(const SuiteOptions& o) {
       // the finest grid writes membrane frames, about 12 per cycle of the grid before it
       double frames = 0;
       if (g + 1 == grids.size() && g > 0 && runs.back().cyc.has_cycle) frames = runs.back().cyc.cycle_time_s / 12.0;
-      Run3d r = run_3d(s, runs_dir, o.threads, &cached, frames);
+      Run3d r = run_3d(s, runs_dir, o.threads, &cached, frames, o.run_progress);
       cr["length_m"] = r.length;
       r.record["grid_value"] = grids[g];
       runs_j.push_back(r.record);
@@ -504,13 +812,21 @@ json run_suite(const SuiteOptions& o) {
     cr["runs3d"] = runs_j;
 
     // 2. the extrapolated reference over the grids that completed a cycle
-    std::vector<double> hs, fd, fT;
+    std::vector<double> hs, fd, fT, hm, fm;
     for (const auto& r : runs)
       if (r.cyc.has_cycle) {
         hs.push_back(r.h);
         fd.push_back(r.cyc.displacement_per_cycle_m);
         fT.push_back(r.cyc.cycle_time_s);
+        if (std::isfinite(r.max_displacement)) {
+          hm.push_back(r.h);
+          fm.push_back(r.max_displacement);
+        }
       }
+    const bool paper_max = cs.contains("paper") && cs["paper"].is_object() &&
+                           cs["paper"].contains("max_displacement_m") && cs["paper"]["max_displacement_m"].is_number();
+    Extrapolation em;
+    const bool have_max = paper_max && hm.size() >= 2;
     json ref = json::object();
     Extrapolation ed, eT, ev;
     const bool have_ref = hs.size() >= 2;
@@ -530,23 +846,76 @@ json run_suite(const SuiteOptions& o) {
       ev.error = std::abs(ev.value) * (std::abs(ed.error / ed.value) + std::abs(eT.error / eT.value));
       ev.asymptotic = ed.asymptotic && eT.asymptotic;
       ev.note = "extrapolated displacement per cycle / extrapolated cycle time (relative errors added)";
-      auto ej = [](const Extrapolation& e) {
-        return json{{"value", e.value},
-                    {"error", e.error},
-                    {"order", e.order},
-                    {"observed_order", std::isfinite(e.observed_order) ? json(e.observed_order) : json(nullptr)},
-                    {"asymptotic", e.asymptotic},
-                    {"note", e.note}};
-      };
       ref = {{"grids_used", hs.size()},
              {"order_range", {orders.lo, orders.hi}},
-             {"displacement_per_cycle_m", ej(ed)},
-             {"cycle_time_s", ej(eT)},
-             {"mean_velocity_per_cycle_m_per_s", ej(ev)}};
+             {"displacement_per_cycle_m", extrapolation_json(ed)},
+             {"cycle_time_s", extrapolation_json(eT)},
+             {"mean_velocity_per_cycle_m_per_s", extrapolation_json(ev)}};
+      // the largest centre displacement over the run, where the paper gives it
+      if (have_max) {
+        em = richardson(hm, fm, assumed, orders);
+        ref["max_displacement_m"] = extrapolation_json(em);
+      }
     } else {
       ref = {{"grids_used", hs.size()}, {"note", "fewer than two grids completed a cycle: no extrapolated reference"}};
     }
     cr["reference3d"] = ref;
+
+    // 2b. the converged reference: the case's scene on the axi tier at each reference grid,
+    // extrapolated with the reference's order range
+    if (cs.contains("reference")) {
+      const json& rs = cs["reference"];
+      const json& rgrids = rs["grids"];
+      const std::string rkey = rs.value("grid_key", std::string("axi.grid.cells_across"));
+      const double target = suite.value("reference_target_relative", 0.01);
+      json axi_runs = json::array();
+      std::vector<RunAxi> aruns;
+      OrderRange rorders = kSharpInterfaceOrders;
+      std::string method;
+      double done_wall = 0;
+      std::vector<double> rh;  // the cell size of each reference grid
+      for (const json& g : rgrids) {
+        json resolved;
+        rh.push_back(axi::read_scene_axi(reference_scene(base, rs, g), resolved).h);
+      }
+      for (std::size_t g = 0; g < rgrids.size(); ++g) {
+        const json s = reference_scene(base, rs, rgrids[g]);
+        json resolved;
+        const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
+        rorders = reference_orders(rs, p);
+        method = p.method_name();
+        // the time left in the stage, estimated from the last run that ran here: a 2D grid's
+        // cost grows as h^-3 (cells as h^-2, steps as h^-1)
+        std::string left;
+        if (g > 0 && !aruns.back().record.value("cached", true) && aruns.back().wall > 0) {
+          double est = 0;
+          for (std::size_t k = g; k < rgrids.size(); ++k) est += aruns.back().wall * std::pow(aruns.back().h / rh[k], 3.0);
+          left = ", about " + std::to_string(long(std::ceil(est))) + " s left in this stage (so far " +
+                 std::to_string(long(std::ceil(done_wall))) + " s)";
+        }
+        say(tag + ": axi reference grid " + std::to_string(g + 1) + "/" + std::to_string(rgrids.size()) + " (" + rkey +
+            " = " + rgrids[g].dump() + ", " + method + ", h = " + std::to_string(p.h * 1e9).substr(0, 5) + " nm" + left +
+            ")");
+        bool cached = false;
+        RunAxi r = run_axi_cached(s, runs_dir, o.run_progress, &cached);
+        done_wall += cached ? 0.0 : r.wall;
+        r.record["grid_value"] = rgrids[g];
+        axi_runs.push_back(r.record);
+        aruns.push_back(std::move(r));
+      }
+      cr["reference"] = axi_reference(aruns, rorders, paper_max, target);
+      cr["reference"]["tier"] = "axi";
+      cr["reference"]["method"] = method;
+      cr["reference"]["grid_key"] = rkey;
+      cr["reference"]["grids"] = rgrids;
+      cr["reference"]["set"] = rs.value("set", json::object());
+      cr["reference"]["runs"] = axi_runs;
+      // 3D against the converged reference, figure by figure
+      std::vector<const Run3d*> done3d;
+      for (const auto& r : runs)
+        if (r.cyc.has_cycle) done3d.push_back(&r);
+      cr["comparison_3d_vs_reference"] = compare_3d_with_reference(cr["reference3d"], cr["reference"], done3d);
+    }
 
     // 3. calibration at the chosen grid
     const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
@@ -624,28 +993,16 @@ json run_suite(const SuiteOptions& o) {
       entry = r.record;
       entry["calibrated"] = calibrated;
       if (r.cyc.has_cycle) {
-        json vs_ref = json::object(), vs_cal = json::object();
-        if (have_ref) {
-          vs_ref["displacement_per_cycle"] = relative(r.cyc.displacement_per_cycle_m, ed.value);
-          vs_ref["cycle_time"] = relative(r.cyc.cycle_time_s, eT.value);
-          vs_ref["mean_velocity_per_cycle"] = relative(r.cyc.mean_velocity_per_cycle_m_per_s, ev.value);
-        }
+        json vs_cal = json::object();
+        // against the case's reference: the axisymmetric one when the case has it, else the
+        // 3D extrapolation (verdicts.hpp)
+        compare_with_reference(entry, cr);
         if (at_cal.cyc.has_cycle) {
           vs_cal["displacement_per_cycle"] = relative(r.cyc.displacement_per_cycle_m, at_cal.cyc.displacement_per_cycle_m);
           vs_cal["cycle_time"] = relative(r.cyc.cycle_time_s, at_cal.cyc.cycle_time_s);
           vs_cal["mean_velocity_per_cycle"] =
               relative(r.cyc.mean_velocity_per_cycle_m_per_s, at_cal.cyc.mean_velocity_per_cycle_m_per_s);
         }
-        entry["relative_error_vs_reference"] = vs_ref;
-        // the reference's error relative to its value: the width of the verdicts' interval
-        json ref_err = json::object();
-        if (have_ref)
-          for (const auto& [k, e] : {std::pair<const char*, const Extrapolation*>{"displacement_per_cycle", &ed},
-                                     {"cycle_time", &eT},
-                                     {"mean_velocity_per_cycle", &ev}})
-            ref_err[k] = std::abs(e->value) > 0 && std::isfinite(e->error / e->value) ? json(std::abs(e->error / e->value))
-                                                                                       : json(nullptr);
-        entry["reference_error_relative"] = ref_err;
         entry["relative_error_vs_calibration_grid"] = vs_cal;
         if (finest.cyc.has_cycle && r.series.t.size() > 1 && finest.series.t.size() > 1) {
           const SeriesComparison ph = compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, finest.series.t,
@@ -683,7 +1040,14 @@ json run_suite(const SuiteOptions& o) {
     // 5. speed/accuracy: the first 1D model over cell counts and integrator tolerances, 3D
     // over the grids and the case's time-step variants (at the calibration grid)
     json trade = json::array();
-    if (have_ref) {
+    // the error of each point against the case's judged reference (the axisymmetric one when
+    // the case has it)
+    const json& jref = judged_reference(cr);
+    const bool have_jref = jref.contains("displacement_per_cycle_m") && jref["displacement_per_cycle_m"].is_object() &&
+                           jref["displacement_per_cycle_m"]["value"].is_number() &&
+                           std::abs(jref["displacement_per_cycle_m"]["value"].get<double>()) > 0;
+    const double d_ref = have_jref ? jref["displacement_per_cycle_m"]["value"].get<double>() : 0.0;
+    if (have_jref) {
       const json& m0 = suite["models1d"][0];
       auto point = [&](const char* tier, const std::string& axis, const std::string& resolution, double wall,
                        double d) {
@@ -691,7 +1055,7 @@ json run_suite(const SuiteOptions& o) {
                          {"axis", axis},
                          {"resolution", resolution},
                          {"wall_time_s", wall},
-                         {"displacement_per_cycle_error", std::abs(d - ed.value) / std::abs(ed.value)}});
+                         {"displacement_per_cycle_error", std::abs(d - d_ref) / std::abs(d_ref)}});
       };
       auto model0 = [&](const std::string& key, const json& value) -> std::optional<Run1d> {
         json s = base;
@@ -726,7 +1090,7 @@ json run_suite(const SuiteOptions& o) {
         say(tag + ": 3D time-step variant " + std::to_string(v + 1) + "/" + std::to_string(variants.size()) + " (" +
             label + ")");
         bool cached = false;
-        const Run3d r = run_3d(s, runs_dir, o.threads, &cached);
+        const Run3d r = run_3d(s, runs_dir, o.threads, &cached, 0, o.run_progress);
         if (r.cyc.has_cycle) point("3d", "time step", label, r.wall, r.cyc.displacement_per_cycle_m);
         else  // a step beyond the stability limit: the outcome is reported, not a point
           trade.push_back({{"tier", "3d"}, {"axis", "time step"}, {"resolution", label}, {"wall_time_s", r.wall},

@@ -13,6 +13,12 @@
 //      the extrapolated reference and with the 3D run at the calibration grid; U(t) is
 //      compared with the finest 3D run (compare.hpp);
 //   5. the 1D default model runs at several cell counts for the speed/accuracy trade.
+// A case with a `reference` (an axisymmetric grid series, `--tier axi`) also runs the axi tier
+// on each of its grids (cached in OUT/runs/ like the 3D runs) and extrapolates its figures with
+// the reference's order range: that extrapolation is then the case's reference for the 1D
+// verdicts and the findings (verdicts.hpp), its convergence is stated against the suite's
+// `reference_target_relative` (default 1 %), and the 3D extrapolation is compared with it
+// figure by figure (agree when |3D - ref| <= e_3d + e_ref).
 // The result is report.json (every metric, threshold and verdict, with downsampled U(t)
 // series for the figures); tools/plot_validation.py turns it into report.md, report.html and
 // the PNG figures.
@@ -35,13 +41,19 @@ struct SuiteOptions {
   std::vector<std::string> only;
   /// progress lines ("case 2/7: 3D grid 3/3 ...") on stderr; empty: quiet
   std::function<void(const std::string&)> progress;
+  /// the progress of each 3D and axi run (its percentage, rate and time left, common/progress.hpp):
+  /// -1 on a terminal only, 0 never, 1 always
+  int run_progress = 0;
 };
 
 /// Runs the suite and returns report.json's content. Throws InputError for a malformed suite
 /// (before any run); numerical failures of single runs are recorded in the report.
 scene::json run_suite(const SuiteOptions& o);
 
-/// Reads and checks a suite file (InputError naming the key on any problem).
-scene::json load_suite(const std::string& path);
+/// Reads and checks a suite file (InputError naming the key on any problem). The scene of a
+/// case with a `reference` is looked up (as given, beside the suite, in data_dir/scenes when
+/// data_dir is not empty) and read by the axi tier on every reference grid: a scene the tier
+/// refuses is an InputError naming suite.cases[i].reference.
+scene::json load_suite(const std::string& path, const std::string& data_dir = "");
 
 }  // namespace swim::validation

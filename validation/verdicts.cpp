@@ -39,17 +39,21 @@ struct Valued {
 
 Valued reference_of(const json& c, const std::string& key) {
   Valued v;
-  const json& ref = c.contains("reference3d") ? c["reference3d"] : json::object();
-  if (ref.contains(key) && ref[key].contains("value") && ref[key]["value"].is_number() && ref[key].contains("error") &&
-      ref[key]["error"].is_number()) {
+  const json& ref = judged_reference(c);
+  if (ref.contains(key) && ref[key].is_object() && ref[key].contains("value") && ref[key]["value"].is_number() &&
+      ref[key].contains("error") && ref[key]["error"].is_number()) {
     v.value = ref[key]["value"].get<double>();
     v.error = std::abs(ref[key]["error"].get<double>());
     if (std::isfinite(v.value) && std::isfinite(v.error)) return v;
   }
+  v.value = v.error = kNaN;
+  if (c.contains("reference") && c["reference"].is_object()) {
+    v.missing = "the axisymmetric reference has no value with an error bar (fewer than two of its grids completed a cycle)";
+    return v;
+  }
   bool one = false;
   if (c.contains("runs3d"))
     for (const auto& r : c["runs3d"]) one = one || (r.contains(key) && r[key].is_number());
-  v.value = v.error = kNaN;
   v.missing = one ? "fewer than two grids completed a cycle: a value without an error bar" : "no 3D value";
   return v;
 }
@@ -75,7 +79,7 @@ std::vector<Point> points(const std::vector<const json*>& cases, const std::stri
   for (const json* c : cases) {
     Point q{c, reference_of(*c, key)};
     json e = {{"case", (*c)["name"]}, {sweep_name, (*c)["sweep_value"]}, {"quantity", key},
-              {"value", num(q.v.value)}, {"error", num(q.v.error)}};
+              {"value", num(q.v.value)}, {"error", num(q.v.error)}, {"reference", judged_reference_name(*c)}};
     if (!q.v.missing.empty()) {
       e["note"] = q.v.missing;
       if (missing.empty()) missing = q.name() + ": " + q.v.missing;
@@ -169,6 +173,42 @@ std::string tolerance_verdict(double rel, double rel_error, double tolerance) {
   if (d + e <= tolerance) return "pass";
   if (d - e > tolerance) return "fail";
   return "inconclusive";
+}
+
+std::string agreement_verdict(double a, double ea, double b, double eb) {
+  if (!std::isfinite(a) || !std::isfinite(ea) || !std::isfinite(b) || !std::isfinite(eb)) return "not assessed";
+  return std::abs(a - b) <= std::abs(ea) + std::abs(eb) ? "agree" : "disagree";
+}
+
+const json& judged_reference(const json& c) {
+  static const json empty = json::object();
+  if (c.is_object() && c.contains("reference") && c["reference"].is_object()) return c["reference"];
+  if (c.is_object() && c.contains("reference3d") && c["reference3d"].is_object()) return c["reference3d"];
+  return empty;
+}
+
+std::string judged_reference_name(const json& c) {
+  return c.is_object() && c.contains("reference") && c["reference"].is_object() ? "axisymmetric reference"
+                                                                                 : "3D reference";
+}
+
+void compare_with_reference(json& entry, const json& c) {
+  const json& ref = judged_reference(c);
+  json rel = json::object(), err = json::object();
+  for (const auto& [k, fig] : {std::pair<const char*, const char*>{"displacement_per_cycle", "displacement_per_cycle_m"},
+                               {"cycle_time", "cycle_time_s"},
+                               {"mean_velocity_per_cycle", "mean_velocity_per_cycle_m_per_s"}}) {
+    if (!ref.contains(fig) || !ref[fig].is_object() || !ref[fig].contains("value") || !ref[fig]["value"].is_number())
+      continue;
+    const double r = ref[fig]["value"].get<double>();
+    const double e = ref[fig].contains("error") && ref[fig]["error"].is_number() ? ref[fig]["error"].get<double>() : kNaN;
+    const double x = entry.contains(fig) && entry[fig].is_number() ? entry[fig].get<double>() : kNaN;
+    rel[k] = std::abs(r) > 0 ? num((x - r) / std::abs(r)) : json(nullptr);
+    err[k] = std::abs(r) > 0 ? num(std::abs(e / r)) : json(nullptr);
+  }
+  entry["relative_error_vs_reference"] = rel;
+  entry["reference_error_relative"] = err;
+  entry["judged_against"] = judged_reference_name(c);
 }
 
 std::string correlation_verdict(double corr, double error, double threshold) {

@@ -18,6 +18,12 @@
 //     inconclusive otherwise; a difference within the reference's error bar cannot fail.
 //   A claim over several cases is refuted when one case refutes it, not assessed when a case
 //   lacks its data, reproduced when every case reproduces it, inconclusive otherwise.
+//   3D against a converged reference (each figure): agree when |3D - ref| <= e_3d + e_ref,
+//     disagree otherwise (the same linear combination of error bars).
+//
+// A case's reference is its axisymmetric reference ("reference", the extrapolation of an axi
+// grid series) when the suite gives it one, else its 3D extrapolation ("reference3d"): every
+// 1D verdict and every finding is judged against that one (judged_reference).
 #pragma once
 
 #include <string>
@@ -36,6 +42,25 @@ OrderRange parse_order_range(const scene::json& value, const std::string& key);
 /// tolerance relative. "pass", "fail" or "inconclusive"; "not assessed" when rel or
 /// rel_error is not finite.
 std::string tolerance_verdict(double rel, double rel_error, double tolerance);
+
+/// Two values with their error bars: "agree" when |a - b| <= ea + eb (the bars overlap),
+/// "disagree" otherwise; "not assessed" when a number is not finite.
+std::string agreement_verdict(double a, double ea, double b, double eb);
+
+/// The reference a case of a report is judged against: its "reference" (the axisymmetric
+/// reference) when it has one, else its "reference3d"; an empty object when it has neither.
+/// Each figure key (displacement_per_cycle_m, ...) holds {"value", "error", ...}.
+const scene::json& judged_reference(const scene::json& case_report);
+
+/// "axisymmetric reference" or "3D reference": which one judged_reference() returns.
+std::string judged_reference_name(const scene::json& case_report);
+
+/// A 1D model's figures (entry: displacement_per_cycle_m, cycle_time_s,
+/// mean_velocity_per_cycle_m_per_s) against the case's judged reference: sets the entry's
+/// `relative_error_vs_reference` ((1D - ref) / |ref| per figure), `reference_error_relative`
+/// (error / |ref|; null when not finite) and `judged_against`. A figure the reference lacks
+/// is left out (no verdict).
+void compare_with_reference(scene::json& entry, const scene::json& case_report);
 
 /// U(t) correlation with the finest 3D run, its uncertainty (the spread of the correlation
 /// over the grids) and the smallest passing correlation: "pass" when corr - error >=

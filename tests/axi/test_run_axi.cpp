@@ -26,6 +26,7 @@ json paper_scene(const std::string& file) { return swim::scene::load_file(std::s
 
 json round_wall(json sc, int cells_across) {
   sc["full3d"]["membrane"]["axisymmetric"] = true;
+  sc["axi"]["method"] = "immersed_boundary";
   sc["axi"]["grid"]["cells_across"] = cells_across;
   return sc;
 }

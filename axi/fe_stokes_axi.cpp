@@ -1,0 +1,712 @@
+#include "axi/fe_stokes_axi.hpp"
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <cstdint>
+#include <cstdio>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+#include "common/errors.hpp"
+
+namespace swim::axi {
+
+namespace {
+
+/// UMFPACK's dense kernels run in the system BLAS. A threaded OpenBLAS (Debian's default
+/// provider once installed) spins its worker threads between calls, which on a shared 2-core
+/// machine costs more than it gains on these small fronts and fights the other tiers' own
+/// threads: the product runs one solve per core and asks any OpenBLAS for one thread. Looked up
+/// at run time, so any BLAS provider works.
+void single_threaded_blas() {
+  static const bool done = [] {
+    using SetThreads = void (*)(int);
+    if (auto f = reinterpret_cast<SetThreads>(dlsym(RTLD_DEFAULT, "openblas_set_num_threads"))) f(1);
+    return true;
+  }();
+  (void)done;
+}
+
+
+constexpr double kTwoPi = 2.0 * std::numbers::pi;
+constexpr int kLoc = 21;  // 9 nodes x 2 velocity components + 3 pressure coefficients
+
+using Clock = std::chrono::steady_clock;
+double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+// 1D quadratic Lagrange basis on the nodes -1, 0, 1 and its derivative.
+inline double lag(int i, double t) {
+  switch (i) {
+    case 0: return 0.5 * t * (t - 1.0);
+    case 1: return 1.0 - t * t;
+    default: return 0.5 * t * (t + 1.0);
+  }
+}
+inline double dlag(int i, double t) {
+  switch (i) {
+    case 0: return t - 0.5;
+    case 1: return -2.0 * t;
+    default: return t + 0.5;
+  }
+}
+
+// 3-point Gauss-Legendre on [-1, 1].
+constexpr double kG = 0.7745966692414834;  // sqrt(3/5)
+constexpr double kGp[3] = {-kG, 0.0, kG};
+constexpr double kGw[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
+// Corner signs of the bilinear map, in the order (-1,-1), (1,-1), (1,1), (-1,1).
+constexpr double kCs[4] = {-1, 1, 1, -1}, kCt[4] = {-1, -1, 1, 1};
+
+// Reference tables at the 9 quadrature points q = 3 qb + qa (qa along xi): Q2 shape functions
+// (local node a = 3 b + i, i along xi) and their reference derivatives.
+struct RefTables {
+  double N[9][9], Nxi[9][9], Neta[9][9], w[9], xi[9], eta[9];
+  RefTables() {
+    for (int qb = 0; qb < 3; ++qb)
+      for (int qa = 0; qa < 3; ++qa) {
+        const int q = 3 * qb + qa;
+        xi[q] = kGp[qa];
+        eta[q] = kGp[qb];
+        w[q] = kGw[qa] * kGw[qb];
+        for (int b = 0; b < 3; ++b)
+          for (int i = 0; i < 3; ++i) {
+            const int a = 3 * b + i;
+            N[q][a] = lag(i, xi[q]) * lag(b, eta[q]);
+            Nxi[q][a] = dlag(i, xi[q]) * lag(b, eta[q]);
+            Neta[q][a] = lag(i, xi[q]) * dlag(b, eta[q]);
+          }
+      }
+  }
+};
+const RefTables& ref() {
+  static const RefTables t;
+  return t;
+}
+
+std::string fmt(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.6g", v);
+  return b;
+}
+
+}  // namespace
+
+// Per-element quadrature data: physical gradients of the 9 Q2 shape functions, position and
+// weight (2 pi w_q det J, without the r of the volume measure) at each of the 9 points.
+struct FittedStokes::Geometry {
+  Eigen::Matrix<double, 9, 9> N, gx, gr;  // (point, shape function)
+  double x[9], r[9], wdet[9];
+  double xc, rc, hx, hr;                  // pressure basis centre and scales
+};
+
+void FittedStokes::element_geometry(int e, Geometry& g) const {
+  const RefTables& T = ref();
+  double cx[4], cr[4];
+  mesh_.corners(e, cx, cr);
+  g.xc = 0.25 * (cx[0] + cx[1] + cx[2] + cx[3]);
+  g.rc = 0.25 * (cr[0] + cr[1] + cr[2] + cr[3]);
+  g.hx = cx[1] - cx[0];
+  g.hr = 0.5 * ((cr[3] - cr[0]) + (cr[2] - cr[1]));
+  for (int q = 0; q < 9; ++q) {
+    const double xi = T.xi[q], eta = T.eta[q];
+    double x = 0, r = 0, xx = 0, xe = 0, rx = 0, re = 0;
+    for (int i = 0; i < 4; ++i) {
+      const double m = 0.25 * (1 + kCs[i] * xi) * (1 + kCt[i] * eta);
+      const double mx = 0.25 * kCs[i] * (1 + kCt[i] * eta), me = 0.25 * kCt[i] * (1 + kCs[i] * xi);
+      x += m * cx[i];
+      r += m * cr[i];
+      xx += mx * cx[i];
+      xe += me * cx[i];
+      rx += mx * cr[i];
+      re += me * cr[i];
+    }
+    const double det = xx * re - xe * rx, inv = 1.0 / det;
+    g.x[q] = x;
+    g.r[q] = r;
+    g.wdet[q] = kTwoPi * T.w[q] * det;
+    for (int a = 0; a < 9; ++a) {
+      g.N(q, a) = T.N[q][a];
+      g.gx(q, a) = (re * T.Nxi[q][a] - rx * T.Neta[q][a]) * inv;
+      g.gr(q, a) = (-xe * T.Nxi[q][a] + xx * T.Neta[q][a]) * inv;
+    }
+  }
+}
+
+FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_nodes, Coupling coupling)
+    : mesh_(p, membrane_nodes), mu_(mu), coupling_(coupling) {
+  single_threaded_blas();
+  if (!(std::isfinite(mu) && mu > 0))
+    throw InputError("fluid.viscosity", fmt(mu) + " Pa s", "must be a positive finite viscosity");
+  lref_ = p.Rc / (p.cells_inner + p.cells_outer);
+  ps_ = mu_ / lref_;
+
+  // Velocity DOFs, node-major: u_x except on the wall row, u_r except on the axis and wall rows.
+  const int nI = mesh_.node_columns(), nJ = mesh_.node_rows(), JW = nJ - 1;
+  dof_x_.assign(mesh_.nodes(), -1);
+  dof_r_.assign(mesh_.nodes(), -1);
+  int d = 0;
+  for (int I = 0; I < nI; ++I)
+    for (int J = 0; J < nJ; ++J) {
+      const int nd = mesh_.node(I, J);
+      if (J < JW) dof_x_[nd] = d++;
+      if (J > 0 && J < JW) dof_r_[nd] = d++;
+    }
+  n_vel_ = d;
+  const int E = mesh_.elements();
+  n_ = n_vel_ + 3 * E - 1;  // element 0's constant pressure is pinned
+
+  loc_.assign(std::size_t(E) * kLoc, -1);
+  for (int e = 0; e < E; ++e) {
+    int* L = &loc_[std::size_t(e) * kLoc];
+    for (int b = 0; b < 3; ++b)
+      for (int i = 0; i < 3; ++i) {
+        const int a = 3 * b + i, nd = mesh_.element_node(e, i, b);
+        L[2 * a] = dof_x_[nd];
+        L[2 * a + 1] = dof_r_[nd];
+      }
+    for (int q = 0; q < 3; ++q) L[18 + q] = (e == 0 && q == 0) ? -1 : n_vel_ + 3 * e + q - 1;
+  }
+
+  // Pattern: every (row, col) pair of an element except pressure-pressure, plus the membrane
+  // vertex pairs up to 2 apart. Keys col * n + row, sorted: column-major order.
+  std::vector<std::int64_t> keys;
+  keys.reserve(std::size_t(E) * (kLoc * kLoc - 9) + std::size_t(membrane_nodes) * 20);
+  for (int e = 0; e < E; ++e) {
+    const int* L = &loc_[std::size_t(e) * kLoc];
+    for (int j = 0; j < kLoc; ++j) {
+      if (L[j] < 0) continue;
+      for (int i = 0; i < kLoc; ++i)
+        if (L[i] >= 0 && (i < 18 || j < 18)) keys.push_back(std::int64_t(L[j]) * n_ + L[i]);
+    }
+  }
+  // Transfer stencils of the membrane vertices (slots V_{k-1}, M_{k-1/2}, V_k, M_{k+1/2}, V_{k+1}).
+  const int nm = membrane_nodes, ci2 = 2 * p.cells_inner;
+  gnode_.assign(nm, {-1, -1, -1, -1, -1});
+  gw_.assign(nm, {0, 0, 0, 0, 0});
+  for (int k = 0; k < nm; ++k) {
+    auto& g = gnode_[k];
+    g[2] = mesh_.membrane_node(k);
+    if (coupling_ == Coupling::vertex) continue;
+    if (k > 0 || p.closed) {
+      g[0] = mesh_.node(2 * k - 2, ci2);
+      g[1] = mesh_.node(2 * k - 1, ci2);
+    }
+    if (k < nm - 1 || p.closed) {
+      g[3] = mesh_.node(2 * k + 1, ci2);
+      g[4] = mesh_.node(2 * k + 2, ci2);
+    }
+  }
+  // The stiffness couplings dt G K G^T: trace nodes of vertices up to 2 apart.
+  for (int k = 0; k < nm; ++k)
+    for (int dk = -2; dk <= 2; ++dk) {
+      int l = k + dk;
+      if (p.closed)
+        l = ((l % nm) + nm) % nm;
+      else if (l < 0 || l >= nm)
+        continue;
+      for (int nk : gnode_[k])
+        for (int nl : gnode_[l]) {
+          if (nk < 0 || nl < 0) continue;
+          const int rk[2] = {dof_x_[nk], dof_r_[nk]}, rl[2] = {dof_x_[nl], dof_r_[nl]};
+          for (int a = 0; a < 2; ++a)
+            for (int b = 0; b < 2; ++b) keys.push_back(std::int64_t(rl[b]) * n_ + rk[a]);
+        }
+    }
+  std::sort(keys.begin(), keys.end());
+  keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
+
+  A_.resize(n_, n_);
+  A_.resizeNonZeros(Eigen::Index(keys.size()));
+  int* outer = A_.outerIndexPtr();
+  int* inner = A_.innerIndexPtr();
+  std::fill(outer, outer + n_ + 1, 0);
+  for (std::size_t k = 0; k < keys.size(); ++k) {
+    ++outer[keys[k] / n_ + 1];
+    inner[k] = int(keys[k] % n_);
+  }
+  for (int c = 0; c < n_; ++c) outer[c + 1] += outer[c];
+  std::fill(A_.valuePtr(), A_.valuePtr() + keys.size(), 0.0);
+  keys.clear();
+  keys.shrink_to_fit();
+
+  pos_.assign(std::size_t(E) * kLoc * kLoc, -1);
+  for (int e = 0; e < E; ++e) {
+    const int* L = &loc_[std::size_t(e) * kLoc];
+    int* P = &pos_[std::size_t(e) * kLoc * kLoc];
+    for (int i = 0; i < kLoc; ++i)
+      for (int j = 0; j < kLoc; ++j)
+        if (L[i] >= 0 && L[j] >= 0 && (i < 18 || j < 18)) P[i * kLoc + j] = find_position(L[i], L[j]);
+  }
+
+  lu_ = std::make_unique<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>>();
+  // One step of iterative refinement (UMFPACK's default allows two): without it the
+  // threshold-pivoted LU of the saddle-point system leaves relative errors near 1e-9; one step
+  // brings them to round-off at the cost of one more solve and residual.
+  lu_->umfpackControl()(UMFPACK_IRSTEP) = 1;
+  rhs_.setZero(n_);
+  sol_.setZero(n_);
+}
+
+FittedStokes::~FittedStokes() = default;
+
+int FittedStokes::find_position(int row, int col) const {
+  const int* inner = A_.innerIndexPtr();
+  const int* b = inner + A_.outerIndexPtr()[col];
+  const int* e = inner + A_.outerIndexPtr()[col + 1];
+  const int* it = std::lower_bound(b, e, row);
+  return (it != e && *it == row) ? int(it - inner) : -1;
+}
+
+void FittedStokes::transfer_weights() {
+  const int nm = mesh_.membrane_nodes();
+  for (auto& w : gw_) w = {0, 0, 0, 0, 0};
+  if (coupling_ == Coupling::vertex) {
+    for (auto& w : gw_) w[2] = 1.0;
+    return;
+  }
+  // G_{a,k} = int phi_k N_a dA / A_k over the membrane edges (2 pi r ds; the integrand is a
+  // polynomial of degree 4 in the edge parameter: 3-point Gauss is exact).
+  const bool closed = mesh_.params().closed;
+  std::vector<double> area(nm, 0.0);
+  const int edges = closed ? nm : nm - 1;
+  for (int k = 0; k < edges; ++k) {
+    const int l = (k + 1) % nm;
+    const double dx = mesh_.column_x(k + 1) - mesh_.column_x(k);  // column k+1 = vertex l (+P when wrapped)
+    const double r0 = mesh_.interface_radius(k), r1 = mesh_.interface_radius(k + 1);
+    const double len = std::hypot(dx, r1 - r0);
+    for (int q = 0; q < 3; ++q) {
+      const double t = kGp[q], r = 0.5 * (r0 * (1 - t) + r1 * (1 + t));
+      const double w = kGw[q] * kTwoPi * r * 0.5 * len;
+      const double pk = 0.5 * (1 - t), pl = 0.5 * (1 + t);
+      area[k] += w * pk;
+      area[l] += w * pl;
+      for (int m = 0; m < 3; ++m) {
+        gw_[k][2 + m] += w * pk * lag(m, t);  // V_k, M_{k+1/2}, V_{k+1} seen from k
+        gw_[l][m] += w * pl * lag(m, t);      // V_k, M_{k+1/2}, V_{k+1} seen from l = k+1
+      }
+    }
+  }
+  for (int k = 0; k < nm; ++k)
+    for (double& w : gw_[k]) w /= area[k];
+}
+
+void FittedStokes::assemble(const Eigen::SparseMatrix<double>* K, double scale) {
+  double* val = A_.valuePtr();
+  std::fill(val, val + A_.nonZeros(), 0.0);
+  const int E = mesh_.elements();
+  Geometry g;
+  Eigen::Matrix<double, 9, 9> Axx, Arr, Axr;
+  Eigen::Matrix<double, 3, 9> Bx, Br;
+  for (int e = 0; e < E; ++e) {
+    element_geometry(e, g);
+    Axx.setZero();
+    Arr.setZero();
+    Axr.setZero();
+    Bx.setZero();
+    Br.setZero();
+    for (int q = 0; q < 9; ++q) {
+      const double r = g.r[q], W = mu_ * g.wdet[q] * r;
+      const auto gx = g.gx.row(q).transpose();
+      const auto gr = g.gr.row(q).transpose();
+      const auto N = g.N.row(q).transpose();
+      Axx.noalias() += (2.0 * W) * gx * gx.transpose() + W * gr * gr.transpose();
+      Arr.noalias() += (2.0 * W) * gr * gr.transpose() + W * gx * gx.transpose() +
+                       (2.0 * mu_ * g.wdet[q] / r) * N * N.transpose();
+      Axr.noalias() += W * gr * gx.transpose();
+      const double phi[3] = {1.0, (g.x[q] - g.xc) / g.hx, (g.r[q] - g.rc) / g.hr};
+      for (int k = 0; k < 3; ++k) {
+        const double c = -ps_ * g.wdet[q] * phi[k];
+        Bx.row(k) += (c * r) * gx.transpose();
+        Br.row(k) += c * (r * gr + N).transpose();
+      }
+    }
+    const int* P = &pos_[std::size_t(e) * kLoc * kLoc];
+    auto add = [&](int i, int j, double v) {
+      const int p = P[i * kLoc + j];
+      if (p >= 0) val[p] += v;
+    };
+    for (int a = 0; a < 9; ++a)
+      for (int b = 0; b < 9; ++b) {
+        add(2 * a, 2 * b, Axx(a, b));
+        add(2 * a + 1, 2 * b + 1, Arr(a, b));
+        add(2 * a, 2 * b + 1, Axr(a, b));
+        add(2 * b + 1, 2 * a, Axr(a, b));
+      }
+    for (int k = 0; k < 3; ++k)
+      for (int b = 0; b < 9; ++b) {
+        add(18 + k, 2 * b, Bx(k, b));
+        add(2 * b, 18 + k, Bx(k, b));
+        add(18 + k, 2 * b + 1, Br(k, b));
+        add(2 * b + 1, 18 + k, Br(k, b));
+      }
+  }
+  if (K && scale != 0.0) {
+    const int nm = mesh_.membrane_nodes();
+    for (int c = 0; c < K->outerSize(); ++c)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(*K, c); it; ++it) {
+        if (it.value() == 0.0) continue;
+        const int i = int(it.row()), j = int(it.col()), k = i / 2, l = j / 2;
+        int d = std::abs(k - l);
+        if (mesh_.params().closed) d = std::min(d, nm - d);
+        if (d > 2)
+          throw std::invalid_argument("FittedStokes::factor: K couples membrane vertices " + std::to_string(k) +
+                                      " and " + std::to_string(l) + " (more than 2 apart, n = " +
+                                      std::to_string(nm) + ")");
+        for (int s = 0; s < 5; ++s) {
+          const int ns = gnode_[k][s];
+          if (ns < 0) continue;
+          const int gi = (i % 2 == 0) ? dof_x_[ns] : dof_r_[ns];
+          for (int t = 0; t < 5; ++t) {
+            const int nt = gnode_[l][t];
+            if (nt < 0) continue;
+            const int gj = (j % 2 == 0) ? dof_x_[nt] : dof_r_[nt];
+            val[find_position(gi, gj)] += scale * it.value() * gw_[k][s] * gw_[l][t];
+          }
+        }
+      }
+  }
+}
+
+void FittedStokes::set_reuse(bool on, int refactor_after, double tolerance) {
+  if (refactor_after < 0) throw std::invalid_argument("FittedStokes::set_reuse: refactor_after must be >= 0");
+  if (!(tolerance > 0.0 && tolerance < 1.0))
+    throw std::invalid_argument("FittedStokes::set_reuse: tolerance must be in (0, 1)");
+  reuse_ = on;
+  refactor_after_ = refactor_after;
+  tol_ = tolerance;
+}
+
+void FittedStokes::numeric_factor() {
+  const auto t0 = Clock::now();
+  lu_valid_ = lu_current_ = false;
+  if (!analysed_) {
+    lu_->analyzePattern(A_);
+    if (lu_->info() != Eigen::Success)
+      throw NumericalError("the symbolic analysis of the fitted Stokes system failed (UMFPACK status " +
+                               std::to_string(lu_->umfpackFactorizeReturncode()) + ")",
+                           "use fewer cells (axi.fitted.cells_inner, axi.fitted.cells_outer, axi.fitted.gap_columns)");
+    analysed_ = true;
+  }
+  lu_->factorize(A_);
+  timing_.factor += seconds_since(t0);
+  if (lu_->info() != Eigen::Success)
+    throw NumericalError("the sparse LU factorisation of the fitted Stokes system failed (UMFPACK status " +
+                             std::to_string(lu_->umfpackFactorizeReturncode()) +
+                             (lu_->umfpackFactorizeReturncode() == 1 ? ": singular matrix" : "") + ")",
+                         "check the wall's shape and the stiffness term; change axi.fitted.cells_inner, "
+                         "axi.fitted.cells_outer or axi.fitted.gap_columns");
+  ++timing_.factorisations;
+  lu_valid_ = lu_current_ = true;
+  last_iters_ = 0;
+}
+
+void FittedStokes::factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<double>* K, double scale, bool force) {
+  const int nm = mesh_.membrane_nodes();
+  if (K && (K->rows() != 2 * nm || K->cols() != 2 * nm))
+    throw std::invalid_argument("FittedStokes::factor: K must be " + std::to_string(2 * nm) + " x " +
+                                std::to_string(2 * nm));
+  if (K && !std::isfinite(scale)) throw std::invalid_argument("FittedStokes::factor: non-finite scale");
+  factored_ = solved_ = false;
+  auto t0 = Clock::now();
+  mesh_.fit(X);
+  transfer_weights();
+  lu_current_ = false;  // A_ changes now (the stored LU, if any, stays valid as a preconditioner)
+  assemble(K, scale);
+  timing_.assemble += seconds_since(t0);
+  // The iteration-count trigger is checked at the next solve (see the header comment).
+  if (!reuse_ || !lu_valid_ || force) numeric_factor();
+  factored_ = true;
+}
+
+bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& relres) {
+  const int m = std::min(20, std::max(1, max_iterations));  // restart length
+  iters = 0;
+  sol_.setZero(n_);
+  const double bnorm = rhs_.norm();
+  if (bnorm == 0.0) {
+    relres = 0.0;
+    return true;
+  }
+  if (kv_.rows() != n_ || kv_.cols() != m + 1) kv_.resize(n_, m + 1);
+  if (kz_.rows() != n_ || kz_.cols() != m) kz_.resize(n_, m);
+  lu_->umfpackControl()(UMFPACK_IRSTEP) = 0;  // preconditioner solves: no refinement (see header)
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);
+  Eigen::VectorXd cs(m), sn(m), g(m + 1), v(n_), z(n_), w(n_);
+  Eigen::VectorXd r = rhs_;
+  double res = 1.0;  // true relative residual of sol_ (x = 0)
+  Eigen::VectorXd best = sol_;
+  double best_res = res;
+  bool ok = false;
+  for (;;) {
+    const double beta = res * bnorm;
+    kv_.col(0) = r / beta;
+    g.setZero();
+    g[0] = beta;
+    H.setZero();
+    int k = 0;
+    while (k < m && iters < max_iterations) {
+      v = kv_.col(k);
+      z = lu_->solve(v);
+      kz_.col(k) = z;
+      w.noalias() = A_ * z;
+      // modified Gram-Schmidt, twice
+      for (int pass = 0; pass < 2; ++pass)
+        for (int i = 0; i <= k; ++i) {
+          const double h = kv_.col(i).dot(w);
+          H(i, k) += h;
+          w -= h * kv_.col(i);
+        }
+      const double hn = w.norm();
+      H(k + 1, k) = hn;
+      for (int i = 0; i < k; ++i) {  // previous rotations
+        const double t = cs[i] * H(i, k) + sn[i] * H(i + 1, k);
+        H(i + 1, k) = -sn[i] * H(i, k) + cs[i] * H(i + 1, k);
+        H(i, k) = t;
+      }
+      const double d = std::hypot(H(k, k), H(k + 1, k));
+      cs[k] = d > 0 ? H(k, k) / d : 1.0;
+      sn[k] = d > 0 ? H(k + 1, k) / d : 0.0;
+      H(k, k) = d;
+      H(k + 1, k) = 0.0;
+      g[k + 1] = -sn[k] * g[k];
+      g[k] = cs[k] * g[k];
+      ++k;
+      ++iters;
+      if (std::abs(g[k]) <= 0.5 * tol_ * bnorm || hn <= 1e-300) break;
+      if (hn > 0) kv_.col(k) = w / hn;
+    }
+    // x += Z y, H y = g (upper triangular)
+    const Eigen::VectorXd y =
+        H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
+    sol_.noalias() += kz_.leftCols(k) * y;
+    r = rhs_;
+    r.noalias() -= A_ * sol_;
+    const double prev = res;
+    res = r.norm() / bnorm;
+    if (!std::isfinite(res)) break;
+    if (res < best_res) best_res = res, best = sol_;
+    if (res <= tol_) {
+      ok = true;
+      break;
+    }
+    if (iters >= max_iterations) break;
+    if (res > 0.5 * prev) break;  // stagnation (round-off floor of this preconditioner)
+  }
+  if (!ok) sol_ = best;
+  relres = best_res;
+  // With the LU of the current system, stagnation is the floor of that factorisation: accepted.
+  return ok || (fresh && std::isfinite(best_res) && best_res < 1e-6);
+}
+
+void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
+                         const std::function<Eigen::Vector2d(double x, double r)>* body) {
+  if (!factored_) throw std::logic_error("FittedStokes::solve before a successful factor()");
+  const int nm = mesh_.membrane_nodes();
+  if (F.cols() != nm)
+    throw std::invalid_argument("FittedStokes::solve: F has " + std::to_string(F.cols()) + " columns, expected " +
+                                std::to_string(nm));
+  const auto t0 = Clock::now();
+  const double factor_before = timing_.factor;  // a refactorisation inside is accounted as such
+  rhs_.setZero();
+  for (int k = 0; k < nm; ++k)
+    for (int s = 0; s < 5; ++s) {
+      const int nd = gnode_[k][s];
+      if (nd < 0) continue;
+      rhs_[dof_x_[nd]] += gw_[k][s] * F(0, k);
+      rhs_[dof_r_[nd]] += gw_[k][s] * F(1, k);
+    }
+  const int E = mesh_.elements();
+  Geometry g;
+  if (body && *body) {
+    for (int e = 0; e < E; ++e) {
+      element_geometry(e, g);
+      const int* L = &loc_[std::size_t(e) * kLoc];
+      for (int q = 0; q < 9; ++q) {
+        const Eigen::Vector2d f = (*body)(g.x[q], g.r[q]);
+        const double W = g.wdet[q] * g.r[q];
+        for (int a = 0; a < 9; ++a) {
+          if (L[2 * a] >= 0) rhs_[L[2 * a]] += W * f[0] * g.N(q, a);
+          if (L[2 * a + 1] >= 0) rhs_[L[2 * a + 1]] += W * f[1] * g.N(q, a);
+        }
+      }
+    }
+  }
+  if (!reuse_) {
+    lu_->umfpackControl()(UMFPACK_IRSTEP) = 1;
+    sol_ = lu_->solve(rhs_);
+    last_iters_ = 0;
+    last_res_ = -1.0;
+  } else {
+    // The previous solve needed too many iterations: factor the current system first.
+    if (!lu_current_ && last_iters_ > refactor_after_) numeric_factor();
+    int it = 0;
+    double res = 0.0;
+    bool fresh = lu_current_;
+    bool ok = gmres(fresh ? 40 : 20, fresh, it, res);
+    timing_.krylov_iterations += it;
+    if (!ok && !fresh) {  // the old factorisation is no longer good enough: refactor, solve again
+      numeric_factor();
+      int it2 = 0;
+      ok = gmres(40, true, it2, res);
+      timing_.krylov_iterations += it2;
+      it = it2;
+      fresh = true;
+    }
+    if (!ok)
+      throw NumericalError("the fitted Stokes solve did not converge (relative residual " + fmt(res) +
+                               " with a fresh factorisation)",
+                           "check the wall's shape and the stiffness term; change axi.fitted.cells_inner or "
+                           "axi.fitted.cells_outer");
+    if (!fresh) ++timing_.reused;
+    last_iters_ = it;
+    last_res_ = res;
+  }
+  if (!sol_.allFinite())
+    throw NumericalError("the fitted Stokes solve returned a non-finite velocity",
+                         "check the forces; change axi.fitted.cells_inner or axi.fitted.cells_outer");
+  solved_ = true;
+  // Volume mean of the raw pressure (the gauge of the queries).
+  p_mean_ = 0.0;
+  double pv = 0.0, vol = 0.0;
+  for (int e = 0; e < E; ++e) {
+    element_geometry(e, g);
+    for (int q = 0; q < 9; ++q) {
+      const double W = g.wdet[q] * g.r[q];
+      pv += W * eval_pressure(e, g.x[q], g.r[q]);
+      vol += W;
+    }
+  }
+  p_mean_ = pv / vol;
+  U.setZero(3, nm);
+  for (int k = 0; k < nm; ++k)
+    for (int s = 0; s < 5; ++s) {
+      const int nd = gnode_[k][s];
+      if (nd < 0) continue;
+      U(0, k) += gw_[k][s] * sol_[dof_x_[nd]];
+      U(1, k) += gw_[k][s] * sol_[dof_r_[nd]];
+    }
+  timing_.solve += seconds_since(t0) - (timing_.factor - factor_before);
+  ++timing_.solves;
+}
+
+Eigen::Vector2d FittedStokes::eval_velocity(int e, double xi, double eta) const {
+  const int* L = &loc_[std::size_t(e) * kLoc];
+  Eigen::Vector2d u(0.0, 0.0);
+  for (int b = 0; b < 3; ++b)
+    for (int i = 0; i < 3; ++i) {
+      const int a = 3 * b + i;
+      const double N = lag(i, xi) * lag(b, eta);
+      u[0] += N * dof_value(L[2 * a]);
+      u[1] += N * dof_value(L[2 * a + 1]);
+    }
+  return u;
+}
+
+double FittedStokes::eval_pressure(int e, double x, double r) const {
+  double cx[4], cr[4];
+  mesh_.corners(e, cx, cr);
+  const double xc = 0.25 * (cx[0] + cx[1] + cx[2] + cx[3]), rc = 0.25 * (cr[0] + cr[1] + cr[2] + cr[3]);
+  const double hx = cx[1] - cx[0], hr = 0.5 * ((cr[3] - cr[0]) + (cr[2] - cr[1]));
+  const int* L = &loc_[std::size_t(e) * kLoc];
+  return ps_ * (dof_value(L[18]) + dof_value(L[19]) * (x - xc) / hx + dof_value(L[20]) * (r - rc) / hr) - p_mean_;
+}
+
+Eigen::Vector2d FittedStokes::velocity(double x, double r) const {
+  if (!solved_) throw std::logic_error("FittedStokes::velocity before solve()");
+  double xi, eta;
+  const int e = mesh_.locate(x, r, xi, eta);
+  return eval_velocity(e, xi, eta);
+}
+
+double FittedStokes::pressure(double x, double r) const {
+  if (!solved_) throw std::logic_error("FittedStokes::pressure before solve()");
+  double xi, eta;
+  const int e = mesh_.locate(x, r, xi, eta);
+  return eval_pressure(e, x, r);
+}
+
+double FittedStokes::end_disc_flux(int end, double frame_velocity) const {
+  if (!solved_) throw std::logic_error("FittedStokes::end_disc_flux before solve()");
+  if (end != 0 && end != 1) throw std::invalid_argument("FittedStokes::end_disc_flux: end must be 0 or 1");
+  const int c = end == 0 ? 0 : mesh_.membrane_nodes() - 1;
+  double s = 0.0;
+  for (int j = 0; j < mesh_.params().cells_inner; ++j) {
+    const double r0 = mesh_.vertex_r(c, j), r1 = mesh_.vertex_r(c, j + 1);
+    double u[3];
+    for (int m = 0; m < 3; ++m) u[m] = dof_value(dof_x_[mesh_.node(2 * c, 2 * j + m)]);
+    for (int q = 0; q < 3; ++q) {
+      const double t = kGp[q], r = 0.5 * (r0 * (1 - t) + r1 * (1 + t));
+      const double ux = lag(0, t) * u[0] + lag(1, t) * u[1] + lag(2, t) * u[2];
+      s += kGw[q] * kTwoPi * r * (ux - frame_velocity) * 0.5 * (r1 - r0);
+    }
+  }
+  return s;
+}
+
+double FittedStokes::element_divergence(int e) const {
+  if (!solved_) throw std::logic_error("FittedStokes::element_divergence before solve()");
+  Geometry g;
+  element_geometry(e, g);
+  const int* L = &loc_[std::size_t(e) * kLoc];
+  double s = 0.0;
+  for (int q = 0; q < 9; ++q) {
+    double ur = 0, drur = 0, dxux = 0;
+    for (int a = 0; a < 9; ++a) {
+      const double vx = dof_value(L[2 * a]), vr = dof_value(L[2 * a + 1]);
+      ur += g.N(q, a) * vr;
+      drur += g.gr(q, a) * vr;
+      dxux += g.gx(q, a) * vx;
+    }
+    s += g.wdet[q] * (g.r[q] * (drur + dxux) + ur);
+  }
+  return s;
+}
+
+double FittedStokes::lumen_divergence_residual() const {
+  if (!solved_) throw std::logic_error("FittedStokes::lumen_divergence_residual before solve()");
+  const double umax = sol_.head(n_vel_).cwiseAbs().maxCoeff();
+  if (umax == 0.0) return 0.0;
+  Geometry g;
+  double worst = 0.0;
+  for (int e = 0; e < mesh_.elements(); ++e) {
+    element_geometry(e, g);
+    double vol = 0.0, area = 0.0;
+    for (int q = 0; q < 9; ++q) {
+      vol += g.wdet[q] * g.r[q];
+      area += g.wdet[q] / kTwoPi;
+    }
+    worst = std::max(worst, std::abs(element_divergence(e)) / (vol * umax / std::sqrt(area)));
+  }
+  return worst;
+}
+
+double FittedStokes::dissipation() const {
+  if (!solved_) throw std::logic_error("FittedStokes::dissipation before solve()");
+  Geometry g;
+  double s = 0.0;
+  for (int e = 0; e < mesh_.elements(); ++e) {
+    element_geometry(e, g);
+    const int* L = &loc_[std::size_t(e) * kLoc];
+    for (int q = 0; q < 9; ++q) {
+      double ur = 0, drur = 0, dxur = 0, dxux = 0, drux = 0;
+      for (int a = 0; a < 9; ++a) {
+        const double vx = dof_value(L[2 * a]), vr = dof_value(L[2 * a + 1]);
+        ur += g.N(q, a) * vr;
+        drur += g.gr(q, a) * vr;
+        dxur += g.gx(q, a) * vr;
+        dxux += g.gx(q, a) * vx;
+        drux += g.gr(q, a) * vx;
+      }
+      const double r = g.r[q], sh = dxur + drux;
+      s += 2.0 * mu_ * g.wdet[q] * r * (drur * drur + (ur / r) * (ur / r) + dxux * dxux + 0.5 * sh * sh);
+    }
+  }
+  return s;
+}
+
+}  // namespace swim::axi

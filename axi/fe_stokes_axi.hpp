@@ -1,0 +1,231 @@
+// Sharp-interface (boundary-fitted) finite-element Stokes solver of the axisymmetric tier.
+//
+// Steady, swirl-free axisymmetric Stokes flow, viscosity mu, in the rigid cylinder r < Rc,
+// periodic along x with period P; unknowns u = (u_x, u_r) and p. u_r = 0 on the axis (u_x free
+// there: the natural condition of the r-weighted form), u = 0 at r = Rc. Weak form with the
+// full volume measure dV = 2 pi r dr dx, so that a ring force F_k (N, on the whole ring) enters
+// directly:
+//   a(u,v) = int 2 mu [ dr u_r dr v_r + (u_r/r)(v_r/r) + dx u_x dx v_x
+//                       + 1/2 (dx u_r + dr u_x)(dx v_r + dr v_x) ] dV
+//   b(v,q) = - int q (dr v_r + v_r/r + dx v_x) dV
+//   a(u,v) + b(v,p) = sum_k F_k . v(X_k) + int f . v dV   for all v,     b(u,q) = 0 for all q.
+// The membrane (the wall's meridian polygon X_k) is a zero-thickness interface inside one
+// fluid: the velocity is continuous across it, the traction jumps by the membrane force.
+//
+// Discretisation: the mesh of axi/fitted_mesh.hpp (rebuilt on X at every factor()), whose
+// membrane vertices are mesh vertices. Crouzeix-Raviart quadrilateral Q2-P1disc: continuous Q2
+// velocity on the bilinear (Q1) geometry map (subparametric: the midside and centre nodes at the
+// bilinear images of the reference midpoints and centre), pressure discontinuous, linear in
+// PHYSICAL coordinates per element with the basis {1, (x - x_c)/h_x, (r - r_c)/h_r} (x_c, r_c the
+// mean of the element's corners, h_x its width, h_r its mean height; the scaling does not change
+// the space). Being discontinuous, the pressure may jump across the membrane, and the constant
+// in each element makes every element conserve mass: int_e div u dV = 0 (to round-off).
+//
+// Quadrature: 3x3 Gauss-Legendre (exact to degree 5 per direction). With the bilinear map's
+// Jacobian det J = x_xi r_eta (the sides of every element are vertical), the divergence terms
+// det J (r dr v_r + v_r + r dx v_x) are polynomials of degree <= 3 per direction, so b(., .) and
+// the element mass balances are EXACT; on rectangles every term of a(., .) except the hoop term
+// u_r v_r / r is of degree <= 5 (exact), and the hoop term is exact in the axis row (u_r = r g
+// there). Elsewhere the integrands are rational (1/r, 1/r_eta) and smooth on the element; the
+// rule's error is O(h^6) per unit volume, far below the O(h^3) of the Q2 velocity. A body force
+// f and the Poiseuille load (constant f) are integrated exactly on rectangles.
+//
+// Algebra: unknowns [velocity DOFs (Dirichlet DOFs eliminated) | pressure coefficients]; the
+// constant pressure coefficient of element 0 (the axis element of column 0) is pinned to 0 and
+// its continuity row dropped (it holds automatically: the sum of all elements' mass balances is
+// the flux through the container wall, zero). The pressure unknowns are scaled by mu/L
+// (L = Rc / (cells_inner + cells_outer)) and the continuity rows by the same factor, so that
+// the symmetric system [A  s B^T; s B  0] has blocks of one size. One CSC pattern (explicit
+// zeros included) for the life of the object, including the couplings between membrane vertices
+// up to 2 apart (closed mode: periodically); each element's 21 x 21 scatter positions are
+// precomputed, so assembly is quadrature plus a scatter. Sparse LU: UMFPACK through Eigen's
+// UmfPackLU, symbolic analysis once (on the first factor(), with real values), numeric
+// factorisation per factor(). The returned pressure has zero volume mean.
+//
+// Membrane coupling (the constructor's `coupling`). The wall is a P1 (piecewise-linear) curve;
+// its ring forces F_k are the generalised forces of the vertex positions, and the membrane
+// velocity U_k drives dX_k/dt. Two symmetric choices, both with the exact power balance
+// F . U = a(u, u) and a symmetric mobility F -> U (reciprocity), because the load is G F and the
+// velocity is G^T u with one matrix G:
+//   vertex:      G = point evaluation at the vertices: load sum_k F_k . v(X_k), U_k = u(X_k)
+//                (the weak form as first specified). The point loads on the Q2 trace excite the
+//                unloaded midside nodes: the membrane velocity converges only at FIRST order
+//                (a uniformly sheared closed membrane: 38 / 19 / 9.6 % error at 2 / 4 / 8 rows;
+//                a uniform radial load moves the fluid at O(h) instead of not at all).
+//   consistent:  (default) G = L D^-1, the P1-Galerkin transfer with a lumped membrane mass: the
+//                force per area at vertex k is t_k = F_k / A_k, A_k = int phi_k dA (phi_k the hat
+//                function of vertex k along the meridian, dA = 2 pi r ds), the traction t_h =
+//                sum t_k phi_k loads the fluid as int t_h . v dA (on the vertex AND midside nodes
+//                of the membrane edges, 3-point Gauss per edge: exact), and the membrane velocity
+//                is the hat average U_k = int phi_k u dA / A_k. A uniform traction is then loaded
+//                exactly (closed-membrane tests: exact pressure jump, no flow; shear at the
+//                Q2 rate); U_k differs from u(X_k) by O(h^2) (h^2 u''/12 on a uniform mesh).
+// The stiffness term is added as dt G K G^T, so its pattern couples the membrane's trace nodes
+// (vertex and midside) of vertices up to 2 apart, i.e. trace nodes up to 4 vertex spacings apart.
+//
+// Reuse of factorisations (set_reuse; ON by default). The time stepper calls factor() on meshes
+// that move only slightly between calls, and the numeric factorisation dominates its cost. With
+// reuse on, factor() always assembles the CURRENT system A(X) + scale G K G^T but factors it only
+// when needed; solve() then solves the current system by right-preconditioned restarted GMRES
+// (Givens rotations, modified Gram-Schmidt with one re-orthogonalisation), the preconditioner
+// being the stored LU of an earlier system. Right preconditioning: the minimised residual is the
+// TRUE residual b - A x, so the stopping test is on what is asked for; after each cycle the true
+// residual is recomputed (one product) and the solve only returns when
+//   ||b - A x||_2 <= reuse_tolerance ||b||_2   (2-norm of the scaled system, default 1e-12),
+// or, with a factorisation of the current system, when GMRES stagnates (the best that
+// factorisation gives; the best iterate by true residual is returned). A numeric factorisation
+// (the pattern never changes: the symbolic analysis is kept) happens when there is none yet,
+// when the caller forces it (factor's `force`), when the previous solve needed more than
+// `refactor_after` iterations (checked at the next solve, so that a system solved twice, as the
+// Rosenbrock stages are, is refactored before its second solve), or when GMRES with the old
+// factorisation does not converge within the cycle (the current system is then factored and
+// solved again: an unconverged answer is never returned). Preconditioner solves run UMFPACK
+// without iterative refinement (UMFPACK_IRSTEP = 0): its refinement would use the CURRENT values
+// of the matrix it refers to with the factors of an older one. With reuse off every factor()
+// factors and solve() is the direct solve with one refinement step (the original behaviour).
+// Measured on a driver run (16 k unknowns): a factorisation costs ~15 GMRES iterations; a reused
+// LU needs 6-9 iterations one step later (the stage system also changes with gamma dt; a scale
+// ratio 1.5 adds ~5 iterations), growing to 12-15 after ~5 steps; refactor_after = 8 was faster
+// than 14, and the answers agree with fresh factorisations to ~1e-14.
+//
+// Not copyable or movable (the LU object refers to the matrix held inside).
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <Eigen/UmfPackSupport>
+
+#include <array>
+#include <cstddef>
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "axi/fitted_mesh.hpp"
+
+namespace swim::axi {
+
+class FittedStokes {
+ public:
+  /// Topology fixed by (params, membrane nodes n): builds the sparsity pattern once (including
+  /// the couplings between membrane vertices up to 2 apart, used by the stiffness term below).
+  /// Throws swim::InputError for bad parameters (check_fitted_mesh_params) and mu not positive
+  /// and finite (key `fluid.viscosity`).
+  /// How ring forces load the fluid and how the membrane velocity is read (see the header
+  /// comment "Membrane coupling"); an addition to the original interface, defaulted.
+  enum class Coupling { consistent, vertex };
+  FittedStokes(const FittedMeshParams& p, double mu, int membrane_nodes, Coupling coupling = Coupling::consistent);
+  ~FittedStokes();
+  FittedStokes(const FittedStokes&) = delete;
+  FittedStokes& operator=(const FittedStokes&) = delete;
+
+  /// Assembles on the mesh fitted to X and factors (numeric factorisation; the symbolic analysis
+  /// on the first call only). Optional: a symmetric stiffness K (2n x 2n, ordering
+  /// [x_0, r_0, x_1, r_1, ...], entries only between membrane vertices at most 2 apart) times
+  /// `scale` (K in N/m, scale in s) is ADDED to the velocity block at the membrane vertices'
+  /// velocity DOFs: (A + dt K) u = F. Throws what FittedMesh::fit throws; std::invalid_argument
+  /// for a K of the wrong size or with an entry between vertices more than 2 apart;
+  /// swim::NumericalError when UMFPACK fails (singular matrix, out of memory).
+  /// With reuse on (see "Reuse of factorisations") the numeric factorisation may be deferred or
+  /// skipped; `force` factors now regardless.
+  void factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<double>* K = nullptr, double scale = 0.0,
+              bool force = false);
+
+  /// Reuse of factorisations as GMRES preconditioners (default on, refactor_after = 8,
+  /// tolerance 1e-12; see the header comment). Off: a fresh factorisation at every factor().
+  /// Throws std::invalid_argument for refactor_after < 0 or a tolerance not in (0, 1).
+  void set_reuse(bool on, int refactor_after = kRefactorAfter, double tolerance = kReuseTolerance);
+  bool reuse() const { return reuse_; }
+  static constexpr int kRefactorAfter = 8;
+  static constexpr double kReuseTolerance = 1e-12;
+  /// GMRES iterations (preconditioner applications) and relative true residual ||b - A x|| / ||b||
+  /// of the last solve (0 and not computed, -1, with reuse off).
+  int last_iterations() const { return last_iters_; }
+  double last_residual() const { return last_res_; }
+
+  /// With the current factorisation: ring forces F (3 x n, rows 0/1 the axial/radial force on the
+  /// whole ring, N) at the membrane vertices, and optionally a body force density (f_x, f_r),
+  /// N/m^3; returns the membrane vertices' velocities U (3 x n, rows 0/1 axial/radial, row 2 = 0).
+  /// May be called several times per factorisation. Keeps the full solution for the queries.
+  void solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
+             const std::function<Eigen::Vector2d(double x, double r)>* body = nullptr);
+
+  // ---- queries on the last solution
+  /// (u_x, u_r) at any point 0 <= r <= Rc (x wrapped by P).
+  Eigen::Vector2d velocity(double x, double r) const;
+  /// The P1 pressure of the element containing the point (on a shared edge either side), Pa,
+  /// zero volume mean.
+  double pressure(double x, double r) const;
+  /// Volume flux through the disc r < r_end spanned by end vertex `end` (0: rear, vertex 0;
+  /// 1: front, vertex n-1) relative to a frame moving axially at frame_velocity, m^3/s:
+  /// int_0^{r_end} 2 pi r (u_x - V) dr, exact (3-point Gauss on the Q2 traces of the vertex
+  /// column's edges). Positive: fluid crossing the disc towards +x.
+  double end_disc_flux(int end, double frame_velocity) const;
+  /// max over elements |int_e div u dV| / (vol_e max|u| / h_e), h_e = sqrt(area_e); a
+  /// dimensionless mass-conservation residual (round-off for a correct solve).
+  double lumen_divergence_residual() const;
+  const FittedMesh& mesh() const { return mesh_; }
+  int unknowns() const { return n_; }
+  std::size_t nonzeros() const { return std::size_t(A_.nonZeros()); }
+
+  struct Timing {
+    double assemble = 0, factor = 0, solve = 0;
+    long factorisations = 0, solves = 0;
+    long krylov_iterations = 0;  ///< GMRES iterations over all solves (reuse on)
+    long reused = 0;             ///< solves done with the factorisation of an earlier system
+  };
+  const Timing& timing() const { return timing_; }
+
+  // ---- additions (diagnostics and tests)
+  /// The viscous dissipation a(u, u) of the last solution, W (element-wise quadrature; the
+  /// stiffness term is not included).
+  double dissipation() const;
+  /// int_e div u dV of element e for the last solution, m^3/s.
+  double element_divergence(int e) const;
+  /// Velocity DOFs and pressure unknowns (unknowns() = velocity + pressure).
+  int velocity_unknowns() const { return n_vel_; }
+  double viscosity() const { return mu_; }
+
+ private:
+  struct Geometry;  // per-element quadrature data
+  void element_geometry(int e, Geometry& g) const;
+  void assemble(const Eigen::SparseMatrix<double>* K, double scale);
+  double dof_value(int dof) const { return dof < 0 ? 0.0 : sol_[dof]; }
+  Eigen::Vector2d eval_velocity(int e, double xi, double eta) const;
+  double eval_pressure(int e, double x, double r) const;
+  int find_position(int row, int col) const;  ///< value index of (row, col) in A_, or -1
+  void transfer_weights();                    ///< gw_ from the fitted mesh (consistent coupling)
+  void numeric_factor();                      ///< factors A_ (symbolic analysis on the first call)
+  /// Right-preconditioned GMRES on A_ x = rhs_ from x = 0 into sol_; returns true when converged
+  /// to tol_; iters and the true relative residual out. fresh: the LU is of A_ itself (then
+  /// stagnation ends the solve with the best iterate).
+  bool gmres(int max_iterations, bool fresh, int& iters, double& relres);
+
+  FittedMesh mesh_;
+  double mu_, lref_, ps_;
+  int n_ = 0, n_vel_ = 0;
+  std::vector<int> dof_x_, dof_r_;  ///< per Q2 node, -1 = Dirichlet
+  std::vector<int> loc_;            ///< elements x 21 global unknowns (-1 = eliminated)
+  std::vector<int> pos_;            ///< elements x 21 x 21 value positions (-1 = none)
+  Coupling coupling_;
+  /// G = transfer of vertex k to the membrane trace nodes (slots: V_{k-1}, M_{k-1/2}, V_k,
+  /// M_{k+1/2}, V_{k+1}; node -1 = absent): node index and weight.
+  std::vector<std::array<int, 5>> gnode_;
+  std::vector<std::array<double, 5>> gw_;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> A_;
+  std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> lu_;
+  bool analysed_ = false, factored_ = false, solved_ = false;
+  bool reuse_ = true;
+  int refactor_after_ = kRefactorAfter;
+  double tol_ = kReuseTolerance;
+  bool lu_valid_ = false;    ///< lu_ holds a numeric factorisation (of some earlier or the current A_)
+  bool lu_current_ = false;  ///< ... of the current A_
+  int last_iters_ = 0;
+  double last_res_ = -1.0;
+  Eigen::MatrixXd kv_, kz_;  ///< GMRES work: Krylov basis and preconditioned basis
+  Eigen::VectorXd rhs_, sol_;
+  double p_mean_ = 0.0;  ///< volume mean of the raw pressure (subtracted in queries)
+  Timing timing_;
+};
+
+}  // namespace swim::axi

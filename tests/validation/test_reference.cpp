@@ -1,0 +1,222 @@
+// The converged reference of a validation case (a suite case's `reference`, an axisymmetric
+// grid series): its strict reading, the agreement rule of the 3D extrapolation against it, and
+// the substitution that judges the 1D verdicts and the findings against it instead of the 3D
+// extrapolation, on synthetic case data (no solver runs).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "common/scene.hpp"
+#include "validation/suite.hpp"
+#include "validation/verdicts.hpp"
+
+using namespace swim;
+using namespace swim::validation;
+using scene::json;
+
+namespace {
+
+constexpr double nm = 1e-9;
+
+const json kThresholds = {{"displacement_per_cycle_relative", 0.25},
+                          {"cycle_time_relative", 0.5},
+                          {"mean_velocity_per_cycle_relative", 0.5},
+                          {"velocity_phase_correlation", 0.8}};
+
+const std::string kRest = R"("models1d": [{"label": "m"}], "thresholds": {"displacement_per_cycle_relative": 0.2,
+    "cycle_time_relative": 0.5, "mean_velocity_per_cycle_relative": 0.5, "velocity_phase_correlation": 0.8})";
+
+/// A suite file with one case of `scene` carrying `reference` (JSON text), `top` extra
+/// top-level members ("" or `"key": value, `).
+std::string write_suite(const std::string& scene, const std::string& reference, const std::string& top = "",
+                        const std::string& case_set = "") {
+  const std::string path = testing::TempDir() + "/reference_suite.json";
+  std::ofstream(path) << "{" << top << R"("cases": [{"scene": ")" << scene << R"(", "grids": [32, 40])"
+                      << (case_set.empty() ? "" : ", \"set\": " + case_set) << R"(, "reference": )" << reference
+                      << "}], " << kRest << "}";
+  return path;
+}
+
+/// load_suite must throw an InputError whose message holds every part.
+void expect_refused(const std::string& path, const std::vector<std::string>& parts) {
+  try {
+    load_suite(path, SWIM_SOURCE_DIR "/data");
+    ADD_FAILURE() << "accepted: " << path;
+  } catch (const InputError& e) {
+    for (const auto& p : parts) EXPECT_NE(std::string(e.what()).find(p), std::string::npos) << p << " in " << e.what();
+  }
+}
+
+const std::string kRound = R"({"full3d.membrane.axisymmetric": true, "full3d.recovery_end": "shape"})";
+
+/// A case of a report: its 3D extrapolation (displacement per cycle, cycle time, mean velocity
+/// per cycle, each value ± error) and, when axi is given, its axisymmetric reference.
+json make_case(const std::string& name, double sweep, const std::vector<double>& r3d,
+               const std::vector<double>& axi = {}) {
+  auto fig = [](double v, double e) { return json{{"value", v}, {"error", e}}; };
+  json c = {{"name", name},
+            {"group", "aspect"},
+            {"sweep_value", sweep},
+            {"length_m", 0.2e-6},
+            {"runs3d", json::array()},
+            {"models1d", json::array()},
+            {"reference3d",
+             {{"displacement_per_cycle_m", fig(r3d[0], r3d[1])},
+              {"cycle_time_s", fig(r3d[2], r3d[3])},
+              {"mean_velocity_per_cycle_m_per_s", fig(r3d[0] / r3d[2], 0.1 * r3d[0] / r3d[2])}}}};
+  if (!axi.empty())
+    c["reference"] = {{"tier", "axi"},
+                      {"displacement_per_cycle_m", fig(axi[0], axi[1])},
+                      {"cycle_time_s", fig(axi[2], axi[3])},
+                      {"mean_velocity_per_cycle_m_per_s", fig(axi[0] / axi[2], 0.01 * axi[0] / axi[2])}};
+  return c;
+}
+
+json find(const json& fs, const std::string& prefix) {
+  for (const auto& f : fs)
+    if (f["claim"].get<std::string>().rfind(prefix, 0) == 0) return f;
+  ADD_FAILURE() << "no finding " << prefix;
+  return json::object();
+}
+
+}  // namespace
+
+// The reference key is read strictly: a tier other than "axi", fewer than three grids, a bad
+// order range, an unknown key, a set that is not an object and a bad target are each an
+// InputError naming the key, the value and what is allowed.
+TEST(SuiteReference, BadValuesAreInputErrorsNamingTheKey) {
+  expect_refused(write_suite("x.json", R"({"tier": "3d", "grids": [64, 128, 256]})"),
+                 {"suite.cases[0].reference.tier", "\"3d\"", "\"axi\""});
+  expect_refused(write_suite("x.json", R"({"grids": [64, 128, 256]})"), {"suite.cases[0].reference.tier", "missing"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128]})"),
+                 {"suite.cases[0].reference.grids", "[64,128]", "three or more"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 64, 128]})"),
+                 {"suite.cases[0].reference.grids", "distinct"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128, 256], "order_range": "second"})"),
+                 {"suite.cases[0].reference.order_range", "second", "sharp_interface"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128, 256], "order_range": [3, 1]})"),
+                 {"suite.cases[0].reference.order_range", "[3,1]", "0 < lo < hi"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128, 256], "grid": 3})"),
+                 {"suite.cases[0].reference.grid", "tier, grid_key, grids, order_range, set"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128, 256], "grid_key": "full3d.grid"})"),
+                 {"suite.cases[0].reference.grid_key", "axi.grid.cells_across"});
+  expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128, 256], "set": 2})"),
+                 {"suite.cases[0].reference.set", "an object"});
+  expect_refused(write_suite("x.json", R"("axi")"), {"suite.cases[0].reference", "an object"});
+  expect_refused(write_suite("paper_amplitude_0.82.json", R"({"tier": "axi", "grids": [16, 24, 32]})",
+                             R"("reference_target_relative": 2, )", kRound),
+                 {"suite.reference_target_relative", "2", "between 0 and 1"});
+}
+
+// A case whose scene the axi tier refuses (here the paper's free wall, not held round; then an
+// odd cells_across) is an InputError at load time naming suite.cases[0].reference, with the
+// axi tier's own reason; the same scene made round loads.
+TEST(SuiteReference, ASceneTheAxiTierRefusesIsRefusedAtLoad) {
+  expect_refused(write_suite("paper_amplitude_0.82.json", R"({"tier": "axi", "grids": [16, 24, 32]})"),
+                 {"suite.cases[0].reference", "paper_amplitude_0.82.json", "full3d.membrane.axisymmetric"});
+  expect_refused(write_suite("paper_amplitude_0.82.json", R"({"tier": "axi", "grids": [16, 25, 32]})", "", kRound),
+                 {"suite.cases[0].reference", "= 25", "even"});
+  // round through the reference's own set, or the case's
+  EXPECT_NO_THROW(load_suite(write_suite("paper_amplitude_0.82.json",
+                                         R"({"tier": "axi", "grids": [16, 24, 32], "set": )" + kRound + "}"),
+                             SWIM_SOURCE_DIR "/data"));
+  EXPECT_NO_THROW(load_suite(write_suite("paper_amplitude_0.82.json",
+                                         R"({"tier": "axi", "grid_key": "axi.grid.cells_across", "grids": [16, 24, 32],
+                                             "order_range": "immersed_boundary", "set": {"axi.tolerance": 2e-4}})",
+                                         R"("reference_target_relative": 0.02, )", kRound),
+                             SWIM_SOURCE_DIR "/data"));
+}
+
+// 3D against the reference: agree when |a - b| <= e_a + e_b (the error bars touch or
+// overlap), disagree beyond; the bound is linear, not quadrature (1.5 apart with bars 1 and
+// 0.5 agree, where quadrature, 1.12, would not).
+TEST(SuiteReference, AgreementIsTheLinearSumOfTheErrorBars) {
+  EXPECT_EQ(agreement_verdict(10.0, 1.0, 11.5, 0.5), "agree");
+  EXPECT_EQ(agreement_verdict(11.5, 0.5, 10.0, 1.0), "agree");
+  EXPECT_EQ(agreement_verdict(10.0, 1.0, 11.6, 0.5), "disagree");
+  EXPECT_EQ(agreement_verdict(10.0, 1.0, 8.4, 0.5), "disagree");
+  EXPECT_EQ(agreement_verdict(10.0, 0.0, 10.0, 0.0), "agree");
+  EXPECT_EQ(agreement_verdict(10.0, -1.0, 11.5, 0.5), "agree");  // an error is a magnitude
+  EXPECT_EQ(agreement_verdict(std::nan(""), 1.0, 10.0, 1.0), "not assessed");
+  EXPECT_EQ(agreement_verdict(10.0, 1.0, 10.0, INFINITY), "not assessed");
+}
+
+// A case with an axisymmetric reference judges its 1D model against it: a 1D displacement of
+// 20.5 nm is +2.5 % off the reference's 20 ± 0.1 nm (pass at 25 %), where against the 3D
+// extrapolation's 10 ± 0.5 nm it would be +105 % (fail). The same case without the reference
+// is judged against 3D.
+TEST(SuiteReference, OneDVerdictsAreJudgedAgainstTheAxisymmetricReference) {
+  const json with = make_case("A", 0.2, {10 * nm, 0.5 * nm, 1.0, 0.1}, {20 * nm, 0.1 * nm, 0.5, 0.005});
+  json model = {{"label", "m"},
+                {"displacement_per_cycle_m", 20.5 * nm},
+                {"cycle_time_s", 0.6},
+                {"mean_velocity_per_cycle_m_per_s", 20.5 * nm / 0.6}};
+  json e = model;
+  compare_with_reference(e, with);
+  EXPECT_EQ(e["judged_against"], "axisymmetric reference");
+  EXPECT_NEAR(e["relative_error_vs_reference"]["displacement_per_cycle"].get<double>(), 0.025, 1e-12);
+  EXPECT_NEAR(e["reference_error_relative"]["displacement_per_cycle"].get<double>(), 0.005, 1e-12);
+  EXPECT_NEAR(e["relative_error_vs_reference"]["cycle_time"].get<double>(), 0.2, 1e-12);
+  json v = model_verdicts(e, kThresholds);
+  EXPECT_EQ(v["displacement_per_cycle"], "pass");
+  EXPECT_EQ(v["cycle_time"], "pass");
+
+  json without = with;
+  without.erase("reference");
+  json e3 = model;
+  compare_with_reference(e3, without);
+  EXPECT_EQ(e3["judged_against"], "3D reference");
+  EXPECT_NEAR(e3["relative_error_vs_reference"]["displacement_per_cycle"].get<double>(), 1.05, 1e-12);
+  EXPECT_EQ(model_verdicts(e3, kThresholds)["displacement_per_cycle"], "fail");
+
+  // a reference without values (its grids did not complete a cycle) gives no verdict: the
+  // case is not silently judged against 3D
+  json empty = with;
+  empty["reference"] = {{"tier", "axi"}, {"note", "fewer than two grids completed a cycle"}};
+  json e0 = model;
+  compare_with_reference(e0, empty);
+  EXPECT_TRUE(e0["relative_error_vs_reference"].empty());
+  EXPECT_TRUE(model_verdicts(e0, kThresholds).empty());
+  EXPECT_EQ(e0.dump().find("NaN"), std::string::npos);
+}
+
+// The findings take the same reference: 3D says the distance falls with L (refuted), the
+// axisymmetric references say it grows (reproduced); the evidence names the reference.
+TEST(SuiteReference, FindingsAreJudgedAgainstTheAxisymmetricReference) {
+  const std::string claim = "distance per cycle grows with the swimmer length";
+  json cs = json::array({make_case("L0.2", 0.2, {30 * nm, 1 * nm, 1.0, 0.1}, {20 * nm, 0.2 * nm, 0.5, 0.01}),
+                         make_case("L0.4", 0.4, {20 * nm, 1 * nm, 1.0, 0.1}, {40 * nm, 0.2 * nm, 0.5, 0.01})});
+  json f = find(findings(cs, kThresholds), claim);
+  EXPECT_EQ(f["status"], "reproduced") << f.dump(1);
+  EXPECT_NEAR(f["evidence"][0]["value"].get<double>(), 20 * nm, 1e-18);
+  EXPECT_EQ(f["evidence"][0]["reference"], "axisymmetric reference");
+  for (auto& c : cs) c.erase("reference");
+  f = find(findings(cs, kThresholds), claim);
+  EXPECT_EQ(f["status"], "refuted") << f.dump(1);
+  EXPECT_EQ(f["evidence"][0]["reference"], "3D reference");
+}
+
+// The shipped converged suite loads (every reference scene is one the axi tier runs): five
+// round-wall cases, each with the axi reference on 24, 32, 48 cells across and the same wall
+// (round, geometric recovery end, fixed bending rigidity) on both tiers.
+TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
+  const json s = load_suite(SWIM_SOURCE_DIR "/data/validation/converged.json", SWIM_SOURCE_DIR "/data");
+  ASSERT_EQ(s["cases"].size(), 5u);
+  for (const auto& c : s["cases"]) {
+    EXPECT_EQ(c["grids"], json::array({32, 40, 48, 56, 64}));
+    const json& ref = c["reference"];
+    EXPECT_EQ(ref["tier"], "axi");
+    EXPECT_EQ(ref["grids"], json::array({24, 32, 48}));
+    EXPECT_EQ(ref["order_range"], "sharp_interface");
+    for (const json* set : {&c["set"], &ref["set"]}) {
+      EXPECT_EQ((*set)["full3d.membrane.axisymmetric"], true);
+      EXPECT_EQ((*set)["full3d.recovery_end"], "shape");
+      EXPECT_EQ((*set)["full3d.membrane.bending_rigidity"], "2.1184615504e-24 J");
+    }
+  }
+  EXPECT_NO_THROW(load_suite(SWIM_SOURCE_DIR "/data/validation/default.json", SWIM_SOURCE_DIR "/data"));
+}
