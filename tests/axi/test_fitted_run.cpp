@@ -29,6 +29,18 @@ json round_wall_fitted(int cells_across) {
   return sc;
 }
 
+/// A small fitted mesh of the paper's container (period 2 µm): 6 element rows inside and outside
+/// the wall, 12 columns across the gap.
+swim::axi::FittedMeshParams small_mesh(double Rc) {
+  swim::axi::FittedMeshParams mp;
+  mp.Rc = Rc;
+  mp.period = 2e-6;
+  mp.cells_inner = 6;
+  mp.cells_outer = 6;
+  mp.gap_columns = 12;
+  return mp;
+}
+
 }  // namespace
 
 // A uniform inward load on the wall coupled to the fitted Stokes solver, stepped by implicit
@@ -43,12 +55,7 @@ TEST(FittedCoupledWall, UniformLoadSettlesAtTheStaticEquilibriumOfTheWallLaw) {
   const int n = 17;
   const AxiWall wall(AxiWallParams{R0, L, ks, 1e-24, n});
   const AxiPressureResponse stat = relax_under_pressure(wall, P);
-  FittedMeshParams mp;
-  mp.Rc = Rc;
-  mp.period = 2e-6;
-  mp.cells_inner = 6;
-  mp.cells_outer = 6;
-  mp.gap_columns = 12;
+  const swim::axi::FittedMeshParams mp = small_mesh(Rc);
   FittedStokes fluid(mp, mu, n);
   Eigen::Matrix3Xd X = wall.reference();
   X.row(0).array() += 0.5 * (mp.period - L);
@@ -124,12 +131,7 @@ std::array<double, 2> front_half_stroke(double T, int steps) {
   const double R0 = 0.125e-6, L = 0.2e-6, Rc = 0.25e-6, mu = 1.2e-3, ks = 5.5e-8, q0 = 0.2;
   const int n = 17;
   const AxiWall wall(AxiWallParams{R0, L, ks, 2e-24, n});
-  FittedMeshParams mp;
-  mp.Rc = Rc;
-  mp.period = 2e-6;
-  mp.cells_inner = 6;
-  mp.cells_outer = 6;
-  mp.gap_columns = 12;
+  const swim::axi::FittedMeshParams mp = small_mesh(Rc);
   FittedStokes fluid(mp, mu, n);
   Eigen::Matrix3Xd X = wall.reference();
   X.row(0).array() += 0.5 * (mp.period - L);
