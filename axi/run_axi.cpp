@@ -247,6 +247,19 @@ class Runner {
       step_heun();
   }
 
+  /// Why the fitted mesh cannot follow the wall's shape X (empty when it can): a ring's axial
+  /// position not beyond its neighbour's, or a ring outside (0, Rc).
+  std::string fold(const Eigen::Matrix3Xd& X) const {
+    const int n = wall_.nodes();
+    for (int k = 0; k < n; ++k) {
+      if (!(X(1, k) > 0.0 && X(1, k) < b_.container_radius))
+        return "ring " + std::to_string(k) + " at radius " + num(X(1, k)) + " m, outside (0, Rc)";
+      if (k > 0 && !(X(0, k) > X(0, k - 1)))
+        return "rings " + std::to_string(k - 1) + " and " + std::to_string(k) + " crossed along the axis";
+    }
+    return {};
+  }
+
   /// The protocol's next event as a function of the shape, zero at the event and positive
   /// before it: the active segment's radius minus R_f while contracting; during the recovery
   /// the largest deviation of a ring's radius from R0 or of its axial position from its
@@ -307,12 +320,15 @@ class Runner {
     const int n = wall_.nodes();
     for (;;) {
       if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
-        throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s",
-                             "loosen axi.tolerance or lower axi.dt_min", t_);
+        throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s" +
+                                 (last_rejection_.empty() ? "" : " (last rejection: " + last_rejection_ + ")"),
+                             "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid", t_);
       bool valid = true;
       double err = 0;
       try {
         const int last = n - 1;
+        if (const std::string bad = fold(X_); !bad.empty())
+          throw NumericalError("the wall's shape cannot be meshed: " + bad, "refine axi.grid", t_);
         stage_->factor(X_, &K, gamma * dt_);
         stage_->solve(F0, k1_);
         const double a_rear = stage_->end_disc_flux(0, k1_(0, 0)), a_front = stage_->end_disc_flux(1, k1_(0, last));
@@ -338,9 +354,13 @@ class Runner {
         step_q_front_ = 1.5 * a_front + 0.5 * (b_front - 2.0 * a_front - gamma * dt_ * c_front);
         if (!k1_.allFinite() || !k2_.allFinite()) throw NumericalError("non-finite stage", "reduce axi.tolerance", t_);
         err = 0.5 * dt_ * (k1_ + k2_).cwiseAbs().maxCoeff();
-      } catch (const NumericalError&) {
-        // a stage shape the fitted mesh cannot follow (folded or outside the container): retry smaller
+        // the step's end shape must be one the mesh can follow, as the stage's is
+        Xn_ = X_ + dt_ * (1.5 * k1_ + 0.5 * k2_);
+        if (const std::string bad = fold(Xn_); !bad.empty()) throw NumericalError(bad, "", t_);
+      } catch (const NumericalError& e) {
+        // a shape the fitted mesh cannot follow (folded or outside the container): retry smaller
         valid = false;
+        last_rejection_ = e.cause();
       }
       if (valid && err <= tol) {
         Xn_ = X_ + dt_ * (1.5 * k1_ + 0.5 * k2_);
@@ -364,6 +384,7 @@ class Runner {
         return;
       }
       ++rejected_;
+      if (valid) last_rejection_ = "local error " + num(err) + " m above axi.tolerance x h = " + num(tol) + " m";
       const double shrink = valid && err > tol ? 0.9 * std::sqrt(tol / err) : 0.25;
       dt_ *= std::clamp(shrink, 0.1, 0.5);
     }
@@ -598,6 +619,7 @@ class Runner {
   double q_rear_ = 0, q_front_ = 0, vol_rear_ = 0, vol_front_ = 0, step_q_rear_ = 0, step_q_front_ = 0;
   long steps_ = 0, rejected_ = 0, solves_ = 0, last_recorded_ = -1, event_retakes_ = 0;
   int event_tries_ = 0;
+  std::string last_rejection_;  ///< why the last fitted step was rejected (for the dt_min message)
   static constexpr int kEventTries = 12;
   bool event_pending_ = false;
   double split_forces_ = 0, split_spread_ = 0, split_fluid_ = 0, split_interp_ = 0, split_stiffness_ = 0;
