@@ -280,7 +280,7 @@ class Runner {
       v.eps = 1e-3 * q.delta;
     } else if (st.phase == 1 && q.shape_end) {
       const int n = wall_.nodes();
-      const double shift = X.row(0).mean() - mesh_.X0.row(0).mean();
+      const double shift = center(X) - center(mesh_.X0);
       double m = 0.0;
       for (int k = 0; k < n; ++k)
         m = std::max({m, std::abs(X(1, k) - b_.R0), std::abs(X(0, k) - mesh_.X0(0, k) - shift)});

@@ -185,7 +185,11 @@ bool Protocol3d::shape_recovered(const Eigen::Matrix3Xd& X) const {
   const CylinderMesh& m = *mesh_;
   const Eigen::VectorXd rr = ring_radii(m, X);
   if ((rr.array() - m.radius).abs().maxCoeff() > p_.delta) return false;
-  const double shift = X.row(0).mean() - m.X0.row(0).mean();
+  // the mean axial translation: the plain node mean, or (dual cells) the mean over the tube's
+  // surface, whose discrete value converges to the continuum one at second order
+  const double shift = p_.dual_cell_segments
+                           ? (X.row(0) - m.X0.row(0)).dot(m.node_area.transpose()) / m.node_area.sum()
+                           : X.row(0).mean() - m.X0.row(0).mean();
   for (int r = 0; r < m.n_rings; ++r) {
     double dx = 0;
     for (int i = 0; i < m.n_theta; ++i) dx += X(0, m.node(r, i)) - m.X0(0, m.node(r, i));
