@@ -318,17 +318,13 @@ class Runner {
     split_stiffness_ += seconds_since(tk);
     const Eigen::Matrix3Xd F0 = total_force(X_);
     const int n = wall_.nodes();
+    const EventValue g0 = event_value(X_);  // X_ is an accepted shape: the mesh follows it
     for (;;) {
-      if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
-        throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s" +
-                                 (last_rejection_.empty() ? "" : " (last rejection: " + last_rejection_ + ")"),
-                             "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid", t_);
+      check_dt_min();
       bool valid = true;
       double err = 0;
       try {
         const int last = n - 1;
-        if (const std::string bad = fold(X_); !bad.empty())
-          throw NumericalError("the wall's shape cannot be meshed: " + bad, "refine axi.grid", t_);
         stage_->factor(X_, &K, gamma * dt_);
         stage_->solve(F0, k1_);
         const double a_rear = stage_->end_disc_flux(0, k1_(0, 0)), a_front = stage_->end_disc_flux(1, k1_(0, last));
@@ -363,11 +359,10 @@ class Runner {
         last_rejection_ = e.cause();
       }
       if (valid && err <= tol) {
-        Xn_ = X_ + dt_ * (1.5 * k1_ + 0.5 * k2_);
         // Protocol events are located, not just detected: a step that carries the event
         // function g (protocol::event_value) past zero by more than its tolerance is taken again,
         // shorter, by the secant through g's values at its two ends.
-        if (const EventValue g0 = event_value(X_); g0.active && g0.g > 0.0 && event_tries_ < kEventTries) {
+        if (g0.active && g0.g > 0.0 && event_tries_ < kEventTries) {
           const EventValue g1 = event_value(Xn_);
           if (g1.g < -g1.eps) {
             ++event_tries_;
@@ -377,17 +372,40 @@ class Runner {
           }
         }
         event_tries_ = 0;
-        const double dt_done = dt_;
-        const double grow = err > 0 ? 0.9 * std::sqrt(tol / err) : 2.0;
-        accept(dt_done);
-        dt_ = dt_done * std::clamp(grow, 0.2, 2.0);
+        accept_and_grow(err, tol);
         return;
       }
-      ++rejected_;
       if (valid) last_rejection_ = "local error " + num(err) + " m above axi.tolerance x h = " + num(tol) + " m";
-      const double shrink = valid && err > tol ? 0.9 * std::sqrt(tol / err) : 0.25;
-      dt_ *= std::clamp(shrink, 0.1, 0.5);
+      reject(valid && err > tol ? err : -1.0, tol, 0.25);
     }
+  }
+
+  /// The step-size floor: a step below axi.dt_min ends the run (unless it only reaches a fixed
+  /// duration's end), naming the last rejection's cause when there is one.
+  void check_dt_min() const {
+    if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
+      throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s" +
+                               (last_rejection_.empty() ? "" : " (last rejection: " + last_rejection_ + ")"),
+                           fitted_ ? "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid"
+                                   : "loosen axi.tolerance or lower axi.dt_min",
+                           t_);
+  }
+
+  /// Accepts the step of size dt_ to Xn_ with local error err, and sets the next step by the
+  /// order-1/2 controller (0.9 sqrt(tol/err), between 0.2 and 2 times).
+  void accept_and_grow(double err, double tol) {
+    const double dt_done = dt_;
+    const double grow = err > 0 ? 0.9 * std::sqrt(tol / err) : 2.0;
+    accept(dt_done);
+    dt_ = dt_done * std::clamp(grow, 0.2, 2.0);
+  }
+
+  /// Rejects the step: shrinks it by the controller when its error err (> 0) was too large,
+  /// else by `fallback` (a failed stage, a CFL excess); between 0.1 and 0.5 times.
+  void reject(double err, double tol, double fallback) {
+    ++rejected_;
+    const double shrink = err > 0 ? 0.9 * std::sqrt(tol / err) : fallback;
+    dt_ *= std::clamp(shrink, 0.1, 0.5);
   }
 
   /// One accepted step of the trapezoidal rule (retried with smaller steps until its local
@@ -400,9 +418,7 @@ class Runner {
     if (umax > 0) dt_ = std::min(dt_, kCfl * h / umax);
     if (b_.duration > 0) dt_ = std::min(dt_, b_.duration - t_);
     for (;;) {
-      if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
-        throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s",
-                             "loosen axi.tolerance or lower axi.dt_min", t_);
+      check_dt_min();
       X1_ = X_ + dt_ * U_;
       std::array<double, 2> e1{};
       evaluate(X1_, U1_, &e1);
@@ -412,15 +428,10 @@ class Runner {
       const double cfl = std::max(umax, u1max) * dt_ / h;
       if (err <= tol && cfl <= kMaxCfl) {
         Xn_ = X_ + (0.5 * dt_) * (U_ + U1_);
-        const double dt_done = dt_;
-        const double grow = err > 0 ? 0.9 * std::sqrt(tol / err) : 2.0;
-        accept(dt_done);
-        dt_ = dt_done * std::clamp(grow, 0.2, 2.0);
+        accept_and_grow(err, tol);
         return;
       }
-      ++rejected_;
-      const double shrink = err > tol ? 0.9 * std::sqrt(tol / err) : 0.5;
-      dt_ *= std::clamp(shrink, 0.1, 0.5);
+      reject(err > tol ? err : -1.0, tol, 0.5);
     }
   }
 
