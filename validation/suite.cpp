@@ -101,6 +101,20 @@ Series series_of(const record::RunRecord& rec) {
   return s;
 }
 
+/// A run's per-cycle figures: from its rows, with the summary's own values where it has them,
+/// computed at full precision from the rows in memory (a cached run's series.csv carries 10
+/// digits), so that a fresh and a cached run report the same.
+record::CycleFigures cycle_figures_of(const record::RunRecord& rec, const json& summary) {
+  record::CycleFigures c = record::cycle_figures(rec);
+  if (summary.contains("displacement_per_cycle_m") && summary["displacement_per_cycle_m"].is_number() &&
+      summary.contains("cycle_time_s") && summary["cycle_time_s"].is_number()) {
+    c.displacement_per_cycle_m = summary["displacement_per_cycle_m"].get<double>();
+    c.cycle_time_s = summary["cycle_time_s"].get<double>();
+    c.mean_velocity_per_cycle_m_per_s = summary["mean_velocity_per_cycle_m_per_s"].get<double>();
+  }
+  return c;
+}
+
 json downsample(const Series& s, double t_end, int n = 400) {
   json t = json::array(), u = json::array(), x = json::array();
   if (s.t.size() < 2) return {{"t_s", t}, {"velocity_m_per_s", u}, {"x_m", x}};
@@ -309,15 +323,7 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   r.ok = status == "ok";
   r.wall = summary.value("wall_time_s", 0.0);
   r.series = series_of(rec);
-  r.cyc = record::cycle_figures(rec);
-  // the run's own per-cycle figures, computed at full precision from the rows in memory (a
-  // cached run's series.csv carries 10 digits): a fresh and a cached run report the same
-  if (summary.contains("displacement_per_cycle_m") && summary["displacement_per_cycle_m"].is_number() &&
-      summary.contains("cycle_time_s") && summary["cycle_time_s"].is_number()) {
-    r.cyc.displacement_per_cycle_m = summary["displacement_per_cycle_m"].get<double>();
-    r.cyc.cycle_time_s = summary["cycle_time_s"].get<double>();
-    r.cyc.mean_velocity_per_cycle_m_per_s = summary["mean_velocity_per_cycle_m_per_s"].get<double>();
-  }
+  r.cyc = cycle_figures_of(rec, summary);
   r.record = {{"cell_size_m", p.h},
               {"grid", {p.nx, p.ny, p.nz}},
               {"status", status},
@@ -398,14 +404,7 @@ RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress,
   const std::string status = summary.value("status", std::string("unknown"));
   r.ok = status == "ok";
   r.wall = summary.value("wall_time_s", 0.0);
-  r.cyc = record::cycle_figures(rec);
-  // the run's own figures at full precision (a cached series.csv carries 10 digits)
-  if (summary.contains("displacement_per_cycle_m") && summary["displacement_per_cycle_m"].is_number() &&
-      summary.contains("cycle_time_s") && summary["cycle_time_s"].is_number()) {
-    r.cyc.displacement_per_cycle_m = summary["displacement_per_cycle_m"].get<double>();
-    r.cyc.cycle_time_s = summary["cycle_time_s"].get<double>();
-    r.cyc.mean_velocity_per_cycle_m_per_s = summary["mean_velocity_per_cycle_m_per_s"].get<double>();
-  }
+  r.cyc = cycle_figures_of(rec, summary);
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number())
     r.max_displacement = summary["max_displacement_m"].get<double>();
   r.record = {{"cell_size_m", p.h},
