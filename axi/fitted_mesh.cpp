@@ -75,14 +75,17 @@ FittedMesh::FittedMesh(const FittedMeshParams& p, int membrane_nodes) : p_(p), n
   ny_ = p.cells_inner + p.cells_outer;
   xcol_.assign(nc_ + 1, 0.0);
   rho_.assign(nc_, 0.0);
+  frac_.assign(size_t(nc_) * (ny_ + 1), 0.0);
 }
 
 double FittedMesh::vertex_r(int c, int j) const {
-  const double rho = rho_[c % nc_];
+  c %= nc_;
+  const double rho = rho_[c];
   const int ci = p_.cells_inner;
-  if (j <= ci) return rho * double(j) / ci;
   if (j == ny_) return p_.Rc;
-  return rho + (p_.Rc - rho) * double(j - ci) / p_.cells_outer;
+  const double f = frac_[size_t(c) * (ny_ + 1) + j];
+  if (j <= ci) return rho * f;
+  return rho + (p_.Rc - rho) * f;
 }
 
 void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
@@ -135,6 +138,30 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     }
   }
   xcol_[nc_] = x0 + P;
+
+  // row fractions: uniform, or graded from the membrane line (heights w_i = eta q^i away from it)
+  const int ci = p_.cells_inner, co = p_.cells_outer;
+  for (int c = 0; c < nc_; ++c) {
+    double* f = &frac_[size_t(c) * (ny_ + 1)];
+    for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
+    for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
+    if (!(p_.wall_row_aspect > 0.0)) continue;
+    const double wl = xcol_[c] - (c > 0 ? xcol_[c - 1] : xcol_[nc_ - 1] - P);
+    const double wr = xcol_[c + 1] - xcol_[c];
+    const double eta = p_.wall_row_aspect * std::min(wl, wr);
+    const double in = rho_[c], out = Rc - rho_[c];
+    const auto hi = gap_widths(in, ci, eta, INFINITY, 4.0), ho = gap_widths(out, co, eta, INFINITY, 4.0);
+    double acc = 0.0;  // inside: from the membrane line down to the axis
+    for (int i = 0; i < ci; ++i) {
+      acc += hi[i];
+      f[ci - 1 - i] = i == ci - 1 ? 0.0 : 1.0 - acc / in;
+    }
+    acc = 0.0;
+    for (int i = 0; i < co; ++i) {
+      acc += ho[i];
+      f[ci + 1 + i] = i == co - 1 ? 1.0 : acc / out;
+    }
+  }
 
   // Jacobian x_xi r_eta at the four corners of every element (x_xi = half the column width,
   // r_eta = half the vertical side of the corner).

@@ -24,7 +24,10 @@
 // Interface radius rho_c of each vertex column: r_c on the membrane columns; in the gap linear in
 // x between r_{n-1} and r_0. Vertex rows j = 0..Ny, Ny = cells_inner + cells_outer, at radius
 //   r_{c,j} = rho_c j / cells_inner                                  (j <= cells_inner)
-//   r_{c,j} = rho_c + (Rc - rho_c)(j - cells_inner) / cells_outer   (j >= cells_inner).
+//   r_{c,j} = rho_c + (Rc - rho_c)(j - cells_inner) / cells_outer   (j >= cells_inner)
+// (uniform rows), or graded towards the membrane line where the columns are narrow
+// (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free rims then
+// sees elements refined in both directions.
 // The membrane is the mesh line j = cells_inner between the vertex columns 0 and n-1 (closed:
 // all columns). Every element (c, j), j = 0..Ny-1, is the quadrilateral with the vertical sides
 // x = x_c, x = x_{c+1} and straight top and bottom edges; the geometry map is bilinear (Q1):
@@ -56,6 +59,11 @@ struct FittedMeshParams {
   int gap_columns = 16;        ///< element columns across the gap between the tube's ends (periodic)
   double gap_growth = 1.2;     ///< largest ratio of neighbouring gap column widths
   bool closed = false;         ///< test mode: the membrane spans the whole period (x_n == x_0 + P implied, no gap, n columns)
+  /// Rows graded towards the membrane line in narrow columns (> 0): in vertex column c the row
+  /// next to the membrane line is at most wall_row_aspect times the narrower adjacent column's
+  /// width high, the rows above and below it growing geometrically (one ratio per side and
+  /// column, at most 4) to fill the distance to the axis and to the container. 0: uniform rows.
+  double wall_row_aspect = 0.0;
 };
 
 /// Throws swim::InputError (keys `axi.fitted.*`, `container.radius`, `container.period`) for
@@ -126,6 +134,7 @@ class FittedMesh {
   bool fitted_ = false;
   std::vector<double> xcol_;  ///< NC + 1
   std::vector<double> rho_;   ///< NC
+  std::vector<double> frac_;  ///< NC x (Ny + 1): r_{c,j} = frac (0..1 of rho_c inside; of Rc - rho_c outside)
   double min_jac_ = 0;
 };
 

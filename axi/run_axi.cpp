@@ -65,7 +65,7 @@ class Runner {
  public:
   Runner(const ParamsAxi& p, const json& resolved, const std::string& out, const RunControlAxi& ctl)
       : p_(p), b_(p.base), resolved_(resolved), out_(out), ctl_(ctl), grid_{p.nr, p.nx, p.h},
-        fitted_(p.method == AxiMethod::Fitted), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes}),
+        fitted_(p.method == AxiMethod::Fitted), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes, p.ring_s0}),
         mesh_(ring_mesh(wall_, b_.R0, b_.L, p.x_start())), e_ref_(wall_.uniform_energy(b_.protocol.R_f)),
         protocol_(effective(), mesh_, e_ref_),
         rec_("axi", fitted_ ? "axisymmetric_fitted_finite_elements" : "axisymmetric_immersed_boundary", b_.L,
@@ -144,7 +144,7 @@ class Runner {
 
   std::vector<double> reference_z() const {
     std::vector<double> z(wall_.nodes());
-    for (int k = 0; k < wall_.nodes(); ++k) z[k] = k * wall_.ds0();
+    for (int k = 0; k < wall_.nodes(); ++k) z[k] = wall_.reference()(0, k);
     return z;
   }
 
@@ -226,6 +226,7 @@ class Runner {
     mp.cells_inner = p_.cells_inner;
     mp.cells_outer = p_.cells_outer;
     mp.gap_columns = p_.gap_columns;
+    mp.wall_row_aspect = p_.wall_row_aspect;
     mp.gap_growth = 4.0;  // the column count is chosen for a ratio near 1 + 5 ds / Rc (scene_axi.cpp)
     return mp;
   }
@@ -560,6 +561,7 @@ class Runner {
                                         : "cells across the radius and along the axis"},
                     {"wall_nodes", wall_.nodes()},
                     {"wall_node_spacing_m", wall_.ds0()},
+                    {"wall_end_spacing_m", wall_.min_ds0()},
                     {"spring_constant_N_per_m", p_.ks},
                     {"stretching_modulus_N_per_m", 2.0 * p_.ks / std::sqrt(3.0)},
                     {"bending_rigidity_J", p_.D},

@@ -4,6 +4,7 @@
 
 #include "common/errors.hpp"
 #include "common/scene_shared.hpp"
+#include "axi/wall_axi.hpp"
 #include "full3d/membrane.hpp"
 
 namespace swim::axi {
@@ -30,6 +31,7 @@ const json& section_keys() {
                              {{"method", "choice:fitted|immersed_boundary"},
                               {"grid", {{"cells_across", "integer"}, {"cell_size", "quantity:m"}}},
                               {"spacing_factor", "number"},
+                              {"rim_refinement", "number"},
                               {"tolerance", "number"},
                               {"dt_max", "quantity:s"},
                               {"dt_min", "quantity:s"},
@@ -110,6 +112,12 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   // (default 2 per h: the wall's bending boundary layers are shorter than the fluid's scales)
   p.spacing_factor = ib ? a.number("spacing_factor", 0.5, Range::open(0.0, 1.0))
                         : a.number("spacing_factor", 1.0, Range::open(0.0, 2.0 + 1e-12));
+  // fitted: the rings are refined geometrically (ratio 1.5) towards the tube's two rims, from
+  // rim_refinement times the interior spacing: the flow is singular at the wall's free edge
+  p.rim_refinement = a.number("rim_refinement", 1.0, Range{0.0, 1.0, true, false});
+  if (ib && p.rim_refinement != 1.0)
+    throw InputError(a.path("rim_refinement"), fmt(p.rim_refinement, ""),
+                     "1 (uniform rings) with axi.method = immersed_boundary; the rim refinement is the fitted method's");
   // local position error per step in cells: the explicit immersed boundary's steps are bounded
   // by its stability anyway; the fitted method's Rosenbrock steps by the tolerance alone (at
   // 2e-3 h its time error is 1e-5 of the displacement and 1e-3 of the cycle time, docs/axi.md)
@@ -156,14 +164,28 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
                        "must exceed swimmer.length + 2 h = " + fmt(L + 2.0 * p.h, "m"));
     p.cells_inner = std::max(2, int(std::lround(R0 / p.h)));
     p.cells_outer = std::max(2, int(std::lround((Rc - R0) / p.h)));
-    p.wall_nodes = std::max(5, int(std::ceil(L / (p.spacing_factor * 0.5 * p.h) - 1e-9)) + 1);
-    // Gap columns: widths growing geometrically from the wall's spacing ds at both ends with the
-    // ratio q = 1 + 5 ds / Rc (so that halving ds splits every column: q -> sqrt(q) to first
-    // order), as many as fill the gap G: 2 ceil(ln(1 + G (q - 1) / (2 ds)) / ln q).
+    if (p.rim_refinement < 1.0) {
+      // rows graded towards the wall next to the refined rims (element aspect 2, as the interior's
+      // h by h/2), one more row on each side per level of the rims' refinement
+      const int levels = int(std::ceil(std::log(1.0 / p.rim_refinement) / std::log(kRimGrowth) - 1e-9));
+      p.cells_inner += levels;
+      p.cells_outer += levels;
+      p.wall_row_aspect = 2.0;
+    }
+    const double spacing = std::min(L / 4.0, p.spacing_factor * 0.5 * p.h);
+    const int uniform_segments = int(std::ceil(L / spacing - 1e-9));
+    p.ring_s0 = graded_ring_positions(L, spacing, p.rim_refinement, kRimGrowth);
+    p.wall_nodes = int(p.ring_s0.size());
+    // Gap columns: widths growing geometrically from the wall's interior spacing ds at both ends
+    // with the ratio q = 1 + 5 ds / Rc (so that halving ds splits every column: q -> sqrt(q) to
+    // first order), as many as fill the gap G: 2 ceil(ln(1 + G (q - 1) / (2 ds)) / ln q); plus
+    // as many per end as the rim refinement adds rings (the first gap columns start from the
+    // end segment's width).
     {
-      const double ds = L / (p.wall_nodes - 1), G = b.period - L, q = 1.0 + 5.0 * ds / Rc;
+      const int graded = p.wall_nodes - 1 - uniform_segments;
+      const double ds = L / uniform_segments, G = b.period - L, q = 1.0 + 5.0 * ds / Rc;
       const int half = int(std::ceil(std::log(1.0 + G * (q - 1.0) / (2.0 * ds)) / std::log(q)));
-      p.gap_columns = std::max(8, 2 * half);
+      p.gap_columns = std::max(8, 2 * half + std::max(0, graded));
     }
     const double elements = double(p.cells_inner + p.cells_outer) * (p.wall_nodes - 1 + p.gap_columns);
     if (elements > 2.0e6)

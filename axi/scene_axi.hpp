@@ -13,6 +13,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "common/scene.hpp"
 #include "full3d/scene3d.hpp"
@@ -25,6 +26,9 @@ enum class AxiMethod {
   Fitted,            ///< finite elements on a mesh fitted to the wall (sharp interface), implicit wall steps
 };
 
+/// Growth ratio of the ring spacing from the rims inwards (axi.rim_refinement < 1).
+inline constexpr double kRimGrowth = 1.5;
+
 struct ParamsAxi {
   full3d::Params3d base;       ///< the shared physics, as the 3D tier reads it
   AxiMethod method = AxiMethod::Fitted;
@@ -36,6 +40,9 @@ struct ParamsAxi {
   // wall
   double spacing_factor = 0.5; ///< meridional node spacing <= spacing_factor * h / 2 (immersed boundary), <= h (fitted)
   int wall_nodes = 0;
+  double rim_refinement = 1.0; ///< fitted: smallest ring spacing at the tube's ends / interior spacing
+  double wall_row_aspect = 0.0; ///< fitted: rows graded towards the wall where columns are narrow (FittedMeshParams)
+  std::vector<double> ring_s0; ///< reference ring positions (fitted; empty: uniform), m
   double ks = 0.0;             ///< N/m, the network's spring constant
   double D = 0.0;              ///< J, the wall's bending rigidity
   std::string bending_source;  ///< "full3d.membrane.bending_rigidity" or the k_b mapping used

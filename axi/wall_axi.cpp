@@ -95,16 +95,62 @@ AxiWall::AxiWall(const AxiWallParams& p) : p_(p) {
   if (!(p.D >= 0.0) || !std::isfinite(p.D))
     throw InputError("axi wall bending rigidity D", num(p.D), "a non-negative bending rigidity in J");
   n_ = p.nodes;
-  h_ = p.L / (n_ - 1);
+  if (!p.s0.empty()) {
+    bool ok = int(p.s0.size()) == n_ && p.s0.front() == 0.0 && p.s0.back() == p.L;
+    for (int k = 1; ok && k < n_; ++k) ok = p.s0[k] > p.s0[k - 1];
+    if (!ok)
+      throw InputError("axi wall reference positions", std::to_string(p.s0.size()) + " values",
+                       std::to_string(n_) + " strictly increasing positions from 0 to L (m)");
+  }
   X0_.setZero(3, n_);
-  A_.resize(n_);
   for (int k = 0; k < n_; ++k) {
-    X0_(0, k) = k == n_ - 1 ? p.L : k * h_;
+    X0_(0, k) = !p.s0.empty() ? p.s0[k] : k == n_ - 1 ? p.L : k * (p.L / (n_ - 1));
     X0_(1, k) = p.R0;
-    A_[k] = 2.0 * kPi * p.R0 * h_ * (k == 0 || k == n_ - 1 ? 0.5 : 1.0);
   }
   h0_.resize(n_ - 1);
   for (int e = 0; e + 1 < n_; ++e) h0_[e] = X0_(0, e + 1) - X0_(0, e);
+  h_ = p.s0.empty() ? p.L / (n_ - 1) : h0_.maxCoeff();
+  h_min_ = p.s0.empty() ? h_ : h0_.minCoeff();
+  A_.resize(n_);
+  w_.setZero(n_);
+  for (int k = 0; k < n_; ++k) {
+    const double left = k > 0 ? h0_[k - 1] : 0.0, right = k + 1 < n_ ? h0_[k] : 0.0;
+    A_[k] = kPi * p.R0 * (left + right);
+    if (k == 0 || k == n_ - 1) continue;
+    w_[k] = 0.5 * (left + right);
+    if (k == 1) w_[k] += 0.5 * h0_[0];            // the rear end's half-cell
+    if (k == n_ - 2) w_[k] += 0.5 * h0_[n_ - 2];  // the front end's half-cell
+  }
+}
+
+std::vector<double> graded_ring_positions(double L, double spacing, double end_ratio, double growth) {
+  if (!(std::isfinite(end_ratio) && end_ratio > 0.0 && end_ratio <= 1.0))
+    throw InputError("axi.rim_refinement", num(end_ratio), "a ratio in (0, 1] (1: uniform ring spacing)");
+  if (!(std::isfinite(growth) && growth > 1.0))
+    throw InputError("axi.rim_refinement", "growth " + num(growth), "a growth ratio > 1");
+  if (!(std::isfinite(L) && L > 0.0 && std::isfinite(spacing) && spacing > 0.0 && spacing <= L))
+    throw InputError("axi.spacing_factor", num(spacing) + " m", "a ring spacing in (0, L = " + num(L) + " m]");
+  // at each end the spacings d end_ratio growth^i (i = 0..m-1, all below d), inwards from the
+  // rim; between them `mid` uniform spacings d: L = d (mid + 2 c), c = sum_i end_ratio growth^i
+  std::vector<double> ratios;
+  for (double w = end_ratio; w < 1.0 - 1e-9; w *= growth) ratios.push_back(w);
+  double c = 0.0;
+  for (double w : ratios) c += w;
+  const int mid = std::max(1, int(std::ceil(L / spacing - 2.0 * c - 1e-9)));
+  const double d = L / (mid + 2.0 * c);
+  std::vector<double> end;
+  for (double w : ratios) end.push_back(w * d);
+  std::vector<double> s{0.0};
+  for (auto it = end.begin(); it != end.end(); ++it) s.push_back(s.back() + *it);
+  const double a = s.back(), b = L - a;
+  for (int i = 1; i < mid; ++i) s.push_back(a + (b - a) * i / mid);
+  s.push_back(b);
+  for (auto it = end.rbegin(); it != end.rend(); ++it) s.push_back(s.back() + *it);
+  s.back() = L;
+  for (size_t k = 1; k < s.size(); ++k)
+    if (!(s[k] > s[k - 1]))
+      throw InputError("axi.rim_refinement", num(end_ratio), "too fine for the swimmer's length; use a larger ratio");
+  return s;
 }
 
 double AxiWall::uniform_energy(double R) const {
@@ -128,9 +174,8 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
     throw InputError("axi wall positions", std::to_string(X.cols()) + " columns",
                      "3 x " + std::to_string(n_) + " (one column per wall node)");
   const int n = n_, ne = n - 1;
-  const double h = h_, R0 = p_.R0, ks = p_.ks, D = p_.D, nu = kWallPoisson;
+  const double R0 = p_.R0, ks = p_.ks, D = p_.D, nu = kWallPoisson;
   const double inv_R0 = 1.0 / R0;
-  const double ws = kPi * R0 * h;  // 2 pi R0 h * (1/2): the Gauss weight of a segment
   const double G = kPi * R0 * D;   // 2 pi R0 * D/2
   const bool grad = F != nullptr;
   if (grad) F->setZero();
@@ -151,6 +196,7 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
     S(5, e) = 0.0;
     // stretching
     const double ls = l / h0_[e];
+    const double ws = kPi * R0 * h0_[e];  // 2 pi R0 h_e * (1/2): the Gauss weight of a segment
     const double ra = X(1, e);
     const double lt1 = (ra + kXi1 * dr) / R0, lt2 = (ra + kXi2 * dr) / R0;
     if (grad) {
@@ -175,17 +221,17 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
     // hoop term, midpoint rule per segment
     for (int e = 0; e < ne; ++e) {
       const double kt = S(3, e);
-      Eb += G * h * kt * kt;
-      S(4, e) += 2.0 * G * h * kt;
+      Eb += G * h0_[e] * kt * kt;
+      S(4, e) += 2.0 * G * h0_[e] * kt;
     }
     // meridional and mixed terms at the interior nodes
     for (int k = 1; k <= n - 2; ++k) {
-      const double w = n == 3 ? 2.0 * h : (k == 1 || k == n - 2) ? 1.5 * h : h;
+      const double w = w_[k], hb = 0.5 * (h0_[k - 1] + h0_[k]);
       const double c0 = S(0, k - 1), s0 = S(1, k - 1), c1 = S(0, k), s1 = S(1, k);
       const double dpsi = std::atan2(c0 * s1 - s0 * c1, c0 * c1 + s0 * s1);
-      const double kap = dpsi / h, ktm = 0.5 * (S(3, k - 1) + S(3, k));
+      const double kap = dpsi / hb, ktm = 0.5 * (S(3, k - 1) + S(3, k));
       Eb += G * w * (kap * kap + 2.0 * nu * kap * ktm);
-      const double dEdpsi = G * w * (2.0 * kap + 2.0 * nu * ktm) / h;
+      const double dEdpsi = G * w * (2.0 * kap + 2.0 * nu * ktm) / hb;
       S(5, k) += dEdpsi;
       S(5, k - 1) -= dEdpsi;
       const double dEdkt = G * w * nu * kap;  // on each of the two segments (d ktm / d kt = 1/2)

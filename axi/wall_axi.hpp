@@ -22,29 +22,32 @@
 //
 // Energy E = int over the reference surface (2 pi R0 ds0) of W_s + W_b.
 //
-// Discretisation: n nodes X_k = (x_k, r_k) at s0_k = k h, h = L/(n-1), linear segments
-// e = (k, k+1) between them.
+// Discretisation: n nodes X_k = (x_k, r_k) at reference positions s0_k (uniform, s0_k = k h with
+// h = L/(n-1), unless given: graded_ring_positions refines them towards the two ends), linear
+// segments e = (k, k+1) of reference length h_e = s0_{k+1} - s0_k between them, dual lengths
+// hb_k = (h_{k-1} + h_k) / 2 at the interior nodes. (Uniform spacing: h_e = hb_k = h.)
 //   Stretching, per segment: lambda_s,e = |X_{k+1} - X_k| / h_e (constant on the segment;
-//     h_e = x0_{k+1} - x0_k of reference(), h up to round-off, so that the reference shape
-//     is exactly stress free),
+//     h_e is taken from reference() so that the reference shape is exactly stress free),
 //     lambda_t linear along it, integrated by 2-point Gauss:
-//       E_s = 2 pi R0 h sum_e (1/2) sum_{g=1,2} W_s(lambda_s,e, lambda_t(xi_g)),
+//       E_s = 2 pi R0 sum_e h_e (1/2) sum_{g=1,2} W_s(lambda_s,e, lambda_t(xi_g)),
 //       xi_g = 1/2 -+ 1/(2 sqrt 3).
 //   Bending: psi_e = atan2(dr_e, dx_e) per segment; at interior node k (1..n-2)
-//       k_s,k = wrap(psi_k - psi_{k-1}) / h = atan2(t_{k-1} x t_k, t_{k-1} . t_k) / h
-//     (the turning angle, in (-pi, pi]); k_t,e = (cos psi_e - 1) / R0 = (dx_e / l_e - 1) / R0;
-//       E_b = 2 pi R0 (D/2) [ sum_e h k_t,e^2
+//       k_s,k = wrap(psi_k - psi_{k-1}) / hb_k = atan2(t_{k-1} x t_k, t_{k-1} . t_k) / hb_k
+//     (the turning angle over the distance between the segments' midpoints, in (-pi, pi]);
+//     k_t,e = (cos psi_e - 1) / R0 = (dx_e / l_e - 1) / R0;
+//       E_b = 2 pi R0 (D/2) [ sum_e h_e k_t,e^2
 //                             + sum_{k=1}^{n-2} w_k ( k_s,k^2 + 2 nu_b k_s,k kbar_t,k ) ],
 //       kbar_t,k = (k_t,k-1 + k_t,k) / 2,
 //     hoop term by the midpoint rule per segment, meridional and mixed terms at the interior
 //     nodes. An end node has one segment and no turning angle: no bending term is centred on
 //     it (the free edge carries no moment). The two end half-cells [0, h/2] and [L - h/2, L]
-//     are carried by the first and last interior nodes (w_1 = w_{n-2} = 3h/2, w_k = h
-//     otherwise; w_1 = 2h = L when n = 3), i.e. k_s is extrapolated as a constant into the end
-//     half-cells. Sum w_k = L, every term is then an O(h^2) quadrature of the continuum
-//     integral even when the curvature does not vanish at the edges (dropping the half-cells,
-//     w_1 = h, is O(h) there), and a node still couples to at most 2 neighbours each side.
-// Node areas (loads): A_k = 2 pi R0 h, and pi R0 h at the two end nodes.
+//     are carried by the first and last interior nodes (w_1 = hb_1 + h_0/2,
+//     w_{n-2} = hb_{n-2} + h_{n-2}/2, w_k = hb_k otherwise; w_1 = L when n = 3), i.e. k_s is
+//     extrapolated as a constant into the end half-cells. Sum w_k = L, every term is then an
+//     O(h^2) quadrature of the continuum integral even when the curvature does not vanish at
+//     the edges (dropping the half-cells is O(h) there), and a node still couples to at most 2
+//     neighbours each side.
+// Node areas (loads): A_k = 2 pi R0 hb_k, and pi R0 h_0, pi R0 h_{n-2} at the two end nodes.
 // Forces are the exact analytic gradient -dE/dX: the generalised force on the WHOLE ring (N),
 // rows 0 (axial) and 1 (radial); row 2 is 0.
 //
@@ -59,6 +62,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <array>
+#include <vector>
 
 namespace swim::axi {
 
@@ -68,7 +72,17 @@ struct AxiWallParams {
   double ks = 0.0;  ///< the network's spring constant, N/m
   double D = 0.0;   ///< bending rigidity, J
   int nodes = 0;    ///< meridian nodes (rings), >= 3
+  /// Reference positions s0_k of the nodes along the meridian, m: empty for the uniform spacing
+  /// L / (nodes - 1), else `nodes` values from 0 to L, strictly increasing.
+  std::vector<double> s0;
 };
+
+/// Reference ring positions from 0 to L refined towards both ends: interior spacing at most
+/// `spacing`; at each end the spacings end_ratio * d, end_ratio * d * growth, ... (d the
+/// interior spacing) until they reach d. end_ratio = 1 gives the uniform spacing
+/// L / ceil(L / spacing). Throws swim::InputError (keys `axi.rim_refinement`,
+/// `axi.spacing_factor`) for end_ratio outside (0, 1], growth <= 1, spacing not in (0, L].
+std::vector<double> graded_ring_positions(double L, double spacing, double end_ratio, double growth);
 
 /// Stretching energy density W_s(lambda_s, lambda_t) per unit reference area (J/m^2) of the
 /// network with spring constant ks (N/m); optionally its partial derivatives.
@@ -85,8 +99,10 @@ class AxiWall {
   explicit AxiWall(const AxiWallParams& p);
 
   int nodes() const { return n_; }
-  /// Reference node spacing h = L / (nodes - 1), m.
+  /// Largest reference node spacing, m (L / (nodes - 1) when uniform).
   double ds0() const { return h_; }
+  /// Smallest reference node spacing, m.
+  double min_ds0() const { return h_min_; }
   const AxiWallParams& params() const { return p_; }
   /// Reference positions: row 0 = axial x_k = s0_k (axis start at 0), row 1 = r = R0, row 2 = 0.
   const Eigen::Matrix3Xd& reference() const { return X0_; }
@@ -114,10 +130,11 @@ class AxiWall {
 
   AxiWallParams p_;
   int n_ = 0;
-  double h_ = 0.0;
+  double h_ = 0.0, h_min_ = 0.0;
   Eigen::Matrix3Xd X0_;
   Eigen::VectorXd A_;
   Eigen::VectorXd h0_;  ///< reference segment lengths h_e
+  Eigen::VectorXd w_;   ///< meridional bending weights w_k (interior nodes; 0 at the ends)
 };
 
 /// Static equilibrium of the wall under a uniform inward pressure P (Pa).

@@ -38,8 +38,11 @@ Protocol3d::Protocol3d(const ProtocolParams& p, const CylinderMesh& mesh, double
   seg_.assign(mesh.nodes(), 0);
   seg_count_.assign(n, 0);
   std::vector<int> ring_count(n, 0);
+  // reference axial position of each ring along the tube (the axi tier's rings may be graded)
+  std::vector<double> ring_s(mesh.n_rings);
+  for (int r = 0; r < mesh.n_rings; ++r) ring_s[r] = mesh.X0(0, mesh.node(r, 0)) - mesh.axis_start.x();
   for (int r = 0; r < mesh.n_rings; ++r) {
-    const double s = r * mesh.ring_spacing;
+    const double s = ring_s[r];
     int k = 0;
     while (k + 1 < n && s >= bounds_[k + 1] - 1e-12 * L) ++k;
     ++ring_count[k];
@@ -55,9 +58,10 @@ Protocol3d::Protocol3d(const ProtocolParams& p, const CylinderMesh& mesh, double
   if (!(e_ref_ > 0.0)) throw InputError("wave.contracted_ratio", "", "the reference energy of the contracted tube must be > 0");
   if (p_.dual_cell_segments) {
     ring_share_.assign(mesh.n_rings, {});
-    const double ds = mesh.ring_spacing;
-    for (int r = 0; r < mesh.n_rings; ++r) {
-      const double a = std::max(0.0, (r - 0.5) * ds), b = std::min(L, (r + 0.5) * ds);
+    const int nr = mesh.n_rings;
+    for (int r = 0; r < nr; ++r) {
+      const double a = r > 0 ? 0.5 * (ring_s[r - 1] + ring_s[r]) : 0.0;
+      const double b = r + 1 < nr ? 0.5 * (ring_s[r] + ring_s[r + 1]) : L;
       for (int k = 0; k < n; ++k) {
         const double o = std::min(b, bounds_[k + 1]) - std::max(a, bounds_[k]);
         if (o > 1e-12 * L) ring_share_[r].emplace_back(k, o / (b - a));
@@ -125,18 +129,20 @@ Eigen::VectorXd Protocol3d::levels(const Eigen::Matrix3Xd& X) const {
       const int nr = mesh_->n_rings;
       constexpr int kSub = 16;  // samples per half-cell (midpoint rule)
       for (int ring = 0; ring < nr; ++ring) {
-        double v = 0.0;
-        int count = 0;
+        double v = 0.0, len = 0.0;
         for (int side : {-1, 1}) {
           const int nb = ring + side;
           if (nb < 0 || nb >= nr) continue;
+          const double half = 0.5 * std::abs(mesh_->X0(0, mesh_->node(nb, 0)) - mesh_->X0(0, mesh_->node(ring, 0)));
+          double sum = 0.0;
           for (int j = 0; j < kSub; ++j) {
             const double w = 0.5 * (j + 0.5) / kSub;  // distance from the ring, in ring spacings
-            v += relay((1.0 - w) * rr[ring] + w * rr[nb], thr, lev, 4, eps);
-            ++count;
+            sum += relay((1.0 - w) * rr[ring] + w * rr[nb], thr, lev, 4, eps);
           }
+          v += half * sum / kSub;
+          len += half;
         }
-        for (int i = 0; i < mesh_->n_theta; ++i) s[mesh_->node(ring, i)] = v / count;
+        for (int i = 0; i < mesh_->n_theta; ++i) s[mesh_->node(ring, i)] = v / len;
       }
     } else {
       const Eigen::VectorXd r = node_radii(*mesh_, X);

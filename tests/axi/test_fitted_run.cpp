@@ -53,7 +53,7 @@ TEST(FittedCoupledWall, UniformLoadSettlesAtTheStaticEquilibriumOfTheWallLaw) {
   using namespace swim::axi;
   const double R0 = 0.125e-6, L = 0.2e-6, Rc = 0.25e-6, P = 0.05, mu = 1.2e-3, ks = 5.5e-8;
   const int n = 17;
-  const AxiWall wall(AxiWallParams{R0, L, ks, 1e-24, n});
+  const AxiWall wall(AxiWallParams{R0, L, ks, 1e-24, n, {}});
   const AxiPressureResponse stat = relax_under_pressure(wall, P);
   const swim::axi::FittedMeshParams mp = small_mesh(Rc);
   FittedStokes fluid(mp, mu, n);
@@ -130,7 +130,7 @@ std::array<double, 2> front_half_stroke(double T, int steps) {
   using namespace swim::axi;
   const double R0 = 0.125e-6, L = 0.2e-6, Rc = 0.25e-6, mu = 1.2e-3, ks = 5.5e-8, q0 = 0.2;
   const int n = 17;
-  const AxiWall wall(AxiWallParams{R0, L, ks, 2e-24, n});
+  const AxiWall wall(AxiWallParams{R0, L, ks, 2e-24, n, {}});
   const swim::axi::FittedMeshParams mp = small_mesh(Rc);
   FittedStokes fluid(mp, mu, n);
   Eigen::Matrix3Xd X = wall.reference();

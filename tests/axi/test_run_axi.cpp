@@ -56,7 +56,7 @@ TEST(AxiCoupledWall, UniformLoadSettlesAtTheStaticRadiusOfTheWallLaw) {
   const AxiGrid g{16, 128, h};
   AxiStokes stokes(g, mu);
   const int n = int(std::ceil(L / (0.25 * h))) + 1;
-  const AxiWall wall(AxiWallParams{R0, L, ks, 1e-24, n});
+  const AxiWall wall(AxiWallParams{R0, L, ks, 1e-24, n, {}});
   const AxiPressureResponse stat = relax_under_pressure(wall, P);
   Eigen::Matrix3Xd X = wall.reference();
   X.row(0).array() += 0.5 * (g.period() - L);

@@ -7,6 +7,10 @@
 #include <limits>
 #include <numbers>
 #include <random>
+#include <vector>
+
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 
 #include "axi/wall_axi.hpp"
 #include "common/errors.hpp"
@@ -84,7 +88,7 @@ TEST(AxiWall, ForcesEqualCentralDifferencesOfTheEnergyOnAPerturbedShape) {
   // ~ 1e-16 E / step, both below 1e-9 of the largest force here.
   for (double D : {0.0, kD, kDStrong})
     for (unsigned seed : {7u, 8u}) {
-      const AxiWall w(AxiWallParams{kR0, kL, kKs, D, 20});
+      const AxiWall w(AxiWallParams{kR0, kL, kKs, D, 20, {}});
       const Eigen::Matrix3Xd X = perturbed(w, 0.05, seed);
       std::array<double, 2> e{};
       const Eigen::Matrix3Xd F = w.forces(X, &e);
@@ -97,7 +101,7 @@ TEST(AxiWall, ForcesEqualCentralDifferencesOfTheEnergyOnAPerturbedShape) {
       EXPECT_DOUBLE_EQ(e[1], e2[1]);
       if (D > 0.0) {
         // the bending part alone (it is small beside stretching at the scene-scale D)
-        const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, 20});
+        const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, 20, {}});
         const Eigen::Matrix3Xd Fb = F - w0.forces(X);
         const auto [errb, scaleb] =
             gradient_error(w, X, Fb, [&](const Eigen::Matrix3Xd& Y) { return w.energies(Y)[1]; });
@@ -109,7 +113,7 @@ TEST(AxiWall, ForcesEqualCentralDifferencesOfTheEnergyOnAPerturbedShape) {
 
 TEST(AxiWall, TheReferenceCylinderHasZeroEnergyAndZeroForce) {
   for (int n : {3, 4, 41, 400}) {
-    const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, n});
+    const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, n, {}});
     std::array<double, 2> e{};
     const Eigen::Matrix3Xd F = w.forces(w.reference(), &e);
     // lambda_s is measured against the stored reference differences: exactly 1 there
@@ -131,7 +135,7 @@ TEST(AxiWall, TheReferenceCylinderHasZeroEnergyAndZeroForce) {
 }
 
 TEST(AxiWall, RigidAxialTranslationChangesNothingAndTheTotalAxialForceVanishes) {
-  const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, 41});
+  const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, 41, {}});
   for (unsigned seed : {3u, 4u, 5u}) {
     const Eigen::Matrix3Xd X = perturbed(w, 0.05, seed);
     Eigen::Matrix3Xd Y = X;
@@ -147,7 +151,7 @@ TEST(AxiWall, RigidAxialTranslationChangesNothingAndTheTotalAxialForceVanishes) 
 }
 
 TEST(AxiWall, MirroringTheShapeMirrorsTheForces) {
-  const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, 25});
+  const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, 25, {}});
   const Eigen::Matrix3Xd X = perturbed(w, 0.05, 11);
   const int n = w.nodes();
   Eigen::Matrix3Xd M(3, n);
@@ -188,7 +192,7 @@ TEST(AxiWall, TheLinearisedStretchingLawIsIsotropicWithYEqualToTwoKsOverRootThre
   EXPECT_NEAR(dt, ft, 1e-8 * kKs);
 
   // the wall's energy of a uniform state is 2 pi R0 L W_s (Gauss is exact for constant lambda_t)
-  const AxiWall w(AxiWallParams{kR0, kL, kKs, kD, 30});
+  const AxiWall w(AxiWallParams{kR0, kL, kKs, kD, 30, {}});
   Eigen::Matrix3Xd X = w.reference();
   X.row(0) *= ls;
   X.row(1) *= lt;
@@ -207,7 +211,7 @@ TEST(AxiWall, SmallUniformPressureGivesC1EqualToYOverR0SquaredInTheMiddleAndALin
   // of this 8 R0 tube is insensitive to the ends by design (full end-node areas A_0 = 2 pi R0 h
   // instead of half would move its C1 by only 2e-7), so the whole tube's uniformity is
   // checked as well (the same fault moves the end rings by half the deflection).
-  const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kD, 65});
+  const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kD, 65, {}});
   const double C1 = swim::axi::young_modulus_2d(kKs) / (kR0 * kR0);
   const double P = 1e-3 * C1 * kR0;  // R0 - R = 1e-3 R0
   const auto a = swim::axi::relax_under_pressure(w, P);
@@ -232,7 +236,7 @@ TEST(AxiWall, LargeUniformPressureMatchesTheClosedFormFreeEndedSolution) {
   ASSERT_LT(std::abs(dls), 1e-12 * kKs);
   ASSERT_NEAR(dlt, -P * kR0, 1e-12 * P * kR0);
   for (double D : {0.0, kD, kDStrong}) {
-    const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, D, 81});
+    const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, D, 81, {}});
     const auto r = swim::axi::relax_under_pressure(w, P);
     const int m = (w.nodes() - 1) / 2;
     // Newton's stopping residual (1e-9 of P A) leaves ~1e-9 of the deformation: 1e-7 is safe
@@ -248,7 +252,7 @@ TEST(AxiWall, LargeUniformPressureMatchesTheClosedFormFreeEndedSolution) {
 }
 
 TEST(AxiWall, RelaxationReportsBadArgumentsAndNonConvergence) {
-  const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kD, 33});
+  const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kD, 33, {}});
   EXPECT_THROW(swim::axi::relax_under_pressure(w, 0.0), swim::InputError);
   EXPECT_THROW(swim::axi::relax_under_pressure(w, 1.0, 0.0, 0), swim::InputError);
   const double P = 0.45 * swim::axi::young_modulus_2d(kKs) / kR0;
@@ -256,13 +260,13 @@ TEST(AxiWall, RelaxationReportsBadArgumentsAndNonConvergence) {
 }
 
 TEST(AxiWall, InvalidParametersAreRejected) {
-  EXPECT_THROW(AxiWall(AxiWallParams{0.0, kL, kKs, kD, 10}), swim::InputError);
-  EXPECT_THROW(AxiWall(AxiWallParams{kR0, -kL, kKs, kD, 10}), swim::InputError);
-  EXPECT_THROW(AxiWall(AxiWallParams{kR0, kL, 0.0, kD, 10}), swim::InputError);
-  EXPECT_THROW(AxiWall(AxiWallParams{kR0, kL, kKs, -kD, 10}), swim::InputError);
-  EXPECT_THROW(AxiWall(AxiWallParams{kR0, kL, kKs, kD, 2}), swim::InputError);
-  EXPECT_NO_THROW(AxiWall(AxiWallParams{kR0, kL, kKs, 0.0, 3}));
-  const AxiWall w(AxiWallParams{kR0, kL, kKs, kD, 10});
+  EXPECT_THROW(AxiWall(AxiWallParams{0.0, kL, kKs, kD, 10, {}}), swim::InputError);
+  EXPECT_THROW(AxiWall(AxiWallParams{kR0, -kL, kKs, kD, 10, {}}), swim::InputError);
+  EXPECT_THROW(AxiWall(AxiWallParams{kR0, kL, 0.0, kD, 10, {}}), swim::InputError);
+  EXPECT_THROW(AxiWall(AxiWallParams{kR0, kL, kKs, -kD, 10, {}}), swim::InputError);
+  EXPECT_THROW(AxiWall(AxiWallParams{kR0, kL, kKs, kD, 2, {}}), swim::InputError);
+  EXPECT_NO_THROW(AxiWall(AxiWallParams{kR0, kL, kKs, 0.0, 3, {}}));
+  const AxiWall w(AxiWallParams{kR0, kL, kKs, kD, 10, {}});
   EXPECT_THROW(w.forces(Eigen::Matrix3Xd::Zero(3, 9)), swim::InputError);
 }
 
@@ -279,11 +283,11 @@ TEST(AxiWall, AMeridionalKinkCostsBendingEnergyProportionalToD) {
     }
     return X;
   };
-  const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, n});
+  const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, n, {}});
   const auto e0 = w0.energies(kinked(w0));
   EXPECT_EQ(e0[1], 0.0);
   for (double D : {kD, kDStrong}) {
-    const AxiWall w(AxiWallParams{kR0, kL, kKs, D, n});
+    const AxiWall w(AxiWallParams{kR0, kL, kKs, D, n, {}});
     const auto e = w.energies(kinked(w));
     const double h = w.ds0(), kap = alpha / h, kt = (std::cos(alpha) - 1) / kR0, nu = 1.0 / 3.0;
     const double expect = kPi * kR0 * D * ((n - 1 - m) * h * kt * kt + h * (kap * kap + nu * kap * kt));
@@ -293,7 +297,7 @@ TEST(AxiWall, AMeridionalKinkCostsBendingEnergyProportionalToD) {
 }
 
 TEST(AxiWall, AUniformContractionCostsNoBendingEnergy) {
-  const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, 33});
+  const AxiWall w(AxiWallParams{kR0, kL, kKs, kDStrong, 33, {}});
   Eigen::Matrix3Xd X = w.reference();
   X.row(1).array() *= 0.6;
   EXPECT_LT(w.energies(X)[1], 1e-15 * kDStrong);
@@ -302,7 +306,7 @@ TEST(AxiWall, AUniformContractionCostsNoBendingEnergy) {
   EXPECT_LT(e[1], 1e-15 * kDStrong);
   EXPECT_GT(e[0], 0.0);
   // and no bending force: the forces are those of the wall without bending
-  const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, 33});
+  const AxiWall w0(AxiWallParams{kR0, kL, kKs, 0.0, 33, {}});
   EXPECT_LT(max_abs(w.forces(X) - w0.forces(X)), 1e-15 * max_abs(w0.forces(X)));
 }
 
@@ -324,7 +328,7 @@ TEST(AxiWall, AGentleAxialUndulationConvergesToTheContinuumIntegralAtSecondOrder
     Es += (kL / M) * 2 * kPi * kR0 * swim::axi::stretching_density(kKs, std::sqrt(g), r / kR0);
   }
   auto errors = [&](int n) {
-    const AxiWall w(AxiWallParams{kR0, kL, kKs, D, n});
+    const AxiWall w(AxiWallParams{kR0, kL, kKs, D, n, {}});
     Eigen::Matrix3Xd X = w.reference();
     for (int k = 0; k < n; ++k) X(1, k) = kR0 * (1 + eps * std::cos(kw * X(0, k)));
     const auto e = w.energies(X);
@@ -338,4 +342,108 @@ TEST(AxiWall, AGentleAxialUndulationConvergesToTheContinuumIntegralAtSecondOrder
   }
   EXPECT_LT(e3[0], 0.01 * Eb);  // and close: 40 nodes per wavelength
   EXPECT_LT(e3[1], 0.01 * Es);
+}
+
+// ---- rings refined towards the rims (graded_ring_positions)
+
+TEST(AxiWall, GradedRingPositionsRefineGeometricallyTowardsBothRimsAndAreUniformAtRatioOne) {
+  const double d = kL / 40;
+  const std::vector<double> u = swim::axi::graded_ring_positions(kL, d, 1.0, 1.5);
+  ASSERT_EQ(u.size(), 41u);
+  for (size_t k = 1; k < u.size(); ++k) EXPECT_NEAR(u[k] - u[k - 1], d, 1e-12 * d);
+  const std::vector<double> s = swim::axi::graded_ring_positions(kL, d, 0.2, 1.5);
+  const int n = int(s.size());
+  EXPECT_EQ(s.front(), 0.0);
+  EXPECT_EQ(s.back(), kL);
+  // 0.2, 0.3, 0.45, 0.675 of the interior spacing at each end (1.625 spacings each), and
+  // ceil(40 - 3.25) = 37 interior spacings: 45 segments
+  ASSERT_EQ(n, 46);
+  const double dm = s[n / 2] - s[n / 2 - 1];
+  EXPECT_LE(dm, d * (1 + 1e-12));
+  const double expect[4] = {0.2, 0.3, 0.45, 0.675};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_NEAR(s[i + 1] - s[i], expect[i] * dm, 1e-12 * dm) << i;
+    EXPECT_NEAR(s[n - 1 - i] - s[n - 2 - i], expect[i] * dm, 1e-12 * dm) << i;  // mirror
+  }
+  EXPECT_THROW(swim::axi::graded_ring_positions(kL, d, 0.0, 1.5), swim::InputError);
+  EXPECT_THROW(swim::axi::graded_ring_positions(kL, d, 1.2, 1.5), swim::InputError);
+  EXPECT_THROW(swim::axi::graded_ring_positions(kL, 2 * kL, 0.5, 1.5), swim::InputError);
+}
+
+TEST(AxiWall, OnGradedRingsTheForcesAreTheEnergysGradientAndTheUniformLoadStateIsExactOnEveryRing) {
+  const std::vector<double> s0 = swim::axi::graded_ring_positions(8 * kR0, 8 * kR0 / 40, 0.15, 1.5);
+  const int n = int(s0.size());
+  for (unsigned seed : {3u, 4u}) {
+    const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kDStrong, n, s0});
+    const Eigen::Matrix3Xd X = perturbed(w, 0.01, seed);
+    const Eigen::Matrix3Xd F = w.forces(X);
+    const auto [err, scale] = gradient_error(w, X, F, [&](const Eigen::Matrix3Xd& Y) { return total(w, Y); });
+    EXPECT_LT(err, 1e-7 * scale) << "seed " << seed;
+  }
+  EXPECT_NEAR(area_sum(AxiWall(AxiWallParams{kR0, 8 * kR0, kKs, kD, n, s0})), 2 * kPi * kR0 * 8 * kR0,
+              1e-13 * 2 * kPi * kR0 * 8 * kR0);
+  // the uniform contraction under a uniform load does not see the spacing (the closed form of
+  // LargeUniformPressureMatchesTheClosedFormFreeEndedSolution)
+  const double Y = swim::axi::young_modulus_2d(kKs), lt = 0.55, P = (1 - lt) * Y / kR0;
+  const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kDStrong, n, s0});
+  const auto r = swim::axi::relax_under_pressure(w, P);
+  double spread = 0;
+  for (int k = 0; k < n; ++k) spread = std::max(spread, std::abs(r.X(1, k) - lt * kR0));
+  EXPECT_LT(spread, 1e-7 * kR0);
+  EXPECT_NEAR(r.X(0, n - 1), std::sqrt((4 - lt * lt) / 3) * 8 * kR0, 1e-7 * 8 * kR0);
+}
+
+/// Equilibrium of the wall under the load -P0 (s0/L)^2 A_k e_r (x_0 held): Newton with the
+/// wall's stiffness. Returns the positions.
+Eigen::Matrix3Xd relax_under_ramp(const AxiWall& w, double P0) {
+  const int n = w.nodes();
+  const Eigen::VectorXd& A = w.node_area();
+  Eigen::Matrix3Xd X = w.reference();
+  for (int it = 0; it < 40; ++it) {
+    const Eigen::Matrix3Xd F = w.forces(X);
+    Eigen::VectorXd g(2 * n);
+    for (int k = 0; k < n; ++k) {
+      const double s = w.reference()(0, k) / w.params().L;
+      g[2 * k] = k == 0 ? 0.0 : -F(0, k);
+      g[2 * k + 1] = -F(1, k) + P0 * s * s * A[k];
+    }
+    if (g.norm() < 1e-10 * P0 * A.maxCoeff()) return X;
+    Eigen::SparseMatrix<double> K = w.stiffness(X, 1e-6 * kR0);
+    for (int c = 0; c < K.outerSize(); ++c)
+      for (Eigen::SparseMatrix<double>::InnerIterator i(K, c); i; ++i)
+        if (i.row() == 0 || i.col() == 0) i.valueRef() = i.row() == i.col() ? 1.0 : 0.0;
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu(K);
+    const Eigen::VectorXd d = lu.solve(-g);
+    for (int k = 0; k < n; ++k) {
+      X(0, k) += d[2 * k];
+      X(1, k) += d[2 * k + 1];
+    }
+    if (d.lpNorm<Eigen::Infinity>() < 1e-12 * kR0) return X;  // the round-off floor of the residual
+  }
+  ADD_FAILURE() << "Newton did not converge on " << n << " rings";
+  return X;
+}
+
+TEST(AxiWall, UnderALoadRampTheRimConvergesAtSecondOrderOnUniformAndOnGradedRingsToOneLimit) {
+  // The load rises as (s0/L)^2 to 0.3 Pa at the front rim, which contracts to about 0.4 R0
+  // with a bending boundary layer there: the rim radius is the wall's most sensitive figure.
+  const double P0 = 0.3;
+  auto rim = [&](int segments, double ratio) {
+    const std::vector<double> s0 = swim::axi::graded_ring_positions(kL, kL / segments, ratio, 1.5);
+    const AxiWall w(AxiWallParams{kR0, kL, kKs, 2.1184615504e-24, int(s0.size()), s0});
+    const Eigen::Matrix3Xd X = relax_under_ramp(w, P0);
+    return X(1, w.nodes() - 1);
+  };
+  const double u1 = rim(32, 1.0), u2 = rim(64, 1.0), u3 = rim(128, 1.0);
+  const double order = std::log2((u2 - u1) / (u3 - u2));
+  EXPECT_GT(order, 1.8);
+  EXPECT_LT(order, 2.2);
+  const double limit = u3 + (u3 - u2) / (std::pow(2.0, order) - 1);
+  EXPECT_GT(limit, 0.35 * kR0);
+  EXPECT_LT(limit, 0.5 * kR0);
+  // graded rims (0.25 of the spacing at the rim) converge to the same limit, and on every grid
+  // are at least as close to it as the uniform rings
+  const double g1 = rim(32, 0.25), g3 = rim(128, 0.25);
+  EXPECT_LT(std::abs(g1 - limit), std::abs(u1 - limit));
+  EXPECT_LT(std::abs(g3 - limit), 1e-3 * (kR0 - limit));
 }
