@@ -155,6 +155,72 @@ TEST(FittedMesh, PlacesTheMembraneVerticesOnMeshNodesAndGradesTheGap) {
     EXPECT_NEAR(u.column_x(c + 1) - u.column_x(c), (kP - kL) / 16, 1e-12 * kP);
 }
 
+// Rows graded towards the membrane line where the columns are narrow (wall_row_aspect): on a tube
+// whose vertices are refined towards its two rims, the row next to the membrane line in a rim
+// column is at most aspect x the narrower adjacent column high, the rows grow monotonically
+// (positive Jacobians) and keep filling the axis-to-membrane and membrane-to-container
+// distances, and where the columns are wide enough the rows are exactly the uniform ones. The
+// Poiseuille solution stays exact on it (the elements are still vertical-sided quadrilaterals).
+// Fails if a graded row overshoots the membrane line or the container, or the grading leaks
+// into the wide columns.
+Eigen::Matrix3Xd rim_graded_tube(const std::vector<double>& s, double amp) {
+  const int n = int(s.size());
+  Eigen::Matrix3Xd X = Eigen::Matrix3Xd::Zero(3, n);
+  for (int k = 0; k < n; ++k) {
+    const double u = s[k] / s.back();
+    X(0, k) = 0.3e-6 + s[k];
+    X(1, k) = kA * (1.0 + amp * std::sin(2 * kPi * u));
+  }
+  return X;
+}
+const std::vector<double> kRimS = {0.0,    2e-9,   5e-9,   9.5e-9, 25e-9,  50e-9,  75e-9,  100e-9, 125e-9,
+                                   150e-9, 175e-9, 200e-9, 225e-9, 250e-9, 275e-9, 300e-9, 325e-9, 350e-9,
+                                   375e-9, 390.5e-9, 395e-9, 398e-9, 400e-9};
+
+TEST(FittedMesh, GradesItsRowsTowardsTheWallInNarrowColumnsOnly) {
+  const int n = int(kRimS.size());
+  FittedMeshParams p = params(10, 10, 24, false, 4.0);
+  p.wall_row_aspect = 2.0;
+  FittedMesh m(p, n);
+  const Eigen::Matrix3Xd X = rim_graded_tube(kRimS, 0.2);
+  m.fit(X);
+  EXPECT_GT(m.min_jacobian(), 0.0);
+  const int ci = p.cells_inner, ny = m.rows();
+  for (int c = 0; c < m.columns(); ++c) {
+    const double wl = m.column_x(c) - (c > 0 ? m.column_x(c - 1) : m.column_x(m.columns() - 1) - kP);
+    const double wr = m.column_x(c + 1) - m.column_x(c);
+    const double rho = m.interface_radius(c), eta = 2.0 * std::min(wl, wr);
+    EXPECT_EQ(m.vertex_r(c, 0), 0.0);
+    EXPECT_EQ(m.vertex_r(c, ci), rho);
+    EXPECT_EQ(m.vertex_r(c, ny), kRc);
+    for (int j = 0; j < ny; ++j) EXPECT_GT(m.vertex_r(c, j + 1), m.vertex_r(c, j)) << c << " " << j;
+    const double below = rho - m.vertex_r(c, ci - 1), above = m.vertex_r(c, ci + 1) - rho;
+    if (eta < rho / ci) {
+      EXPECT_LE(below, eta * (1 + 1e-12)) << c;
+    } else {
+      EXPECT_NEAR(below, rho / ci, 1e-12 * rho) << c;  // uniform
+    }
+    if (eta < (kRc - rho) / p.cells_outer) {
+      EXPECT_LE(above, eta * (1 + 1e-12)) << c;
+    } else {
+      EXPECT_NEAR(above, (kRc - rho) / p.cells_outer, 1e-12 * kRc) << c;
+    }
+  }
+  // the rim columns are graded: their first rows are 2 x 2 nm, a third of the uniform 12.5 nm
+  EXPECT_LT(X(1, 0) - m.vertex_r(0, ci - 1), 0.35 * X(1, 0) / ci);
+  EXPECT_LT(m.vertex_r(n - 1, ci + 1) - X(1, n - 1), 0.35 * (kRc - X(1, n - 1)) / p.cells_outer);
+  // the middle columns (25 nm wide: eta = 50 nm above the 12.5 nm uniform rows) are not
+  EXPECT_NEAR(X(1, n / 2) - m.vertex_r(n / 2, ci - 1), X(1, n / 2) / ci, 1e-12 * kA);
+
+  FittedStokes st(p, kMu, n);
+  st.factor(X);
+  Eigen::Matrix3Xd U;
+  const Body f = [](double, double) { return Eigen::Vector2d(kG, 0.0); };
+  st.solve(Eigen::Matrix3Xd::Zero(3, n), U, &f);
+  const double eu = nodal_error(st, [](double, double r) { return Eigen::Vector2d(poiseuille_w(r), 0.0); });
+  EXPECT_LT(eu / poiseuille_w(0.0), 1e-11);
+}
+
 // ---------------------------------------------------------------------------------------------
 // 1. Poiseuille
 
