@@ -112,12 +112,15 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   // (default 2 per h: the wall's bending boundary layers are shorter than the fluid's scales)
   p.spacing_factor = ib ? a.number("spacing_factor", 0.5, Range::open(0.0, 1.0))
                         : a.number("spacing_factor", 1.0, Range::open(0.0, 2.0 + 1e-12));
-  // fitted: the rings are refined geometrically (ratio 1.5) towards the tube's two rims, from
-  // rim_refinement times the interior spacing: the flow is singular at the wall's free edge
-  p.rim_refinement = a.number("rim_refinement", 1.0, Range{0.0, 1.0, true, false});
-  if (ib && p.rim_refinement != 1.0)
-    throw InputError(a.path("rim_refinement"), fmt(p.rim_refinement, ""),
-                     "1 (uniform rings) with axi.method = immersed_boundary; the rim refinement is the fitted method's");
+  // fitted: the rings are refined geometrically (ratio 1.5) towards the tube's two rims, the end
+  // segments min(1, rim_refinement h / R0) times the interior spacing: the flow is singular at
+  // the wall's free edge, and an end spacing proportional to h^2 keeps its error second order
+  const bool rim_given = a.has("rim_refinement");
+  const double rim = a.number("rim_refinement", 1.0, Range::positive());
+  if (ib && rim_given)
+    throw InputError(a.path("rim_refinement"), fmt(rim, ""),
+                     "no value with axi.method = immersed_boundary (its rings are uniform); the rim refinement is the "
+                     "fitted method's");
   // local position error per step in cells: the explicit immersed boundary's steps are bounded
   // by its stability anyway; the fitted method's Rosenbrock steps by the tolerance alone (at
   // 2e-3 h its time error is 1e-5 of the displacement and 1e-3 of the cycle time, docs/axi.md)
@@ -164,6 +167,7 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
                        "must exceed swimmer.length + 2 h = " + fmt(L + 2.0 * p.h, "m"));
     p.cells_inner = std::max(2, int(std::lround(R0 / p.h)));
     p.cells_outer = std::max(2, int(std::lround((Rc - R0) / p.h)));
+    p.rim_refinement = std::min(1.0, rim * p.h / R0);
     if (p.rim_refinement < 1.0) {
       // rows graded towards the wall next to the refined rims (element aspect 2, as the interior's
       // h by h/2), one more row on each side per level of the rims' refinement

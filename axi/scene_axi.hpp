@@ -40,7 +40,7 @@ struct ParamsAxi {
   // wall
   double spacing_factor = 0.5; ///< meridional node spacing <= spacing_factor * h / 2 (immersed boundary), <= h (fitted)
   int wall_nodes = 0;
-  double rim_refinement = 1.0; ///< fitted: smallest ring spacing at the tube's ends / interior spacing
+  double rim_refinement = 1.0; ///< fitted: end ring spacing / interior spacing, min(1, axi.rim_refinement h / R0)
   double wall_row_aspect = 0.0; ///< fitted: rows graded towards the wall where columns are narrow (FittedMeshParams)
   std::vector<double> ring_s0; ///< reference ring positions (fitted; empty: uniform), m
   double ks = 0.0;             ///< N/m, the network's spring constant

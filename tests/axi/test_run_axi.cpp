@@ -101,6 +101,16 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
   s = base;
   s["axi"]["tolerance"] = 0.0;
   EXPECT_EQ(input_error_key(s), "axi.tolerance");
+  // the rims' refinement is the fitted method's: the immersed boundary keeps uniform rings
+  s = base;
+  s["axi"]["rim_refinement"] = 0.25;
+  EXPECT_EQ(input_error_key(s), "axi.rim_refinement");
+  s["axi"]["method"] = "fitted";
+  EXPECT_EQ(input_error_key(s), "(accepted)");
+  for (double bad : {0.0, -0.5}) {
+    s["axi"]["rim_refinement"] = bad;
+    EXPECT_EQ(input_error_key(s), "axi.rim_refinement") << bad;
+  }
 }
 
 namespace {
