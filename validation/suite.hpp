@@ -56,4 +56,10 @@ scene::json run_suite(const SuiteOptions& o);
 /// refuses is an InputError naming suite.cases[i].reference.
 scene::json load_suite(const std::string& path, const std::string& data_dir = "");
 
+/// The checks of load_suite on a suite document read from `path`: every key known and of its
+/// type at every level, thresholds and lists in range, and (with `scenes`) every case's scene
+/// read by the 3D reader on each grid and time-step variant, every 1D model's scene by the 1D
+/// reader (also at each of cells1d and rtol1d), the extremes' and the references' scenes.
+void check_suite(const scene::json& suite, const std::string& path, const std::string& data_dir, bool scenes = true);
+
 }  // namespace swim::validation
