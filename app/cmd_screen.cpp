@@ -122,7 +122,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     plot("plot_screen.py", plot_args);
   } catch (const Interrupted& e) {
     // the designs are complete; the figure is not: the status says so, and nothing announces it
-    summary["status"] = std::string("interrupted: ") + e.what() + "; designs.csv is complete, screen.png was not written";
+    summary["status"] = std::string(e.what()) + "; designs.csv is complete, screen.png was not written";
     output::write_json(out + "/screen.json", summary);
     throw;
   }

@@ -39,6 +39,7 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   o.only = only;
   if (progress != 0) o.progress = [](const std::string& line) { std::fprintf(stderr, "validate: %s\n", line.c_str()); };
   o.run_progress = progress;
+  o.scenes_checked = true;
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);
   const bool plotted = plot("plot_validation.py", {out});

@@ -49,7 +49,10 @@ void check_other_tier(const scene::json& sc, const std::string& tier) {
 
 void check_sweep_scenes(const sweep::Sweep& sw) {
   check_other_tier(sw.base, "1d");
-  for (const auto& a : sw.axes)
+  for (const auto& a : sw.axes) {
+    // only an axis into those sections can change them
+    const std::string section = a.key.substr(0, a.key.find('.'));
+    if (section != "full3d" && section != "axi") continue;
     for (const auto& v : a.values) {
       scene::json sc = sw.base;
       try {
@@ -59,6 +62,7 @@ void check_sweep_scenes(const sweep::Sweep& sw) {
         throw InputError("vary." + a.key, scene::show(v), std::string("a value swim run --set accepts: ") + e.what());
       }
     }
+  }
 }
 
 OutputEstimate estimate_output(const reduced1d::Params& p) {

@@ -50,8 +50,9 @@ std::string json_text_with_checksum(json value);
 /// What a JSON text's own checksum says of it.
 enum class OwnChecksum {
   Ok,        ///< "self_fnv1a64" matches the text
-  Absent,    ///< no "self_fnv1a64" (written before files carried one, with the legacy basis)
-  Mismatch,  ///< the text was changed after it was written (or its checksum is malformed)
+  Absent,    ///< complete JSON without "checksum_algorithm" and "self_fnv1a64": written before
+             ///< files carried them (with the legacy basis)
+  Mismatch,  ///< the text was changed or cut after it was written (or its checksum is malformed)
 };
 OwnChecksum check_own_checksum(std::string_view text);
 

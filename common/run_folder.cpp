@@ -92,7 +92,8 @@ std::string verify_folder(const std::string& dir, const std::vector<std::string>
     case OwnChecksum::Absent:
       return summary + ": written by an older swim (no checksum of its own; its file checksums use the legacy FNV "
                        "offset basis), so it cannot be verified";
-    case OwnChecksum::Mismatch: return summary + ": changed after it was written (its own checksum does not match)";
+    case OwnChecksum::Mismatch:
+      return summary + ": changed or cut after it was written (its own checksum does not match)";
   }
   const scene::json j = scene::json::parse(text, nullptr, false);
   if (j.is_discarded() || !j.is_object()) return summary + ": not valid JSON";
