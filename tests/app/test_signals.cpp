@@ -136,8 +136,9 @@ TEST(Signals, UsageErrorsAreOneLineAndAnEmptyOutIsRefused) {
     const int st = std::system((swim + args + " > /dev/null 2> \"" + (dir / "err.txt").string() + "\"").c_str());
     return std::make_pair(WIFEXITED(st) ? WEXITSTATUS(st) : -1, slurp(dir / "err.txt"));
   };
-  for (const std::string args : {"run " + demo + " --tier 2d", "run " + demo + " " + demo, "screen x.json --jobs -3",
-                                 "run " + demo + " --out \"\"", "validate --out \"\""}) {
+  for (const std::string& args : std::vector<std::string>{"run " + demo + " --tier 2d", "run " + demo + " " + demo,
+                                                          "screen x.json --jobs -3", "run " + demo + " --out \"\"",
+                                                          "validate --out \"\""}) {
     const auto [code, err] = run(args);
     EXPECT_EQ(code, 2) << args << ": " << err;
     EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << args << ": " << err;

@@ -140,8 +140,14 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   // where the uninterrupted run ended
   const std::string stopped = c["runs3d"][0]["folder"].get<std::string>();
   {
-    scene::json resolved = scene::load_file(stopped + "/scene.resolved.json"), again;
-    const full3d::Params3d p = full3d::read_scene3d(resolved, again);
+    // the scene the edited suite runs on the first grid, as the suite builds it (the output
+    // settings are part of what a checkpoint resumes)
+    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json"), again;
+    for (const auto& [k, v] : suite["cases"][0]["set"].items()) scene::apply_override(sc, k + "=" + v.dump());
+    scene::apply_override(sc, "full3d.grid=" + suite["cases"][0]["grids"][0].dump());
+    for (const char* set : {"full3d.threads=1", "full3d.output.vtk=false", "full3d.output.fluid_fields=false"})
+      scene::apply_override(sc, set);
+    const full3d::Params3d p = full3d::read_scene3d(sc, again);
     fs::remove_all(stopped);
     fs::create_directories(stopped);
     full3d::RunControl ctl;
