@@ -156,3 +156,26 @@ TEST(Signals, UsageErrorsAreOneLineAndAnEmptyOutIsRefused) {
   EXPECT_EQ(left, std::vector<std::string>{"notes.txt"});
   fs::remove_all(dir);
 }
+
+// A plotting failure says why: a python3 without matplotlib (here an importable module that
+// refuses to load) is named as such, and the command still succeeds with its data files.
+TEST(Signals, APlottingFailureSaysMatplotlibIsMissing) {
+  const fs::path dir = tmpdir("nompl");
+  fs::create_directories(dir / "py" / "matplotlib");
+  std::ofstream(dir / "py" / "matplotlib" / "__init__.py") << "raise ImportError('matplotlib stand-in')\n";
+  const json sweep = {{"base", SWIM_SOURCE_DIR "/data/scenes/demo.json"},
+                      {"vary", {{"wave.contracted_ratio", {{"values", {0.5, 0.6}}}}}}};
+  std::ofstream(dir / "sweep.json") << sweep.dump();
+  const std::string cmd = "PYTHONPATH=\"" + (dir / "py").string() + "\" \"" SWIM_BINARY_DIR "/bin/swim\" screen \"" +
+                          (dir / "sweep.json").string() + "\" --out \"" + (dir / "out").string() +
+                          "\" --quiet > /dev/null 2> \"" + (dir / "err.txt").string() + "\"";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st));
+  EXPECT_EQ(WEXITSTATUS(st), 0);
+  const std::string err = slurp(dir / "err.txt");
+  EXPECT_NE(err.find("python3-matplotlib is not installed"), std::string::npos) << err;
+  EXPECT_TRUE(fs::exists(dir / "out" / "designs.csv"));
+  EXPECT_FALSE(fs::exists(dir / "out" / "screen.png"));
+  EXPECT_EQ(json::parse(slurp(dir / "out" / "screen.json"))["status"], "ok");
+  fs::remove_all(dir);
+}
