@@ -2,6 +2,7 @@
 // errors propagate as swim::InputError (exit 2) or swim::NumericalError (exit 3).
 #pragma once
 
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,8 +36,33 @@ int validate(const std::string& suite, bool quick, const std::string& out, int t
 
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
 std::string data_dir();
-/// Run a plotting script of tools/ with Debian's python3; returns false (with a warning on
-/// stderr) when plotting is unavailable. Plots are a convenience: their failure never fails a run.
+/// Run a plotting script of tools/ with Debian's python3 (run_child); returns false (with a
+/// warning on stderr saying whether python3-matplotlib is missing or the script failed) when
+/// plotting is unavailable. Plots are a convenience: their failure never fails a run, but an
+/// interruption does (Interrupted).
 bool plot(const std::string& script, const std::vector<std::string>& args);
+
+/// A command interrupted by a signal (SIGINT, SIGTERM, SIGHUP) while a child process ran: the
+/// child has been stopped and waited for. Exit status 128 + the signal.
+class Interrupted : public std::runtime_error {
+ public:
+  Interrupted(int signal, const std::string& during);
+  int signal() const { return signal_; }
+
+ private:
+  int signal_;
+};
+
+/// How a child process ended.
+struct ChildResult {
+  std::string spawn_error;  ///< not started (the program is missing): the reason
+  int exit_code = -1;       ///< its exit status when it exited
+  int killed_by = 0;        ///< the signal that ended it otherwise
+};
+
+/// Runs argv (argv[0] a path) as a child in its own process group (posix_spawn), its stderr
+/// sent to swim's stdout. While it runs, SIGINT, SIGTERM and SIGHUP sent to swim are forwarded
+/// to its group; swim waits for it, then throws Interrupted naming `what` when a signal came.
+ChildResult run_child(const std::vector<std::string>& argv, const std::string& what);
 
 }  // namespace swim::app

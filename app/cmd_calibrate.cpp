@@ -5,6 +5,7 @@
 #include <cstdio>
 
 #include "app/app.hpp"
+#include "app/scene_checks.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/run_folder.hpp"
@@ -22,6 +23,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   for (const auto& s : sets) scene::apply_override(sc, s);
   scene::json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+  check_other_tier(sc, "3d");  // the whole scene, as a 3D run checks it
   const std::string out = out_opt.empty() ? "out/" + p.name + "-calibration" : out_opt;
   // The folder belongs to this calibration from the start: a folder in use, or holding another
   // run's results (without --overwrite), is refused before minutes of 3D runs.

@@ -30,18 +30,6 @@ std::string data_dir() {
   return SWIM_SOURCE_DIR "/data";
 }
 
-bool plot(const std::string& script, const std::vector<std::string>& args) {
-  std::string cmd = std::string("\"") + SWIM_PLOT_PYTHON + "\" \"" + SWIM_SOURCE_DIR + "/tools/" + script + "\"";
-  for (const auto& a : args) cmd += " \"" + a + "\"";
-  cmd += " 2>&1";
-  if (std::system(cmd.c_str()) != 0) {
-    std::fprintf(stderr, "swim: warning: plotting with %s failed (python3-matplotlib missing?); data files are complete\n",
-                 script.c_str());
-    return false;
-  }
-  return true;
-}
-
 namespace {
 
 // One human-readable line per 1D run, SI prefixes; per-cycle figures only when a cycle completed.

@@ -10,6 +10,7 @@
 #include "common/progress.hpp"
 #include "common/run_folder.hpp"
 #include "common/sweep.hpp"
+#include "app/scene_checks.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/screen.hpp"
 
@@ -37,6 +38,7 @@ std::string csv_field(std::string s) {
 
 int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, int progress, bool overwrite) {
   const sweep::Sweep sw = sweep::read_sweep(sweep_path, reduced1d::metric_names());
+  check_sweep_scenes(sw);
   // Validate every design before running any of them (exit 2, nothing written).
   std::vector<reduced1d::Params> designs;
   designs.reserve(sw.count());
@@ -116,7 +118,14 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   }
   std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name};
   for (const auto& a : sw.axes) plot_args.push_back(a.key);
-  plot("plot_screen.py", plot_args);
+  try {
+    plot("plot_screen.py", plot_args);
+  } catch (const Interrupted& e) {
+    // the designs are complete; the figure is not: the status says so, and nothing announces it
+    summary["status"] = std::string(e.what()) + "; designs.csv is complete, screen.png was not written";
+    output::write_json(out + "/screen.json", summary);
+    throw;
+  }
   output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
 
   std::printf("screened %zu designs in %.3g s (%.4g designs/s), %ld failed\n", results.size(), wall,

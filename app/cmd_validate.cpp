@@ -39,6 +39,7 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   o.only = only;
   if (progress != 0) o.progress = [](const std::string& line) { std::fprintf(stderr, "validate: %s\n", line.c_str()); };
   o.run_progress = progress;
+  o.scenes_checked = true;
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);
   const bool plotted = plot("plot_validation.py", {out});
@@ -56,6 +57,18 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
                   c["reference"]["statement"].get<std::string>().c_str());
   for (const auto& f : report["findings"])
     std::printf("  %-13s %s\n", f["status"].get<std::string>().c_str(), f["claim"].get<std::string>().c_str());
+  const scene::json& cache = report["cache"];
+  std::printf("  cache: %ld result(s) reused after verification, %zu rejected and recomputed%s\n",
+              cache["reused"].get<long>(), cache["rejections"].size(), cache["rejections"].empty() ? "" : ":");
+  for (const auto& r : cache["rejections"])
+    std::printf("    %s: %s\n", r["path"].get<std::string>().c_str(), r["reason"].get<std::string>().c_str());
+  if (!cache["verified"].get<bool>()) {
+    const scene::json& u = cache["unverified"][0];
+    std::fprintf(stderr, "swim: output failure: %zu result file(s) the report read changed while the suite ran (%s: %s); "
+                 "run swim validate again to recompute them\n",
+                 cache["unverified"].size(), u["path"].get<std::string>().c_str(), u["reason"].get<std::string>().c_str());
+    return 3;
+  }
   return 0;
 }
 

@@ -99,9 +99,22 @@ int main(int argc, char** argv) {
   } catch (const CLI::CallForAllHelp& e) {
     return cli.exit(e);
   } catch (const CLI::ParseError& e) {
-    std::fprintf(stderr, "swim: invalid input: %s\nRun 'swim --help' for usage.\n", e.what());
+    // one message, one line, as every other refusal
+    std::string m = e.what();
+    for (char& ch : m)
+      if (ch == '\n' || ch == '\r') ch = ' ';
+    while (!m.empty() && m.back() == ' ') m.pop_back();
+    std::fprintf(stderr, "swim: invalid input: %s (run 'swim --help' for usage)\n", m.c_str());
     return 2;
   }
+  // a folder flag given an empty value is a mistake, not "the default folder"
+  for (CLI::App* c : {run, demo, scr, ben, cal, val})
+    for (const char* flag : {"--out", "--resume"})
+      if (*c && c->get_option_no_throw(flag) && c->get_option(flag)->count() > 0 &&
+          c->get_option(flag)->as<std::string>().empty()) {
+        std::fprintf(stderr, "swim: invalid input: key '%s' = \"\": a folder name (leave the flag out for the default)\n", flag);
+        return 2;
+      }
   const int progress = progress_off ? 0 : progress_on ? 1 : -1;
   try {
     if (*run) {
@@ -114,6 +127,9 @@ int main(int argc, char** argv) {
     if (*sc) return app::scenes();
     if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);
+  } catch (const app::Interrupted& e) {
+    std::fprintf(stderr, "swim: %s; the child process was stopped and nothing runs on\n", e.what());
+    return 128 + e.signal();
   } catch (const InputError& e) {
     std::fprintf(stderr, "swim: %s\n", e.what());
     return 2;

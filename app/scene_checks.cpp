@@ -7,6 +7,7 @@
 #include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "full3d/scene3d_keys.hpp"
+#include "reduced1d/scene1d.hpp"
 #include "reduced1d/scene1d_keys.hpp"
 #include "reduced1d/solver.hpp"
 
@@ -35,6 +36,33 @@ void check_other_tier(const scene::json& sc, const std::string& tier) {
   const scene::json& keys = reduced1d::section_keys();
   for (auto it = keys.begin(); it != keys.end(); ++it)
     if (sc.contains(it.key())) scene::check_section(sc.at(it.key()), it.key(), it.value());
+  // one scene, one validation: the values of the 1D tier's own sections are read by its reader
+  // (cheap) as in a 1D run; a refusal of one of them refuses the scene here too
+  try {
+    scene::json resolved;
+    reduced1d::read_scene(sc, resolved);
+  } catch (const InputError& e) {
+    for (auto it = keys.begin(); it != keys.end(); ++it)
+      if (e.key() == it.key() || e.key().rfind(it.key() + ".", 0) == 0) throw;
+  }
+}
+
+void check_sweep_scenes(const sweep::Sweep& sw) {
+  check_other_tier(sw.base, "1d");
+  for (const auto& a : sw.axes) {
+    // only an axis into those sections can change them
+    const std::string section = a.key.substr(0, a.key.find('.'));
+    if (section != "full3d" && section != "axi") continue;
+    for (const auto& v : a.values) {
+      scene::json sc = sw.base;
+      try {
+        scene::apply_override(sc, a.key + "=" + v.dump());
+        check_other_tier(sc, "1d");
+      } catch (const InputError& e) {
+        throw InputError("vary." + a.key, scene::show(v), std::string("a value swim run --set accepts: ") + e.what());
+      }
+    }
+  }
 }
 
 OutputEstimate estimate_output(const reduced1d::Params& p) {

@@ -7,6 +7,7 @@
 #include <string>
 
 #include "common/scene.hpp"
+#include "common/sweep.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/params.hpp"
 
@@ -14,8 +15,15 @@ namespace swim::app {
 
 /// Throws InputError naming the key when a section of the tier that is not running
 /// (`running_tier` "1d": full3d and axi; "3d": model1d, numerics1d and axi; "axi": model1d and
-/// numerics1d; the full3d section is read by the axisymmetric tier itself) is malformed.
+/// numerics1d; the full3d section is read by the axisymmetric tier itself) is malformed. In a
+/// 3D or axi run (and a calibration) the 1D sections' values are also read by the 1D reader:
+/// `numerics1d.cells = 0` is refused there as in a 1D run.
 void check_other_tier(const scene::json& scene, const std::string& running_tier);
+
+/// The sections of a sweep's scenes that the 1D reader does not read, checked as `swim run`
+/// checks them (check_other_tier) for the base scene and for every value of every axis: an axis
+/// `full3d.nosuch` is refused like `--set full3d.nosuch=...`. InputError naming vary.<key>.
+void check_sweep_scenes(const sweep::Sweep& sw);
 
 /// Estimated bytes a run writes (series, radius samples, VTK frames), and the key whose
 /// interval dominates the estimate. Zero when the run's span is not known before it runs

@@ -355,6 +355,24 @@ void reset_ledger(const std::string& dir) {
     it = inside(it->first, d) ? l.failures.erase(it) : std::next(it);
 }
 
+bool adopt(const std::string& path) {
+  std::error_code ec;
+  if (!fs::is_regular_file(path, ec)) return false;
+  std::ifstream in(path, std::ios::binary);
+  if (!in) return false;
+  std::uint64_t sum = kFnv1a64Offset;
+  std::uintmax_t bytes = 0;
+  char b[1 << 16];
+  while (in) {
+    in.read(b, sizeof b);
+    const auto got = static_cast<std::size_t>(in.gcount());
+    sum = fnv1a64(b, got, sum);
+    bytes += got;
+  }
+  record(path, bytes, sum);
+  return true;
+}
+
 std::string file_checksum(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
   if (!in) return "";

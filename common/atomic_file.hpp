@@ -118,6 +118,12 @@ void note_failure(const std::string& path, const std::string& reason);
 /// Forget the ledger of `dir` (a new run owns the folder).
 void reset_ledger(const std::string& dir);
 
+/// Record a file already in its folder in the ledger, with its size and checksum now: a file
+/// an earlier process of the same run committed (the VTK frames a resumed run wrote before its
+/// checkpoint), so that the folder's summary.json lists it. False when it is not a readable
+/// regular file.
+bool adopt(const std::string& path);
+
 /// FNV-1a 64-bit checksum of a file's bytes, as 16 hex digits ("" when unreadable).
 std::string file_checksum(const std::string& path);
 

@@ -51,8 +51,49 @@ void write_json(const std::string& path, const json& value) {
     out = &with_files;
   }
   AtomicFile f(path);
-  f.stream() << out->dump(2, ' ', false, json::error_handler_t::replace) << "\n";
+  if (carries_own_checksum(path)) f.stream() << json_text_with_checksum(*out);
+  else f.stream() << out->dump(2, ' ', false, json::error_handler_t::replace) << "\n";
   f.commit();
+}
+
+bool carries_own_checksum(const std::string& path) {
+  const std::string name = fs::path(path).filename().string();
+  return name == "summary.json" || name == "calibration.json";
+}
+
+namespace {
+constexpr std::string_view kOwnKey = "\"self_fnv1a64\": \"";
+constexpr std::string_view kZeros = "0000000000000000";
+}  // namespace
+
+std::string json_text_with_checksum(json value) {
+  value.erase("checksum_algorithm");
+  value.erase("self_fnv1a64");
+  value["checksum_algorithm"] = kChecksumAlgorithm;
+  value["self_fnv1a64"] = std::string(kZeros);
+  std::string text = value.dump(2, ' ', false, json::error_handler_t::replace) + "\n";
+  // the key is the text's last: its value is found from the end, never inside a scene's text
+  const std::size_t at = text.rfind(kOwnKey);
+  const std::string sum = hex64(fnv1a64(text));
+  text.replace(at + kOwnKey.size(), kZeros.size(), sum);
+  return text;
+}
+
+OwnChecksum check_own_checksum(std::string_view text) {
+  const std::size_t at = text.rfind(kOwnKey);
+  if (at == std::string_view::npos) {
+    // a file of an older swim is complete JSON without the trailer; a cut one is not JSON
+    const json j = json::parse(text, nullptr, false);
+    return !j.is_discarded() && j.is_object() && !j.contains("checksum_algorithm") ? OwnChecksum::Absent
+                                                                                   : OwnChecksum::Mismatch;
+  }
+  const std::size_t v = at + kOwnKey.size();
+  if (text.size() < v + kZeros.size() + 1 || text[v + kZeros.size()] != '"') return OwnChecksum::Mismatch;
+  const std::string_view written = text.substr(v, kZeros.size());
+  if (written.find_first_not_of("0123456789abcdef") != std::string_view::npos) return OwnChecksum::Mismatch;
+  std::string zeroed(text);
+  zeroed.replace(v, kZeros.size(), kZeros);
+  return hex64(fnv1a64(zeroed)) == written ? OwnChecksum::Ok : OwnChecksum::Mismatch;
 }
 
 CsvWriter::CsvWriter(const std::string& path, std::vector<std::string> header)

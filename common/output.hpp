@@ -35,7 +35,26 @@ void make_dir(const std::string& dir);
 /// Write `value` as indented JSON to `path`, atomically; every number must be finite.
 /// For a file named summary.json, a "files" list (name, bytes, fnv1a64) of the files
 /// written into its folder is added, and a folder with a failed file is an OutputError.
+/// summary.json and calibration.json also carry a checksum of themselves (json_text_with_checksum).
 void write_json(const std::string& path, const json& value);
+
+/// True for the files that carry a checksum of themselves: summary.json and calibration.json,
+/// the commit points of run and calibration folders.
+bool carries_own_checksum(const std::string& path);
+
+/// `value` as indented JSON text ending with "checksum_algorithm" (kChecksumAlgorithm) and
+/// "self_fnv1a64": the FNV-1a 64 of the whole text with those 16 digits written as zeros. Any
+/// "checksum_algorithm" and "self_fnv1a64" already in `value` are replaced.
+std::string json_text_with_checksum(json value);
+
+/// What a JSON text's own checksum says of it.
+enum class OwnChecksum {
+  Ok,        ///< "self_fnv1a64" matches the text
+  Absent,    ///< complete JSON without "checksum_algorithm" and "self_fnv1a64": written before
+             ///< files carried them (with the legacy basis)
+  Mismatch,  ///< the text was changed or cut after it was written (or its checksum is malformed)
+};
+OwnChecksum check_own_checksum(std::string_view text);
 
 /// True when `value` holds no NaN/Inf number anywhere.
 bool all_finite(const json& value);

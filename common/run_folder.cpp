@@ -75,6 +75,57 @@ std::string json_hash(const scene::json& value) {
   return hex64(fnv1a64(s));
 }
 
+std::string json_hash_legacy(const scene::json& value) {
+  const std::string s = value.dump(-1, ' ', false, scene::json::error_handler_t::replace);
+  return hex64(fnv1a64(s.data(), s.size(), kFnv1a64LegacyOffset));
+}
+
+std::string verify_folder(const std::string& dir, const std::vector<std::string>& required, const std::string& summary) {
+  const fs::path sp = fs::path(dir) / summary;
+  std::error_code ec;
+  if (!fs::is_regular_file(sp, ec)) return summary + ": missing";
+  const auto size = fs::file_size(sp, ec);
+  if (ec || size > (64u << 20)) return summary + ": unreadable or larger than 64 MB";
+  const std::string text = read_text(sp, static_cast<std::size_t>(size));
+  switch (check_own_checksum(text)) {
+    case OwnChecksum::Ok: break;
+    case OwnChecksum::Absent:
+      return summary + ": written by an older swim (no checksum of its own; its file checksums use the legacy FNV "
+                       "offset basis), so it cannot be verified";
+    case OwnChecksum::Mismatch:
+      return summary + ": changed or cut after it was written (its own checksum does not match)";
+  }
+  const scene::json j = scene::json::parse(text, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return summary + ": not valid JSON";
+  std::set<std::string> listed;
+  if (j.contains("files")) {
+    if (!j["files"].is_array()) return summary + ": \"files\" is not a list";
+    for (const auto& f : j["files"]) {
+      if (!f.is_object() || !f.contains("name") || !f["name"].is_string() || !f.contains("bytes") ||
+          !f["bytes"].is_number_unsigned() || !f.contains("fnv1a64") || !f["fnv1a64"].is_string())
+        return summary + ": an entry of \"files\" is malformed";
+      const std::string name = f["name"].get<std::string>();
+      const fs::path rel(name);
+      if (name.empty() || rel.is_absolute() || name.find("..") != std::string::npos)
+        return summary + ": lists a file outside its folder (" + message_text(name, 60) + ")";
+      listed.insert(name);
+      const fs::path p = fs::path(dir) / rel;
+      if (!fs::is_regular_file(p, ec)) return name + ": missing (listed in " + summary + ")";
+      const auto bytes = fs::file_size(p, ec);
+      const auto want = f["bytes"].get<std::uintmax_t>();
+      if (ec || bytes != want)
+        return name + ": " + std::to_string(bytes) + " bytes, " + summary + " lists " + std::to_string(want);
+      const std::string sum = file_checksum(p.string());
+      if (sum != f["fnv1a64"].get<std::string>())
+        return name + ": changed (FNV-1a 64 " + sum + ", " + summary + " lists " +
+               message_text(f["fnv1a64"].get<std::string>(), 20) + ")";
+    }
+  }
+  for (const auto& r : required)
+    if (!listed.count(r)) return r + ": not listed in " + summary;
+  return {};
+}
+
 bool RunFolder::is_result_name(const std::string& rel) {
   static const std::set<std::string> fixed = {"summary.json",  "series.csv",     "radius.csv",  "series.csv.part",
                                               "radius.csv.part", "solver_stats.json",
@@ -94,11 +145,13 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
   std::error_code ec;
   if (fs::exists(dir_, ec) && !fs::is_directory(dir_, ec))
     throw InputError(o.key, shown, "is not a folder; give a folder for the run's results");
+  const bool folder_existed = fs::exists(dir_, ec);
   fs::create_directories(dir_, ec);
   if (ec) throw InputError(o.key, shown, "cannot create the output folder: " + ec.message());
 
   // 1. The lock: one run per folder at a time.
   const std::string lock_path = (fs::path(dir_) / kLock).string();
+  const bool lock_existed = fs::exists(lock_path, ec);
   lock_fd_ = ::open(lock_path.c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
   if (lock_fd_ < 0)
     throw InputError(o.key, shown, std::string("cannot create the lock file .swim.lock: ") + std::strerror(errno) +
@@ -163,8 +216,9 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
                                    : old_summary.is_object() && old_summary.contains("scene")
                                        ? json_hash(old_summary["scene"])
                                        : "";
+      // a record written before the standard FNV-1a basis holds the legacy hash of the scene
       const bool same_run =
-          old_hash == hash && old_tier == o.tier && old_status.rfind("running", 0) != 0 && !old_status.empty();
+          (old_hash == hash || old_hash == json_hash_legacy(o.resolved)) && old_tier == o.tier && old_status.rfind("running", 0) != 0 && !old_status.empty();
       if (!o.overwrite && !same_run)
         throw InputError(o.key, shown,
                          "holds the results of another run (" + (old_tier.empty() ? "" : old_tier + ", ") +
@@ -188,7 +242,14 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
     AtomicFile f((fs::path(dir_) / kOwner).string());
     f.stream() << rec.dump(2) << "\n";
     f.commit();
-  } catch (...) {  // InputError (exit 2), or OutputError (exit 3: the run's record cannot be written)
+  } catch (const InputError&) {
+    // a refusal leaves the folder as it was: the lock file and the folder this run created go
+    if (!lock_existed) ::unlink(lock_path.c_str());
+    ::close(lock_fd_);
+    lock_fd_ = -1;
+    if (!folder_existed) fs::remove(dir_, ec);  // only when empty
+    throw;
+  } catch (...) {  // OutputError (exit 3: the run's record cannot be written)
     ::close(lock_fd_);
     lock_fd_ = -1;
     throw;
@@ -207,7 +268,8 @@ bool RunFolder::mark_failed(const std::string& message) noexcept {
     s["status"] = "failed: " + message;
     s.erase("files");  // the listed files may be the partial ones
     AtomicFile f(summary.string());
-    f.stream() << s.dump(2, ' ', false, scene::json::error_handler_t::replace) << "\n";
+    if (carries_own_checksum(summary.string())) f.stream() << json_text_with_checksum(s);
+    else f.stream() << s.dump(2, ' ', false, scene::json::error_handler_t::replace) << "\n";
     f.commit();
     return true;
   } catch (...) {

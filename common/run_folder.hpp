@@ -61,7 +61,18 @@ class RunFolder {
   int lock_fd_ = -1;
 };
 
+/// Why the results of a finished folder cannot be trusted, "" when they can: its summary
+/// (`summary`, "summary.json" or "calibration.json") carries its own checksum and it matches
+/// (output::check_own_checksum), and every file it lists (`files`) exists with the listed size and
+/// FNV-1a 64 checksum; each name of `required` must be listed. The reason names the file and
+/// what is wrong with it ("series.csv: 1204 bytes, summary.json lists 1210").
+std::string verify_folder(const std::string& dir, const std::vector<std::string>& required = {},
+                          const std::string& summary = "summary.json");
+
 /// FNV-1a 64-bit hash of the compact dump of `value`, 16 hex digits.
 std::string json_hash(const scene::json& value);
+/// The same with the legacy offset basis (kFnv1a64LegacyOffset): the scene hash of run records
+/// written before the standard basis.
+std::string json_hash_legacy(const scene::json& value);
 
 }  // namespace swim::output

@@ -3,13 +3,17 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
+#include <iterator>
 
 #include "common/errors.hpp"
 #include "common/units.hpp"
 
 namespace swim::sweep {
 namespace {
+
+constexpr std::size_t kMaxDesigns = 1000000;
 
 std::string num(double v) {
   char b[32];
@@ -45,6 +49,8 @@ Axis read_axis(const std::string& key, const json& spec) {
       throw InputError(where + ".count", spec.contains("count") ? scene::show(spec["count"]) : "(missing)",
                        "must be an integer in [1, 100000]");
     const long n = spec["count"].get<long>();
+    if (spec.contains("spacing") && !spec["spacing"].is_string())
+      throw InputError(where + ".spacing", scene::show(spec["spacing"]), "must be one of: \"linear\", \"log\"");
     const std::string spacing = spec.value("spacing", std::string("linear"));
     if (spacing != "linear" && spacing != "log")
       throw InputError(where + ".spacing", "\"" + spacing + "\"", "must be one of: linear, log");
@@ -64,15 +70,27 @@ Axis read_axis(const std::string& key, const json& spec) {
     }
     if (spacing == "log" && !(from > 0 && to > 0))
       throw InputError(where + ".from", scene::show(f), "log spacing needs positive from and to");
+    // every value of the range a normal double (no overflow to inf, no NaN, no subnormal)
+    auto normal = [](double v) { return v == 0 || std::isnormal(v); };
+    if (!normal(from) || !normal(to))
+      throw InputError(where, scene::show(spec),
+                       "from and to must be finite numbers of normal size (0, or between 2.2e-308 and 1.8e308 in "
+                       "magnitude)");
     for (long i = 0; i < n; ++i) {
       const double s = n == 1 ? 0.0 : double(i) / double(n - 1);
       const double v = spacing == "log" ? from * std::pow(to / from, s) : from + (to - from) * s;
       // The values go into scenes and printouts as written: rounded to 8 significant digits,
       // so that 0.35 + 0.1 reads 0.45 (not 0.44999999999999996) in designs.csv and screen.json.
+      const std::string text = num(v);
+      const double rounded = std::strtod(text.c_str(), nullptr);
+      if (!std::isfinite(v) || !normal(rounded))
+        throw InputError(where, scene::show(spec),
+                         "a range whose every value is a finite number of normal size; value " + std::to_string(i) +
+                             " is " + text);
       if (unit.empty())
-        a.values.push_back(std::stod(num(v)));
+        a.values.push_back(rounded);
       else
-        a.values.push_back(num(v) + " " + unit);
+        a.values.push_back(text + " " + unit);
     }
   } else {
     throw InputError(where, scene::show(spec),
@@ -112,7 +130,7 @@ Axis read_axis(const std::string& key, const json& spec) {
 
 size_t Sweep::count() const {
   size_t n = 1;
-  for (const auto& a : axes) n *= a.values.size();
+  for (const auto& a : axes) n *= a.values.size();  // read_sweep refuses a product above kMaxDesigns
   return n;
 }
 
@@ -134,10 +152,20 @@ json Sweep::design(size_t index) const {
 
 Sweep read_sweep(const std::string& path, const std::vector<std::string>& metrics) {
   namespace fs = std::filesystem;
-  const json j = scene::load_file(path);
+  return parse_sweep(scene::load_file(path), fs::path(path).parent_path().string(), fs::path(path).stem().string(),
+                     metrics);
+}
+
+Sweep parse_sweep(const json& j, const std::string& dir_name, const std::string& stem,
+                  const std::vector<std::string>& metrics) {
+  namespace fs = std::filesystem;
   Sweep sw;
-  sw.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : fs::path(path).stem().string();
-  const fs::path dir = fs::path(path).parent_path();
+  if (!j.is_object()) throw InputError("sweep", scene::show(j), "a JSON object with base, vary, metric and goal");
+  for (const char* k : {"name", "description", "metric", "goal"})
+    if (j.contains(k) && !j[k].is_string()) throw InputError(k, scene::show(j[k]), "a text");
+  if (j.contains("name")) scene::check_name(j["name"].get<std::string>());
+  sw.name = j.contains("name") ? j["name"].get<std::string>() : stem;
+  const fs::path dir(dir_name);
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.key() != "base" && it.key() != "vary" && it.key() != "metric" && it.key() != "goal" &&
         it.key() != "name" && it.key() != "description")
@@ -158,7 +186,21 @@ Sweep read_sweep(const std::string& path, const std::vector<std::string>& metric
   if (!j.contains("vary") || !j["vary"].is_object() || j["vary"].empty())
     throw InputError("vary", j.contains("vary") ? scene::show(j["vary"]) : "(missing)",
                      "must be an object mapping scene keys to value lists or ranges");
-  for (auto it = j["vary"].begin(); it != j["vary"].end(); ++it) sw.axes.push_back(read_axis(it.key(), it.value()));
+  std::size_t designs = 1;
+  std::string names;
+  for (auto it = j["vary"].begin(); it != j["vary"].end(); ++it) {
+    const std::string& k = it.key();
+    if (k.empty() || k.front() == '.' || k.back() == '.' || k.find("..") != std::string::npos)
+      throw InputError("vary." + k, scene::show(it.value()),
+                       "a dotted scene key with non-empty components, as swim run --set takes (\"swimmer.length\")");
+    sw.axes.push_back(read_axis(it.key(), it.value()));
+    names += (names.empty() ? "" : " x ") + it.key() + " (" + std::to_string(sw.axes.back().values.size()) + ")";
+    // the product checked as it grows: it never wraps
+    designs = designs > kMaxDesigns / sw.axes.back().values.size() ? kMaxDesigns + 1 : designs * sw.axes.back().values.size();
+    if (designs > kMaxDesigns)
+      throw InputError("vary", names + (std::next(it) == j["vary"].end() ? "" : " x ..."),
+                       "at most " + std::to_string(kMaxDesigns) + " designs (the product of the axes' value counts)");
+  }
   sw.metric = j.value("metric", std::string("mean_velocity_m_per_s"));
   if (std::find(metrics.begin(), metrics.end(), sw.metric) == metrics.end()) {
     std::string allowed;
@@ -168,7 +210,6 @@ Sweep read_sweep(const std::string& path, const std::vector<std::string>& metric
   const std::string goal = j.value("goal", std::string("max"));
   if (goal != "max" && goal != "min") throw InputError("goal", "\"" + goal + "\"", "must be one of: max, min");
   sw.maximize = goal == "max";
-  if (sw.count() > 1000000) throw InputError("vary", std::to_string(sw.count()) + " designs", "at most 1000000 designs");
   return sw;
 }
 

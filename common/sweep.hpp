@@ -42,5 +42,8 @@ struct Sweep {
 /// Read and validate a sweep file. `metrics` lists the allowed metric names.
 /// Throws InputError naming the key.
 Sweep read_sweep(const std::string& path, const std::vector<std::string>& metrics);
+/// The same for a sweep document already read: `dir` is the folder of relative base paths,
+/// `stem` the name when the sweep has none.
+Sweep parse_sweep(const json& j, const std::string& dir, const std::string& stem, const std::vector<std::string>& metrics);
 
 }  // namespace swim::sweep

@@ -105,6 +105,9 @@ CheckpointReader::CheckpointReader(const std::string& path, std::uint64_t scene_
   const auto bytes = load<std::uint64_t>(all, at);
   at += sizeof bytes;
   const auto sum = load<std::uint64_t>(all, at);
+  if (version == 4)
+    damaged("checkpoint format version 4, written by a swim whose checksums used a non-standard FNV-1a offset basis; "
+            "this swim reads version " + std::to_string(kCheckpointVersion) + " only");
   if (version != kCheckpointVersion)
     damaged("checkpoint format version " + std::to_string(version) + ", this swim reads version " +
             std::to_string(kCheckpointVersion) + " (written by another swim version, or damaged)");

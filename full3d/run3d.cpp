@@ -151,6 +151,8 @@ class Runner {
                                    " s (resume with --resume " + out_ + ")",
                                wall, stepper_, measured_);
     checkpoint_.save(stepper_, measured_, output_, marks, wall);
+    // summary.json last, listing checkpoint.bin as it now is
+    output_.write_snapshot_summary();
   }
 
   const Params3d& p_;

@@ -1,6 +1,8 @@
 #include "full3d/run3d_checkpoint.hpp"
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include "common/checksum.hpp"
 #include "full3d/grid.hpp"
@@ -140,6 +142,18 @@ CheckpointReader RunCheckpoint::open() const {
   if (!record::RunStream::matches(dir_, r.get_vector(kOutputMarks)))
     r.damaged("the partial results series.csv.part and radius.csv.part next to it are missing or do not match it "
               "(changed, or shorter than at the checkpoint)");
+  // every VTK frame the checkpoint (and the collections) refer to is still there
+  const std::pair<const char*, const char*> kinds[] = {{"vtk_frames", "vtk/membrane_%06d.vtp"}, {"fluid_frames", "vtk/fluid_%06d.vti"}};
+  for (const auto& [record, pattern] : kinds) {
+    const std::size_t n = r.get_vector(record).size();
+    for (std::size_t k = 0; k < n; ++k) {
+      char name[64];
+      std::snprintf(name, sizeof name, pattern, int(k));
+      std::error_code ec;
+      if (!std::filesystem::is_regular_file(std::filesystem::path(dir_) / name, ec))
+        r.damaged(std::string("the frame ") + name + " written before the checkpoint is missing");
+    }
+  }
   return r;
 }
 

@@ -173,6 +173,8 @@ std::vector<double> RunOutput::write_snapshot(const std::string& status, double 
   return record::write_snapshot(dir_, rec_, resolved_);
 }
 
+void RunOutput::write_snapshot_summary() { output::write_json(dir_ + "/summary.json", record::summary(rec_, resolved_)); }
+
 void RunOutput::save(CheckpointWriter& w, const std::vector<double>& marks) const {
   w.put(kOutputMarks, marks);
   std::vector<double> ft;
@@ -185,8 +187,16 @@ void RunOutput::save(CheckpointWriter& w, const std::vector<double>& marks) cons
 }
 
 void RunOutput::load(const CheckpointReader& r, std::uintmax_t max_bytes) {
-  for (double t : r.get_vector("vtk_frames")) pvd_.add(t, frame_name("membrane", "vtp", pvd_.frames().size()));
-  for (double t : r.get_vector("fluid_frames")) fluid_pvd_.add(t, frame_name("fluid", "vti", fluid_pvd_.frames().size()));
+  // the frames written before the checkpoint (RunCheckpoint::open checked they are there) are
+  // files of this run: the final summary.json lists them with the frames written after it
+  for (double t : r.get_vector("vtk_frames")) {
+    pvd_.add(t, frame_name("membrane", "vtp", pvd_.frames().size()));
+    output::adopt(dir_ + "/" + pvd_.frames().back().second);
+  }
+  for (double t : r.get_vector("fluid_frames")) {
+    fluid_pvd_.add(t, frame_name("fluid", "vti", fluid_pvd_.frames().size()));
+    output::adopt(dir_ + "/" + fluid_pvd_.frames().back().second);
+  }
   if (vtk_) pvd_.write();
   if (fluid_) fluid_pvd_.write();
   stream_ = std::make_unique<record::RunStream>(dir_, r.get_vector(kOutputMarks));

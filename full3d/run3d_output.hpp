@@ -41,6 +41,9 @@ class RunOutput {
   /// this status listing the part files so far). Returns the streams' marks for the checkpoint.
   std::vector<double> write_snapshot(const std::string& status, double wall, const Stepper& stepper,
                                      const Measurements& measured);
+  /// summary.json again as write_snapshot wrote it, now listing the checkpoint written after it:
+  /// the summary is the last file of every checkpoint, as of the end.
+  void write_snapshot_summary();
 
   /// The frame times, the bytes of the frames written and the streams' marks; load() also
   /// rewrites the collections of the enabled frame kinds, continues the streams from the

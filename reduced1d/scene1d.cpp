@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 
 #include "common/errors.hpp"
+#include "common/output.hpp"
 #include "common/scene_shared.hpp"
 #include "common/units.hpp"
 #include "reduced1d/outer_flow.hpp"
@@ -27,14 +29,32 @@ json load_calibration(const std::string& key, const std::string& path, const std
   namespace fs = std::filesystem;
   fs::path p(path);
   if (p.is_relative() && !fs::exists(p)) p = fs::path(scene_dir) / path;
-  std::ifstream in(p);
+  std::error_code ec;
+  if (fs::exists(p, ec) && !fs::is_regular_file(p, ec))
+    throw InputError(key, "\"" + path + "\"", "a calibration file (calibration.json written by swim calibrate); this is "
+                                              "a directory or another kind of file");
+  std::ifstream in(p, std::ios::binary);
   if (!in) throw InputError(key, "\"" + path + "\"", "calibration file not found (relative paths are tried from the "
                                                      "working directory, then from the scene's directory)");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  const std::string text = ss.str();
+  // a file that carries its own checksum (swim calibrate writes one) must still match it
+  if (text.find("\"self_fnv1a64\"") != std::string::npos &&
+      output::check_own_checksum(text) == output::OwnChecksum::Mismatch)
+    throw InputError(key, "\"" + path + "\"", "the calibration file was changed after it was written (its own "
+                                              "FNV-1a 64 checksum, self_fnv1a64, does not match); calibrate again");
+  json j;
   try {
-    return json::parse(in);
+    j = json::parse(text);
   } catch (const json::exception& e) {  // syntax, and numbers beyond a double (out_of_range)
     throw InputError(key, "\"" + path + "\"", std::string("calibration file is not valid JSON: ") + e.what());
   }
+  // a failed calibration may hold some of its figures; none of them is used
+  if (j.is_object() && j.contains("status") && !(j["status"].is_string() && j["status"].get<std::string>() == "ok"))
+    throw InputError(key, "\"" + path + "\"", "a calibration whose status is \"ok\"; this one's status is " +
+                                              scene::show(j["status"]));
+  return j;
 }
 }  // namespace
 

@@ -10,6 +10,12 @@
 #include <optional>
 #include <sstream>
 
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdlib>
+#include <cstring>
+
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/run_record.hpp"
@@ -211,17 +217,50 @@ std::string swimmer_key(const fs::path& file, const char* member, bool axi_tier 
   return key;
 }
 
+/// What the suite did with its cache: the results it reused, those it rejected (and why), and
+/// every folder and calibration file the report reads, verified again at the end.
+struct CacheLog {
+  long reused = 0;
+  json rejected = json::array();  ///< {"path", "reason"}
+  std::vector<std::string> folders, calibrations;
+  void reject(const std::string& path, const std::string& reason) {
+    rejected.push_back({{"path", path}, {"reason", reason}});
+  }
+};
+
+/// The files of a cached run the report reads (the series), and those that make it the run it
+/// is (its resolved scene, its radius field): each must be listed in its summary.json.
+const std::vector<std::string> kCachedRunFiles = {"series.csv", "radius.csv", "scene.resolved.json"};
+
+/// Why a calibration file cannot be used, "" when it can: it carries its own checksum and it
+/// matches, it is a JSON object and its status is "ok".
+std::string calibration_problem(const std::string& file) {
+  const fs::path p(file);
+  std::string why = output::verify_folder(p.parent_path().string(), {}, p.filename().string());
+  if (!why.empty()) return why;
+  std::ifstream in(file);
+  const json c = json::parse(in, nullptr, false);
+  if (c.is_discarded() || !c.is_object()) return "calibration.json: not valid JSON";
+  if (c.value("status", std::string()) != "ok")
+    return "calibration.json: status " + scene::show(c.value("status", json("(none)")));
+  return {};
+}
+
 /// A calibration file under `cal_dir` written in the current format for a scene whose physics,
 /// resolved by the current reader, is `physics` (same_swimmer); empty when there is none. A
 /// folder's name carries the hash of the physics it was written for and of its format
 /// version, which tells an older format apart.
-std::string cached_calibration(const std::string& cal_dir, const json& physics) {
+std::string cached_calibration(const std::string& cal_dir, const json& physics, CacheLog& log) {
   const std::string wanted = output::json_hash(physics);
   if (!fs::is_directory(cal_dir)) return {};
   for (const auto& e : fs::directory_iterator(cal_dir)) {
     const fs::path file = e.path() / "calibration.json";
+    if (!fs::exists(file)) continue;
+    if (const std::string why = calibration_problem(file.string()); !why.empty()) {
+      log.reject(file.string(), why);
+      continue;
+    }
     std::ifstream in(file);
-    if (!in) continue;
     const json c = json::parse(in, nullptr, false);
     if (c.is_discarded() || !c.contains("scene")) continue;
     const std::string folder = e.path().filename().string();
@@ -239,12 +278,27 @@ bool is_running(const json& summary) {
   return st.rfind("running", 0) == 0;
 }
 
-/// A finished run (summary status not "running") in `dir`, or null.
-json finished_summary(const std::string& dir) {
+/// A finished run (summary status not "running") in `dir` whose files pass their checks
+/// (output::verify_folder: summary.json's own checksum, every listed file's size and checksum,
+/// kCachedRunFiles listed), or null. A finished run that fails them is recorded in the log as
+/// rejected, with the reason, and is not used: the caller recomputes it.
+json finished_summary(const std::string& dir, CacheLog& log) {
+  if (!fs::exists(fs::path(dir) / "summary.json")) return nullptr;
+  {
+    std::ifstream in(dir + "/summary.json");
+    const json s = json::parse(in, nullptr, false);
+    if (!s.is_discarded() && is_running(s)) return nullptr;  // an interrupted run: resumed when its checkpoint passes
+  }
+  if (const std::string why = output::verify_folder(dir, kCachedRunFiles); !why.empty()) {
+    log.reject(dir, why);
+    return nullptr;
+  }
   std::ifstream in(dir + "/summary.json");
-  if (!in) return nullptr;
   json s = json::parse(in, nullptr, false);
-  if (s.is_discarded() || !s.contains("status") || !s["status"].is_string() || is_running(s)) return nullptr;
+  if (s.is_discarded() || !s.contains("status") || !s["status"].is_string()) {
+    log.reject(dir, "summary.json: no status");
+    return nullptr;
+  }
   return s;
 }
 
@@ -257,8 +311,8 @@ bool interrupted_run(const std::string& dir) {
 }
 
 /// frame_interval > 0: membrane frames (VTK) at that interval, for the side-view figure.
-Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached, double frame_interval = 0,
-             int progress = 0) {
+Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cached, CacheLog& log,
+             double frame_interval = 0, int progress = 0) {
   json s = sc;
   set_key(s, "full3d.threads", threads);
   set_key(s, "full3d.output.vtk", frame_interval > 0);
@@ -277,11 +331,11 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
   Run3d r;
   r.h = p.h;
   r.length = p.L;
-  json summary = finished_summary(dir);
+  json summary = finished_summary(dir, log);
   if (summary.is_null())
     for (const auto& e : fs::directory_iterator(runs_dir)) {
-      if (swimmer_key(e.path() / "scene.resolved.json", nullptr) != key) continue;
-      summary = finished_summary(e.path().string());
+      if (e.path() == fs::path(dir) || swimmer_key(e.path() / "scene.resolved.json", nullptr) != key) continue;
+      summary = finished_summary(e.path().string(), log);
       // an axi run of the same scene resolves to the same 3D physics: only a 3D run is one
       if (!summary.is_null() && summary.value("tier", std::string("3d")) != "3d") summary = nullptr;
       if (!summary.is_null()) {
@@ -297,11 +351,13 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
     try {
       full3d::check_resumable(p, resolved, dir);
       resume = true;
-    } catch (const InputError&) {
+    } catch (const InputError& e) {
+      log.reject(dir, std::string("interrupted run not resumed: ") + e.what());
     }
   }
   if (!*cached && !resume) {
     fs::remove_all(dir);
+    output::reset_ledger(dir);  // the folder's files are this run's alone
     fs::create_directories(dir);
   }
   // a fresh run's record comes from the tier; a cached one is read back from its folder
@@ -318,7 +374,9 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
     rec = resume ? record::read_run(dir) : std::move(out.record);
   } else {
     rec = record::read_run(dir);
+    ++log.reused;
   }
+  log.folders.push_back(dir);
   const std::string status = summary.value("status", std::string("unknown"));
   r.ok = status == "ok";
   r.wall = summary.value("wall_time_s", 0.0);
@@ -367,18 +425,18 @@ struct RunAxi {
 /// One run of the axisymmetric tier, cached in runs_dir like the 3D runs: a finished run
 /// whose physics (its scene resolved again by the current reader) is this scene's is reused,
 /// found by its folder name or by its own scene.resolved.json; any other change reruns it.
-RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress, bool* cached) {
+RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress, bool* cached, CacheLog& log) {
   json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
   const std::string key = axi_key(resolved);
   std::string dir = runs_dir + "/" + p.name() + "-axi-" + key;
-  json summary = finished_summary(dir);
+  json summary = finished_summary(dir, log);
   // the summary's own scene must still resolve to this physics
   if (!summary.is_null() && swimmer_key(fs::path(dir) / "scene.resolved.json", nullptr, true) != key) summary = nullptr;
   if (summary.is_null())
     for (const auto& e : fs::directory_iterator(runs_dir)) {
-      if (swimmer_key(e.path() / "scene.resolved.json", nullptr, true) != key) continue;
-      summary = finished_summary(e.path().string());
+      if (e.path() == fs::path(dir) || swimmer_key(e.path() / "scene.resolved.json", nullptr, true) != key) continue;
+      summary = finished_summary(e.path().string(), log);
       if (!summary.is_null() && summary.value("tier", std::string()) != "axi") summary = nullptr;
       if (!summary.is_null()) {
         dir = e.path().string();
@@ -389,6 +447,7 @@ RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress,
   record::RunRecord rec;
   if (!*cached) {
     fs::remove_all(dir);
+    output::reset_ledger(dir);
     fs::create_directories(dir);
     axi::RunControlAxi ctl;
     ctl.progress = progress;
@@ -398,7 +457,9 @@ RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress,
     rec = std::move(out.record);
   } else {
     rec = record::read_run(dir);
+    ++log.reused;
   }
+  log.folders.push_back(dir);
   RunAxi r;
   r.h = p.h;
   const std::string status = summary.value("status", std::string("unknown"));
@@ -656,14 +717,144 @@ void check_reference(const json& ref, const std::string& at) {
 
 }  // namespace
 
+namespace {
+
+std::string key_list(std::initializer_list<const char*> keys) {
+  std::string s;
+  for (const char* k : keys) s += std::string(s.empty() ? "" : ", ") + k;
+  return s;
+}
+
+/// `j` must be an object whose keys are all in `allowed` (InputError naming the first other key).
+void only_keys(const json& j, const std::string& at, const std::string& what, std::initializer_list<const char*> allowed) {
+  if (!j.is_object()) throw InputError(at, scene::show(j), "an object: " + what + " (keys " + key_list(allowed) + ")");
+  for (const auto& [k, v] : j.items()) {
+    bool ok = false;
+    for (const char* a : allowed) ok = ok || k == a;
+    if (!ok) throw InputError(at + "." + k, scene::show(v), "not a key of " + what + ": " + key_list(allowed));
+  }
+}
+
+void optional_text(const json& j, const char* key, const std::string& at) {
+  if (j.contains(key) && !j[key].is_string()) throw InputError(at + "." + key, scene::show(j[key]), "a text");
+}
+
+/// A `set`: an object {"dotted.key": value}, every key a dotted path with non-empty components.
+/// The values are checked by the tier's reader on the scene they are applied to.
+void check_set(const json& set, const std::string& at) {
+  if (!set.is_object()) throw InputError(at, scene::show(set), "an object {\"dotted.key\": value} applied to the scene");
+  for (const auto& [k, v] : set.items()) {
+    bool ok = !k.empty() && k.front() != '.' && k.back() != '.' && k.find("..") == std::string::npos;
+    if (!ok) throw InputError(at + "." + k, scene::show(v), "a dotted scene key with non-empty components (\"wall.C1\")");
+  }
+}
+
+/// A list of numbers accepted by `ok`, at least one.
+template <class Ok>
+void number_list(const json& j, const std::string& at, Ok ok, const std::string& allowed) {
+  bool good = j.is_array() && !j.empty();
+  for (const auto& v : good ? j : json::array()) good = good && v.is_number() && ok(v);
+  if (!good) throw InputError(at, scene::show(j), allowed);
+}
+
+/// The scene (after its sets) read by the 3D tier's reader; a refusal names `at`.
+void check_3d(const json& s, const std::string& at, const std::string& what) {
+  try {
+    json resolved;
+    full3d::read_scene3d(s, resolved);
+  } catch (const InputError& e) {
+    throw InputError(at, what, std::string("a scene the 3D tier runs; it refuses this one: ") + e.what());
+  }
+}
+
+/// A calibration file for the 1D reads of calibrated models before the calibration exists: the
+/// 3D spring network's C1 and zero offsets, in the system's temporary folder, removed after.
+class StandInCalibration {
+ public:
+  explicit StandInCalibration(double c1) {
+    std::string tmpl = (fs::temp_directory_path() / "swim-suite-check-XXXXXX").string();
+    const int fd = ::mkstemp(tmpl.data());
+    if (fd < 0) throw OutputError("a temporary calibration file", std::strerror(errno));
+    ::close(fd);
+    path_ = tmpl;
+    std::ofstream(path_) << json{{"C1_Pa_per_m", c1}, {"hydraulic_offset_inner_m", 0.0},
+                                 {"hydraulic_offset_outer_m", 0.0}, {"status", "ok"}}.dump();
+  }
+  ~StandInCalibration() {
+    std::error_code ec;
+    fs::remove(path_, ec);
+  }
+  StandInCalibration(const StandInCalibration&) = delete;
+  StandInCalibration& operator=(const StandInCalibration&) = delete;
+  const std::string& path() const { return path_; }
+
+ private:
+  std::string path_;
+};
+
+/// A 1D model's scene as the suite runs it (calibrated: wall.calibration instead of the scene's
+/// stiffness), read by the 1D tier's reader; a refusal names `at`.
+void check_1d(json s, const json& model, const std::string& cal, const std::string& scene_dir, const std::string& at,
+              const std::string& what) {
+  apply_sets(s, model.value("set", json()));
+  if (model.value("calibrated", false)) {
+    if (s.contains("wall") && s["wall"].is_object()) {
+      s["wall"].erase("spring_constant");
+      s["wall"].erase("C1");
+    }
+    set_key(s, "wall.calibration", cal);
+  }
+  try {
+    json resolved;
+    reduced1d::read_scene(s, resolved, scene_dir);
+  } catch (const InputError& e) {
+    throw InputError(at, what, std::string("a scene the 1D tier runs; it refuses this one: ") + e.what());
+  }
+}
+
+}  // namespace
+
 json load_suite(const std::string& path, const std::string& data_dir) {
   const json s = scene::load_file(path);
+  check_suite(s, path, data_dir, true);
+  return s;
+}
+
+void check_suite(const json& s, const std::string& path, const std::string& data_dir, bool scenes) {
   if (!s.is_object()) throw InputError("suite", path, "a JSON object with \"cases\" and \"models1d\"");
+  only_keys(s, "suite", "a suite file",
+            {"name", "description", "order_range", "thresholds", "cells1d", "rtol1d", "cases", "models1d",
+             "reference_target_relative", "extremes3d"});
+  optional_text(s, "name", "suite");
+  optional_text(s, "description", "suite");
   const json& cases = member(s, "cases", "suite");
   if (!cases.is_array() || cases.empty()) throw InputError("suite.cases", scene::show(cases), "a non-empty array");
   for (std::size_t i = 0; i < cases.size(); ++i) {
     const std::string at = "suite.cases[" + std::to_string(i) + "]";
-    member(cases[i], "scene", at);
+    only_keys(cases[i], at, "a case",
+              {"scene", "grid_key", "grids", "calibration_grid", "time_variants3d", "set", "paper", "group",
+               "sweep_value", "order_range", "reference"});
+    const json& sc = member(cases[i], "scene", at);
+    if (!sc.is_string() || sc.get<std::string>().empty())
+      throw InputError(at + ".scene", scene::show(sc), "a scene file name (text)");
+    optional_text(cases[i], "group", at);
+    if (cases[i].contains("grid_key")) {
+      const json& k = cases[i]["grid_key"];
+      if (!k.is_string() || k.get<std::string>().rfind("full3d.grid", 0) != 0)
+        throw InputError(at + ".grid_key", scene::show(k),
+                         "a dotted key of the 3D grid: \"full3d.grid.cells_across\" (default), \"full3d.grid\" or "
+                         "another key under full3d.grid");
+    }
+    if (cases[i].contains("set")) check_set(cases[i]["set"], at + ".set");
+    if (cases[i].contains("paper")) {
+      const json& pp = cases[i]["paper"];
+      only_keys(pp, at + ".paper", "the paper's values",
+                {"source", "max_displacement_m", "displacement_per_cycle_m", "cycle_time_s",
+                 "mean_velocity_per_cycle_m_per_s"});
+      for (const auto& [k, v] : pp.items())
+        if (k == "source" ? !v.is_string() : !(v.is_number() && std::isfinite(v.get<double>())))
+          throw InputError(at + ".paper." + k, scene::show(v), k == "source" ? "a text" : "a number (SI units)");
+    }
     const json& g = member(cases[i], "grids", at);
     if (!g.is_array() || g.size() < 2) throw InputError(at + ".grids", scene::show(g), "two or more grid values");
     if (cases[i].contains("calibration_grid")) {
@@ -677,11 +868,14 @@ json load_suite(const std::string& path, const std::string& data_dir) {
     if (cases[i].contains("time_variants3d")) {
       const json& v = cases[i]["time_variants3d"];
       bool ok = v.is_array();
-      for (const auto& e : ok ? v : json::array()) ok = ok && e.is_object() && e.contains("label") && e["label"].is_string() &&
-                                                        e.contains("set") && e["set"].is_object();
+      for (const auto& e : ok ? v : json::array())
+        ok = ok && e.is_object() && e.size() == 2 && e.contains("label") && e["label"].is_string() && e.contains("set") &&
+             e["set"].is_object();
       if (!ok)
         throw InputError(at + ".time_variants3d", scene::show(v),
                          "an array of {\"label\": text, \"set\": {\"dotted.key\": value}} (3D time-step variants)");
+      for (std::size_t k = 0; k < v.size(); ++k)
+        check_set(v[k]["set"], at + ".time_variants3d[" + std::to_string(k) + "].set");
     }
   }
   if (s.contains("order_range")) parse_order_range(s["order_range"], "suite.order_range");
@@ -692,45 +886,137 @@ json load_suite(const std::string& path, const std::string& data_dir) {
                        "a number between 0 and 1 (exclusive): the relative error below which a reference counts as "
                        "converged (default 0.01)");
   }
+  if (s.contains("cells1d"))
+    number_list(
+        s["cells1d"], "suite.cells1d",
+        [](const json& v) { return v.is_number_integer() && v.get<long>() >= 4 && v.get<long>() <= 100000; },
+        "a non-empty array of cell counts of the 1D speed/accuracy runs, integers from 4 to 100000");
+  if (s.contains("rtol1d"))
+    number_list(
+        s["rtol1d"], "suite.rtol1d", [](const json& v) { return v.get<double>() >= 1e-14 && v.get<double>() < 1; },
+        "a non-empty array of relative tolerances of the 1D speed/accuracy runs, from 1e-14 to below 1");
   if (s.contains("extremes3d")) {
     const json& ex = s["extremes3d"];
     bool ok = ex.is_array();
-    for (const auto& e : ok ? ex : json::array())
+    for (const auto& e : ok ? ex : json::array()) {
       ok = ok && e.is_object() && e.contains("label") && e["label"].is_string() && e.contains("scene") &&
            e["scene"].is_string() && e.contains("expect") &&
            (e["expect"] == "ok" || e["expect"] == "failed" || e["expect"] == "rejected") &&
            (!e.contains("set") || e["set"].is_object()) && (!e.contains("cause") || e["cause"].is_string());
+      if (ok)
+        for (const auto& [k, v] : e.items())
+          ok = ok && (k == "label" || k == "scene" || k == "expect" || k == "set" || k == "cause");
+    }
     if (!ok)
       throw InputError("suite.extremes3d", scene::show(ex),
                        "an array of {\"label\": text, \"scene\": file, \"set\": {...}, \"expect\": \"ok\" | "
                        "\"failed\" | \"rejected\", \"cause\": text in the message}");
+    for (std::size_t k = 0; k < ex.size(); ++k)
+      if (ex[k].contains("set")) check_set(ex[k]["set"], "suite.extremes3d[" + std::to_string(k) + "].set");
   }
   const json& models = member(s, "models1d", "suite");
   if (!models.is_array() || models.empty()) throw InputError("suite.models1d", scene::show(models), "a non-empty array");
-  for (std::size_t i = 0; i < models.size(); ++i) member(models[i], "label", "suite.models1d[" + std::to_string(i) + "]");
+  for (std::size_t i = 0; i < models.size(); ++i) {
+    const std::string at = "suite.models1d[" + std::to_string(i) + "]";
+    only_keys(models[i], at, "a 1D model", {"label", "calibrated", "set"});
+    const json& l = member(models[i], "label", at);
+    if (!l.is_string() || l.get<std::string>().empty()) throw InputError(at + ".label", scene::show(l), "a non-empty text");
+    if (models[i].contains("calibrated") && !models[i]["calibrated"].is_boolean())
+      throw InputError(at + ".calibrated", scene::show(models[i]["calibrated"]), "true or false");
+    if (models[i].contains("set")) check_set(models[i]["set"], at + ".set");
+  }
   const json& th = member(s, "thresholds", "suite");
-  for (const char* k : {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative",
-                        "velocity_phase_correlation"})
-    if (!member(th, k, "suite.thresholds").is_number()) throw InputError(std::string("suite.thresholds.") + k, scene::show(th[k]), "a number");
+  only_keys(th, "suite.thresholds", "the thresholds",
+            {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative",
+             "velocity_phase_correlation"});
+  for (const char* k : {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative"}) {
+    const json& v = member(th, k, "suite.thresholds");
+    if (!v.is_number() || !(v.get<double>() > 0 && v.get<double>() <= 10))
+      throw InputError(std::string("suite.thresholds.") + k, scene::show(v),
+                       "a relative error above 0 and at most 10 (0.1: 10 %)");
+  }
+  {
+    const json& v = member(th, "velocity_phase_correlation", "suite.thresholds");
+    if (!v.is_number() || !(v.get<double>() > -1 && v.get<double>() <= 1))
+      throw InputError("suite.thresholds.velocity_phase_correlation", scene::show(v),
+                       "a correlation above -1 and at most 1");
+  }
+  if (!scenes) return;
+  // every case's scene, on every grid, with its time-step variants, and every 1D model on it:
+  // read by the tiers' own readers here, before anything runs or is written
+  const std::string suite_dir = fs::path(path).parent_path().string();
+  auto scene_file = [&](const json& name, const std::string& at) {
+    const std::string n = name.get<std::string>();
+    for (const fs::path& q : {fs::path(n), fs::path(suite_dir) / n,
+                              data_dir.empty() ? fs::path() : fs::path(data_dir) / "scenes" / n})
+      if (!q.empty() && fs::is_regular_file(q)) return q.string();
+    throw InputError(at, scene::show(name), "a scene file (tried as given, beside the suite file and in the shipped data/scenes/)");
+  };
+  for (std::size_t i = 0; i < cases.size(); ++i) {
+    const std::string at = "suite.cases[" + std::to_string(i) + "]";
+    const std::string scene_path = scene_file(cases[i]["scene"], at + ".scene");
+    const std::string scene_dir = fs::path(scene_path).parent_path().string();
+    json base;
+    try {
+      base = scene::load_file(scene_path);
+    } catch (const InputError& e) {
+      throw InputError(at + ".scene", scene::show(cases[i]["scene"]), std::string("a readable scene: ") + e.what());
+    }
+    apply_sets(base, cases[i].value("set", json()));
+    const std::string grid_key = cases[i].value("grid_key", std::string("full3d.grid.cells_across"));
+    const json& grids = cases[i]["grids"];
+    // the 3D reader builds the membrane mesh (up to seconds on a fine grid): the scene and its
+    // time-step variants are read at the first (coarsest) grid
+    json s0 = base;
+    set_key(s0, grid_key, grids[0]);
+    check_3d(s0, at + ".grids[0]", grid_key + " = " + grids[0].dump());
+    json resolved0;
+    const double c1 = full3d::read_scene3d(s0, resolved0).c1_estimate();
+    if (cases[i].contains("time_variants3d"))
+      for (std::size_t k = 0; k < cases[i]["time_variants3d"].size(); ++k) {
+        json sv = s0;
+        apply_sets(sv, cases[i]["time_variants3d"][k]["set"]);
+        check_3d(sv, at + ".time_variants3d[" + std::to_string(k) + "].set", scene::show(cases[i]["time_variants3d"][k]["set"]));
+      }
+    const StandInCalibration cal(c1 > 0 && std::isfinite(c1) ? c1 : 1.0);
+    for (std::size_t m = 0; m < models.size(); ++m) {
+      const std::string mat = "suite.models1d[" + std::to_string(m) + "]";
+      const std::string what = "the model on " + cases[i]["scene"].get<std::string>();
+      check_1d(base, models[m], cal.path(), scene_dir, mat, what);
+      if (m == 0) {
+        for (const json& cells : s.value("cells1d", json::array())) {
+          json sc = base;
+          set_key(sc, "numerics1d.cells", cells);
+          check_1d(sc, models[m], cal.path(), scene_dir, "suite.cells1d", cells.dump());
+        }
+        for (const json& rtol : s.value("rtol1d", json::array())) {
+          json sc = base;
+          set_key(sc, "numerics1d.rtol", rtol);
+          check_1d(sc, models[m], cal.path(), scene_dir, "suite.rtol1d", rtol.dump());
+        }
+      }
+    }
+  }
+  // the extremes' scenes exist and are scenes (their outcome, a refusal included, is what they
+  // report: a scene the reader refuses is recorded as "rejected", never a stop of the suite)
+  if (s.contains("extremes3d"))
+    for (std::size_t k = 0; k < s["extremes3d"].size(); ++k) {
+      const std::string at = "suite.extremes3d[" + std::to_string(k) + "].scene";
+      try {
+        scene::load_file(scene_file(s["extremes3d"][k]["scene"], at));
+      } catch (const InputError& e) {
+        if (e.key() == at) throw;
+        throw InputError(at, scene::show(s["extremes3d"][k]["scene"]), std::string("a readable scene: ") + e.what());
+      }
+    }
   // the scene of every case with a reference must be one the axi tier runs, on every grid:
   // refused here, before anything runs
-  const std::string suite_dir = fs::path(path).parent_path().string();
   for (std::size_t i = 0; i < cases.size(); ++i) {
     if (!cases[i].contains("reference")) continue;
     const std::string at = "suite.cases[" + std::to_string(i) + "].reference";
     const json& ref = cases[i]["reference"];
-    const std::string scene_name = cases[i]["scene"].is_string() ? cases[i]["scene"].get<std::string>() : "";
-    std::string scene_path;
-    for (const fs::path& q : {fs::path(scene_name), fs::path(suite_dir) / scene_name,
-                              data_dir.empty() ? fs::path() : fs::path(data_dir) / "scenes" / scene_name})
-      if (!scene_name.empty() && !q.empty() && fs::is_regular_file(q)) {
-        scene_path = q.string();
-        break;
-      }
-    if (scene_path.empty())
-      throw InputError("suite.cases[" + std::to_string(i) + "].scene", scene::show(cases[i]["scene"]),
-                       "a scene file (tried as given, beside the suite file and in the shipped data/scenes/)");
-    json base = scene::load_file(scene_path);
+    const std::string scene_name = cases[i]["scene"].get<std::string>();
+    json base = scene::load_file(scene_file(cases[i]["scene"], "suite.cases[" + std::to_string(i) + "].scene"));
     apply_sets(base, cases[i].value("set", json()));
     for (const json& g : ref["grids"]) {
       try {
@@ -743,11 +1029,11 @@ json load_suite(const std::string& path, const std::string& data_dir) {
       }
     }
   }
-  return s;
 }
 
 json run_suite(const SuiteOptions& o) {
-  const json suite = load_suite(o.suite, o.data_dir);
+  json suite = scene::load_file(o.suite);
+  check_suite(suite, o.suite, o.data_dir, !o.scenes_checked);
   const std::string suite_dir = fs::path(o.suite).parent_path().string();
   const json& th = suite["thresholds"];
   const std::string runs_dir = o.out_dir + "/runs", cal_dir = o.out_dir + "/calibrations";
@@ -757,6 +1043,7 @@ json run_suite(const SuiteOptions& o) {
     if (o.progress) o.progress(s);
   };
   const auto t_suite = std::chrono::steady_clock::now();
+  CacheLog log;
 
   json report = {{"suite", suite.value("name", fs::path(o.suite).stem().string())},
                  {"description", suite.value("description", std::string())},
@@ -802,7 +1089,7 @@ json run_suite(const SuiteOptions& o) {
       // the finest grid writes membrane frames, about 12 per cycle of the grid before it
       double frames = 0;
       if (g + 1 == grids.size() && g > 0 && runs.back().cyc.has_cycle) frames = runs.back().cyc.cycle_time_s / 12.0;
-      Run3d r = run_3d(s, runs_dir, o.threads, &cached, frames, o.run_progress);
+      Run3d r = run_3d(s, runs_dir, o.threads, &cached, log, frames, o.run_progress);
       cr["length_m"] = r.length;
       r.record["grid_value"] = grids[g];
       runs_j.push_back(r.record);
@@ -896,7 +1183,7 @@ json run_suite(const SuiteOptions& o) {
             " = " + rgrids[g].dump() + ", " + method + ", h = " + std::to_string(p.h * 1e9).substr(0, 5) + " nm" + left +
             ")");
         bool cached = false;
-        RunAxi r = run_axi_cached(s, runs_dir, o.run_progress, &cached);
+        RunAxi r = run_axi_cached(s, runs_dir, o.run_progress, &cached, log);
         done_wall += cached ? 0.0 : r.wall;
         r.record["grid_value"] = rgrids[g];
         axi_runs.push_back(r.record);
@@ -929,13 +1216,22 @@ json run_suite(const SuiteOptions& o) {
       // keyed by the physics of the resolved scene and the calibration file's format version
       const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
       cal_file = dir + "/calibration.json";
+      if (fs::exists(cal_file)) {
+        // a damaged calibration is recomputed, never read
+        if (const std::string why = calibration_problem(cal_file); !why.empty()) {
+          log.reject(cal_file, why);
+          fs::remove(cal_file);
+        }
+      }
       if (!fs::exists(cal_file)) {
-        const std::string found = cached_calibration(cal_dir, same_swimmer(resolved));
+        const std::string found = cached_calibration(cal_dir, same_swimmer(resolved), log);
         if (!found.empty()) cal_file = found;
       }
       if (fs::exists(cal_file)) {
         std::ifstream in(cal_file);
         cal_j = json::parse(in);
+        ++log.reused;
+        log.calibrations.push_back(cal_file);
       } else {
         say(tag + ": calibration at grid " + std::to_string(cg + 1));
         try {
@@ -949,8 +1245,10 @@ json run_suite(const SuiteOptions& o) {
           cal_j.update(hj);
           cal_j.update(calibrate_towed(p, hr).json);
           cal_j["wall_time_s"] = seconds_since(t0);
+          cal_j["status"] = "ok";
           fs::create_directories(dir);
           output::write_json(cal_file, cal_j);
+          log.calibrations.push_back(cal_file);
         } catch (const NumericalError& e) {
           cal_j = {{"status", std::string("failed: ") + e.what()}};
           cal_file.clear();
@@ -1089,7 +1387,7 @@ json run_suite(const SuiteOptions& o) {
         say(tag + ": 3D time-step variant " + std::to_string(v + 1) + "/" + std::to_string(variants.size()) + " (" +
             label + ")");
         bool cached = false;
-        const Run3d r = run_3d(s, runs_dir, o.threads, &cached, 0, o.run_progress);
+        const Run3d r = run_3d(s, runs_dir, o.threads, &cached, log, 0, o.run_progress);
         if (r.cyc.has_cycle) point("3d", "time step", label, r.wall, r.cyc.displacement_per_cycle_m);
         else  // a step beyond the stability limit: the outcome is reported, not a point
           trade.push_back({{"tier", "3d"}, {"axis", "time step"}, {"resolution", label}, {"wall_time_s", r.wall},
@@ -1122,7 +1420,7 @@ json run_suite(const SuiteOptions& o) {
     std::string kind, text;
     try {
       bool cached = false;
-      const Run3d r = run_3d(s, runs_dir, o.threads, &cached);
+      const Run3d r = run_3d(s, runs_dir, o.threads, &cached, log);
       const std::string status = r.record.value("status", std::string("unknown"));
       kind = status == "ok" ? "ok" : "failed";
       text = status;
@@ -1143,6 +1441,18 @@ json run_suite(const SuiteOptions& o) {
     extremes.push_back(entry);
   }
   report["extremes3d"] = extremes;
+  // every folder and calibration the report read, verified again now that the report is complete
+  json unverified = json::array();
+  for (const std::string& d : log.folders)
+    if (const std::string why = output::verify_folder(d, kCachedRunFiles); !why.empty())
+      unverified.push_back({{"path", d}, {"reason", why}});
+  for (const std::string& f : log.calibrations)
+    if (const std::string why = calibration_problem(f); !why.empty()) unverified.push_back({{"path", f}, {"reason", why}});
+  report["cache"] = {{"reused", log.reused},
+                     {"rejected", log.rejected.size()},
+                     {"rejections", log.rejected},
+                     {"verified", unverified.empty()},
+                     {"unverified", unverified}};
   report["wall_time_s"] = seconds_since(t_suite);
   return report;
 }

@@ -44,6 +44,9 @@ struct SuiteOptions {
   /// the progress of each 3D and axi run (its percentage, rate and time left, common/progress.hpp):
   /// -1 on a terminal only, 0 never, 1 always
   int run_progress = 0;
+  /// the suite's scenes were read by check_suite already (swim validate does it before it
+  /// creates the output folder): run_suite checks the file's keys only
+  bool scenes_checked = false;
 };
 
 /// Runs the suite and returns report.json's content. Throws InputError for a malformed suite
@@ -55,5 +58,13 @@ scene::json run_suite(const SuiteOptions& o);
 /// data_dir is not empty) and read by the axi tier on every reference grid: a scene the tier
 /// refuses is an InputError naming suite.cases[i].reference.
 scene::json load_suite(const std::string& path, const std::string& data_dir = "");
+
+/// The checks of load_suite on a suite document read from `path`: every key known and of its
+/// type at every level, thresholds and lists in range, and (with `scenes`) every case's scene
+/// read by the 3D reader with its time-step variants, every 1D model's scene by the 1D
+/// reader (also at each of cells1d and rtol1d), the extremes' scene files, the references' scenes
+/// by the axi reader. The 3D reader reads each case (and its time-step variants) at its first
+/// grid: it builds the membrane mesh, seconds on a fine grid; the other grids are read as they run.
+void check_suite(const scene::json& suite, const std::string& path, const std::string& data_dir, bool scenes = true);
 
 }  // namespace swim::validation

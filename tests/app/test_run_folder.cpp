@@ -81,6 +81,8 @@ void expect_consistent_folder(const fs::path& dir) {
   const json s = summary_of(dir);
   ASSERT_TRUE(s.is_object());
   ASSERT_TRUE(s.contains("files"));
+  // the summary's own checksum too (output::verify_folder)
+  EXPECT_EQ(swim::output::verify_folder(dir.string()), "");
   std::set<std::string> listed = {"summary.json", ".swim.lock", ".swim-run.json"};
   for (const auto& f : s["files"]) {
     const fs::path p = dir / f["name"].get<std::string>();

@@ -27,7 +27,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// header: magic 8, version 4, scene hash 8, payload bytes 8, payload checksum 8
+// header: magic 8, version 4 bytes, scene hash 8, payload bytes 8, payload checksum 8
 constexpr std::size_t kSumAt = 28, kPayloadAt = 36;
 
 std::string slurp(const std::string& path) {

@@ -9,6 +9,8 @@
 #include <sstream>
 
 #include "common/errors.hpp"
+#include "common/output.hpp"
+#include "common/run_folder.hpp"
 #include "common/scene.hpp"
 #include "full3d/fft.hpp"
 #include "full3d/run3d.hpp"
@@ -101,11 +103,22 @@ TEST(Run3d, ResumeEqualsUninterruptedRun) {
         EXPECT_LT(f["bytes"].get<std::uintmax_t>(), std::filesystem::file_size(b + "/series.csv.part"));
       }
     EXPECT_TRUE(listed);
+    // the summary is the checkpoint's last file: it lists checkpoint.bin as it is on disk
+    bool checkpoint = false;
+    for (const auto& f : sb["files"])
+      if (f["name"] == "checkpoint.bin") {
+        checkpoint = true;
+        EXPECT_EQ(f["bytes"].get<std::uintmax_t>(), std::filesystem::file_size(b + "/checkpoint.bin"));
+        EXPECT_EQ(f["fnv1a64"], output::file_checksum(b + "/checkpoint.bin"));
+      }
+    EXPECT_TRUE(checkpoint);
   }
   RunControl res = ctl;
   res.resume = true;
   const RunOutcome rc = run3d(s.p, s.resolved, b, res);
   ASSERT_FALSE(rc.failed) << rc.message;
+  // the resumed run's folder verifies as a whole: every listed file with its size and checksum
+  EXPECT_EQ(output::verify_folder(b, {"series.csv", "radius.csv", "scene.resolved.json", "checkpoint.bin"}), "");
   EXPECT_EQ(rc.steps, ra.steps);
   // the rows after the checkpoint are recomputed to the bit: the files are byte-identical
   for (const char* f : {"/series.csv", "/radius.csv"}) {
@@ -130,6 +143,45 @@ TEST(Run3d, ResumeEqualsUninterruptedRun) {
               std::abs(da - dc) / std::abs(da));
   EXPECT_LE(std::abs(da - dc), 1e-12 * std::abs(da));
   EXPECT_EQ(ra.summary["pumped_volume_m3"].get<double>(), rc.summary["pumped_volume_m3"].get<double>());
+}
+
+// A resumed run's folder tells the whole run: its final summary.json lists the VTK frames
+// written before the interruption too; a frame deleted before the resume is found before the
+// folder is touched (exit 2 naming the frame).
+TEST(Run3d, AResumedRunListsEveryFrameAndRefusesAMissingOne) {
+  const std::vector<std::string> sets = {"full3d.dt=\"1 ms\"", "time.duration=\"12 ms\"",
+                                         "time.output_interval=\"1 ms\"", "full3d.checkpoint_interval=\"4 ms\"",
+                                         "full3d.output.vtk=true", "full3d.output.vtk_interval=\"2 ms\""};
+  const Scene s = tiny(sets);
+  RunControl stop;
+  stop.progress = 0;
+  stop.stop_after_steps = 9;  // "killed" at step 9; the last checkpoint is at step 8
+  const std::string b = fresh_dir("resume_frames"), c = fresh_dir("resume_frames_deleted");
+  ASSERT_TRUE(run3d(s.p, s.resolved, b, stop).interrupted);
+  ASSERT_TRUE(fs::exists(b + "/vtk/membrane_000002.vtp"));
+  fs::remove_all(c);
+  fs::copy(b, c, fs::copy_options::recursive);
+  fs::remove(c + "/vtk/membrane_000002.vtp");
+  try {
+    check_resumable(s.p, s.resolved, c);
+    ADD_FAILURE() << "a missing frame was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "--resume");
+    EXPECT_NE(std::string(e.what()).find("vtk/membrane_000002.vtp"), std::string::npos) << e.what();
+  }
+  RunControl res;
+  res.progress = 0;
+  res.resume = true;
+  const RunOutcome r = run3d(s.p, s.resolved, b, res);
+  ASSERT_FALSE(r.failed) << r.message;
+  std::size_t frames = 0, listed = 0;
+  for (const auto& e : fs::directory_iterator(b + "/vtk")) frames += e.path().extension() == ".vtp";
+  std::ifstream in(b + "/summary.json");
+  const scene::json sum = scene::json::parse(in);
+  for (const auto& f : sum["files"]) listed += f["name"].get<std::string>().rfind("vtk/membrane_", 0) == 0;
+  EXPECT_GE(frames, 6u);
+  EXPECT_EQ(listed, frames);
+  EXPECT_EQ(output::verify_folder(b, {"series.csv", "radius.csv", "membrane.pvd", "vtk/membrane_000000.vtp"}), "");
 }
 
 // The VTK frames count toward output.max_bytes with series.csv and radius.csv; a resumed run

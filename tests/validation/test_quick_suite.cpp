@@ -7,7 +7,9 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <sstream>
 
+#include "common/output.hpp"
 #include "common/scene.hpp"
 
 #include "full3d/run3d.hpp"
@@ -123,14 +125,29 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
     ASSERT_TRUE(older["full3d"]["membrane"].contains("axisymmetric"));
     older["full3d"]["membrane"].erase("axisymmetric");
     std::ofstream(folder / "scene.resolved.json") << older.dump(2);
+    // as that older run listed it: its size and checksum in summary.json, whose own checksum follows
+    std::ifstream in(folder / "summary.json");
+    scene::json summary = scene::json::parse(in);
+    for (auto& f : summary["files"])
+      if (f["name"] == "scene.resolved.json") {
+        f["bytes"] = fs::file_size(folder / "scene.resolved.json");
+        f["fnv1a64"] = output::file_checksum((folder / "scene.resolved.json").string());
+      }
+    std::ofstream(folder / "summary.json") << output::json_text_with_checksum(summary);
     fs::rename(folder, folder.string() + "-older");
   }
   // a run stopped part way (the suite interrupted) continues from its checkpoint and ends
   // where the uninterrupted run ended
   const std::string stopped = c["runs3d"][0]["folder"].get<std::string>();
   {
-    scene::json resolved = scene::load_file(stopped + "/scene.resolved.json"), again;
-    const full3d::Params3d p = full3d::read_scene3d(resolved, again);
+    // the scene the edited suite runs on the first grid, as the suite builds it (the output
+    // settings are part of what a checkpoint resumes)
+    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json"), again;
+    for (const auto& [k, v] : suite["cases"][0]["set"].items()) scene::apply_override(sc, k + "=" + v.dump());
+    scene::apply_override(sc, "full3d.grid=" + suite["cases"][0]["grids"][0].dump());
+    for (const char* set : {"full3d.threads=1", "full3d.output.vtk=false", "full3d.output.fluid_fields=false"})
+      scene::apply_override(sc, set);
+    const full3d::Params3d p = full3d::read_scene3d(sc, again);
     fs::remove_all(stopped);
     fs::create_directories(stopped);
     full3d::RunControl ctl;
@@ -150,4 +167,35 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   EXPECT_TRUE(c4["runs3d"][1]["cached"].get<bool>());
   EXPECT_EQ(c4["runs3d"][1]["folder"], c["runs3d"][1]["folder"].get<std::string>() + "-older");
   EXPECT_EQ(c4["runs3d"][1]["displacement_per_cycle_m"], c["runs3d"][1]["displacement_per_cycle_m"]);
+  EXPECT_EQ(r4["cache"]["rejected"], 0) << r4["cache"].dump();
+  EXPECT_TRUE(r4["cache"]["verified"].get<bool>());
+
+  // nothing cached is used unverified: a changed digit in a cached run's series.csv and in the
+  // cached calibration's C1 are found, reported with the file and the reason, and recomputed; the
+  // figures are those of the first suite
+  auto change_digit = [](const fs::path& p, const std::string& near) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    std::string t = ss.str();
+    std::size_t at = t.find(near);
+    ASSERT_NE(at, std::string::npos) << p << " " << near;
+    at = t.find_first_of("123456789", at + near.size());
+    t[at] = t[at] == '9' ? '8' : char(t[at] + 1);
+    std::ofstream(p, std::ios::binary) << t;
+  };
+  change_digit(fs::path(stopped) / "series.csv", "\n");
+  change_digit(c4["calibration"]["file"].get<std::string>(), "\"C1_Pa_per_m\"");
+  const scene::json r5 = validation::run_suite(o);
+  const scene::json& c5 = r5["cases"][0];
+  ASSERT_EQ(r5["cache"]["rejected"], 2) << r5["cache"].dump();
+  std::string reasons;
+  for (const auto& j : r5["cache"]["rejections"]) reasons += j["reason"].get<std::string>() + "\n";
+  EXPECT_NE(reasons.find("series.csv: changed"), std::string::npos) << reasons;
+  EXPECT_NE(reasons.find("calibration.json: changed or cut after it was written"), std::string::npos) << reasons;
+  EXPECT_TRUE(r5["cache"]["verified"].get<bool>());
+  EXPECT_FALSE(c5["runs3d"][0]["cached"].get<bool>());
+  EXPECT_EQ(c5["runs3d"][0]["displacement_per_cycle_m"], c["runs3d"][0]["displacement_per_cycle_m"]);
+  EXPECT_EQ(c5["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
+  EXPECT_EQ(c5["models1d"][0]["displacement_per_cycle_m"], c["models1d"][0]["displacement_per_cycle_m"]);
 }

@@ -122,5 +122,5 @@ TEST(SuiteFile, MalformedSuitesNameTheKey) {
 // The shipped suites are well formed.
 TEST(SuiteFile, ShippedSuitesLoad) {
   for (const char* s : {"quick.json", "default.json"})
-    EXPECT_NO_THROW(load_suite(std::string(SWIM_SOURCE_DIR "/data/validation/") + s)) << s;
+    EXPECT_NO_THROW(load_suite(std::string(SWIM_SOURCE_DIR "/data/validation/") + s, SWIM_SOURCE_DIR "/data")) << s;
 }
