@@ -33,6 +33,10 @@ struct RunFolderOptions {
   /// The file written last, whose "status" says whether the run finished ("summary.json";
   /// "screen.json" for a sweep, "calibration.json" for a calibration).
   std::string summary = "summary.json";
+  /// A sub-folder of finished child runs (the 3D confirmation runs of a sweep) that a new run
+  /// of the same identity keeps, so that it reuses them; such a run also continues a folder
+  /// whose previous run of the same identity did not finish. Empty: none.
+  std::string keep;
 };
 
 class RunFolder {

@@ -140,8 +140,10 @@ Sweep read_sweep(const std::string& path, const std::vector<std::string>& metric
   const fs::path dir = fs::path(path).parent_path();
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.key() != "base" && it.key() != "vary" && it.key() != "metric" && it.key() != "goal" &&
-        it.key() != "name" && it.key() != "description")
-      throw InputError(it.key(), scene::show(it.value()), "unknown key; allowed: name, description, base, vary, metric, goal");
+        it.key() != "name" && it.key() != "description" && it.key() != "confirm")
+      throw InputError(it.key(), scene::show(it.value()),
+                       "unknown key; allowed: name, description, base, vary, metric, goal, confirm");
+  if (j.contains("confirm")) sw.confirm = j["confirm"];  // checked by swim screen --confirm
   if (!j.contains("base")) throw InputError("base", "(missing)", "a sweep needs a base scene (path or object)");
   if (j["base"].is_string()) {
     fs::path b = dir / j["base"].get<std::string>();
