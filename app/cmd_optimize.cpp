@@ -127,7 +127,13 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
                          {"evaluations", r.trajectory.size()},
                          {"feasible_evaluations", feasible},
                          {"wall_time_s", wall}};
-  plot("plot_optimize.py", {out + "/trajectory.csv", out + "/optimize.png", spec.objective, spec.name});
+  std::vector<std::string> plot_args = {out + "/trajectory.csv", out + "/optimize.png", spec.objective, spec.name};
+  for (const auto& p : spec.parameters) {
+    char b[80];
+    std::snprintf(b, sizeof b, "%.10g:%.10g", p.lo * p.to_si, p.hi * p.to_si);
+    plot_args.push_back(b);
+  }
+  plot("plot_optimize.py", plot_args);
   std::printf("optimize %s: %zu evaluations in %s (%zu feasible), %s\n", spec.name.c_str(), r.trajectory.size(),
               si(wall, "s").c_str(), feasible, r.stop_reason.c_str());
   if (r.best < 0) {

@@ -218,28 +218,24 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name};
   for (const auto& a : sw.axes) plot_args.push_back(a.key);
   plot("plot_screen.py", plot_args);
+  std::printf("screened %zu designs in %.3g s (%.4g designs/s), %ld failed\n", results.size(), wall,
+              summary["designs_per_s"].get<double>(), failed);
+  if (best < 0) {
+    output::write_json(out + "/screen.json", summary);
+    std::fprintf(stderr, "swim: every design failed numerically; see %s/designs.csv for the causes\n", out.c_str());
+    return 3;
+  }
+  std::printf("best by %s (%s): design %ld: %s -> %s\n  -> %s/designs.csv, %s/screen.png\n", sw.metric.c_str(),
+              sw.maximize ? "max" : "min", best, describe(sw, best).c_str(),
+              shown(reduced1d::metric_value(results[best].metrics, sw.metric), sw.metric).c_str(), out.c_str(),
+              out.c_str());
+  std::fflush(stdout);
   int code = 0;
-  if (confirm > 0 && best >= 0) {
+  if (confirm > 0) {
     summary["confirm"] = confirm_sweep(sw, results, static_cast<size_t>(confirm), confirm_section, threads, progress, out);
     code = summary["confirm"]["status"] == "ok" ? 0 : 3;
   }
   output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
-
-  std::printf("screened %zu designs in %.3g s (%.4g designs/s), %ld failed\n", results.size(), wall,
-              summary["designs_per_s"].get<double>(), failed);
-  if (best < 0) {
-    std::fprintf(stderr, "swim: every design failed numerically; see %s/designs.csv for the causes\n", out.c_str());
-    return 3;
-  }
-  const std::string unit = reduced1d::metric_unit(sw.metric);
-  const double bv = reduced1d::metric_value(results[best].metrics, sw.metric);
-  char value[64];
-  if (unit == "m" || unit == "m/s" || unit == "m^3" || unit == "s")
-    std::snprintf(value, sizeof value, "%s", si(bv, unit).c_str());
-  else
-    std::snprintf(value, sizeof value, "%.4g%s%s", bv, unit.empty() ? "" : " ", unit.c_str());
-  std::printf("best by %s (%s): design %ld: %s -> %s\n  -> %s/designs.csv, %s/screen.png\n", sw.metric.c_str(),
-              sw.maximize ? "max" : "min", best, describe(sw, best).c_str(), value, out.c_str(), out.c_str());
   if (code != 0)
     std::fprintf(stderr, "swim: a 3D confirmation run failed: %s\n  the finished runs and the report are kept in %s\n",
                  summary["confirm"]["status"].get<std::string>().c_str(), out.c_str());
