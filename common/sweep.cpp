@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <tuple>
 
 #include "common/errors.hpp"
 #include "common/units.hpp"
@@ -132,31 +133,37 @@ json Sweep::design(size_t index) const {
   return s;
 }
 
+std::pair<json, std::string> read_base(const json& file, const std::string& path, const std::string& what) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::path(path).parent_path();
+  if (!file.contains("base")) throw InputError("base", "(missing)", "a " + what + " needs a base scene (path or object)");
+  const json& base = file["base"];
+  std::pair<json, std::string> r;
+  if (base.is_string()) {
+    fs::path b = dir / base.get<std::string>();
+    if (!fs::exists(b)) b = base.get<std::string>();
+    r = {scene::load_file(b.string()), b.parent_path().string()};
+  } else if (base.is_object()) {
+    r = {base, dir.string()};
+  } else {
+    throw InputError("base", scene::show(base), "must be a scene file path or an inline scene object");
+  }
+  if (r.second.empty()) r.second = ".";
+  return r;
+}
+
 Sweep read_sweep(const std::string& path, const std::vector<std::string>& metrics) {
   namespace fs = std::filesystem;
   const json j = scene::load_file(path);
   Sweep sw;
   sw.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : fs::path(path).stem().string();
-  const fs::path dir = fs::path(path).parent_path();
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.key() != "base" && it.key() != "vary" && it.key() != "metric" && it.key() != "goal" &&
         it.key() != "name" && it.key() != "description" && it.key() != "confirm")
       throw InputError(it.key(), scene::show(it.value()),
                        "unknown key; allowed: name, description, base, vary, metric, goal, confirm");
   if (j.contains("confirm")) sw.confirm = j["confirm"];  // checked by swim screen --confirm
-  if (!j.contains("base")) throw InputError("base", "(missing)", "a sweep needs a base scene (path or object)");
-  if (j["base"].is_string()) {
-    fs::path b = dir / j["base"].get<std::string>();
-    if (!fs::exists(b)) b = j["base"].get<std::string>();
-    sw.base = scene::load_file(b.string());
-    sw.base_dir = b.parent_path().string();
-  } else if (j["base"].is_object()) {
-    sw.base = j["base"];
-    sw.base_dir = dir.string();
-  } else {
-    throw InputError("base", scene::show(j["base"]), "must be a scene file path or an inline scene object");
-  }
-  if (sw.base_dir.empty()) sw.base_dir = ".";
+  std::tie(sw.base, sw.base_dir) = read_base(j, path, "sweep");
   if (!j.contains("vary") || !j["vary"].is_object() || j["vary"].empty())
     throw InputError("vary", j.contains("vary") ? scene::show(j["vary"]) : "(missing)",
                      "must be an object mapping scene keys to value lists or ranges");

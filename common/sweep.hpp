@@ -10,6 +10,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -40,6 +41,11 @@ struct Sweep {
   /// Axis value indices of design `index`.
   std::vector<size_t> indices(size_t index) const;
 };
+
+/// The "base" of a sweep or optimisation file at `path`: the scene (a path relative to the file,
+/// or an inline scene) and the folder its relative paths start from. `what` names the file kind
+/// in messages. Throws InputError (key "base").
+std::pair<json, std::string> read_base(const json& file, const std::string& path, const std::string& what);
 
 /// Read and validate a sweep file. `metrics` lists the allowed metric names.
 /// Throws InputError naming the key.

@@ -5,8 +5,10 @@
 #include <cstdio>
 #include <filesystem>
 #include <nlopt.hpp>
+#include <tuple>
 
 #include "common/errors.hpp"
+#include "common/sweep.hpp"
 #include "common/units.hpp"
 #include "design/confirm.hpp"
 #include "reduced1d/scene1d.hpp"
@@ -185,20 +187,7 @@ Spec read_spec(const std::string& path) {
                     "tolerance", "confirm"});
   Spec s;
   s.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : fs::path(path).stem().string();
-  const fs::path dir = fs::path(path).parent_path();
-  if (!j.contains("base")) throw InputError("base", "(missing)", "a spec needs a base scene (path or object)");
-  if (j["base"].is_string()) {
-    fs::path b = dir / j["base"].get<std::string>();
-    if (!fs::exists(b)) b = j["base"].get<std::string>();
-    s.base = scene::load_file(b.string());
-    s.base_dir = b.parent_path().string();
-  } else if (j["base"].is_object()) {
-    s.base = j["base"];
-    s.base_dir = dir.string();
-  } else {
-    throw InputError("base", scene::show(j["base"]), "must be a scene file path or an inline scene object");
-  }
-  if (s.base_dir.empty()) s.base_dir = ".";
+  std::tie(s.base, s.base_dir) = sweep::read_base(j, path, "spec");
   if (!j.contains("parameters") || !j["parameters"].is_object() || j["parameters"].empty() || j["parameters"].size() > 8)
     throw InputError("parameters", j.contains("parameters") ? scene::show(j["parameters"]) : "(missing)",
                      "must map 1 to 8 scene keys to {\"min\": .., \"max\": .., \"start\": .., \"integer\": false}");
