@@ -1,6 +1,7 @@
 // swim optimize SPEC.json: the best design of a parameter box on the 1D tier (design/optimize.hpp),
 // confirmed in 3D (design/confirm.hpp). Writes trajectory.csv, optimum.scene.json, optimize.png,
 // confirm.json, confirm.md, confirm.png, and optimum.json last.
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -24,6 +25,7 @@ namespace fs = std::filesystem;
 namespace {
 
 std::string value_text(const design::Parameter& p, double v) {
+  if (!p.integer && (p.si_unit == "m" || p.si_unit == "s")) return si(v * p.to_si, p.si_unit, 4);
   const scene::json j = p.scene_value(v);
   return j.is_string() ? j.get<std::string>() : j.dump();
 }
@@ -137,10 +139,20 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   std::printf("optimize %s: %zu evaluations in %s (%zu feasible), %s\n", spec.name.c_str(), r.trajectory.size(),
               si(wall, "s").c_str(), feasible, r.stop_reason.c_str());
   if (r.best < 0) {
-    std::string why = spec.min_ratio > 0 ? "constraints.min_directed_to_diffusive_ratio" : "the 1D runs (see trajectory.csv)";
+    std::string why = "the 1D runs (see trajectory.csv)";
+    if (spec.min_ratio > 0) {  // the ratio reached: g = (min - ratio) / min
+      double g = 1;
+      for (const auto& e : r.trajectory)
+        if (e.ok) g = std::min(g, e.constraints[0]);
+      char b[160];
+      std::snprintf(b, sizeof b, "constraints.min_directed_to_diffusive_ratio = %g (the largest ratio reached: %.3g)",
+                    spec.min_ratio, spec.min_ratio * (1 - g));
+      why = b;
+    }
     summary["status"] = "failed: no feasible design among " + std::to_string(r.trajectory.size()) +
                         " evaluations; the binding constraint: " + why;
     output::write_json(out + "/optimum.json", summary);
+    std::fflush(stdout);
     std::fprintf(stderr, "swim: %s\n  the trajectory is kept in %s/trajectory.csv\n",
                  summary["status"].get<std::string>().c_str(), out.c_str());
     return 3;
@@ -193,6 +205,7 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   }
   output::write_json(out + "/optimum.json", summary);  // last: its status says the search finished
   std::printf("  -> %s/optimum.json, %s/trajectory.csv, %s/optimize.png\n", out.c_str(), out.c_str(), out.c_str());
+  std::fflush(stdout);
   if (code != 0)
     std::fprintf(stderr, "swim: the 3D confirmation run failed: %s\n", summary["confirm"]["status"].get<std::string>().c_str());
   return code;

@@ -236,6 +236,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     code = summary["confirm"]["status"] == "ok" ? 0 : 3;
   }
   output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
+  std::fflush(stdout);
   if (code != 0)
     std::fprintf(stderr, "swim: a 3D confirmation run failed: %s\n  the finished runs and the report are kept in %s\n",
                  summary["confirm"]["status"].get<std::string>().c_str(), out.c_str());

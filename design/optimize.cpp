@@ -183,11 +183,16 @@ reduced1d::Params read_design(const Spec& s, const std::vector<double>& x, const
 
 Spec read_spec(const std::string& path) {
   const json j = scene::load_file(path);
-  only_keys(j, "", {"name", "description", "base", "parameters", "objective", "goal", "constraints", "max_evaluations",
+  only_keys(j, "", {"name", "description", "base", "set", "parameters", "objective", "goal", "constraints", "max_evaluations",
                     "tolerance", "confirm"});
   Spec s;
   s.name = j.contains("name") && j["name"].is_string() ? j["name"].get<std::string>() : fs::path(path).stem().string();
   std::tie(s.base, s.base_dir) = sweep::read_base(j, path, "spec");
+  if (j.contains("set")) {  // fixed changes of the base scene (null removes a key)
+    if (!j["set"].is_object()) throw InputError("set", scene::show(j["set"]), "must map scene keys to values");
+    for (auto it = j["set"].begin(); it != j["set"].end(); ++it)
+      scene::apply_override(s.base, it.key() + "=" + it.value().dump());
+  }
   if (!j.contains("parameters") || !j["parameters"].is_object() || j["parameters"].empty() || j["parameters"].size() > 8)
     throw InputError("parameters", j.contains("parameters") ? scene::show(j["parameters"]) : "(missing)",
                      "must map 1 to 8 scene keys to {\"min\": .., \"max\": .., \"start\": .., \"integer\": false}");

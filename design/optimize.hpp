@@ -7,7 +7,7 @@
 // its magnitude at the start, so that the trust region and the merit function see O(1) numbers.
 //
 // Spec file (docs/optimize.md):
-//   { "name": "...", "base": "../scenes/demo.json",
+//   { "name": "...", "base": "../scenes/demo.json", "set": {"protocol.total_force": null},
 //     "parameters": { "swimmer.length": {"min": "0.2 um", "max": "0.8 um", "start": "0.4 um"},
 //                     "protocol.segments": {"min": 2, "max": 8, "integer": true} },
 //     "objective": "mean_velocity_m_per_s", "goal": "max",
