@@ -2,7 +2,8 @@
 diagonal (1D = 3D), and the designs' ranks in both tiers.
 
 usage: plot_confirm.py CONFIRM_JSON OUT_PNG TITLE_NAME
-Axes carry SI-prefixed units; each point is labelled with its design number.
+Axes carry SI-prefixed units; each point is labelled with its design number. Designs whose
+3D run failed are left out (confirm.md lists them).
 """
 import json
 import sys
@@ -22,7 +23,14 @@ def main(path, png, name):
     unit = LABELS.get(metric, (metric, ""))[1]
     pts = [(d["design"], d["figures_1d"][metric], d["figures_3d"][metric], d.get("error_bar_3d", 0.0),
             d.get("rank_1d"), d.get("rank_3d"), d["selected_as"])
-           for d in rep["designs"] if d["figures_3d"].get(metric) is not None]
+           for d in rep["designs"] if d["status_3d"] == "ok" and d["figures_3d"].get(metric) is not None]
+    if not pts:
+        fig, ax = plt.subplots(figsize=(7, 3))
+        ax.axis("off")
+        ax.text(0.5, 0.5, f"3D confirmation of {name}: no 3D run finished\n(see confirm.md for each run's status)",
+                ha="center", va="center")
+        fig.savefig(png, dpi=110)
+        return
     ranked = [p for p in pts if p[4] is not None]
     panels = 2 if len(ranked) >= 2 else 1
     fig, axes = plt.subplots(1, panels, figsize=(5.8 * panels, 5.0), squeeze=False)
@@ -52,7 +60,10 @@ def main(path, png, name):
     if panels == 2:
         ax = axes[0][1]
         n = len(ranked)
-        ax.plot([p[4] for p in ranked], [p[5] for p in ranked], "o", ms=8)
+        for sel, marker in (("best", "o"), ("spread", "s")):
+            sp = [p for p in ranked if p[6] == sel]
+            if sp:
+                ax.plot([p[4] for p in sp], [p[5] for p in sp], marker, ms=8, label=f"{sel} by 1D")
         for p in ranked:
             ax.annotate(str(p[0]), (p[4], p[5]), textcoords="offset points", xytext=(5, 4), fontsize=8)
         ax.plot([0.5, n + 0.5], [0.5, n + 0.5], "k--", lw=1, label="same rank")
