@@ -21,7 +21,13 @@ struct RunOptions {
 
 int run(const RunOptions& o);
 int demo(const std::string& out, int progress);
-int screen(const std::string& sweep, const std::string& out, int jobs, int progress, bool overwrite);
+/// swim screen: a 1D sweep; confirm > 0: that many designs also run in 3D with `threads`
+/// threads each (design/confirm.hpp), reported in confirm.json, confirm.md and confirm.png.
+int screen(const std::string& sweep, const std::string& out, int jobs, int progress, bool overwrite, int confirm = 0,
+           int threads = 1);
+/// swim optimize: a continuous design search on the 1D tier (design/optimize.hpp); confirm:
+/// the best design also runs in 3D with `threads` threads.
+int optimize(const std::string& spec, const std::string& out, int progress, bool overwrite, bool confirm, int threads);
 int bench(const std::string& out, bool quick, bool paper_cycle, const std::string& tier = "all");
 int scenes();
 /// swim calibrate: C1 of the 1D tier from 3D uniform loads (validation/calibration.hpp).

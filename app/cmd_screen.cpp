@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -11,6 +12,9 @@
 #include "common/run_folder.hpp"
 #include "common/sweep.hpp"
 #include "app/scene_checks.hpp"
+#include "design/confirm.hpp"
+#include "design/rank_agreement.hpp"
+#include "full3d/scene3d.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/screen.hpp"
 
@@ -34,11 +38,106 @@ std::string csv_field(std::string s) {
   return s;
 }
 
+// Human-facing value of a metric: SI prefixes for lengths, velocities, times, volumes.
+std::string shown(double v, const std::string& metric) {
+  const std::string unit = reduced1d::metric_unit(metric);
+  if (unit == "m" || unit == "m/s" || unit == "m^3" || unit == "s") return si(v, unit);
+  char b[64];
+  std::snprintf(b, sizeof b, "%.4g%s%s", v, unit.empty() ? "" : " ", unit.c_str());
+  return b;
+}
+
+// --confirm K: the K/2 best and K/2 spread over the rest of the ranking, run in 3D, compared
+// with the 1D tier; writes confirm.json, confirm.md, confirm.png and returns the summary for
+// screen.json.
+scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::DesignOutcome>& results, size_t k,
+                          const scene::json& section, int threads, int progress, const std::string& out) {
+  std::vector<size_t> ranked;
+  for (size_t i = 0; i < results.size(); ++i)
+    if (results[i].ok) ranked.push_back(i);
+  auto value = [&](size_t i) { return reduced1d::metric_value(results[i].metrics, sw.metric); };
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [&](size_t a, size_t b) { return sw.maximize ? value(a) > value(b) : value(a) < value(b); });
+  const std::vector<size_t> chosen = design::select_for_confirmation(ranked, k);
+  std::vector<design::Candidate> cands;
+  for (size_t c = 0; c < chosen.size(); ++c) {
+    const size_t i = chosen[c];
+    const long rank = static_cast<long>(std::find(ranked.begin(), ranked.end(), i) - ranked.begin()) + 1;
+    cands.push_back({i, describe(sw, i), c < chosen.size() - chosen.size() / 2 ? "best" : "spread", rank, sw.design(i),
+                     results[i].metrics});
+  }
+  std::printf("confirming %zu of %zu designs in 3D (%zu best, %zu spread over the rest)%s\n", cands.size(),
+              ranked.size(), cands.size() - cands.size() / 2, cands.size() / 2,
+              cands.size() < k ? "; fewer designs completed in 1D than --confirm asks" : "");
+  std::fflush(stdout);
+  design::ConfirmOptions o{sw.metric, sw.maximize, section, threads, progress, out + "/confirm-runs"};
+  scene::json report = design::confirm_candidates(cands, o, [&](size_t c, const design::Confirmed& r) {
+    const auto& d = cands[c];
+    const auto f3 = design::figures_3d(r.summary, sw.metric);
+    std::printf("  design %zu (%s, 1D rank %ld): 1D %s, 3D %s; %s%s\n", d.design, d.values.c_str(), d.rank_in_sweep,
+                shown(value(d.design), sw.metric).c_str(),
+                f3[sw.metric].is_number() ? shown(f3[sw.metric].get<double>(), sw.metric).c_str() : "n/a",
+                r.reused ? "finished run reused" : ("3D run " + si(r.summary.value("wall_time_s", 0.0), "s")).c_str(),
+                r.ok ? "" : (" -- " + r.summary.value("status", std::string())).c_str());
+    std::fflush(stdout);
+  });
+  report["sweep"] = sw.name;
+  report["selection"] = {{"requested", k},
+                         {"rule", "the ceil(K/2) best by the sweep's metric, then floor(K/2) spread evenly over the rest "
+                                  "of the 1D ranking (the worst included)"},
+                         {"designs_completed_1d", ranked.size()}};
+  output::write_json(out + "/confirm.json", report);
+  {
+    output::AtomicFile md(out + "/confirm.md");
+    md.stream() << design::confirm_markdown(report, "3D confirmation of the sweep " + sw.name);
+    md.commit();
+  }
+  plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", sw.name});
+  if (report["agreement"].is_object()) {
+    const auto& a = report["agreement"];
+    std::printf("rank agreement over %d designs: Kendall tau %.3g [%.3g, %.3g], Spearman rho %.3g [%.3g, %.3g] (95 %%); "
+                "%zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
+                a["designs"].get<int>(), a["kendall_tau"].get<double>(), a["kendall_tau_ci_95"][0].get<double>(),
+                a["kendall_tau_ci_95"][1].get<double>(), a["spearman_rho"].get<double>(),
+                a["spearman_rho_ci_95"][0].get<double>(), a["spearman_rho_ci_95"][1].get<double>(),
+                report["misranked_designs"].size(), out.c_str(), out.c_str());
+  }
+  scene::json s = {{"status", report["status"]}, {"designs", report["designs_confirmed"]}, {"file", "confirm.json"}};
+  if (report["agreement"].is_object()) {
+    s["kendall_tau"] = report["agreement"]["kendall_tau"];
+    s["spearman_rho"] = report["agreement"]["spearman_rho"];
+  }
+  return s;
+}
+
 }  // namespace
 
-int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, int progress, bool overwrite) {
+int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, int progress, bool overwrite,
+           int confirm, int threads) {
   const sweep::Sweep sw = sweep::read_sweep(sweep_path, reduced1d::metric_names());
   check_sweep_scenes(sw);
+  // --confirm K: checked in full (K, the metric, every design's 3D scene) before any 1D run
+  scene::json confirm_section;
+  if (confirm > 0) {
+    if (static_cast<size_t>(confirm) > sw.count())
+      throw InputError("--confirm", std::to_string(confirm),
+                       "must be at most the number of designs in the sweep (" + std::to_string(sw.count()) + ")");
+    if (confirm < 2)
+      throw InputError("--confirm", std::to_string(confirm), "must be at least 2 (a rank agreement needs two designs)");
+    design::check_metric_in_3d(sw.metric, "metric");
+    confirm_section = design::read_confirm_section(sw.confirm, "confirm");
+    for (size_t k = 0; k < sw.count(); ++k) {
+      scene::json resolved;
+      try {
+        full3d::read_scene3d(design::confirm_scene(sw.design(k), confirm_section, threads), resolved);
+      } catch (const InputError& e) {
+        throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) +
+                                          ") on the 3D tier: " + e.what());
+      }
+    }
+  } else if (!sw.confirm.is_null()) {
+    design::read_confirm_section(sw.confirm, "confirm");
+  }
   // Validate every design before running any of them (exit 2, nothing written).
   std::vector<reduced1d::Params> designs;
   designs.reserve(sw.count());
@@ -56,7 +155,9 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   // the same sweep's finished results replaced); the sweep is identified by what it runs.
   scene::json identity = {{"base", sw.base}, {"metric", sw.metric}, {"goal", sw.maximize ? "max" : "min"}};
   for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
-  output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json"});
+  if (!sw.confirm.is_null()) identity["confirm"] = sw.confirm;
+  // the 3D runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
+  output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json", "confirm-runs"});
 
   Progress bar("screen " + name, static_cast<double>(designs.size()), progress);
   size_t finished = 0;
@@ -126,24 +227,29 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     output::write_json(out + "/screen.json", summary);
     throw;
   }
-  output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
-
   std::printf("screened %zu designs in %.3g s (%.4g designs/s), %ld failed\n", results.size(), wall,
               summary["designs_per_s"].get<double>(), failed);
   if (best < 0) {
+    output::write_json(out + "/screen.json", summary);
     std::fprintf(stderr, "swim: every design failed numerically; see %s/designs.csv for the causes\n", out.c_str());
     return 3;
   }
-  const std::string unit = reduced1d::metric_unit(sw.metric);
-  const double bv = reduced1d::metric_value(results[best].metrics, sw.metric);
-  char value[64];
-  if (unit == "m" || unit == "m/s" || unit == "m^3" || unit == "s")
-    std::snprintf(value, sizeof value, "%s", si(bv, unit).c_str());
-  else
-    std::snprintf(value, sizeof value, "%.4g%s%s", bv, unit.empty() ? "" : " ", unit.c_str());
   std::printf("best by %s (%s): design %ld: %s -> %s\n  -> %s/designs.csv, %s/screen.png\n", sw.metric.c_str(),
-              sw.maximize ? "max" : "min", best, describe(sw, best).c_str(), value, out.c_str(), out.c_str());
-  return 0;
+              sw.maximize ? "max" : "min", best, describe(sw, best).c_str(),
+              shown(reduced1d::metric_value(results[best].metrics, sw.metric), sw.metric).c_str(), out.c_str(),
+              out.c_str());
+  std::fflush(stdout);
+  int code = 0;
+  if (confirm > 0) {
+    summary["confirm"] = confirm_sweep(sw, results, static_cast<size_t>(confirm), confirm_section, threads, progress, out);
+    code = summary["confirm"]["status"] == "ok" ? 0 : 3;
+  }
+  output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
+  std::fflush(stdout);
+  if (code != 0)
+    std::fprintf(stderr, "swim: a 3D confirmation run failed: %s\n  the finished runs and the report are kept in %s\n",
+                 summary["confirm"]["status"].get<std::string>().c_str(), out.c_str());
+  return code;
 }
 
 }  // namespace swim::app

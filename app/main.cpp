@@ -1,7 +1,8 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
 //   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
-//   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite]
+//   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
+//   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|all]
 //   swim scenes
 //   swim demo [--out DIR]
@@ -52,9 +53,25 @@ int main(int argc, char** argv) {
   scr->add_option("sweep", sweep, "Sweep file (JSON)")->required();
   scr->add_option("--out", out, "Output directory (default out/screen-<sweep name>)");
   scr->add_option("--jobs", jobs, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+  int scr_confirm = 0, threads3d = 1;
+  scr->add_option("--confirm", scr_confirm,
+                  "Also run K designs in 3D (the K/2 best and K/2 spread over the rest) and report the rank agreement")
+      ->check(CLI::Range(0, 100000));
+  scr->add_option("--threads", threads3d, "Threads of each 3D run (default 1)")->check(CLI::Range(1, 1024));
   bool scr_overwrite = false;
   scr->add_flag("--overwrite", scr_overwrite, "Replace another run's results in the output folder (its files are removed first)");
   add_progress(scr);
+
+  CLI::App* opt = cli.add_subcommand("optimize", "Search the best design on the 1D tier (NLopt COBYLA) and confirm it in 3D");
+  std::string opt_spec;
+  bool opt_overwrite = false, opt_no_confirm = false;
+  opt->add_option("spec", opt_spec, "Optimisation spec (JSON: base scene, parameters with bounds, objective, constraints)")
+      ->required();
+  opt->add_option("--out", out, "Output directory (default out/optimize-<spec name>)");
+  opt->add_option("--threads", threads3d, "Threads of the 3D confirmation run (default 1)")->check(CLI::Range(1, 1024));
+  opt->add_flag("--no-confirm", opt_no_confirm, "Do not run the best design in 3D");
+  opt->add_flag("--overwrite", opt_overwrite, "Replace another run's results in the output folder (its files are removed first)");
+  add_progress(opt);
 
   bool quick = false;
   CLI::App* ben = cli.add_subcommand("bench", "Measure performance figures");
@@ -122,7 +139,8 @@ int main(int argc, char** argv) {
       return app::run(ro);
     }
     if (*demo) return app::demo(out, progress);
-    if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite);
+    if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite, scr_confirm, threads3d);
+    if (*opt) return app::optimize(opt_spec, out, progress, opt_overwrite, !opt_no_confirm, threads3d);
     if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
     if (*sc) return app::scenes();
     if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite);

@@ -133,7 +133,10 @@ bool RunFolder::is_result_name(const std::string& rel) {
                                               "run.png",       "vtk",            kOwner,
                                               // swim screen, swim calibrate
                                               "designs.csv", "screen.json", "screen.png", "calibration.json",
-                                              "calibration.png"};
+                                              "calibration.png",
+                                              // swim screen --confirm, swim optimize
+                                              "confirm.json", "confirm.md", "confirm.png", "trajectory.csv",
+                                              "optimum.json", "optimum.scene.json", "optimize.png"};
   if (fixed.count(rel)) return true;
   static const std::regex frames(R"(vtk/(membrane_\d+\.vtp|fluid_\d+\.vti))");
   static const std::regex temps(R"((vtk/)?\.[^/]+\.tmp(-\d+)?)");
@@ -181,7 +184,8 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
          it.increment(ec)) {
       const std::string rel = fs::relative(it->path(), dir_, ec).generic_string();
       if (rel == kLock) continue;
-      (is_result_name(rel) || listed.count(rel) ? results : foreign).push_back(rel);
+      const bool kept = !o.keep.empty() && (rel == o.keep || rel.rfind(o.keep + "/", 0) == 0);
+      (kept || is_result_name(rel) || listed.count(rel) ? results : foreign).push_back(rel);
     }
     if (ec) throw InputError(o.key, shown, "cannot list the output folder: " + ec.message());
     std::sort(results.begin(), results.end());
@@ -217,8 +221,9 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
                                        ? json_hash(old_summary["scene"])
                                        : "";
       // a record written before the standard FNV-1a basis holds the legacy hash of the scene
-      const bool same_run =
-          (old_hash == hash || old_hash == json_hash_legacy(o.resolved)) && old_tier == o.tier && old_status.rfind("running", 0) != 0 && !old_status.empty();
+      const bool finished = old_status.rfind("running", 0) != 0 && !old_status.empty();
+      const bool same_run = (old_hash == hash || old_hash == json_hash_legacy(o.resolved)) && old_tier == o.tier &&
+                            (finished || !o.keep.empty());
       if (!o.overwrite && !same_run)
         throw InputError(o.key, shown,
                          "holds the results of another run (" + (old_tier.empty() ? "" : old_tier + ", ") +
@@ -230,7 +235,9 @@ RunFolder::RunFolder(std::string dir, const RunFolderOptions& o) : dir_(std::mov
       // Clear the old run's files: the summary first (it would otherwise claim them).
       fs::remove(fs::path(dir_) / o.summary, ec);
       std::sort(results.begin(), results.end(), [](const std::string& a, const std::string& b) { return a > b; });
+      const bool keep = same_run && !o.overwrite && !o.keep.empty();
       for (const auto& r : results) {
+        if (keep && (r == o.keep || r.rfind(o.keep + "/", 0) == 0)) continue;  // reused by this run
         fs::remove(fs::path(dir_) / r, ec);  // files first (reverse order puts vtk/x before vtk)
         if (ec) throw InputError(o.key, shown, "cannot remove the old result " + r + ": " + ec.message());
       }

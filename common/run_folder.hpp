@@ -25,7 +25,7 @@
 namespace swim::output {
 
 struct RunFolderOptions {
-  std::string tier;        ///< "1d", "3d", "screen" or "calibration"
+  std::string tier;        ///< "1d", "3d", "axi", "screen", "optimize" or "calibration"
   scene::json resolved;    ///< the resolved scene (or sweep) of this run (its hash identifies the run)
   bool overwrite = false;  ///< --overwrite
   bool resume = false;     ///< --resume
@@ -33,6 +33,11 @@ struct RunFolderOptions {
   /// The file written last, whose "status" says whether the run finished ("summary.json";
   /// "screen.json" for a sweep, "calibration.json" for a calibration).
   std::string summary = "summary.json";
+  /// A sub-folder of child runs (the 3D confirmation runs of a sweep or search) that a new run
+  /// of the same identity keeps, so that it reuses them; such a run also continues a folder
+  /// whose previous run of the same identity did not finish. Everything under it counts as
+  /// this run's results (removed with --overwrite or by another run). Empty: none.
+  std::string keep{};
 };
 
 class RunFolder {

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <iterator>
+#include <tuple>
 
 #include "common/errors.hpp"
 #include "common/units.hpp"
@@ -150,6 +151,25 @@ json Sweep::design(size_t index) const {
   return s;
 }
 
+std::pair<json, std::string> read_base(const json& file, const std::string& dir_name, const std::string& what) {
+  namespace fs = std::filesystem;
+  const fs::path dir(dir_name);
+  if (!file.contains("base")) throw InputError("base", "(missing)", "a " + what + " needs a base scene (path or object)");
+  const json& base = file["base"];
+  std::pair<json, std::string> r;
+  if (base.is_string()) {
+    fs::path b = dir / base.get<std::string>();
+    if (!fs::exists(b)) b = base.get<std::string>();
+    r = {scene::load_file(b.string()), b.parent_path().string()};
+  } else if (base.is_object()) {
+    r = {base, dir.string()};
+  } else {
+    throw InputError("base", scene::show(base), "must be a scene file path or an inline scene object");
+  }
+  if (r.second.empty()) r.second = ".";
+  return r;
+}
+
 Sweep read_sweep(const std::string& path, const std::vector<std::string>& metrics) {
   namespace fs = std::filesystem;
   return parse_sweep(scene::load_file(path), fs::path(path).parent_path().string(), fs::path(path).stem().string(),
@@ -165,24 +185,13 @@ Sweep parse_sweep(const json& j, const std::string& dir_name, const std::string&
     if (j.contains(k) && !j[k].is_string()) throw InputError(k, scene::show(j[k]), "a text");
   if (j.contains("name")) scene::check_name(j["name"].get<std::string>());
   sw.name = j.contains("name") ? j["name"].get<std::string>() : stem;
-  const fs::path dir(dir_name);
   for (auto it = j.begin(); it != j.end(); ++it)
     if (it.key() != "base" && it.key() != "vary" && it.key() != "metric" && it.key() != "goal" &&
-        it.key() != "name" && it.key() != "description")
-      throw InputError(it.key(), scene::show(it.value()), "unknown key; allowed: name, description, base, vary, metric, goal");
-  if (!j.contains("base")) throw InputError("base", "(missing)", "a sweep needs a base scene (path or object)");
-  if (j["base"].is_string()) {
-    fs::path b = dir / j["base"].get<std::string>();
-    if (!fs::exists(b)) b = j["base"].get<std::string>();
-    sw.base = scene::load_file(b.string());
-    sw.base_dir = b.parent_path().string();
-  } else if (j["base"].is_object()) {
-    sw.base = j["base"];
-    sw.base_dir = dir.string();
-  } else {
-    throw InputError("base", scene::show(j["base"]), "must be a scene file path or an inline scene object");
-  }
-  if (sw.base_dir.empty()) sw.base_dir = ".";
+        it.key() != "name" && it.key() != "description" && it.key() != "confirm")
+      throw InputError(it.key(), scene::show(it.value()),
+                       "unknown key; allowed: name, description, base, vary, metric, goal, confirm");
+  if (j.contains("confirm")) sw.confirm = j["confirm"];  // checked by swim screen --confirm
+  std::tie(sw.base, sw.base_dir) = read_base(j, dir_name, "sweep");
   if (!j.contains("vary") || !j["vary"].is_object() || j["vary"].empty())
     throw InputError("vary", j.contains("vary") ? scene::show(j["vary"]) : "(missing)",
                      "must be an object mapping scene keys to value lists or ranges");

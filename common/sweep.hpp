@@ -3,12 +3,14 @@
 //   { "base": "../scenes/demo.json",            // path (relative to the sweep file) or an inline scene
 //     "vary": { "swimmer.length": {"from": "0.2 um", "to": "0.8 um", "count": 4, "spacing": "linear"},
 //               "wave.contracted_ratio": {"values": [0.35, 0.55, 0.82]} },
-//     "metric": "mean_velocity_m_per_s", "goal": "max" }
+//     "metric": "mean_velocity_m_per_s", "goal": "max",
+//     "confirm": {"grid": {"cells_across": 16}} }     // optional: the 3D grid of swim screen --confirm
 //
 // The designs are the Cartesian product of the axes, in row-major order (last axis fastest).
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -32,12 +34,18 @@ struct Sweep {
   std::vector<Axis> axes;
   std::string metric;
   bool maximize = true;
+  json confirm;              ///< the 3D confirmation's settings ("confirm": {"grid": ...}); null when absent
   size_t count() const;
   /// Scene of design `index`, with the axis values applied.
   json design(size_t index) const;
   /// Axis value indices of design `index`.
   std::vector<size_t> indices(size_t index) const;
 };
+
+/// The "base" of a sweep or optimisation file in the folder `dir`: the scene (a path relative to that folder,
+/// or an inline scene) and the folder its relative paths start from. `what` names the file kind
+/// in messages. Throws InputError (key "base").
+std::pair<json, std::string> read_base(const json& file, const std::string& dir, const std::string& what);
 
 /// Read and validate a sweep file. `metrics` lists the allowed metric names.
 /// Throws InputError naming the key.

@@ -1,0 +1,92 @@
+// Confirmation of 1D designs in 3D: the design's scene on the 3D grid its sweep chooses, run
+// once (a finished run in the runs folder is reused, an interrupted one continues from its
+// checkpoint), and the figures of both tiers side by side.
+//
+//   figures compared per design: the sweep's metric, displacement per cycle [m], cycle time [s],
+//   mean velocity [m/s]; relative difference (3D - 1D) / |3D|.
+//   error bars: a 3D summary's "error_bars" object ({"<figure key>": value in the figure's unit}),
+//   when a run writes one; the 3D tier's single runs write none today, so no pair is tied by them.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "common/scene.hpp"
+#include "design/rank_agreement.hpp"
+#include "reduced1d/report.hpp"
+
+namespace swim::design {
+
+using scene::json;
+
+/// The sweep metrics a 3D summary reports (every 1D metric but the Brownian ratio).
+const std::vector<std::string>& metrics_in_3d();
+/// Throws InputError naming `key` when the 3D tier does not report `metric`.
+void check_metric_in_3d(const std::string& metric, const std::string& key);
+
+/// A "confirm" section ({"grid": {"cells_across": n} | {"cell_size": "<length>"}}) read and
+/// checked; `where` names it in messages. Absent (null): the design scene's own full3d.grid,
+/// which is the 3D tier's default (32 cells across the container) when the scene sets none.
+json read_confirm_section(const json& section, const std::string& where);
+
+/// A design scene prepared for its 3D run: the section's grid, `threads`, no VTK frames.
+json confirm_scene(json scene, const json& section, int threads);
+
+struct Confirmed {
+  json summary;        ///< the 3D run's summary.json
+  std::string folder;  ///< its run folder
+  bool reused = false; ///< a finished run found in the runs folder
+  bool ok = false;     ///< status "ok"
+  double cell_size_m = 0;  ///< the grid's h
+};
+
+/// The 3D run of `scene` (validated by the 3D reader) in runs_dir/<label>-<hash of the
+/// resolved scene>: reused when finished, continued from a matching checkpoint, else run.
+Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const std::string& label, int progress);
+
+/// One tier's figures of a design: {"<metric>", "displacement_per_cycle_m", "cycle_time_s",
+/// "mean_velocity_m_per_s"}; a figure the run did not produce (no completed cycle) is null.
+json figures_1d(const reduced1d::Metrics& m, const std::string& metric);
+json figures_3d(const json& summary, const std::string& metric);
+/// The error bar of a 3D figure (0 when the run reports none).
+double error_bar_3d(const json& summary, const std::string& figure);
+
+/// {"<figure>": (3D - 1D) / |3D|} for every figure both tiers have (null otherwise).
+json relative_differences(const json& fig1d, const json& fig3d);
+
+/// The agreement as JSON: n, kendall_tau (+ _ci_95), spearman_rho (+ _ci_95), the method,
+/// pair counts and the misranked pairs by design label.
+json agreement_json(const RankAgreement& a, const std::vector<std::string>& labels);
+
+/// A design of a sweep (or the optimum of a search) to confirm in 3D.
+struct Candidate {
+  std::size_t design = 0;   ///< its index in the sweep
+  std::string values;       ///< its swept values, for people ("swimmer.length=\"0.3 um\", ...")
+  std::string selected_as;  ///< "best", "spread" or "optimum"
+  long rank_in_sweep = 0;   ///< 1 = best of the whole sweep by its metric
+  json scene;               ///< the design's scene (1D; the section's grid is applied here)
+  reduced1d::Metrics metrics;
+};
+
+struct ConfirmOptions {
+  std::string metric;  ///< must be in metrics_in_3d()
+  bool maximize = true;
+  json section;        ///< read_confirm_section()
+  int threads = 1;     ///< threads of each 3D run
+  int progress = -1;   ///< progress of each 3D run
+  std::string runs_dir;
+};
+
+/// Runs every candidate in 3D (design/confirm.hpp: reused when finished) and returns the report
+/// written as confirm.json: per design both tiers' figures, their relative differences and
+/// ranks; the rank agreement over the designs whose 3D run finished ("agreement", null with
+/// "agreement_absent_because" below two); "status" "ok" or "failed: <the 3D failures>".
+/// on_done(i, confirmed) after each run (printouts).
+json confirm_candidates(const std::vector<Candidate>& candidates, const ConfirmOptions& o,
+                        const std::function<void(std::size_t, const Confirmed&)>& on_done = {});
+
+/// The confirmation report for people (confirm.md): SI-prefixed figures, ranks, agreement.
+std::string confirm_markdown(const json& report, const std::string& title);
+
+}  // namespace swim::design

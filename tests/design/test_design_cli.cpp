@@ -1,0 +1,214 @@
+// swim screen --confirm and swim optimize end to end on a tiny 3D scene (a 32x12x12 duct, 20 ms
+// of simulated time: about a second per 3D run): the selection, the report, a rerun that reuses
+// the finished 3D runs, the optimiser's bounds, and bad input (exit 2 naming the key, nothing written).
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+
+#include "common/scene.hpp"
+
+namespace fs = std::filesystem;
+using swim::scene::json;
+
+namespace {
+
+const std::string kTiny = SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json";
+
+fs::path tmpdir(const std::string& tag) {
+  const fs::path d = fs::temp_directory_path() / ("swim_design_" + tag + "_" + std::to_string(::getpid()));
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+json read(const fs::path& p) { return json::parse(slurp(p)); }
+
+void write(const fs::path& p, const json& j) { std::ofstream(p) << j.dump(2); }
+
+struct Cli {
+  int code = -1;
+  std::string err;
+};
+
+Cli run_swim(const std::string& args, const fs::path& scratch) {
+  const fs::path err = scratch / "stderr.txt";
+  const std::string cmd = "\"" SWIM_BINARY_DIR "/bin/swim\" " + args + " --quiet > /dev/null 2> \"" + err.string() + "\"";
+  const int status = std::system(cmd.c_str());
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(err)};
+}
+
+// The tiny scene cut to 20 ms (20 steps in 3D).
+json tiny_scene() {
+  json s = json::parse(slurp(kTiny));
+  s["time"]["duration"] = "20 ms";
+  return s;
+}
+
+// Three designs of the tiny scene; ranked by the mean velocity.
+json tiny_sweep() {
+  return {{"name", "tiny"},
+          {"base", tiny_scene()},
+          {"vary", {{"wave.contracted_ratio", {{"values", {0.6, 0.75, 0.9}}}}}},
+          {"metric", "mean_velocity_m_per_s"},
+          {"goal", "max"}};
+}
+
+}  // namespace
+
+TEST(ScreenConfirm, RunsTheBestAndTheSpreadIn3dReportsTheAgreementAndReusesFinishedRuns) {
+  const fs::path d = tmpdir("confirm");
+  write(d / "tiny.json", tiny_sweep());
+  const fs::path out = d / "out";
+  const std::string cmd = "screen \"" + (d / "tiny.json").string() + "\" --jobs 1 --threads 1 --out \"" + out.string() + "\"";
+  Cli c = run_swim(cmd + " --confirm 2", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  json r = read(out / "confirm.json");
+  EXPECT_EQ(r["status"], "ok");
+  ASSERT_EQ(r["designs"].size(), 2u);
+  // the best and the worst of the 1D ranking
+  EXPECT_EQ(r["designs"][0]["selected_as"], "best");
+  EXPECT_EQ(r["designs"][0]["rank_in_sweep_1d"], 1);
+  EXPECT_EQ(r["designs"][1]["selected_as"], "spread");
+  EXPECT_EQ(r["designs"][1]["rank_in_sweep_1d"], 3);
+  for (const auto& x : r["designs"]) {
+    EXPECT_EQ(x["reused_3d"], false);
+    EXPECT_TRUE(x["figures_3d"]["mean_velocity_m_per_s"].is_number());
+    EXPECT_TRUE(x["relative_difference_3d_vs_1d"]["mean_velocity_m_per_s"].is_number());
+    EXPECT_NEAR(x["cell_size_3d_m"].get<double>(), 4e-8, 1e-12);
+  }
+  // two designs: tau is +1 or -1, and a tau of -1 is one misranked pair
+  const double tau = r["agreement"]["kendall_tau"].get<double>();
+  EXPECT_DOUBLE_EQ(std::abs(tau), 1.0);
+  EXPECT_EQ(r["agreement"]["misranked_pairs"].size(), tau < 0 ? 1u : 0u);
+  EXPECT_EQ(read(out / "screen.json")["confirm"]["kendall_tau"], tau);
+  EXPECT_TRUE(fs::exists(out / "confirm.md"));
+  EXPECT_NE(slurp(out / "confirm.md").find("Kendall"), std::string::npos);
+
+  // interrupted before the report (screen.json and confirm.json missing): the same command
+  // continues in the folder and reuses both finished 3D runs, with the same figures
+  fs::remove(out / "screen.json");
+  fs::remove(out / "confirm.json");
+  c = run_swim(cmd + " --confirm 2", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  json again = read(out / "confirm.json");
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(again["designs"][i]["reused_3d"], true);
+    EXPECT_EQ(again["designs"][i]["figures_3d"], r["designs"][i]["figures_3d"]);
+  }
+  EXPECT_DOUBLE_EQ(again["wall_time_3d_s"].get<double>(), 0.0);
+  // a larger K runs only the design not run yet
+  c = run_swim(cmd + " --confirm 3", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  again = read(out / "confirm.json");
+  ASSERT_EQ(again["designs"].size(), 3u);
+  int fresh = 0;
+  for (const auto& x : again["designs"]) fresh += x["reused_3d"] == false;
+  EXPECT_EQ(fresh, 1);
+  EXPECT_EQ(again["agreement"]["designs"], 3);
+  fs::remove_all(d);
+}
+
+TEST(ScreenConfirm, BadInputIsExitTwoNamingTheKeyAndWritesNothing) {
+  const fs::path d = tmpdir("confirm_bad");
+  json sw = tiny_sweep();
+  write(d / "tiny.json", sw);
+  const fs::path out = d / "out";
+  const std::string tail = " --jobs 1 --out \"" + out.string() + "\"";
+  Cli c = run_swim("screen \"" + (d / "tiny.json").string() + "\" --confirm 4" + tail, d);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("--confirm"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("(3)"), std::string::npos) << c.err;  // the number of designs allowed
+  sw["metric"] = "directed_to_diffusive_ratio";  // a 1D figure the 3D tier does not report
+  write(d / "ratio.json", sw);
+  c = run_swim("screen \"" + (d / "ratio.json").string() + "\" --confirm 2" + tail, d);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("metric"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("directed_to_diffusive_ratio"), std::string::npos) << c.err;
+  sw = tiny_sweep();
+  sw["confirm"] = {{"grid", {{"cells", 16}}}};
+  write(d / "grid.json", sw);
+  c = run_swim("screen \"" + (d / "grid.json").string() + "\" --confirm 2" + tail, d);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("confirm.grid"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(d);
+}
+
+TEST(OptimizeCli, StaysWithinTheBoundsAndConfirmsTheOptimumIn3d) {
+  const fs::path d = tmpdir("optimize");
+  const json spec = {{"name", "tiny"},
+                     {"base", tiny_scene()},
+                     {"parameters",
+                      {{"wave.contracted_ratio", {{"min", 0.6}, {"max", 0.9}}},
+                       {"swimmer.length", {{"min", "0.32 um"}, {"max", "0.44 um"}, {"start", "0.4 um"}}}}},
+                     {"objective", "mean_velocity_m_per_s"},
+                     {"max_evaluations", 8}};
+  write(d / "spec.json", spec);
+  const fs::path out = d / "out";
+  Cli c = run_swim("optimize \"" + (d / "spec.json").string() + "\" --threads 1 --out \"" + out.string() + "\"", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  std::istringstream csv(slurp(out / "trajectory.csv"));
+  std::string line;
+  std::getline(csv, line);
+  EXPECT_EQ(line.rfind("evaluation,wave.contracted_ratio_si,swimmer.length_si[m],mean_velocity_m_per_s", 0),
+            0u)
+      << line;
+  int rows = 0;
+  while (std::getline(csv, line)) {
+    ++rows;
+    double eps = 0, len = 0;
+    int k = 0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%d,%lf,%lf", &k, &eps, &len), 3) << line;
+    EXPECT_GE(eps, 0.6);
+    EXPECT_LE(eps, 0.9);
+    EXPECT_GE(len, 0.32e-6 * (1 - 1e-12));
+    EXPECT_LE(len, 0.44e-6 * (1 + 1e-12));
+  }
+  EXPECT_GE(rows, 2);
+  EXPECT_LE(rows, 8);
+  const json opt = read(out / "optimum.json");
+  EXPECT_EQ(opt["status"], "ok");
+  EXPECT_EQ(opt["evaluations"], rows);
+  EXPECT_TRUE(fs::exists(out / "optimum.scene.json"));
+  const json conf = read(out / "confirm.json");
+  ASSERT_EQ(conf["designs"].size(), 1u);
+  EXPECT_EQ(conf["designs"][0]["selected_as"], "optimum");
+  EXPECT_TRUE(conf["designs"][0]["figures_3d"]["mean_velocity_m_per_s"].is_number());
+  EXPECT_TRUE(opt["confirm"]["relative_difference_3d_vs_1d"]["mean_velocity_m_per_s"].is_number());
+  fs::remove_all(d);
+}
+
+TEST(OptimizeCli, AnEmptyFeasibleSetIsExitTwoNamingTheConstraint) {
+  const fs::path d = tmpdir("optimize_empty");
+  json spec = {{"base", tiny_scene()},
+               {"parameters", {{"protocol.load_factor", {{"min", 1.5}, {"max", 3}}}}},
+               {"constraints", {{"max_load", "1 uPa"}}}};
+  write(d / "spec.json", spec);
+  const fs::path out = d / "out";
+  Cli c = run_swim("optimize \"" + (d / "spec.json").string() + "\" --no-confirm --out \"" + out.string() + "\"", d);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("constraints.max_load"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("no feasible design"), std::string::npos) << c.err;
+  // an empty box is refused the same way, naming the bound
+  spec = {{"base", tiny_scene()}, {"parameters", {{"wave.contracted_ratio", {{"min", 0.8}, {"max", 0.7}}}}}};
+  write(d / "spec.json", spec);
+  c = run_swim("optimize \"" + (d / "spec.json").string() + "\" --no-confirm --out \"" + out.string() + "\"", d);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("parameters.wave.contracted_ratio.max"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(d);
+}
