@@ -151,7 +151,7 @@ int run_axi(const RunOptions& o, const scene::json& sc) {
   std::string per_cycle = "no cycle completed";
   if (s["mean_velocity_per_cycle_m_per_s"].is_number())
     per_cycle = si(s["displacement_per_cycle_m"].get<double>(), "m") + " per cycle in " +
-                si(s["cycle_times_s"].back().get<double>(), "s") + ", " +
+                si(s["cycle_time_s"].get<double>(), "s") + ", " +
                 si(s["mean_velocity_per_cycle_m_per_s"].get<double>(), "m/s");
   std::printf("%s (axi): displacement %s; %s; %d cycle(s); pumped %s; %ld steps on %d x %d cells (h = %s); wall time %s\n"
               "  -> %s/summary.json\n",

@@ -570,18 +570,7 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
     throw NumericalError("the fitted Stokes solve returned a non-finite velocity",
                          "check the forces; change axi.fitted.cells_inner or axi.fitted.cells_outer");
   solved_ = true;
-  // Volume mean of the raw pressure (the gauge of the queries).
-  p_mean_ = 0.0;
-  double pv = 0.0, vol = 0.0;
-  for (int e = 0; e < E; ++e) {
-    element_geometry(e, g);
-    for (int q = 0; q < 9; ++q) {
-      const double W = g.wdet[q] * g.r[q];
-      pv += W * eval_pressure(e, g.x[q], g.r[q]);
-      vol += W;
-    }
-  }
-  p_mean_ = pv / vol;
+  pressure_gauge();
   U.setZero(3, nm);
   for (int k = 0; k < nm; ++k)
     for (int s = 0; s < 5; ++s) {
@@ -592,6 +581,108 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
     }
   timing_.solve += seconds_since(t0) - (timing_.factor - factor_before);
   ++timing_.solves;
+}
+
+void FittedStokes::pressure_gauge() {
+  // Volume mean of the raw pressure (the gauge of the queries).
+  p_mean_ = 0.0;
+  Geometry g;
+  double pv = 0.0, vol = 0.0;
+  for (int e = 0; e < mesh_.elements(); ++e) {
+    element_geometry(e, g);
+    for (int q = 0; q < 9; ++q) {
+      const double W = g.wdet[q] * g.r[q];
+      pv += W * eval_pressure(e, g.x[q], g.r[q]);
+      vol += W;
+    }
+  }
+  p_mean_ = pv / vol;
+}
+
+FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen::Matrix3Xd& X,
+                                                                    const Eigen::Matrix3Xd& V) {
+  const int nm = mesh_.membrane_nodes();
+  if (V.cols() != nm || !V.topRows(2).allFinite())
+    throw std::invalid_argument("FittedStokes::prescribed_wall_velocity: V must be 3 x " + std::to_string(nm) +
+                                " and finite");
+  factored_ = solved_ = false;
+  lu_valid_ = lu_current_ = false;  // the stored LU will be of the constrained system
+  auto t0 = Clock::now();
+  mesh_.fit(X);
+  transfer_weights();
+  assemble(nullptr, 0.0);
+  // The wall line's Q2 nodes: vertex columns 2k and midside columns 2k + 1 between the rims
+  // (closed test mode: the whole line). Their values: V interpolated linearly (a), 1 axial (b).
+  const bool closed = mesh_.params().closed;
+  const int ci2 = 2 * mesh_.params().cells_inner, last = closed ? 2 * nm - 1 : 2 * (nm - 1);
+  std::vector<signed char> fixed(n_, 0);  // 1: axial, 2: radial wall unknown
+  Eigen::VectorXd ga = Eigen::VectorXd::Zero(n_), gb = Eigen::VectorXd::Zero(n_);
+  for (int I = 0; I <= last; ++I) {
+    const int nd = mesh_.node(I, ci2), k = I / 2, l = (k + 1) % nm;
+    const Eigen::Vector2d v = I % 2 == 0 ? Eigen::Vector2d(V(0, k), V(1, k))
+                                         : Eigen::Vector2d(0.5 * (V(0, k) + V(0, l)), 0.5 * (V(1, k) + V(1, l)));
+    fixed[dof_x_[nd]] = 1;
+    fixed[dof_r_[nd]] = 2;
+    ga[dof_x_[nd]] = v[0];
+    ga[dof_r_[nd]] = v[1];
+    gb[dof_x_[nd]] = 1.0;
+  }
+  // Constrained rows: keep the axial ones' entries for the reaction, then replace every such row
+  // by its diagonal (the row's own scale) times the prescribed value. Column-major storage: a
+  // row's entries are spread over the columns.
+  double* val = A_.valuePtr();
+  const int* inner = A_.innerIndexPtr();
+  const int* outer = A_.outerIndexPtr();
+  std::vector<std::pair<int, double>> reaction;  // (column, value) of the axial rows, summed over them
+  Eigen::VectorXd diag = Eigen::VectorXd::Zero(n_);
+  for (int c = 0; c < n_; ++c)
+    for (int q = outer[c]; q < outer[c + 1]; ++q) {
+      const int row = inner[q];
+      if (!fixed[row]) continue;
+      if (fixed[row] == 1) reaction.emplace_back(c, val[q]);
+      if (row == c)
+        diag[row] = val[q];
+      else
+        val[q] = 0.0;
+    }
+  for (int i = 0; i < n_; ++i)
+    if (fixed[i] && !(diag[i] > 0.0))
+      throw NumericalError("a wall unknown of the fitted Stokes system has no positive diagonal",
+                           "check the wall's shape; change axi.grid");
+  timing_.assemble += seconds_since(t0);
+  numeric_factor();
+  lu_current_ = false;  // A_ is not the traction system any more
+  lu_valid_ = false;
+  const auto t1 = Clock::now();
+  lu_->umfpackControl()(UMFPACK_IRSTEP) = 1;
+  auto solve_one = [&](const Eigen::VectorXd& g, Eigen::VectorXd& x) {
+    rhs_.setZero();
+    for (int i = 0; i < n_; ++i)
+      if (fixed[i]) rhs_[i] = diag[i] * g[i];
+    x = lu_->solve(rhs_);
+    if (!x.allFinite())
+      throw NumericalError("the fitted Stokes solve of the prescribed wall returned a non-finite velocity",
+                           "check the wave's shape; change axi.grid");
+    double f = 0.0;
+    for (const auto& [c, v] : reaction) f += v * x[c];
+    return f;
+  };
+  Eigen::VectorXd xa, xb;
+  PrescribedWall res;
+  res.force = solve_one(ga, xa);
+  res.drag = solve_one(gb, xb);
+  if (!(std::isfinite(res.drag) && res.drag > 0.0) || !std::isfinite(res.force))
+    throw NumericalError("the towed tube's drag is not positive (" + fmt(res.drag) + " N s/m)",
+                         "check the wall's shape; change axi.grid");
+  res.velocity = -res.force / res.drag;
+  sol_ = xa + res.velocity * xb;
+  solved_ = true;
+  last_iters_ = 0;
+  last_res_ = -1.0;
+  pressure_gauge();
+  timing_.solve += seconds_since(t1);
+  timing_.solves += 2;
+  return res;
 }
 
 Eigen::Vector2d FittedStokes::eval_velocity(int e, double xi, double eta) const {

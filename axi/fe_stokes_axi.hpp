@@ -150,6 +150,27 @@ class FittedStokes {
   void solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
              const std::function<Eigen::Vector2d(double x, double r)>* body = nullptr);
 
+  /// Prescribed wall motion with a free axial translation: the force-free swimmer of a
+  /// prescribed wave (docs/axi.md "Prescribed waves"). On the mesh fitted to the rings X, the
+  /// wall line's Q2 nodes (vertex and midside, between the two rims) carry the Dirichlet
+  /// velocity V + (U, 0), V (3 x n, rows 0/1 axial/radial ring velocity, m/s) interpolated
+  /// linearly between the rings; the rest is the plain fluid problem (no loads). By linearity,
+  /// on one factorisation: (a) V alone gives the axial force F_a the wall exerts on the fluid,
+  /// (b) V = (1, 0) on every ring gives F_b (the drag of the towed tube, N per m/s); the
+  /// force-free condition F_a + U F_b = 0 gives U = -F_a / F_b. The force is the sum of the
+  /// residuals a(u, phi_i) + b(phi_i, p) of the constrained axial unknowns (the weak traction
+  /// jump tested with the wall line's shape functions). The last solution is then V + (U, 0)'s
+  /// flow: the queries (velocity, end_disc_flux, dissipation, ...) refer to it.
+  /// Always factors (no reuse); a later factor()/solve() pair works as before.
+  /// Throws std::invalid_argument for V of the wrong size or not finite, what factor() throws,
+  /// and swim::NumericalError for a tube with no drag (F_b not positive and finite).
+  struct PrescribedWall {
+    double velocity = 0.0;  ///< U, the force-free axial velocity, m/s
+    double force = 0.0;     ///< F_a, axial force of V alone (U = 0) on the fluid, N
+    double drag = 0.0;      ///< F_b, axial force on the fluid per unit U, N s/m (> 0)
+  };
+  PrescribedWall prescribed_wall_velocity(const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& V);
+
   // ---- queries on the last solution
   /// (u_x, u_r) at any point 0 <= r <= Rc (x wrapped by P).
   Eigen::Vector2d velocity(double x, double r) const;
@@ -200,6 +221,7 @@ class FittedStokes {
   /// to tol_; iters and the true relative residual out. fresh: the LU is of A_ itself (then
   /// stagnation ends the solve with the best iterate).
   bool gmres(int max_iterations, bool fresh, int& iters, double& relres);
+  void pressure_gauge();  ///< p_mean_ of the current sol_
 
   FittedMesh mesh_;
   double mu_, lref_, ps_;

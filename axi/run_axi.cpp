@@ -218,18 +218,7 @@ class Runner {
     return std::max(p_.event_dt, 1.02 * gap / -V);
   }
 
-  /// The fitted mesh's parameters (axi/scene_axi.cpp derives them from h).
-  FittedMeshParams fitted_mesh_params() const {
-    FittedMeshParams mp;
-    mp.Rc = b_.container_radius;
-    mp.period = b_.period;
-    mp.cells_inner = p_.cells_inner;
-    mp.cells_outer = p_.cells_outer;
-    mp.gap_columns = p_.gap_columns;
-    mp.wall_row_aspect = p_.wall_row_aspect;
-    mp.gap_growth = 4.0;  // the column count is chosen for a ratio near 1 + 5 ds / Rc (scene_axi.cpp)
-    return mp;
-  }
+  FittedMeshParams fitted_mesh_params() const { return axi::fitted_mesh_params(p_); }
 
   /// Wall and actuation forces at X for the current protocol state; throws on non-finite ones.
   Eigen::Matrix3Xd total_force(const Eigen::Matrix3Xd& X, std::array<double, 2>* energy = nullptr) {
@@ -641,6 +630,7 @@ class Runner {
 }  // namespace
 
 RunOutcomeAxi run_axi(const ParamsAxi& p, const json& resolved, const std::string& out_dir, const RunControlAxi& ctl) {
+  if (p.base.wave.prescribed()) return run_prescribed_axi(p, resolved, out_dir, ctl);
   Runner r(p, resolved, out_dir, ctl);
   return r.run();
 }

@@ -45,6 +45,11 @@ struct RunOutcomeAxi {
 RunOutcomeAxi run_axi(const ParamsAxi& p, const scene::json& resolved, const std::string& out_dir,
                       const RunControlAxi& ctl = {});
 
+/// A prescribed wave (wave.kind = step | sine; fitted method): the force-free swimmer of the
+/// given R(z, t) (axi/prescribed_axi.hpp), written as run_axi writes. run_axi dispatches to it.
+RunOutcomeAxi run_prescribed_axi(const ParamsAxi& p, const scene::json& resolved, const std::string& out_dir,
+                                 const RunControlAxi& ctl = {});
+
 /// The columns of an axisymmetric run's series.csv: the common ones, then the energy split,
 /// the protocol state and the step statistics.
 const std::vector<std::string>& series_columns();

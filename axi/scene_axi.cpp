@@ -40,10 +40,23 @@ const json& section_keys() {
   return keys;
 }
 
+FittedMeshParams fitted_mesh_params(const ParamsAxi& p) {
+  FittedMeshParams mp;
+  mp.Rc = p.base.container_radius;
+  mp.period = p.base.period;
+  mp.cells_inner = p.cells_inner;
+  mp.cells_outer = p.cells_outer;
+  mp.gap_columns = p.gap_columns;
+  mp.wall_row_aspect = p.wall_row_aspect;
+  mp.gap_growth = 4.0;  // the column count is chosen for a ratio near 1 + 5 ds / Rc (read_scene_axi)
+  return mp;
+}
+
 ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   ParamsAxi p;
   // 1. The shared physics, read by the 3D tier's reader (the axi section is passed through).
-  p.base = full3d::read_scene3d(sc, resolved);
+  // Prescribed waves (step, sine) are read as by the 1D tier (common/scene_shared.hpp read_wave).
+  p.base = full3d::read_scene3d(sc, resolved, /*prescribed_waves=*/true);
   const full3d::Params3d& b = p.base;
   const json& f3 = section_or_empty(sc, "full3d");
   const json& mem = section_or_empty(f3, "membrane");
@@ -85,6 +98,10 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   p.method = a.choice("method", "fitted", {"fitted", "immersed_boundary"}) == "fitted" ? AxiMethod::Fitted
                                                                                      : AxiMethod::ImmersedBoundary;
   const bool ib = p.method == AxiMethod::ImmersedBoundary;
+  if (ib && b.wave.prescribed())
+    throw InputError("wave.kind", "\"" + b.wave.kind + "\"",
+                     "axi.method = \"immersed_boundary\" runs \"force_driven\" only; the prescribed waves (step, "
+                     "sine) run with axi.method = \"fitted\"");
   {
     Reader g = a.child("grid");
     if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {
@@ -124,7 +141,8 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   // local position error per step in cells: the explicit immersed boundary's steps are bounded
   // by its stability anyway; the fitted method's Rosenbrock steps by the tolerance alone (at
   // 2e-3 h its time error is 1e-5 of the displacement and 1e-3 of the cycle time, docs/axi.md)
-  p.tolerance = a.number("tolerance", ib ? 2e-4 : 2e-3, Range::open(0.0, 1.0));
+  // (a prescribed wave: the quadrature's error in the displacement over the whole run, in cells)
+  p.tolerance = a.number("tolerance", ib ? 2e-4 : (b.wave.prescribed() ? kPrescribedTolerance : 2e-3), Range::open(0.0, 1.0));
   p.dt_max = a.quantity("dt_max", "s", "8 ms", Range::positive());
   p.dt_min = a.quantity("dt_min", "s", "10 ns", Range::positive());
   p.event_dt = a.quantity("event_dt", "s", "0.1 ms", Range::positive());

@@ -8,13 +8,16 @@
 //   - the wall must be held round: full3d.membrane.axisymmetric = true;
 //   - the container must be the rigid cylinder (container.kind = "cylinder");
 //   - Stokes flow, no wall inertia, no dry swimmer (full3d.navier_stokes, full3d.wall_inertia,
-//     full3d.dry must be false), the reference-angle bending form.
+//     full3d.dry must be false), the reference-angle bending form;
+//   - wave.kind = step | sine (the prescribed waves, read as by the 1D tier; the protocol
+//     section is then refused) with axi.method = fitted only.
 // Anything else is an InputError (exit 2) naming the key, before anything is written.
 #pragma once
 
 #include <string>
 #include <vector>
 
+#include "axi/fitted_mesh.hpp"
 #include "common/scene.hpp"
 #include "full3d/scene3d.hpp"
 
@@ -25,6 +28,10 @@ enum class AxiMethod {
   ImmersedBoundary,  ///< MAC grid, FFT along the axis, Peskin kernel: the 3D tier's family, first order
   Fitted,            ///< finite elements on a mesh fitted to the wall (sharp interface), implicit wall steps
 };
+
+/// Default axi.tolerance of a prescribed wave: the time quadrature's error in the displacement
+/// over the run, in cells h (docs/axi.md "Prescribed waves").
+inline constexpr double kPrescribedTolerance = 1e-4;
 
 /// Growth ratio of the ring spacing from the rims inwards (axi.rim_refinement < 1).
 inline constexpr double kRimGrowth = 1.5;
@@ -56,6 +63,9 @@ struct ParamsAxi {
   const char* method_name() const { return method == AxiMethod::Fitted ? "fitted" : "immersed_boundary"; }
   double x_start() const { return 0.5 * (nx * h - base.L); }  ///< axial position of the rear end
 };
+
+/// The fitted mesh's parameters (method Fitted; read_scene_axi derives them from h).
+FittedMeshParams fitted_mesh_params(const ParamsAxi& p);
 
 /// Throws swim::InputError naming the key, the value and what is allowed.
 ParamsAxi read_scene_axi(const scene::json& scene, scene::json& resolved);

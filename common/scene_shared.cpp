@@ -95,6 +95,31 @@ double read_contracted_radius(Reader& w, double R0) {
   return R0 * w.number("contracted_ratio", 0.55, Range::open(0.0, 1.0));
 }
 
+double WaveSpec::transit(double L) const {
+  if (kind == "step") return L / speed;
+  if (kind == "sine") return wavelength / speed;
+  return 0.0;
+}
+
+WaveSpec read_wave(Reader& top, double R0, double L) {
+  WaveSpec s;
+  Reader w = top.child("wave");
+  s.kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven"});
+  s.R_f = read_contracted_radius(w, R0);
+  if (s.kind == "step") {
+    s.speed = w.quantity("speed", "m/s", "10 um/s", Range::positive());
+    s.width = w.quantity("width", "m", "0.01 um", Range::positive());
+    if (!(s.width <= 0.25 * L))
+      throw InputError(w.path("width"), format_quantity(s.width, "m"),
+                       "must be at most a quarter of swimmer.length = " + format_quantity(L, "m"));
+  } else if (s.kind == "sine") {
+    s.speed = w.quantity("speed", "m/s", "10 um/s", Range::positive());
+    s.wavelength = w.quantity("wavelength", "m", format_quantity(L, "m"), Range::positive());
+  }
+  w.finish();
+  return s;
+}
+
 ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1) {
   ProtocolSpec p;
   Reader r = top.child("protocol");

@@ -56,6 +56,21 @@ double c1_from_spring_constant(double k_s, double R0);
 /// wave keys and finishes `wave`.
 double read_contracted_radius(Reader& wave, double R0);
 
+/// The wave section (docs/scenes.md "wave.*"): its kind, the contracted radius and the
+/// prescribed waves' kinematics (reduced1d/params.hpp StepWave, SineWave).
+struct WaveSpec {
+  std::string kind;         ///< "step", "sine" or "force_driven"
+  double R_f = 0;           ///< contracted radius [m]: the step's R_min, the sine's R0 - amplitude
+  double speed = 0;         ///< step, sine: wave speed s > 0, the wave travels towards -z [m/s]
+  double width = 0;         ///< step: smoothing width w [m]
+  double wavelength = 0;    ///< sine: lambda [m]
+  bool prescribed() const { return kind != "force_driven"; }
+  /// The default end time of a prescribed wave: L/s (step), lambda/s (sine); 0 (force_driven).
+  double transit(double L) const;
+};
+/// Reads (and finishes) the wave section of a swimmer of radius R0 and length L [m].
+WaveSpec read_wave(Reader& top, double R0, double L);
+
 struct ProtocolSpec {
   double q = 0;             ///< actuation pressure [Pa], inward positive
   int segments = 0;

@@ -41,7 +41,7 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh) {
 
 CylinderMesh make_mesh(const Params3d& p) { return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor); }
 
-Params3d read_scene3d(const json& scene, json& resolved) {
+Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) {
   Params3d p;
   resolved = json::object();
   Reader top(scene, "", resolved);
@@ -70,20 +70,20 @@ Params3d read_scene3d(const json& scene, json& resolved) {
     p.membrane.ks = w.value;
     p.mass_per_area = w.mass_per_area;
   }
-  double R_f = 0;
   {
-    Reader w = top.child("wave");
-    const std::string kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven"});
-    if (kind != "force_driven")
-      throw InputError(w.path("kind"), "\"" + kind + "\"",
+    p.wave = scene::read_wave(top, R0, L);
+    if (p.wave.prescribed() && !prescribed_waves)
+      throw InputError("wave.kind", "\"" + p.wave.kind + "\"",
                        "the 3D tier drives the wall by forces only (prescribed kinematics are not implemented): "
-                       "use \"force_driven\" or run --tier 1d");
-    R_f = scene::read_contracted_radius(w, R0);
-    w.finish();
+                       "use \"force_driven\" or run --tier 1d or --tier axi");
   }
-  {
+  const double R_f = p.wave.R_f;
+  p.protocol.R_f = R_f;
+  if (p.wave.prescribed()) {
+    if (top.has("protocol"))
+      throw InputError("protocol", scene::show(scene.at("protocol")), "is only used when wave.kind = \"force_driven\"");
+  } else {
     const scene::ProtocolSpec r = scene::read_protocol(top, R0, L, R_f, p.c1_estimate());
-    p.protocol.R_f = R_f;
     p.protocol.q = r.q;
     p.protocol.segments = r.segments;
     p.protocol.first_ratio = r.first_ratio;
@@ -103,11 +103,13 @@ Params3d read_scene3d(const json& scene, json& resolved) {
       t.text("duration", "auto");
       p.duration = 0;
     }
-    const std::string def = p.duration > 0 ? fmt(p.duration / 200.0, "s") : "0.5 ms";
+    // a prescribed wave (axi tier): auto is its transit time, the output interval 1/200 of the run
+    const double span = p.duration > 0 ? p.duration : p.wave.transit(L);
+    const std::string def = span > 0 ? fmt(span / 200.0, "s") : "0.5 ms";
     p.output_interval = t.quantity("output_interval", "s", def, Range::positive());
-    if (p.duration > 0 && p.output_interval > p.duration)
+    if (span > 0 && p.output_interval > span)
       throw InputError(t.path("output_interval"), fmt(p.output_interval, "s"),
-                       "must not exceed the run duration " + fmt(p.duration, "s"));
+                       "must not exceed the run duration " + fmt(span, "s"));
     t.finish();
   }
   p.protocol.repeat_until_duration = p.duration > 0;

@@ -8,12 +8,14 @@
 //   - the spring network needs k_s: wall.C1 and wall.calibration (1D lumped
 //     stiffnesses) are rejected; wall.spring_constant (default 5.5e-8 N/m) is k_s.
 //   - node masses m_i = (mass per area) * A_i, A_i the node's reference area.
-//   - wave.kind must be force_driven (no prescribed kinematics in 3D).
+//   - wave.kind must be force_driven (no prescribed kinematics in 3D; the axisymmetric tier
+//     reads the same scene with prescribed_waves).
 #pragma once
 
 #include <string>
 
 #include "common/scene.hpp"
+#include "common/scene_shared.hpp"
 #include "full3d/grid.hpp"
 #include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
@@ -45,6 +47,9 @@ struct Params3d {
   MembraneParams membrane{};      ///< ks from wall.spring_constant; kb, bending form from full3d.membrane
   double mass_per_area = 0.0;     ///< kg/m^2
   ProtocolParams protocol{};
+  /// The wave section; prescribed kinds (step, sine) only when the reader allows them (the
+  /// axisymmetric tier), the protocol then keeps its defaults with R_f.
+  scene::WaveSpec wave{};
   double duration = 0.0;          ///< s; <= 0: until protocol.cycles cycles are complete
   double output_interval = 5e-4;  ///< s
   // full3d
@@ -88,7 +93,9 @@ struct Params3d {
 };
 
 /// Throws swim::InputError naming the key, the value and what is allowed.
-Params3d read_scene3d(const scene::json& scene, scene::json& resolved);
+/// prescribed_waves: accept wave.kind = step | sine (the axisymmetric tier's fitted method;
+/// the protocol section is then refused, as the 1D tier does); false: force_driven only.
+Params3d read_scene3d(const scene::json& scene, scene::json& resolved, bool prescribed_waves = false);
 
 /// The protocol parameters with the recovery-end energy of full3d.recovery_end filled in.
 ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh);

@@ -121,22 +121,18 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
 
   double R_f = 0;
   {
-    Reader w = top.child("wave");
-    const std::string kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven"});
-    p.wave = kind == "step" ? WaveKind::Step : kind == "sine" ? WaveKind::Sine : WaveKind::ForceDriven;
-    R_f = scene::read_contracted_radius(w, R0);
+    const scene::WaveSpec w = scene::read_wave(top, R0, L);
+    p.wave = w.kind == "step" ? WaveKind::Step : w.kind == "sine" ? WaveKind::Sine : WaveKind::ForceDriven;
+    R_f = w.R_f;
     if (p.wave == WaveKind::Step) {
       p.step.R_min = R_f;
-      p.step.speed = w.quantity("speed", "m/s", "10 um/s", Range::positive());
-      p.step.width = w.quantity("width", "m", "0.01 um", Range::positive());
-      if (!(p.step.width <= 0.25 * L))
-        throw InputError(w.path("width"), fmt(p.step.width, "m"), "must be at most a quarter of swimmer.length = " + fmt(L, "m"));
+      p.step.speed = w.speed;
+      p.step.width = w.width;
     } else if (p.wave == WaveKind::Sine) {
       p.sine.amplitude = R0 - R_f;
-      p.sine.speed = w.quantity("speed", "m/s", "10 um/s", Range::positive());
-      p.sine.wavelength = w.quantity("wavelength", "m", fmt(L, "m"), Range::positive());
+      p.sine.speed = w.speed;
+      p.sine.wavelength = w.wavelength;
     }
-    w.finish();
   }
 
   const bool forced = p.wave == WaveKind::ForceDriven;
