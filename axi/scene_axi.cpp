@@ -132,12 +132,11 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   // fitted: the rings are refined geometrically (ratio 1.5) towards the tube's two rims, the end
   // segments min(1, rim_refinement h / R0) times the interior spacing: the flow is singular at
   // the wall's free edge, and an end spacing proportional to h^2 keeps its error second order
-  const bool rim_given = a.has("rim_refinement");
   const double rim = a.number("rim_refinement", 1.0, Range::positive());
-  if (ib && rim_given)
+  if (ib && rim != 1.0)
     throw InputError(a.path("rim_refinement"), fmt(rim, ""),
-                     "no value with axi.method = immersed_boundary (its rings are uniform); the rim refinement is the "
-                     "fitted method's");
+                     "1 (the default, unused) with axi.method = immersed_boundary: its rings are uniform; the rim "
+                     "refinement is the fitted method's");
   // local position error per step in cells: the explicit immersed boundary's steps are bounded
   // by its stability anyway; the fitted method's Rosenbrock steps by the tolerance alone (at
   // 2e-3 h its time error is 1e-5 of the displacement and 1e-3 of the cycle time, docs/axi.md)
