@@ -43,13 +43,19 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);
   const bool plotted = plot("plot_validation.py", {out});
-  int pass = 0, fail = 0;
+  int pass = 0, fail = 0, inconclusive = 0;
   for (const auto& c : report["cases"])
     for (const auto& m : c["models1d"])
       if (m.contains("verdicts"))
-        for (const auto& [k, v] : m["verdicts"].items()) (v == "pass" ? pass : fail) += (v == "pass" || v == "fail");
-  std::printf("validation suite %s: %zu case(s), %d verdicts pass, %d fail; wall time %s\n  -> %s/report.json%s\n",
-              name.c_str(), report["cases"].size(), pass, fail, si(report["wall_time_s"].get<double>(), "s").c_str(),
+        for (const auto& [k, v] : m["verdicts"].items()) {
+          pass += v == "pass";
+          fail += v == "fail";
+          inconclusive += v == "inconclusive";
+        }
+  std::printf("validation suite %s: %zu case(s), %d verdicts pass, %d fail, %d inconclusive; wall time %s\n  -> "
+              "%s/report.json%s\n",
+              name.c_str(), report["cases"].size(), pass, fail, inconclusive,
+              si(report["wall_time_s"].get<double>(), "s").c_str(),
               out.c_str(), plotted ? ", report.md, report.html and figures" : "");
   for (const auto& c : report["cases"])
     if (c.contains("reference") && c["reference"].contains("statement"))
