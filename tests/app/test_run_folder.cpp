@@ -20,6 +20,7 @@
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/run_folder.hpp"
+#include "tests/support/files.hpp"
 
 namespace fs = std::filesystem;
 using swim::scene::json;
@@ -31,17 +32,8 @@ const std::string kTiny3d = SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json";
 const std::string kTiny3dFast =
     " --set full3d.dt='\"1 ms\"' --set time.duration='\"12 ms\"' --set full3d.output.vtk_interval='\"5 ms\"'";
 
-fs::path tmpdir(const std::string& tag) {
-  const fs::path d = fs::temp_directory_path() / ("swim_folder_" + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+fs::path tmpdir(const std::string& tag) { return swim::test::scratch_dir("swim_folder_" + tag); }
+using swim::test::slurp;
 
 struct Cli {
   int code = -1;

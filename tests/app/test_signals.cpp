@@ -22,6 +22,7 @@
 #include <vector>
 
 #include "common/scene.hpp"
+#include "tests/support/files.hpp"
 
 extern char** environ;
 
@@ -30,17 +31,8 @@ using swim::scene::json;
 
 namespace {
 
-fs::path tmpdir(const std::string& tag) {
-  const fs::path d = fs::temp_directory_path() / ("swim_signals_" + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+fs::path tmpdir(const std::string& tag) { return swim::test::scratch_dir("swim_signals_" + tag); }
+using swim::test::slurp;
 
 /// The PIDs whose parent is `parent` (from /proc).
 std::vector<pid_t> children_of(pid_t parent) {

@@ -15,6 +15,7 @@
 #include <string>
 
 #include "common/scene.hpp"
+#include "tests/support/files.hpp"
 
 namespace fs = std::filesystem;
 using swim::scene::json;
@@ -23,17 +24,8 @@ namespace {
 
 const std::string kTiny = SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json";
 
-fs::path tmpdir(const std::string& tag) {
-  const fs::path d = fs::temp_directory_path() / ("swim_design_" + tag + "_" + std::to_string(::getpid()));
-  fs::remove_all(d);
-  fs::create_directories(d);
-  return d;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
+fs::path tmpdir(const std::string& tag) { return swim::test::scratch_dir("swim_design_" + tag); }
+using swim::test::slurp;
 
 json read(const fs::path& p) { return json::parse(slurp(p)); }
 
