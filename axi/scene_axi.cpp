@@ -195,7 +195,15 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
     }
     const double spacing = std::min(L / 4.0, p.spacing_factor * 0.5 * p.h);
     const int uniform_segments = int(std::ceil(L / spacing - 1e-9));
-    p.ring_s0 = graded_ring_positions(L, spacing, p.rim_refinement, kRimGrowth);
+    // the protocol's segment boundaries (Protocol3d's) fall between rings: no ring cell
+    // straddles a segment, so the segments' radii and actuation see whole cells on every grid
+    std::vector<double> cuts;
+    if (!b.wave.prescribed()) {
+      const int n = b.protocol.segments;
+      const double other = L / (b.protocol.first_ratio + n - 1);
+      for (int k = 1; k < n; ++k) cuts.push_back(k * other);
+    }
+    p.ring_s0 = segment_aligned_ring_positions(L, spacing, p.rim_refinement, kRimGrowth, cuts);
     p.wall_nodes = int(p.ring_s0.size());
     // Gap columns: widths growing geometrically from the wall's interior spacing ds at both ends
     // with the ratio q = 1 + 5 ds / Rc (so that halving ds splits every column: q -> sqrt(q) to

@@ -254,6 +254,60 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
   return Es + Eb;
 }
 
+std::vector<double> segment_aligned_ring_positions(double L, double spacing, double end_ratio, double growth,
+                                                   const std::vector<double>& cuts) {
+  if (cuts.empty()) return graded_ring_positions(L, spacing, end_ratio, growth);
+  (void)graded_ring_positions(L, spacing, end_ratio, growth);  // the same argument checks
+  for (size_t i = 0; i < cuts.size(); ++i)
+    if (!(cuts[i] > (i ? cuts[i - 1] : 0.0) && cuts[i] < L))
+      throw InputError("protocol.segments", std::to_string(cuts.size() + 1), "segment boundaries inside the tube, increasing");
+  // the interior intervals' cell size: the finest that keeps every interval's cells <= spacing
+  double d = spacing;
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double len = cuts[i + 1] - cuts[i];
+    d = std::min(d, len / std::ceil(len / spacing - 1e-9));
+  }
+  if (cuts.size() == 1) d = std::min(spacing, std::min(cuts[0], L - cuts[0]));
+  std::vector<double> ratios;  // the rim's graded spacings, in cells d, inwards from the rim
+  for (double w = end_ratio; w < 1.0 - 1e-9; w *= growth) ratios.push_back(w);
+  double c = 0.0;
+  for (double w : ratios) c += w;
+  // an end interval of length len: d/2 at the cut, then k equal cells of at most d, then the
+  // rim's graded spacings (scaled down by sigma < 1 only when the interval is shorter than them)
+  auto end_spacings = [&](double len) {
+    const double room = len / d - 0.5;  // in cells
+    if (!(room > 0.0))
+      throw InputError("protocol.segments", "", "an end segment shorter than half a ring cell (" + num(d) + " m)");
+    std::vector<double> w;  // inwards from the rim
+    const double sigma = std::min(1.0, c > 0.0 ? room / c : 1.0);
+    for (double r : ratios) w.push_back(sigma * r * d);
+    const double rest = room - sigma * c;  // cells left for the uniform part
+    const int k = rest > 1e-9 ? int(std::ceil(rest - 1e-9)) : 0;
+    for (int i = 0; i < k; ++i) w.push_back(rest * d / k);
+    return w;
+  };
+  std::vector<double> s{0.0};
+  const std::vector<double> rear = end_spacings(cuts.front());
+  for (double w : rear) s.push_back(s.back() + w);  // ends at cuts[0] - d/2
+  for (size_t i = 0; i + 1 < cuts.size(); ++i) {
+    const double a = cuts[i], len = cuts[i + 1] - a;
+    const int m = int(std::lround(len / d));
+    const double di = len / m;  // = d up to round-off when the lengths are multiples of d
+    for (int j = 0; j < m; ++j) s.push_back(a + (j + 0.5) * di);
+  }
+  const std::vector<double> front = end_spacings(L - cuts.back());
+  double x = L;
+  std::vector<double> tail{L};
+  for (double w : front) tail.push_back(x -= w);
+  // tail: L, then inwards; its last entry is cuts.back() + d/2 (up to round-off)
+  for (auto it = tail.rbegin(); it != tail.rend(); ++it) s.push_back(*it);
+  s.back() = L;
+  for (size_t k = 1; k < s.size(); ++k)
+    if (!(s[k] > s[k - 1] + 1e-12 * L))
+      throw InputError("axi.rim_refinement", num(end_ratio), "rings that do not fit the protocol's segments; refine the grid");
+  return s;
+}
+
 AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double tol_force, int max_iterations) {
   if (!(P != 0.0) || !std::isfinite(P))
     throw InputError("pressure", num(P), "a non-zero finite pressure in Pa (C1 = P / (R0 - R_mid))");

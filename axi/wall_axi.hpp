@@ -84,6 +84,17 @@ struct AxiWallParams {
 /// `axi.spacing_factor`) for end_ratio outside (0, 1], growth <= 1, spacing not in (0, L].
 std::vector<double> graded_ring_positions(double L, double spacing, double end_ratio, double growth);
 
+/// As graded_ring_positions, with every cut (interior segment boundaries of the actuation
+/// protocol, increasing, in (0, L)) the midpoint of two neighbouring rings, so that the rings'
+/// cells never straddle a segment: between two cuts the rings sit at the centres of m equal
+/// cells (m = ceil(length / spacing), the same cell size d on every such interval when their
+/// lengths are equal); in the two end intervals the rings run from the cut's half-cell d/2
+/// through uniform cells d to the rim's graded spacings, scaled by a common factor so that they
+/// fill the interval exactly. Without cuts it is graded_ring_positions. Throws as that does, and
+/// swim::InputError (key `protocol.segments`) when an end interval is shorter than half a cell.
+std::vector<double> segment_aligned_ring_positions(double L, double spacing, double end_ratio, double growth,
+                                                   const std::vector<double>& cuts);
+
 /// Stretching energy density W_s(lambda_s, lambda_t) per unit reference area (J/m^2) of the
 /// network with spring constant ks (N/m); optionally its partial derivatives.
 double stretching_density(double ks, double lambda_s, double lambda_t, double* dW_dls = nullptr,

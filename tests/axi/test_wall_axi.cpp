@@ -3,6 +3,7 @@
 // the quadrature's order.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <numbers>
@@ -446,4 +447,34 @@ TEST(AxiWall, UnderALoadRampTheRimConvergesAtSecondOrderOnUniformAndOnGradedRing
   const double g1 = rim(32, 0.25), g3 = rim(128, 0.25);
   EXPECT_LT(std::abs(g1 - limit), std::abs(u1 - limit));
   EXPECT_LT(std::abs(g3 - limit), 1e-3 * (kR0 - limit));
+}
+
+TEST(AxiWall, SegmentAlignedRingsPutEverySegmentBoundaryBetweenTwoRingsAndRefineTheRims) {
+  // the paper's protocol: six segments, the front one a third of the others (Protocol3d's bounds)
+  const double other = kL / (1.0 / 3.0 + 5);
+  std::vector<double> cuts;
+  for (int k = 1; k < 6; ++k) cuts.push_back(k * other);
+  for (double spacing : {kL / 26, kL / 39, kL / 52}) {
+    const std::vector<double> s = swim::axi::segment_aligned_ring_positions(kL, spacing, 0.25, 1.5, cuts);
+    ASSERT_GE(s.size(), 10u);
+    EXPECT_EQ(s.front(), 0.0);
+    EXPECT_EQ(s.back(), kL);
+    for (size_t k = 1; k < s.size(); ++k) {
+      EXPECT_GT(s[k], s[k - 1]);
+      EXPECT_LE(s[k] - s[k - 1], spacing * (1 + 1e-12)) << k;
+    }
+    // every cut is the midpoint of the two rings around it: no ring cell straddles a segment
+    for (double c : cuts) {
+      const auto hi = std::upper_bound(s.begin(), s.end(), c);
+      ASSERT_TRUE(hi != s.begin() && hi != s.end());
+      EXPECT_NEAR(0.5 * (*(hi - 1) + *hi), c, 1e-12 * kL) << c;
+    }
+    // the rims are refined: the end segments are well below the interior cells
+    const double d = s[s.size() / 2] - s[s.size() / 2 - 1];
+    EXPECT_LT(s[1] - s[0], 0.4 * d);
+    EXPECT_LT(s.back() - s[s.size() - 2], 0.4 * d);
+  }
+  // without cuts: the graded layout
+  EXPECT_EQ(swim::axi::segment_aligned_ring_positions(kL, kL / 40, 0.2, 1.5, {}),
+            swim::axi::graded_ring_positions(kL, kL / 40, 0.2, 1.5));
 }
