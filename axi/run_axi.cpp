@@ -69,7 +69,7 @@ class Runner {
         mesh_(ring_mesh(wall_, b_.R0, b_.L, p.x_start())), e_ref_(wall_.uniform_energy(b_.protocol.R_f)),
         protocol_(effective(), mesh_, e_ref_),
         rec_("axi", fitted_ ? "axisymmetric_fitted_finite_elements" : "axisymmetric_immersed_boundary", b_.L,
-             series_columns(), reference_z()) {
+             series_columns(), wall_.reference_positions()) {
     rec_.keep(ctl.keep_rows);
     if (fitted_) {
       const FittedMeshParams mp = fitted_mesh_params();
@@ -142,11 +142,6 @@ class Runner {
     return q;
   }
 
-  std::vector<double> reference_z() const {
-    std::vector<double> z(wall_.nodes());
-    for (int k = 0; k < wall_.nodes(); ++k) z[k] = wall_.reference()(0, k);
-    return z;
-  }
 
   bool finished() const {
     if (b_.duration > 0) return t_ >= b_.duration * (1.0 - 1e-12) || protocol_.finished();

@@ -30,10 +30,10 @@ class PrescribedRunner {
   PrescribedRunner(const ParamsAxi& p, const json& resolved, const std::string& out, const RunControlAxi& ctl)
       : p_(p), b_(p.base), resolved_(resolved), out_(out), ctl_(ctl),
         wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes, p.ring_s0}),
-        rec_("axi", "axisymmetric_fitted_finite_elements", b_.L, series_columns(), reference_z()) {
+        rec_("axi", "axisymmetric_fitted_finite_elements", b_.L, series_columns(), wall_.reference_positions()) {
     rec_.keep(ctl.keep_rows);
     t_end_ = b_.duration > 0 ? b_.duration : b_.wave.transit(b_.L);
-    swimmer_ = std::make_unique<PrescribedSwimmer>(fitted_mesh_params(p_), b_.fluid.mu, reference_z(),
+    swimmer_ = std::make_unique<PrescribedSwimmer>(fitted_mesh_params(p_), b_.fluid.mu, wall_.reference_positions(),
                                                    wave_kinematics(b_.wave, b_.R0, b_.L), p.x_start());
     // the quadrature's tolerances over the whole run: X to axi.tolerance x h, the end volumes to
     // the volume of a lumen slice that thick
@@ -83,11 +83,6 @@ class PrescribedRunner {
   }
 
  private:
-  std::vector<double> reference_z() const {
-    std::vector<double> z(wall_.nodes());
-    for (int k = 0; k < wall_.nodes(); ++k) z[k] = wall_.reference()(0, k);
-    return z;
-  }
 
   /// One series row and radius snapshot at the state s (the integrals up to s.t accumulated);
   /// dt: the shortest quadrature piece of the interval that ended at s.t (0 at t = 0).

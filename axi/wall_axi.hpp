@@ -117,6 +117,12 @@ class AxiWall {
   const AxiWallParams& params() const { return p_; }
   /// Reference positions: row 0 = axial x_k = s0_k (axis start at 0), row 1 = r = R0, row 2 = 0.
   const Eigen::Matrix3Xd& reference() const { return X0_; }
+  /// Reference positions s0_k of the nodes along the meridian (row 0 of reference()), m.
+  std::vector<double> reference_positions() const {
+    std::vector<double> s(n_);
+    for (int k = 0; k < n_; ++k) s[k] = X0_(0, k);
+    return s;
+  }
   /// Reference area carried by each node (2 pi R0 h, half at the two ends), m^2.
   const Eigen::VectorXd& node_area() const { return A_; }
 
