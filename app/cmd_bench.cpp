@@ -14,6 +14,10 @@
 #include <vector>
 
 #include "app/app.hpp"
+#include "axi/fe_stokes_axi.hpp"
+#include "axi/run_axi.hpp"
+#include "axi/scene_axi.hpp"
+#include "axi/wall_axi.hpp"
 #include "common/output.hpp"
 #include "common/scene.hpp"
 #include "reduced1d/report.hpp"
@@ -125,10 +129,68 @@ double fft_floor_staggered(int nx, int ny, int nz, int threads, int reps) {
   return time_floor(nx, {cells, vface, wface, cells}, threads, reps);
 }
 
+/// The axisymmetric reference tier: one cycle of the round-wall amplitude scene (R_f = 0.82 R0,
+/// D fixed, the geometric recovery end) with the fitted method at `cells` across, one core,
+/// against the cost of one numeric factorisation of its fitted system (the unit of this
+/// method's cost: a step factors or reuses, and solves three times). Written to report["axi_cycle"].
+void bench_axi(scene::json& report, const std::string& out, int cells) {
+  std::printf("== axisymmetric tier (fitted) ==\n");
+  scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.82.json");
+  for (const char* set : {"full3d.membrane.axisymmetric=true", "full3d.recovery_end=\"shape\"",
+                          "full3d.membrane.bending_rigidity=\"2.1184615504e-24 J\""})
+    scene::apply_override(sc, set);
+  scene::apply_override(sc, "axi.grid.cells_across=" + std::to_string(cells));
+  scene::json resolved;
+  const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+  // one factorisation of the system on the reference shape, best of 3
+  double factor_s = 1e300;
+  long unknowns = 0;
+  {
+    axi::FittedStokes fs(axi::fitted_mesh_params(p), p.base.fluid.mu, p.wall_nodes);
+    const axi::AxiWall wall(axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
+    Eigen::Matrix3Xd X = wall.reference();  // the reference shape, as the run starts
+    X.row(0).array() += p.x_start();
+    for (int rep = 0; rep < 3; ++rep) {
+      const auto t0 = std::chrono::steady_clock::now();
+      fs.factor(X, nullptr, 0.0, /*force=*/true);
+      factor_s = std::min(factor_s, seconds_since(t0));
+    }
+    unknowns = fs.unknowns();
+  }
+  const std::string dir = out + "/axi_cycle";
+  output::make_dir(dir);
+  axi::RunControlAxi ctl;
+  ctl.progress = 1;
+  std::printf("one cycle of paper_amplitude_0.82, round wall, %d cells across (h = %.3g nm, %ld unknowns) ...\n",
+              cells, 1e9 * p.h, unknowns);
+  std::fflush(stdout);
+  const double c0 = process_cpu_seconds();
+  const auto t0 = std::chrono::steady_clock::now();
+  const axi::RunOutcomeAxi r = axi::run_axi(p, resolved, dir, ctl);
+  const double wall = seconds_since(t0), cpu = process_cpu_seconds() - c0;
+  const scene::json& sm = r.summary;
+  const scene::json split = r.record.stats.value("wall_time_split_s", scene::json::object());
+  const double fact = split.value("factorisation", 0.0), solves = split.value("solves", 0.0);
+  const long nfact = split.value("factorisations", 0L), iters = split.value("gmres_iterations", 0L);
+  const long solves_n = r.record.stats.value("stokes_solves", 0L);
+  std::printf("  %s: %ld steps, %ld solves, %ld factorisations, %ld GMRES iterations; wall %.0f s (CPU %.0f s), "
+              "= %.0f factorisations of %.3g s; factorising %.0f %%, solving %.0f %% (target: <= 300 s per cycle)%s\n",
+              r.failed ? "FAILED" : "cycle ended", r.steps, solves_n, nfact, iters, wall, cpu, wall / factor_s, factor_s,
+              100 * fact / wall, 100 * solves / wall, r.failed ? ("  " + r.message).c_str() : "");
+  report["axi_cycle"] = {{"scene", "paper_amplitude_0.82 (round wall, D fixed, recovery_end shape)"},
+                         {"cells_across", cells}, {"h_m", p.h}, {"unknowns", unknowns}, {"steps", r.steps},
+                         {"stokes_solves", solves_n}, {"factorisations", nfact}, {"gmres_iterations", iters},
+                         {"wall_time_s", wall}, {"cpu_time_s", cpu}, {"one_factorisation_s", factor_s},
+                         {"wall_over_factorisation", wall / factor_s}, {"wall_time_split_s", split},
+                         {"displacement_per_cycle_m", sm.value("displacement_per_cycle_m", scene::json())},
+                         {"cycle_times_s", sm.value("cycle_times_s", scene::json::array())}, {"failed", r.failed}};
+}
+
 }  // namespace
 
 int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const std::string& tier) {
-  const bool do1d = tier != "3d", do3d = tier != "1d";
+  const bool do1d = tier == "1d" || tier == "all", do3d = tier == "3d" || tier == "all";
+  const bool do_axi = tier == "axi" || tier == "all";
   const bool paper_cycle = do3d && (paper_cycle_opt || !quick);
   const std::string out = out_opt.empty() ? "out/bench" : out_opt;
   output::make_dir(out);
@@ -405,6 +467,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
     std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
   }
   }
+  if (do_axi) bench_axi(report, out, quick ? 16 : 32);
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());
   return 0;

@@ -3,7 +3,7 @@
 //   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
 //   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
 //   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
-//   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|all]
+//   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|axi|all]
 //   swim scenes
 //   swim demo [--out DIR]
 //   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--overwrite]
@@ -79,8 +79,8 @@ int main(int argc, char** argv) {
   ben->add_flag("--quick", quick, "Fewer repetitions (a smoke run); skips the paper-cycle run");
   bool paper_cycle = false;
   std::string bench_tier = "all";
-  ben->add_option("--tier", bench_tier, "Measure only one tier: 1d, 3d or all (default)")
-      ->check(CLI::IsMember({"1d", "3d", "all"}));
+  ben->add_option("--tier", bench_tier, "Measure only one tier: 1d, 3d, axi or all (default)")
+      ->check(CLI::IsMember({"1d", "3d", "axi", "all"}));
   ben->add_flag("--paper-cycle", paper_cycle,
                 "Also run the paper's single-cycle 3D scene end to end with --quick (minutes)");
 
