@@ -37,6 +37,7 @@
 
 #include "reduced1d/discretisation.hpp"
 #include "reduced1d/internal.hpp"
+#include "reduced1d/linear_solvers.hpp"
 #include "reduced1d/outer_flow.hpp"
 #include "reduced1d/protocol.hpp"
 #include "reduced1d/sundials.hpp"
