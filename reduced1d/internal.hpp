@@ -52,18 +52,6 @@ Result solve_fixed_actuation(const Params& p, const std::vector<double>& q_cells
 /// samples when kept, then the progress report. R: the N cell radii.
 void emit(Result& res, const Output& out, const Sample& s, const double* R, int N, double t_end);
 
-/// Test of the analytic Newton-matrix Jacobians against central finite differences of the
-/// right-hand side (CVODE) or residual (IDA) at a random state: radii drawn in
-/// [R_f - 2 delta, R_f + 2 delta] (held segments, so that segment means fall on the ramps) or
-/// in [0.45, 1.05] R0, protocol in `phase` with `active` as the active segment. Returns the
-/// largest entry error relative to the largest entry of its row; rank = number of segment terms.
-struct JacobianCheck {
-  double max_rel_error = 0;
-  int rank = 0;
-  int entries = 0;  ///< non-zero entries compared
-};
-JacobianCheck check_jacobian(const Params& p, int phase, int active, unsigned seed);
-
 /// The short-wave wall traction's operator |k| on the cells (docs/outer-flow-1d.md, 3b):
 /// |k| ~= sum_j c_j k^2 / (k^2 + s_j^2) within 1 % for every wavenumber of the grid, from the
 /// tube's lowest mode pi/L to the discrete 2/h, with log-spaced nodes s_j (step <= 1.5 in

@@ -1,4 +1,6 @@
 // Thin RAII layer over the SUNDIALS 6 C API used by the reduced 1D tier.
+// (The tier's own solvers behind SUNDIALS' interfaces are in linear_solvers.hpp and
+// serial_kernels.hpp.)
 //
 // Every SUNDIALS object is owned by a unique_ptr with the matching destroy call, so an
 // exception thrown anywhere in the solver releases everything. `check` is the one place
@@ -9,7 +11,6 @@
 #include <memory>
 #include <stdexcept>
 #include <string>
-#include <vector>
 
 #include <nvector/nvector_serial.h>
 #include <sundials/sundials_context.h>
@@ -81,8 +82,9 @@ using CvodeMem = std::unique_ptr<void, CvodeDeleter>;
 using IdaMem = std::unique_ptr<void, IdaDeleter>;
 
 Context make_context();
-Vector make_vector(long n, SUNContext ctx);  ///< serial vector, zero-filled
-/// Band matrix n x n with upper/lower half-bandwidths mu, ml (storage for LU fill-in included).
+Vector make_vector(long n, SUNContext ctx);  ///< serial vector, zero-filled, kernels of serial_kernels.hpp
+/// Band matrix n x n with upper/lower half-bandwidths mu, ml (storage for LU fill-in
+/// included), zeroed by the kernel of serial_kernels.hpp.
 Matrix make_band_matrix(long n, long mu, long ml, SUNContext ctx);
 Matrix make_dense_matrix(long n, SUNContext ctx);
 LinearSolver make_band_solver(N_Vector y, SUNMatrix A, SUNContext ctx);
@@ -90,42 +92,6 @@ LinearSolver make_dense_solver(N_Vector y, SUNMatrix A, SUNContext ctx);
 NonlinearSolver make_fixed_point_solver(N_Vector y, int m_accel, SUNContext ctx);
 CvodeMem make_cvode(int lmm, SUNContext ctx);
 IdaMem make_ida(SUNContext ctx);
-
-/// Low-rank correction of a banded Newton matrix: the matrix actually solved with is
-/// M + scale() U V^T, M the band matrix handed to the solver's setup, U and V column-major
-/// n x rank. The owner refreshes U, V, rank together with the band Jacobian.
-struct LowRankTerm {
-  int rank = 0;
-  std::vector<double> U, V;
-  double (*scale)(void* ctx) = nullptr;  ///< factor of U V^T at the time of setup (1 if null)
-  void* scale_ctx = nullptr;
-};
-
-/// Direct linear solver for (band M) + scale U V^T: band LU with partial pivoting (own
-/// optimised kernel, same algorithm as SUNLinSol_Band/LAPACK dgbtf2) and the
-/// Sherman-Morrison-Woodbury formula with a rank x rank dense solve. `term` must outlive the
-/// solver. A must be a SUNBandMatrix with the bandwidths used later.
-LinearSolver make_low_rank_band_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, SUNContext ctx);
-
-/// Block structure of a band matrix whose unknowns are grouped in cells: unknowns
-/// [offset, offset + block * count) are `count` cells of `block` unknowns each; a cell's rows
-/// reach only its own and its two neighbouring cells; the unknowns before and after the cells
-/// (the border) appear in no cell's row.
-struct CellBlocks {
-  long offset = 0;
-  int block = 0;
-  long count = 0;
-};
-
-/// The same solver for a band matrix with the structure of `cells`: the cells are factored
-/// by block LU (block tridiagonal, each diagonal block inverted with partial pivoting), the
-/// border by a small dense LU after them. A setup whose matrix leaves that structure, or
-/// whose diagonal blocks are singular or too ill-conditioned for block elimination, falls
-/// back to the band LU.
-LinearSolver make_low_rank_block_solver(N_Vector y, SUNMatrix A, LowRankTerm* term, const CellBlocks& cells,
-                                        SUNContext ctx);
-/// Whether the last set-up of a solver made by make_low_rank_block_solver factored by blocks.
-bool factored_by_blocks(SUNLinearSolver S);
 
 /// Raw data pointer of a serial vector.
 inline double* data(N_Vector v) { return N_VGetArrayPointer(v); }

@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <utility>
 
+#include "jacobian_check.hpp"
 #include "reduced1d/internal.hpp"
 #include "reduced1d/protocol.hpp"
 #include "reduced1d/solver.hpp"
@@ -67,7 +68,7 @@ TEST(Reduced1dForceDriven, AnalyticJacobianMatchesFiniteDifferences) {
       // contraction with segments 3..n-1 held (segment n-1 holds the right end), and recovery
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}}) {
         for (unsigned seed : {1u, 2u, 3u}) {
-          const auto c = detail::check_jacobian(p, phase, active, seed);
+          const auto c = test::check_jacobian(p, phase, active, seed);
           EXPECT_LT(c.max_rel_error, 1e-6) << "inertia=" << inertia << " N=" << N << " phase=" << phase
                                             << " active=" << active << " seed=" << seed;
           EXPECT_GT(c.entries, 3 * N);

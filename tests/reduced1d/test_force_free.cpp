@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "jacobian_check.hpp"
 #include "reduced1d/internal.hpp"
 #include "reduced1d/report.hpp"
 #include "reduced1d/solver.hpp"
@@ -149,7 +150,7 @@ TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
       const int n = p.protocol.segments;
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
-          const auto c = detail::check_jacobian(p, phase, active, seed);
+          const auto c = test::check_jacobian(p, phase, active, seed);
           EXPECT_LT(c.max_rel_error, 1e-6)
               << "traction=" << traction << " N=" << N << " phase=" << phase << " active=" << active;
           const int held = phase == 0 ? n - 1 - active : 0;

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "reduced1d/linear_solvers.hpp"
 #include "reduced1d/sundials.hpp"
 
 using namespace swim::reduced1d;

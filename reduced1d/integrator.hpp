@@ -1,0 +1,98 @@
+// Time integration of the force-driven wave: one interface over the two SUNDIALS back-ends.
+//
+// CVODE (BDF) integrates the inertia-free model dy/dt = f(y); IDA (BDF) the DAE F(t, y, y') = 0
+// of the wall-inertia and short-wave-traction models. Both locate the protocol's switches as
+// roots of the functions of RootFunctions and solve their Newton systems with the band (CVODE)
+// or block-tridiagonal (IDA) LU plus the Woodbury correction of the low-rank segment and
+// closure couplings (reduced1d/linear_solvers.hpp).
+#pragma once
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "reduced1d/force_model.hpp"
+#include "reduced1d/linear_solvers.hpp"
+#include "reduced1d/protocol.hpp"
+
+namespace swim::reduced1d::detail {
+
+/// Root functions of the current protocol state (ProtocolMachine::root_count order):
+/// collapse (minimum radius - collapse level), then in phase 0 the active segment's mean
+/// radius - R_f, in phase 1 the wall energy / energy level - 1.
+struct RootFunctions {
+  const ForceModel* M = nullptr;
+  const ProtocolMachine* machine = nullptr;
+  std::vector<double> Rbuf;
+  double collapse_level = 0, Rf = 0, energy_level = 1;
+
+  void eval(const double* y, double* g);
+};
+
+/// Everything the SUNDIALS callbacks need (their user data).
+struct Problem {
+  ForceModel M;
+  ModelState state;  ///< the model at the state of the last callback
+  ProtocolMachine machine;
+  RootFunctions roots;
+  sun::LowRankTerm low_rank;  ///< segment and closure couplings of the Newton matrix
+  /// `step_velocity`: ForceModel's velocity quadrature where the model allows it.
+  Problem(const Params& P, std::vector<double> fixed_q, bool step_velocity);
+};
+
+/// An integrator of the force-driven model, restartable at the protocol's switches.
+class Integrator {
+ public:
+  virtual ~Integrator() = default;
+  virtual double* y() = 0;
+  /// Restart at t from the current y() after a change of the discrete state.
+  virtual void restart(double t) = 0;
+  virtual void set_roots(int n) = 0;  ///< n root functions, all reported on falling crossings
+  virtual void set_stop_time(double t) = 0;
+  void set_max_steps(long n);
+  /// 0: reached tout, 1: root found, 2: stop time, -1: step budget exhausted; throws
+  /// sun::SundialsError otherwise. t: the time reached.
+  int advance(double tout, double& t);
+  virtual void root_info(int* found) = 0;
+  long steps();  ///< steps since the last restart
+  /// Add the solver's counters since the last restart to `stats`.
+  void harvest(std::map<std::string, long>& stats);
+  std::string last_msg;  ///< the solver's last error message
+  /// Called after every accepted step with (t_n, y_n) (advance then steps one at a time and
+  /// interpolates to tout, the same steps as CV_NORMAL / IDA_NORMAL).
+  std::function<void(double, const double*)> on_step;
+
+ protected:
+  /// A solver counter of the statistics (SUNDIALS' Get function) under its key.
+  struct Counter {
+    const char* key;
+    int (*get)(void*, long*);
+  };
+  /// One call of the solver towards tout, in one-step or normal mode: 0, 1 (root), 2 (stop
+  /// time) or -1 (step budget, normal mode only) as advance(); throws otherwise.
+  virtual int solve(double tout, double& t, bool one_step) = 0;
+  virtual void interpolate(double tout) = 0;  ///< y(tout) into y() (within the last step)
+  virtual double current_time() = 0;          ///< t_n of the last step
+  virtual void solver_max_steps(long n) = 0;
+  virtual void* memory() = 0;
+  /// The counters, "steps" first.
+  virtual const std::vector<Counter>& counters() const = 0;
+  virtual int size() const = 0;
+
+ private:
+  /// advance() with on_step: one step at a time from tn to tout, on_step after each accepted
+  /// step, y(tout) interpolated. A root found beyond tout is held back until the outputs
+  /// before it are reported, as the normal modes do.
+  int advance_by_steps(double tout, double& t);
+  long max_steps_ = 500;
+  bool pending_root_ = false;
+  double root_t_ = 0;
+  std::vector<double> root_y_;
+};
+
+/// IDA for the DAE path (ForceModel::dae), CVODE otherwise; initial state at rest (R = R0).
+std::unique_ptr<Integrator> make_integrator(Problem& pb, const Params& P);
+
+}  // namespace swim::reduced1d::detail
