@@ -279,9 +279,13 @@ std::vector<double> segment_aligned_ring_positions(double L, double spacing, dou
     if (!(room > 0.0))
       throw InputError("protocol.segments", "", "an end segment shorter than half a ring cell (" + num(d) + " m)");
     std::vector<double> w;  // inwards from the rim
-    const double sigma = std::min(1.0, c > 0.0 ? room / c : 1.0);
+    // The uniform part holds what the graded spacings leave, in k equal cells; less than half a
+    // cell left goes to the graded spacings instead (scaled by sigma <= 1 + 1/(2c)), so that no
+    // sliver cell appears whose size jumps from grid to grid.
+    double rest = room - c;
+    const double sigma = (c > 0.0 && rest < 0.5) ? room / c : 1.0;
+    if (sigma != 1.0) rest = 0.0;
     for (double r : ratios) w.push_back(sigma * r * d);
-    const double rest = room - sigma * c;  // cells left for the uniform part
     const int k = rest > 1e-9 ? int(std::ceil(rest - 1e-9)) : 0;
     for (int i = 0; i < k; ++i) w.push_back(rest * d / k);
     return w;

@@ -89,8 +89,10 @@ std::vector<double> graded_ring_positions(double L, double spacing, double end_r
 /// cells never straddle a segment: between two cuts the rings sit at the centres of m equal
 /// cells (m = ceil(length / spacing), the same cell size d on every such interval when their
 /// lengths are equal); in the two end intervals the rings run from the cut's half-cell d/2
-/// through uniform cells d to the rim's graded spacings, scaled by a common factor so that they
-/// fill the interval exactly. Without cuts it is graded_ring_positions. Throws as that does, and
+/// through k equal cells of at most d to the rim's graded spacings; when less than half a cell
+/// d is left beside the graded spacings, they alone fill the interval, scaled by a common
+/// factor (below 1 when the interval is shorter than them, at most 1 + 1/(2 sum of the ratios)
+/// above), so that no sliver cell appears. Without cuts it is graded_ring_positions. Throws as that does, and
 /// swim::InputError (key `protocol.segments`) when an end interval is shorter than half a cell.
 std::vector<double> segment_aligned_ring_positions(double L, double spacing, double end_ratio, double growth,
                                                    const std::vector<double>& cuts);
