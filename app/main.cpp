@@ -16,10 +16,18 @@
 #include <exception>
 
 #include "app/app.hpp"
+#include "app/ranks.hpp"
 #include "common/errors.hpp"
 
 int main(int argc, char** argv) {
   using namespace swim;
+  // mpirun -n N swim …: rank 0 runs the command, the other ranks serve its runs (docs/mpi.md)
+  app::ranks::Session mpi(&argc, &argv);
+  if (const std::string why = app::ranks::unsupported_launch(); !why.empty()) {
+    std::fprintf(stderr, "swim: %s\n", why.c_str());
+    return 2;
+  }
+  if (app::ranks::rank() > 0) return app::ranks::serve(app::run_task);
   CLI::App cli{"swim: design and check peristaltic elastic micro-swimmers (1D lubrication and 3D immersed-boundary tiers)"};
   cli.require_subcommand(1);
   cli.set_help_all_flag("--help-all", "Help for every subcommand");
