@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "common/scene.hpp"
+#include "reduced1d/params.hpp"
 
 namespace swim::app {
 
@@ -47,7 +48,7 @@ int validate(const std::string& suite, bool quick, const std::string& out, int t
 /// "validate" (validation::run_planned).
 scene::json run_task(const scene::json& payload);
 /// Scheduling estimates of a run's cost (larger first): 1D cells x simulated time, 3D cells x steps.
-double cost_1d(const scene::json& scene, const std::string& base_dir);
+double cost_1d(const reduced1d::Params& design);
 double cost_3d(const scene::json& scene);
 
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.

@@ -209,7 +209,10 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     std::vector<ranks::Task> tasks;
     const std::string base_dir = fs::absolute(sw.base_dir).string();
     for (size_t k = 0; k < sw.count(); ++k)
-      tasks.push_back({"1D run of design " + std::to_string(k), {{"kind", "1d"}, {"scene", sw.design(k)}, {"base_dir", base_dir}}, cost_1d(sw.design(k), base_dir), {}});
+      tasks.push_back({"1D run of design " + std::to_string(k),
+                       {{"kind", "1d"}, {"scene", sw.design(k)}, {"base_dir", base_dir}},
+                       cost_1d(designs[k]),
+                       {}});
     const ranks::Outcome r =
         ranks::distribute(tasks, run_task, 2, [&](size_t, const scene::json&) { bar.update(static_cast<double>(++finished)); });
     for (const auto& x : r.results) {

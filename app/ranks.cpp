@@ -12,6 +12,7 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+#include <ctime>
 
 #ifdef SWIM_HAVE_MPI
 #include <mpi.h>
@@ -28,6 +29,13 @@ bool g_mpi = false;          // MPI initialised by Session
 bool g_stopped = false;      // stop_workers() done
 std::vector<LostRank> g_lost;
 std::map<int, long> g_kept;  // results kept per rank
+double g_master_cpu = 0;     // s, rank 0's main thread in distribute()
+
+[[maybe_unused]] double thread_cpu_s() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return double(t.tv_sec) + 1e-9 * double(t.tv_nsec);
+}
 
 /// The job's size as the launcher's environment gives it (0 when not launched by one).
 int launcher_size() {
@@ -67,7 +75,7 @@ json summary() {
   for (const auto& l : g_lost) lost.push_back({{"rank", l.rank}, {"tasks", l.tasks}, {"silent_s", l.silent_s}});
   json per = json::object();
   for (const auto& [r, n] : g_kept) per[std::to_string(r)] = n;
-  return {{"ranks", g_size}, {"lost_ranks", lost}, {"tasks_per_rank", per}};
+  return {{"ranks", g_size}, {"lost_ranks", lost}, {"tasks_per_rank", per}, {"master_cpu_s", g_master_cpu}};
 }
 
 #ifndef SWIM_HAVE_MPI
@@ -122,14 +130,14 @@ bool receive_any(int& source, int& tag, std::string& text) {
   return true;
 }
 
-/// Polling interval: short after activity, growing to 1 ms when idle (a blocking MPI receive
+/// Polling interval: short after activity, growing to `cap` µs when idle (a blocking MPI receive
 /// would spin a core, which oversubscribed ranks cannot spare).
 struct Backoff {
   int us = 20;
   void reset() { us = 20; }
-  std::chrono::microseconds next() {
-    const int v = us;
-    us = std::min(us * 2, 1000);
+  std::chrono::microseconds next(int cap) {
+    const int v = std::min(us, cap);
+    us = std::min(us * 2, cap);
     return std::chrono::microseconds(v);
   }
 };
@@ -247,8 +255,10 @@ int serve(const Work& work) {
       last_beat = Clock::now();
     }
     if (busy) backoff.reset();
-    // a finished task wakes the wait at once; a message from rank 0 is seen within 1 ms
-    for (auto& [id, result] : runner.take(backoff.next())) {
+    // a finished task wakes the wait at once; a task from rank 0 is awaited only when this rank
+    // holds fewer than two (one running, one waiting): then it is seen within 1 ms, else the
+    // rank sleeps up to 20 ms (rank 0 sends nothing else but the stop at the end)
+    for (auto& [id, result] : runner.take(backoff.next(runner.held() >= 2 ? 20000 : 1000))) {
       send_text(json{{"task", id}, {"result", std::move(result)}}.dump(), 0, kResult);
       last_beat = Clock::now();
       backoff.reset();
@@ -287,6 +297,7 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
                    const std::function<void(std::size_t, const json&)>& on_result) {
   Outcome o;
   const auto t0 = Clock::now();
+  const double cpu0 = thread_cpu_s();
   const std::size_t n = tasks.size();
   o.results.assign(n, json());
   o.ran_on.assign(n, -1);
@@ -439,7 +450,9 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
       backoff.reset();
     } else {
       // a result of rank 0's own thread wakes the wait at once
-      for (auto& [id, result] : local.take(backoff.next())) {
+      // a result of rank 0's own thread wakes the wait at once; the ranks' messages are seen
+      // within 2 ms (a rank holding two tasks does not wait for the hand-over)
+      for (auto& [id, result] : local.take(backoff.next(2000))) {
         local_held.erase(std::remove(local_held.begin(), local_held.end(), id), local_held.end());
         finish(id, std::move(result), 0);
         backoff.reset();
@@ -456,6 +469,8 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
     abandoned.push_back(std::move(send_buffers[k]));
   }
   o.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  o.master_cpu_s = thread_cpu_s() - cpu0;
+  g_master_cpu += o.master_cpu_s;
   return o;
 }
 

@@ -63,6 +63,7 @@ struct Outcome {
   std::vector<int> ran_on;        ///< per task: the rank whose result was kept
   std::vector<LostRank> lost;     ///< ranks lost during this call
   double wall_s = 0;
+  double master_cpu_s = 0;        ///< CPU time of rank 0's main thread (handing out, gathering)
 };
 
 /// Rank 0: run every task over the ranks and return the results in task order. depth: tasks a
@@ -83,8 +84,9 @@ const std::vector<LostRank>& lost_ranks();
 /// Seconds of silence after which a rank is declared lost: $SWIM_MPI_LOST_AFTER_S, default 60.
 double lost_after_s();
 
-/// {"ranks", "lost_ranks": [{"rank", "tasks", "silent_s"}], "tasks_per_rank"} for a command's
-/// summary; tasks_per_rank counts the results kept per rank over the process.
+/// {"ranks", "lost_ranks": [{"rank", "tasks", "silent_s"}], "tasks_per_rank", "master_cpu_s"} for a
+/// command's summary; tasks_per_rank counts the results kept per rank over the process,
+/// master_cpu_s the CPU time rank 0's main thread spent handing out and gathering runs.
 json summary();
 
 }  // namespace swim::app::ranks

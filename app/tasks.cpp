@@ -26,9 +26,7 @@ scene::json run_task(const scene::json& t) {
   throw std::logic_error("unknown task kind " + kind);
 }
 
-double cost_1d(const scene::json& scene, const std::string& base_dir) {
-  scene::json resolved;
-  const reduced1d::Params p = reduced1d::read_scene(scene, resolved, base_dir);
+double cost_1d(const reduced1d::Params& p) {
   // cells times simulated time: a proxy (a force-driven design without a duration runs its cycles)
   return double(p.numerics.cells) * (p.duration > 0 ? p.duration : 1.0);
 }
