@@ -60,7 +60,7 @@ int main(int argc, char** argv) {
   CLI::App* scr = cli.add_subcommand("screen", "Run a 1D design sweep in parallel and rank the designs");
   scr->add_option("sweep", sweep, "Sweep file (JSON)")->required();
   scr->add_option("--out", out, "Output directory (default out/screen-<sweep name>)");
-  scr->add_option("--jobs", jobs, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+  scr->add_option("--jobs", jobs, "Worker threads (default: all cores; under mpirun each rank runs one design at a time)")->check(CLI::Range(0, 1024));
   int scr_confirm = 0, threads3d = 1;
   scr->add_option("--confirm", scr_confirm,
                   "Also run K designs in 3D (the K/2 best and K/2 spread over the rest) and report the rank agreement")

@@ -12,6 +12,8 @@
 #include <memory>
 #include <mutex>
 #include <thread>
+
+#include <unistd.h>
 #include <ctime>
 
 #ifdef SWIM_HAVE_MPI
@@ -46,6 +48,22 @@ int launcher_size() {
 }
 
 json error_result(const std::string& what) { return {{"error", what}}; }
+
+json run_guarded(const Work& work, const json& payload);
+
+/// Every task in this process, in order (no ranks to spread them over).
+[[maybe_unused]] Outcome run_here(const std::vector<Task>& tasks, const Work& work,
+                                  const std::function<void(std::size_t, const json&)>& on_result) {
+  Outcome o;
+  const auto t0 = Clock::now();
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    o.results.push_back(run_guarded(work, tasks[i].payload));
+    o.ran_on.push_back(0);
+    if (on_result) on_result(i, o.results.back());
+  }
+  o.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
+  return o;
+}
 
 json run_guarded(const Work& work, const json& payload) {
   try {
@@ -92,16 +110,9 @@ std::string unsupported_launch() {
   return {};
 }
 int serve(const Work&) { return 0; }
-Outcome distribute(const std::vector<Task>& tasks, const Work& work, int, const std::function<void(std::size_t, const json&)>& on_result) {
-  Outcome o;
-  const auto t0 = Clock::now();
-  for (std::size_t i = 0; i < tasks.size(); ++i) {
-    o.results.push_back(run_guarded(work, tasks[i].payload));
-    o.ran_on.push_back(0);
-    if (on_result) on_result(i, o.results.back());
-  }
-  o.wall_s = std::chrono::duration<double>(Clock::now() - t0).count();
-  return o;
+Outcome distribute(const std::vector<Task>& tasks, const Work& work, int,
+                   const std::function<void(std::size_t, const json&)>& on_result) {
+  return run_here(tasks, work, on_result);
 }
 void stop_workers() {}
 
@@ -205,7 +216,20 @@ class Runner {
 };
 
 volatile std::sig_atomic_t g_signal = 0;
-extern "C" void on_stop_signal(int s) { g_signal = s; }
+volatile std::sig_atomic_t g_in_distribute = 0;
+// Rank 0 of a distributed command: mpirun stops the job with SIGTERM (then SIGKILL) when a rank
+// dies without --enable-recovery. While runs are handed out, the master's loop names the runs in
+// flight; elsewhere this says why the command stops (only async-signal-safe calls here).
+extern "C" void on_stop_signal(int s) {
+  g_signal = s;
+  if (g_in_distribute) return;
+  static const char msg[] =
+      "swim: stopped by a signal from mpirun (it ends the job when a rank dies; --enable-recovery lets the others "
+      "go on); finished runs are kept in their folders: run the same command again to go on from them\n";
+  const ssize_t ignored = ::write(2, msg, sizeof msg - 1);
+  (void)ignored;
+  std::_Exit(128 + s);
+}
 
 }  // namespace
 
@@ -217,6 +241,12 @@ Session::Session(int* argc, char*** argv) {
   MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN);
   MPI_Comm_size(MPI_COMM_WORLD, &g_size);
   MPI_Comm_rank(MPI_COMM_WORLD, &g_rank);
+  if (g_rank == 0 && g_size > 1) {
+    struct sigaction act = {};
+    act.sa_handler = on_stop_signal;
+    sigemptyset(&act.sa_mask);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP}) sigaction(sig, &act, nullptr);
+  }
 }
 
 Session::~Session() {
@@ -295,6 +325,7 @@ std::vector<RankState> g_ranks;
 
 Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
                    const std::function<void(std::size_t, const json&)>& on_result) {
+  if (!g_mpi || g_size == 1) return run_here(tasks, work, on_result);
   Outcome o;
   const auto t0 = Clock::now();
   const double cpu0 = thread_cpu_s();
@@ -341,13 +372,8 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
     if (on_result) on_result(id, o.results[id]);
   };
 
-  struct sigaction act = {}, old_int = {}, old_term = {}, old_hup = {};
-  act.sa_handler = on_stop_signal;
-  sigemptyset(&act.sa_mask);
-  sigaction(SIGINT, &act, &old_int);
-  sigaction(SIGTERM, &act, &old_term);
-  sigaction(SIGHUP, &act, &old_hup);
   g_signal = 0;
+  g_in_distribute = 1;
 
   Backoff backoff;
   while (done < n) {
@@ -459,9 +485,7 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
       }
     }
   }
-  sigaction(SIGINT, &old_int, nullptr);
-  sigaction(SIGTERM, &old_term, nullptr);
-  sigaction(SIGHUP, &old_hup, nullptr);
+  g_in_distribute = 0;
   // sends still pending go to lost ranks only: abandoned, their buffers kept for the process's life
   static std::vector<std::unique_ptr<std::string>> abandoned;
   for (std::size_t k = 0; k < sends.size(); ++k) {

@@ -71,7 +71,8 @@ struct Outcome {
 /// runs best). on_result(i, result) is called on rank 0's main thread as each result arrives.
 /// Lost ranks (a crash, a kill) are reported on stderr and in the outcome; their tasks are redone
 /// by the others. A SIGINT/SIGTERM/SIGHUP (mpirun stopping the job after a rank died without
-/// --enable-recovery) prints the runs in flight and ends the process with 128 + the signal.
+/// --enable-recovery) prints the runs in flight and ends the process with 128 + the signal;
+/// outside this call rank 0 says it was stopped and ends the same way (Session installs it).
 Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth = 1,
                    const std::function<void(std::size_t, const json&)>& on_result = {});
 
