@@ -27,8 +27,8 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 int g_size = 1, g_rank = 0;
-bool g_mpi = false;          // MPI initialised by Session
-bool g_stopped = false;      // stop_workers() done
+[[maybe_unused]] bool g_mpi = false;      // MPI initialised by Session
+[[maybe_unused]] bool g_stopped = false;  // stop_workers() done
 std::vector<LostRank> g_lost;
 std::map<int, long> g_kept;  // results kept per rank
 double g_master_cpu = 0;     // s, rank 0's main thread in distribute()
