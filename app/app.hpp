@@ -6,6 +6,9 @@
 #include <string>
 #include <vector>
 
+#include "common/scene.hpp"
+#include "reduced1d/params.hpp"
+
 namespace swim::app {
 
 struct RunOptions {
@@ -39,6 +42,14 @@ int calibrate(const std::string& scene, const std::vector<std::string>& sets, co
 /// only: case filter (scene file names); empty: every case.
 int validate(const std::string& suite, bool quick, const std::string& out, int threads, int progress,
              const std::vector<std::string>& only);
+
+/// One independent run of a distributed command (app/ranks.hpp), by its payload's "kind":
+/// "1d" (a screen design: reduced1d::outcome_to_json), "confirm3d" (design::confirmed_to_json),
+/// "validate" (validation::run_planned).
+scene::json run_task(const scene::json& payload);
+/// Scheduling estimates of a run's cost (larger first): 1D cells x simulated time, 3D cells x steps.
+double cost_1d(const reduced1d::Params& design);
+double cost_3d(const scene::json& scene);
 
 /// Directory of the shipped data (scenes, sweeps): $SWIM_DATA_DIR or the source tree's data/.
 std::string data_dir();

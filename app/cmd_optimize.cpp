@@ -8,6 +8,7 @@
 #include <filesystem>
 
 #include "app/app.hpp"
+#include "app/ranks.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/progress.hpp"
@@ -62,6 +63,12 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   so.maximize = spec.maximize;
   so.max_evaluations = spec.max_evaluations;
   so.xtol_rel = spec.tolerance;
+  if (ranks::distributed())
+    // COBYLA chooses each point from the evaluations before it: the search is sequential, and
+    // so is the single 3D run of its optimum; the other ranks wait for the command to end
+    std::printf("optimize: COBYLA evaluates one design at a time (each point follows from the ones before), so the "
+                "search and its 3D confirmation run on rank 0; the other %d rank(s) have nothing to run\n",
+                ranks::size() - 1);
   Progress bar("optimize " + spec.name, spec.max_evaluations, progress);
   std::vector<double> wall_of;
   const auto t0 = std::chrono::steady_clock::now();
@@ -178,7 +185,7 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
     scene::json resolved;
     const reduced1d::Params p = reduced1d::read_scene(best_scene, resolved, spec.base_dir);
     const auto one = reduced1d::run_designs({p}, 1);
-    design::ConfirmOptions o{spec.objective, spec.maximize, spec.confirm, threads, progress, out + "/confirm-runs"};
+    design::ConfirmOptions o{spec.objective, spec.maximize, spec.confirm, threads, progress, out + "/confirm-runs", {}};
     const std::vector<design::Candidate> optimum = {{0, best_text, "optimum", 1, best_scene, one[0].metrics}};
     scene::json report = design::confirm_candidates(optimum, o);
     report["agreement_absent_because"] = "one design (the optimum) is confirmed: the agreement is its relative differences";

@@ -5,6 +5,7 @@
 #include <fstream>
 
 #include "app/app.hpp"
+#include "app/ranks.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/si_format.hpp"
@@ -47,6 +48,38 @@ std::string shown(double v, const std::string& metric) {
   return b;
 }
 
+// The confirmation runs of `cands` over the MPI ranks, in candidate order. A run whose rank
+// reported an error (not a numerical failure, which the run's own summary records) is a failed
+// run of that design.
+std::vector<design::Confirmed> confirm_over_ranks(const std::vector<design::Candidate>& cands,
+                                                  const design::ConfirmOptions& o) {
+  fs::create_directories(o.runs_dir);
+  std::vector<ranks::Task> tasks;
+  for (const auto& c : cands) {
+    const scene::json sc = design::confirm_scene(c.scene, o.section, o.threads);
+    tasks.push_back({"3D run of design " + std::to_string(c.design),
+                     {{"kind", "confirm3d"},
+                      {"scene", sc},
+                      {"runs_dir", fs::absolute(o.runs_dir).string()},
+                      {"label", design::confirm_label(c)}},
+                     cost_3d(sc),
+                     {}});
+  }
+  const ranks::Outcome r = ranks::distribute(tasks, run_task, 1);
+  std::vector<design::Confirmed> runs;
+  for (size_t i = 0; i < cands.size(); ++i) {
+    if (r.results[i].contains("error")) {
+      design::Confirmed c;
+      c.folder = (fs::path(o.runs_dir) / design::confirm_label(cands[i])).string();
+      c.summary = {{"status", "failed: " + r.results[i]["error"].get<std::string>()}};
+      runs.push_back(c);
+    } else {
+      runs.push_back(design::confirmed_from_json(r.results[i]));
+    }
+  }
+  return runs;
+}
+
 // --confirm K: the K/2 best and K/2 spread over the rest of the ranking, run in 3D, compared
 // with the 1D tier; writes confirm.json, confirm.md, confirm.png and returns the summary for
 // screen.json.
@@ -70,7 +103,14 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
               ranked.size(), cands.size() - cands.size() / 2, cands.size() / 2,
               cands.size() < k ? "; fewer designs completed in 1D than --confirm asks" : "");
   std::fflush(stdout);
-  design::ConfirmOptions o{sw.metric, sw.maximize, section, threads, progress, out + "/confirm-runs"};
+  design::ConfirmOptions o{sw.metric, sw.maximize, section, threads, progress, out + "/confirm-runs", {}};
+  std::vector<design::Confirmed> ranked_runs;
+  if (ranks::distributed()) {
+    // the 3D runs over the ranks (largest first, one at a time per rank), gathered here; the
+    // report below is then written from them exactly as from runs made in this process
+    ranked_runs = confirm_over_ranks(cands, o);
+    o.run = [&](size_t i, const scene::json&, const std::string&) { return ranked_runs[i]; };
+  }
   scene::json report = design::confirm_candidates(cands, o, [&](size_t c, const design::Confirmed& r) {
     const auto& d = cands[c];
     const auto f3 = design::figures_3d(r.summary, sw.metric);
@@ -162,7 +202,31 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   Progress bar("screen " + name, static_cast<double>(designs.size()), progress);
   size_t finished = 0;
   const auto t0 = std::chrono::steady_clock::now();
-  const auto results = reduced1d::run_designs(designs, jobs, [&](size_t) { bar.update(static_cast<double>(++finished)); });
+  std::vector<reduced1d::DesignOutcome> results;
+  if (ranks::distributed()) {
+    // mpirun: one design at a time per rank (rank 0's own thread included), two held per rank to
+    // hide the hand-over; the outcomes come back exactly as computed
+    std::vector<ranks::Task> tasks;
+    const std::string base_dir = fs::absolute(sw.base_dir).string();
+    for (size_t k = 0; k < sw.count(); ++k)
+      tasks.push_back({"1D run of design " + std::to_string(k),
+                       {{"kind", "1d"}, {"scene", sw.design(k)}, {"base_dir", base_dir}},
+                       cost_1d(designs[k]),
+                       {}});
+    const ranks::Outcome r =
+        ranks::distribute(tasks, run_task, 2, [&](size_t, const scene::json&) { bar.update(static_cast<double>(++finished)); });
+    for (const auto& x : r.results) {
+      if (x.contains("error")) {
+        reduced1d::DesignOutcome o;
+        o.message = x["error"].get<std::string>();
+        results.push_back(o);
+      } else {
+        results.push_back(reduced1d::outcome_from_json(x));
+      }
+    }
+  } else {
+    results = reduced1d::run_designs(designs, jobs, [&](size_t) { bar.update(static_cast<double>(++finished)); });
+  }
   bar.done();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
@@ -244,6 +308,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     summary["confirm"] = confirm_sweep(sw, results, static_cast<size_t>(confirm), confirm_section, threads, progress, out);
     code = summary["confirm"]["status"] == "ok" ? 0 : 3;
   }
+  if (ranks::distributed()) summary["mpi"] = ranks::summary();
   output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
   std::fflush(stdout);
   if (code != 0)

@@ -3,6 +3,7 @@
 #include <filesystem>
 
 #include "app/app.hpp"
+#include "app/ranks.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/si_format.hpp"
@@ -40,6 +41,29 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   if (progress != 0) o.progress = [](const std::string& line) { std::fprintf(stderr, "validate: %s\n", line.c_str()); };
   o.run_progress = progress;
   o.scenes_checked = true;
+  if (ranks::distributed()) {
+    // mpirun: the suite's 3D runs, axi runs and calibrations over the ranks (largest first; the
+    // finest grid after the grid whose cycle sets its frame interval), into the suite's cache;
+    // the report's pass below then reads them as it reads any cached run
+    const scene::json plan = validation::plan_runs(o);
+    std::vector<ranks::Task> tasks;
+    for (const auto& j : plan)
+      tasks.push_back({j["label"].get<std::string>(), {{"kind", "validate"}, {"job", j["job"]}}, j["cost"].get<double>(),
+                       j["after"].get<std::vector<std::size_t>>()});
+    size_t finished = 0;
+    const ranks::Outcome r = ranks::distribute(tasks, run_task, 1, [&](size_t i, const scene::json& res) {
+      ++finished;
+      if (progress != 0)
+        std::fprintf(stderr, "validate: run %zu/%zu (%s) on the ranks: %s\n", finished, tasks.size(),
+                     tasks[i].label.c_str(),
+                     res.contains("error") ? res["error"].get<std::string>().c_str()
+                                           : res.value("status", std::string()).c_str());
+    });
+    std::printf("validation suite %s: %zu run(s) over %d ranks in %s%s\n", name.c_str(), tasks.size(), ranks::size(),
+                si(r.wall_s, "s").c_str(),
+                r.lost.empty() ? "" : (", " + std::to_string(r.lost.size()) + " rank(s) lost (their runs redone)").c_str());
+    std::fflush(stdout);
+  }
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);
   const bool plotted = plot("plot_validation.py", {out});

@@ -16,10 +16,18 @@
 #include <exception>
 
 #include "app/app.hpp"
+#include "app/ranks.hpp"
 #include "common/errors.hpp"
 
 int main(int argc, char** argv) {
   using namespace swim;
+  // mpirun -n N swim …: rank 0 runs the command, the other ranks serve its runs (docs/mpi.md)
+  app::ranks::Session mpi(&argc, &argv);
+  if (const std::string why = app::ranks::unsupported_launch(); !why.empty()) {
+    std::fprintf(stderr, "swim: %s\n", why.c_str());
+    return 2;
+  }
+  if (app::ranks::rank() > 0) return app::ranks::serve(app::run_task);
   CLI::App cli{"swim: design and check peristaltic elastic micro-swimmers (1D lubrication and 3D immersed-boundary tiers)"};
   cli.require_subcommand(1);
   cli.set_help_all_flag("--help-all", "Help for every subcommand");
@@ -52,7 +60,7 @@ int main(int argc, char** argv) {
   CLI::App* scr = cli.add_subcommand("screen", "Run a 1D design sweep in parallel and rank the designs");
   scr->add_option("sweep", sweep, "Sweep file (JSON)")->required();
   scr->add_option("--out", out, "Output directory (default out/screen-<sweep name>)");
-  scr->add_option("--jobs", jobs, "Worker threads (default: all cores)")->check(CLI::Range(0, 1024));
+  scr->add_option("--jobs", jobs, "Worker threads (default: all cores; under mpirun each rank runs one design at a time)")->check(CLI::Range(0, 1024));
   int scr_confirm = 0, threads3d = 1;
   scr->add_option("--confirm", scr_confirm,
                   "Also run K designs in 3D (the K/2 best and K/2 spread over the rest) and report the rank agreement")

@@ -66,6 +66,22 @@ bool running(const json& s) { return !s.is_null() && s["status"].get<std::string
 json number_or_null(double v, bool present) { return present && std::isfinite(v) ? json(v) : json(nullptr); }
 }  // namespace
 
+json confirmed_to_json(const Confirmed& c) {
+  return {{"summary", c.summary}, {"folder", c.folder}, {"reused", c.reused}, {"ok", c.ok}, {"cell_size_m", c.cell_size_m}};
+}
+
+Confirmed confirmed_from_json(const json& j) {
+  Confirmed c;
+  c.summary = j.at("summary");
+  c.folder = j.at("folder").get<std::string>();
+  c.reused = j.at("reused").get<bool>();
+  c.ok = j.at("ok").get<bool>();
+  c.cell_size_m = j.at("cell_size_m").get<double>();
+  return c;
+}
+
+std::string confirm_label(const Candidate& c) { return "design-" + std::to_string(c.design); }
+
 Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::string& label, int progress) {
   json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
@@ -177,8 +193,8 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
   for (std::size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const std::string label = "design " + std::to_string(c.design);
-    Confirmed r = run_confirmed(confirm_scene(c.scene, o.section, o.threads), o.runs_dir,
-                                "design-" + std::to_string(c.design), o.progress);
+    const json sc = confirm_scene(c.scene, o.section, o.threads);
+    Confirmed r = o.run ? o.run(i, sc, confirm_label(c)) : run_confirmed(sc, o.runs_dir, confirm_label(c), o.progress);
     if (on_done) on_done(i, r);
     const json f1 = figures_1d(c.metrics, o.metric), f3 = figures_3d(r.summary, o.metric);
     const std::string status = r.summary.value("status", std::string("unknown"));

@@ -41,6 +41,10 @@ struct Confirmed {
   double cell_size_m = 0;  ///< the grid's h
 };
 
+/// A Confirmed as JSON and back (how an MPI rank sends it to rank 0; the summary round-trips exactly).
+json confirmed_to_json(const Confirmed& c);
+Confirmed confirmed_from_json(const json& j);
+
 /// The 3D run of `scene` (validated by the 3D reader) in runs_dir/<label>-<hash of the
 /// resolved scene>: reused when finished, continued from a matching checkpoint, else run.
 Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const std::string& label, int progress);
@@ -76,7 +80,13 @@ struct ConfirmOptions {
   int threads = 1;     ///< threads of each 3D run
   int progress = -1;   ///< progress of each 3D run
   std::string runs_dir;
+  /// runs candidate i's prepared scene (confirm_scene) as run_confirmed(scene, runs_dir, label,
+  /// progress) would; empty: run_confirmed itself. An MPI command passes the runs its ranks made.
+  std::function<Confirmed(std::size_t i, const json& scene, const std::string& label)> run;
 };
+
+/// The label of candidate c's run folder ("design-<k>").
+std::string confirm_label(const Candidate& c);
 
 /// Runs every candidate in 3D (design/confirm.hpp: reused when finished) and returns the report
 /// written as confirm.json: per design both tiers' figures, their relative differences and

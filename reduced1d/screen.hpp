@@ -17,6 +17,14 @@ struct DesignOutcome {
   double wall_time_s = 0;
 };
 
+/// Run one design (the unit of run_designs).
+DesignOutcome run_design(const Params& design);
+
+/// A design's outcome as JSON and back, exactly (every double round-trips): how the ranks of
+/// an MPI screen send it to rank 0 (app/ranks.hpp).
+scene::json outcome_to_json(const DesignOutcome& o);
+DesignOutcome outcome_from_json(const scene::json& j);
+
 /// Run every design, `jobs` at a time (jobs <= 0: one per hardware thread).
 /// `on_done(k)` is called (from a worker, serialised) after design k finishes.
 std::vector<DesignOutcome> run_designs(const std::vector<Params>& designs, int jobs,

@@ -6,6 +6,7 @@ Axes carry SI-prefixed units; each point is labelled with its design number. Des
 3D run failed are left out (confirm.md lists them).
 """
 import json
+import os
 import sys
 
 import matplotlib
@@ -13,6 +14,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # plot_screen beside it
 from plot_screen import LABELS, label, si_scale  # noqa: E402
 
 

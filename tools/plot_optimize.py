@@ -5,6 +5,7 @@ usage: plot_optimize.py TRAJECTORY_CSV OUT_PNG OBJECTIVE SPEC_NAME LO:HI [LO:HI 
 The LO:HI pairs are the parameters' bounds in SI, in the order of the CSV's parameter columns.
 """
 import csv
+import os
 import sys
 
 import matplotlib
@@ -12,6 +13,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))  # plot_screen beside it
 from plot_screen import LABELS, label, si_scale  # noqa: E402
 
 

@@ -370,8 +370,9 @@ Run3d run_3d(const json& sc, const std::string& runs_dir, int threads, bool* cac
     ctl.resume = resume;
     full3d::RunOutcome out = full3d::run3d(p, resolved, dir, ctl);
     summary = out.summary;
-    // a resumed run holds only this process's rows in memory: the whole run is in its folder
-    rec = resume ? record::read_run(dir) : std::move(out.record);
+    // the record is read back from the folder, as a cached run's is: the report is the same
+    // whether this process, another (an MPI rank) or an earlier invocation made the run
+    rec = record::read_run(dir);
   } else {
     rec = record::read_run(dir);
     ++log.reused;
@@ -454,7 +455,7 @@ RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress,
     ctl.keep_rows = true;
     axi::RunOutcomeAxi out = axi::run_axi(p, resolved, dir, ctl);
     summary = out.summary;
-    rec = std::move(out.record);
+    rec = record::read_run(dir);  // as a cached run's (run_3d)
   } else {
     rec = record::read_run(dir);
     ++log.reused;
@@ -487,6 +488,62 @@ RunAxi run_axi_cached(const json& sc, const std::string& runs_dir, int progress,
     r.record["no_cycle_reason"] = r.cyc.absent_because;
   }
   return r;
+}
+
+/// The calibration of `base` at `grid` (grid_key): read from cal_dir when a valid one of this
+/// physics and format is there, else computed and written (`starting` called first). Returns
+/// the calibration file ("" when it failed) and its content in cal_j.
+std::string calibration_at(const json& base, const std::string& grid_key, const json& grid, const std::string& name,
+                           int threads, const std::string& cal_dir, CacheLog& log, json& cal_j,
+                           const std::function<void()>& starting) {
+  std::string cal_file;
+  json s = base;
+  set_key(s, grid_key, grid);
+  set_key(s, "full3d.threads", threads);  // as the 3D runs; not part of the key
+  json resolved;
+  const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+  // keyed by the physics of the resolved scene and the calibration file's format version
+  const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
+  cal_file = dir + "/calibration.json";
+  if (fs::exists(cal_file)) {
+    // a damaged calibration is recomputed, never read
+    if (const std::string why = calibration_problem(cal_file); !why.empty()) {
+      log.reject(cal_file, why);
+      fs::remove(cal_file);
+    }
+  }
+  if (!fs::exists(cal_file)) {
+    const std::string found = cached_calibration(cal_dir, same_swimmer(resolved), log);
+    if (!found.empty()) cal_file = found;
+  }
+  if (fs::exists(cal_file)) {
+    std::ifstream in(cal_file);
+    cal_j = json::parse(in);
+    ++log.reused;
+    log.calibrations.push_back(cal_file);
+    return cal_file;
+  }
+  if (starting) starting();
+  try {
+    const auto t0 = std::chrono::steady_clock::now();
+    const StaticCalibration c = calibrate_static(p, default_loads(p));
+    const HydraulicRadii hr = measure_hydraulic_radii(p);
+    cal_j = to_json(c, p, resolved);
+    json hj = to_json(hr);
+    hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
+    hj.erase("wall_time_s");
+    cal_j.update(hj);
+    cal_j.update(calibrate_towed(p, hr).json);
+    cal_j["wall_time_s"] = seconds_since(t0);
+    cal_j["status"] = "ok";
+    fs::create_directories(dir);
+    output::write_json(cal_file, cal_j);
+    log.calibrations.push_back(cal_file);
+  } catch (const NumericalError& e) {
+    cal_j = {{"status", std::string("failed: ") + e.what()}};
+    cal_file.clear();
+  }
+  return cal_file;
 }
 
 // ---- one 1D run --------------------------------------------------------------------------
@@ -1031,6 +1088,149 @@ void check_suite(const json& s, const std::string& path, const std::string& data
   }
 }
 
+// ---- the suite's heavy runs as independent jobs (MPI: validation/suite.hpp) ---------------
+
+json plan_runs(const SuiteOptions& o) {
+  json suite = scene::load_file(o.suite);
+  check_suite(suite, o.suite, o.data_dir, !o.scenes_checked);
+  const std::string suite_dir = fs::path(o.suite).parent_path().string();
+  const std::string runs_dir = fs::absolute(o.out_dir + "/runs").string();
+  const std::string cal_dir = fs::absolute(o.out_dir + "/calibrations").string();
+  fs::create_directories(runs_dir);
+  fs::create_directories(cal_dir);
+  json jobs = json::array();
+  std::string key;  // the cache key of the run being planned (its folder)
+  auto cost3d = [&](json s) {
+    set_key(s, "full3d.threads", 1);
+    json resolved;
+    const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+    key = output::json_hash(same_swimmer(resolved));
+    return double(p.nx) * p.ny * p.nz * ((p.duration > 0 ? p.duration : p.time_limit) / p.dt);
+  };
+  // two jobs of one physics share a folder: the second waits for the first and reuses it
+  std::map<std::string, std::size_t> first_of;
+  auto add = [&](json job, double cost, json after = json::array()) {
+    if (auto it = first_of.find(key); !key.empty() && it != first_of.end()) after.push_back(it->second);
+    if (!key.empty()) first_of.emplace(key, jobs.size());
+    key.clear();
+    const json& sc = job.contains("scene") ? job["scene"] : job["base"];
+    std::string label = job["type"].get<std::string>() + " run of " + sc.value("name", std::string("a scene"));
+    if (job.contains("grid")) label = "calibration of " + job["name"].get<std::string>() + " at " + job["grid"].dump();
+    else if (sc.contains("full3d") && sc["full3d"].contains("grid")) label += " at " + sc["full3d"]["grid"].dump();
+    jobs.push_back({{"job", std::move(job)}, {"cost", cost}, {"after", std::move(after)}, {"label", label}});
+    return jobs.size() - 1;
+  };
+  for (const json& cs : suite["cases"]) {
+    const std::string stem = fs::path(cs["scene"].get<std::string>()).stem().string();
+    bool take = o.only.empty();
+    for (const auto& n : o.only) take = take || n == stem || n == stem + ".json";
+    if (!take) continue;
+    const std::string scene_path = find_scene(cs["scene"], suite_dir, o.data_dir);
+    json base = scene::load_file(scene_path);
+    apply_sets(base, cs.value("set", json()));
+    const std::string name = base.value("name", fs::path(scene_path).stem().string());
+    const std::string grid_key = cs.value("grid_key", std::string("full3d.grid.cells_across"));
+    const json& grids = cs["grids"];
+    json grid_jobs = json::array();
+    for (std::size_t g = 0; g < grids.size(); ++g) {
+      json s = base;
+      set_key(s, grid_key, grids[g]);
+      json job = {{"type", "3d"}, {"scene", s}, {"runs_dir", runs_dir}, {"threads", o.threads}};
+      json after = json::array();
+      // the finest grid writes membrane frames at an interval taken from the grid before it
+      if (g + 1 == grids.size() && g > 0) {
+        job["frames_from"] = jobs[grid_jobs.back().get<std::size_t>()]["job"]["scene"];
+        after.push_back(grid_jobs.back());
+      }
+      grid_jobs.push_back(add(job, cost3d(s), after));
+    }
+    if (cs.contains("reference")) {
+      const json& rs = cs["reference"];
+      for (const json& g : rs["grids"]) {
+        const json s = reference_scene(base, rs, g);
+        json resolved;
+        const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
+        key = axi_key(resolved);
+        add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
+            double(p.nr) * p.nx * (p.time_limit / p.dt_max));
+      }
+    }
+    const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
+    {
+      json s = base;
+      set_key(s, grid_key, grids[cg]);
+      const double cost = cost3d(s);
+      key = "calibration " + key;
+      add({{"type", "calibration"}, {"base", base}, {"grid_key", grid_key}, {"grid", grids[cg]}, {"name", name},
+           {"threads", o.threads}, {"cal_dir", cal_dir}},
+          cost);
+    }
+    // the time-step variants run when the case has a reference to judge them by: after its grids
+    const json& variants = cs.contains("time_variants3d") ? cs["time_variants3d"] : json::array();
+    for (const json& v : variants) {
+      json s = base;
+      set_key(s, grid_key, grids[cg]);
+      apply_sets(s, v.value("set", json()));
+      add({{"type", "3d"}, {"scene", s}, {"runs_dir", runs_dir}, {"threads", o.threads},
+           {"unless_no_reference", {{"grids", grid_jobs.size()}, {"has_axi_reference", cs.contains("reference")}}},
+           {"grid_scenes", [&] {
+              json a = json::array();
+              for (const auto& i : grid_jobs) a.push_back(jobs[i.get<std::size_t>()]["job"]["scene"]);
+              return a;
+            }()}},
+          cost3d(s), grid_jobs);
+    }
+  }
+  const json& ex = suite.contains("extremes3d") && o.only.empty() ? suite["extremes3d"] : json::array();
+  for (const json& e : ex) {
+    json s = scene::load_file(find_scene(e["scene"], suite_dir, o.data_dir));
+    apply_sets(s, e.value("set", json()));
+    double cost = 0;
+    try {
+      cost = cost3d(s);
+    } catch (const InputError&) {
+      continue;  // a scene the 3D tier refuses: the suite reports it, nothing to run
+    }
+    add({{"type", "3d"}, {"scene", s}, {"runs_dir", runs_dir}, {"threads", o.threads}}, cost);
+  }
+  return jobs;
+}
+
+json run_planned(const json& job) {
+  CacheLog log;  // this process's view; the report's pass builds its own
+  const std::string type = job.at("type").get<std::string>();
+  bool cached = false;
+  if (type == "3d") {
+    const std::string runs_dir = job["runs_dir"];
+    const int threads = job["threads"];
+    double frames = 0;
+    if (job.contains("frames_from")) {
+      const Run3d prev = run_3d(job["frames_from"], runs_dir, threads, &cached, log);  // finished before this job
+      if (prev.cyc.has_cycle) frames = prev.cyc.cycle_time_s / 12.0;
+    }
+    if (job.contains("grid_scenes")) {
+      // a time-step variant is run only for a case with a reference (two grids with a cycle, or the axi one)
+      int with_cycle = 0;
+      for (const json& g : job["grid_scenes"]) with_cycle += run_3d(g, runs_dir, threads, &cached, log).cyc.has_cycle;
+      if (with_cycle < 2 && !job["unless_no_reference"].value("has_axi_reference", false))
+        return {{"status", "not needed: the case has no reference"}};
+    }
+    const Run3d r = run_3d(job["scene"], runs_dir, threads, &cached, log, frames);
+    return {{"status", r.record.value("status", std::string("unknown"))}, {"cached", cached}};
+  }
+  if (type == "axi") {
+    const RunAxi r = run_axi_cached(job["scene"], job["runs_dir"], 0, &cached, log);
+    return {{"status", r.record.value("status", std::string("unknown"))}, {"cached", cached}};
+  }
+  if (type == "calibration") {
+    json cal;
+    const std::string file = calibration_at(job["base"], job["grid_key"], job["grid"], job["name"], job["threads"],
+                                            job["cal_dir"], log, cal, {});
+    return {{"status", cal.value("status", std::string("unknown"))}, {"file", file}};
+  }
+  throw std::logic_error("unknown validation job " + type);
+}
+
 json run_suite(const SuiteOptions& o) {
   json suite = scene::load_file(o.suite);
   check_suite(suite, o.suite, o.data_dir, !o.scenes_checked);
@@ -1206,55 +1406,8 @@ json run_suite(const SuiteOptions& o) {
     // 3. calibration at the chosen grid
     const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
     json cal_j;
-    std::string cal_file;
-    {
-      json s = base;
-      set_key(s, grid_key, grids[cg]);
-      set_key(s, "full3d.threads", o.threads);  // as the 3D runs; not part of the key
-      json resolved;
-      const full3d::Params3d p = full3d::read_scene3d(s, resolved);
-      // keyed by the physics of the resolved scene and the calibration file's format version
-      const std::string dir = cal_dir + "/" + name + "-" + output::json_hash({physics_of(resolved), kCalibrationFormat});
-      cal_file = dir + "/calibration.json";
-      if (fs::exists(cal_file)) {
-        // a damaged calibration is recomputed, never read
-        if (const std::string why = calibration_problem(cal_file); !why.empty()) {
-          log.reject(cal_file, why);
-          fs::remove(cal_file);
-        }
-      }
-      if (!fs::exists(cal_file)) {
-        const std::string found = cached_calibration(cal_dir, same_swimmer(resolved), log);
-        if (!found.empty()) cal_file = found;
-      }
-      if (fs::exists(cal_file)) {
-        std::ifstream in(cal_file);
-        cal_j = json::parse(in);
-        ++log.reused;
-        log.calibrations.push_back(cal_file);
-      } else {
-        say(tag + ": calibration at grid " + std::to_string(cg + 1));
-        try {
-          const auto t0 = std::chrono::steady_clock::now();
-          const StaticCalibration c = calibrate_static(p, default_loads(p));
-          const HydraulicRadii hr = measure_hydraulic_radii(p);
-          cal_j = to_json(c, p, resolved);
-          json hj = to_json(hr);
-          hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
-          hj.erase("wall_time_s");
-          cal_j.update(hj);
-          cal_j.update(calibrate_towed(p, hr).json);
-          cal_j["wall_time_s"] = seconds_since(t0);
-          cal_j["status"] = "ok";
-          fs::create_directories(dir);
-          output::write_json(cal_file, cal_j);
-          log.calibrations.push_back(cal_file);
-        } catch (const NumericalError& e) {
-          cal_j = {{"status", std::string("failed: ") + e.what()}};
-          cal_file.clear();
-        }
-      }
-    }
+    const std::string cal_file = calibration_at(base, grid_key, grids[cg], name, o.threads, cal_dir, log, cal_j,
+                                                [&] { say(tag + ": calibration at grid " + std::to_string(cg + 1)); });
     cr["calibration"] = {{"grid_index", cg}, {"grid_value", grids[cg]}, {"file", cal_file}};
     for (const char* k : {"C1_Pa_per_m", "C1_stderr_Pa_per_m", "C1_spring_network_Pa_per_m", "hydraulic_offset_inner_m",
                           "hydraulic_offset_inner_uncertainty_m", "hydraulic_offset_outer_m",

@@ -53,6 +53,16 @@ struct SuiteOptions {
 /// (before any run); numerical failures of single runs are recorded in the report.
 scene::json run_suite(const SuiteOptions& o);
 
+/// The suite's heavy runs (every 3D run of the resolution studies, the time-step variants and
+/// the extremes, every axi reference run, every calibration) as independent jobs, for `mpirun`
+/// to spread over ranks before run_suite: [{"job": {...}, "cost": estimate, "after": [jobs that
+/// must finish first], "label": for messages}]. Each job run by run_planned puts its result in the suite's cache
+/// (OUT/runs, OUT/calibrations), exactly as run_suite would make it, so that run_suite then finds
+/// them all and its report is the one a single process writes.
+scene::json plan_runs(const SuiteOptions& o);
+/// Runs one job of plan_runs into the cache (a finished one is reused); returns {"status", ...}.
+scene::json run_planned(const scene::json& job);
+
 /// Reads and checks a suite file (InputError naming the key on any problem). The scene of a
 /// case with a `reference` is looked up (as given, beside the suite, in data_dir/scenes when
 /// data_dir is not empty) and read by the axi tier on every reference grid: a scene the tier
