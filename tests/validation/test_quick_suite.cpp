@@ -1,6 +1,8 @@
 // The quick validation suite end to end (swim validate --quick, without the figures): three
 // coarse 3D grids of the small duct scene, the calibration, every 1D model, the report; the
 // cache of runs (other output settings, an older resolution, an interrupted run).
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -20,7 +22,7 @@ using namespace swim;
 namespace fs = std::filesystem;
 
 TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
-  const std::string out = testing::TempDir() + "/swim_quick_suite";
+  const std::string out = testing::TempDir() + "/swim_quick_suite_" + std::to_string(::getpid());
   fs::remove_all(out);
   fs::create_directories(out);
   validation::SuiteOptions o;

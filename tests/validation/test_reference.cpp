@@ -2,6 +2,8 @@
 // grid series): its strict reading, the agreement rule of the 3D extrapolation against it, and
 // the substitution that judges the 1D verdicts and the findings against it instead of the 3D
 // extrapolation, on synthetic case data (no solver runs).
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -34,7 +36,7 @@ const std::string kRest = R"("models1d": [{"label": "m"}], "thresholds": {"displ
 /// top-level members ("" or `"key": value, `).
 std::string write_suite(const std::string& scene, const std::string& reference, const std::string& top = "",
                         const std::string& case_set = "") {
-  const std::string path = testing::TempDir() + "/reference_suite.json";
+  const std::string path = testing::TempDir() + "/reference_suite_" + std::to_string(::getpid()) + ".json";
   std::ofstream(path) << "{" << top << R"("cases": [{"scene": ")" << scene << R"(", "grids": [32, 40])"
                       << (case_set.empty() ? "" : ", \"set\": " + case_set) << R"(, "reference": )" << reference
                       << "}], " << kRest << "}";

@@ -2,6 +2,8 @@
 // round wall on three very coarse 3D grids and three coarse axisymmetric grids; the reference
 // replaces the 3D extrapolation in the 1D verdicts, the 3D extrapolation is compared with it,
 // the axi runs are cached and rerun when the reference's scene changes.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -52,7 +54,7 @@ json make_suite(const json& axi_set) {
 }  // namespace
 
 TEST(ReferenceSuite, TheAxiSeriesIsTheReferenceOfTheCase) {
-  const std::string out = testing::TempDir() + "/swim_reference_suite";
+  const std::string out = testing::TempDir() + "/swim_reference_suite_" + std::to_string(::getpid());
   fs::remove_all(out);
   fs::create_directories(out);
   json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");

@@ -1,4 +1,6 @@
 // Richardson extrapolation, U(t) comparison and suite-file checks of the validation layer.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -98,7 +100,7 @@ TEST(CompareSeries, PhaseNormalisationAndCorrelation) {
 
 // A malformed suite is rejected naming the key, before any run.
 TEST(SuiteFile, MalformedSuitesNameTheKey) {
-  const std::string path = testing::TempDir() + "/bad_suite.json";
+  const std::string path = testing::TempDir() + "/bad_suite_" + std::to_string(::getpid()) + ".json";
   auto expect_key = [&](const std::string& text, const std::string& key) {
     std::ofstream(path) << text;
     try {

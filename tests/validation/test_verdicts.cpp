@@ -1,6 +1,8 @@
 // The observed-order range of the Richardson extrapolation and the verdicts of the validation
 // suite judged with the error bars of the 3D reference (validation/verdicts.hpp), on
 // synthetic case data.
+#include <unistd.h>
+
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -129,7 +131,7 @@ TEST(SuiteOrderRange, BadOrderRangeIsAnInputErrorNamingTheKey) {
   EXPECT_EQ(parse_order_range("immersed_boundary", "k").hi, 2.0);
   EXPECT_EQ(parse_order_range("sharp_interface", "k").hi, 3.5);
   EXPECT_EQ(parse_order_range(json::array({0.8, 1.6}), "k").lo, 0.8);
-  const std::string path = testing::TempDir() + "/order_range_suite.json";
+  const std::string path = testing::TempDir() + "/order_range_suite_" + std::to_string(::getpid()) + ".json";
   const std::string rest = R"("models1d": [{"label": "m"}], "thresholds": {"displacement_per_cycle_relative": 0.2,
       "cycle_time_relative": 0.5, "mean_velocity_per_cycle_relative": 0.5, "velocity_phase_correlation": 0.8})";
   auto expect = [&](const std::string& text, const std::vector<std::string>& parts) {
