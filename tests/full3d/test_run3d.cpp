@@ -189,7 +189,7 @@ TEST(Run3d, AResumedRunListsEveryFrameAndRefusesAMissingOne) {
 // frame, with the same message, as the uninterrupted run.
 TEST(Run3d, AResumedRunStopsAtTheOutputLimitWhereTheUninterruptedRunDid) {
   const std::vector<std::string> sets = {"full3d.dt=\"1 ms\"", "full3d.output.vtk_interval=\"2 ms\"",
-                                         "full3d.checkpoint_interval=\"5 ms\""};
+                                         "full3d.checkpoint_interval=\"5 ms\"", "time.duration=\"auto\""};
   const Scene s = tiny(sets);  // time.duration auto: no estimate before the run
   RunControl ctl;
   ctl.progress = 0;
