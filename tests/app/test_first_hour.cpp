@@ -6,9 +6,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <regex>
 #include <string>
 #include <vector>
@@ -16,6 +19,7 @@
 #include "common/run_folder.hpp"
 #include "common/scene.hpp"
 #include "tests/support/files.hpp"
+#include "tests/support/vtk_read.hpp"
 
 namespace fs = std::filesystem;
 using swim::scene::json;
@@ -298,5 +302,60 @@ TEST(Printouts, VolumesInOneUnitAndAPrescribedWavePrintsItsTransit) {
   EXPECT_EQ(p.out.find("0 cycle"), std::string::npos) << p.out;
   EXPECT_NE(p.out.find("per wave transit"), std::string::npos) << p.out;
   EXPECT_NE(p.out.find("\u00b5m\u00b3"), std::string::npos) << p.out;
+  fs::remove_all(d);
+}
+
+// The frames of a run read back with an independent decoder (tests/support/vtk_read.hpp): each
+// compressed, carrying its time (the same as its collection's timestep), segment as integers,
+// and the cylinder's fluid frames with the inside/outside mask of the fictitious domain.
+TEST(VtkFrames, ARunsFramesReadBackWithTheirTimeSegmentsAndTheCylindersMask) {
+  using namespace swim::test::vtk_read;
+  const fs::path d = swim::test::scratch_dir("swim_first_hour_vtk");
+  const fs::path out = d / "run";
+  const Cli c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json\" --tier 3d --quiet --threads 2 --out \"" +
+                         out.string() +
+                         "\" --set time.duration='\"4 ms\"' --set full3d.output.vtk_interval='\"2 ms\"'"
+                         " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"2 ms\"'",
+                     d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const int segments = summary_of(out)["scene"]["protocol"]["segments"].get<int>();
+  for (const std::string kind : {"membrane", "fluid"}) {
+    SCOPED_TRACE(kind);
+    const std::string pvd = slurp(out / (kind + ".pvd"));
+    const std::regex entry(R"re(<DataSet timestep="([^"]+)" part="0" file="([^"]+)"/>)re");
+    int frames = 0;
+    for (auto it = std::sregex_iterator(pvd.begin(), pvd.end(), entry); it != std::sregex_iterator(); ++it) {
+      ++frames;
+      const std::string xml = slurp(out / std::string((*it)[2]));
+      EXPECT_NE(xml.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
+      std::map<std::string, Array> by;
+      for (const auto& a : arrays(xml)) by[a.name] = a;
+      ASSERT_TRUE(by.count("TimeValue"));
+      const auto t = decode<double>(by["TimeValue"].body);
+      ASSERT_EQ(t.size(), 1u);
+      EXPECT_NEAR(t[0], std::stod((*it)[1]), 1e-9 * std::max(1.0, t[0]));
+      if (kind == "membrane") {
+        EXPECT_EQ(by["segment"].type, "Int32");
+        const auto seg = decode<std::int32_t>(by["segment"].body);
+        ASSERT_FALSE(seg.empty());
+        EXPECT_EQ(*std::min_element(seg.begin(), seg.end()), 0);
+        EXPECT_EQ(*std::max_element(seg.begin(), seg.end()), segments - 1);
+      } else {
+        ASSERT_TRUE(by.count("inside_container"));
+        EXPECT_EQ(by["inside_container"].type, "Int32");
+        const auto mask = decode<std::int32_t>(by["inside_container"].body);
+        const auto p = decode<float>(by["pressure_Pa"].body);
+        ASSERT_EQ(mask.size(), p.size());
+        // the cylinder fills pi/4 of its square duct's cross-section
+        double inside = 0;
+        for (auto m : mask) {
+          EXPECT_TRUE(m == 0 || m == 1);
+          inside += m;
+        }
+        EXPECT_NEAR(inside / double(mask.size()), M_PI / 4, 0.03);
+      }
+    }
+    EXPECT_GE(frames, 2);
+  }
   fs::remove_all(d);
 }

@@ -20,6 +20,7 @@
 
 #include "common/errors.hpp"
 #include "common/vtk.hpp"
+#include "tests/support/vtk_read.hpp"
 
 #include <zlib.h>
 
@@ -27,31 +28,7 @@ using namespace swim;
 
 namespace {
 
-std::vector<unsigned char> unbase64(const std::string& s) {
-  auto val = [](char c) -> int {
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
-    return -1;
-  };
-  std::vector<unsigned char> out;
-  std::uint32_t acc = 0;
-  int bits = 0;
-  for (char c : s) {
-    if (c == '=') break;
-    const int v = val(c);
-    if (v < 0) continue;  // whitespace
-    acc = (acc << 6) | std::uint32_t(v);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out.push_back(static_cast<unsigned char>((acc >> bits) & 0xFF));
-    }
-  }
-  return out;
-}
+using namespace swim::test::vtk_read;
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -74,54 +51,6 @@ bool balanced(const std::string& xml) {
     }
   }
   return stack.empty();
-}
-
-struct Array {
-  std::string type, name, body;
-};
-
-std::vector<Array> arrays(const std::string& xml) {
-  std::vector<Array> out;
-  const std::regex da(R"re(<DataArray type="([A-Za-z0-9]+)"(?: Name="([^"]*)")?[^>]*format="binary">\s*([A-Za-z0-9+/=]*)\s*</DataArray>)re");
-  for (std::sregex_iterator it(xml.begin(), xml.end(), da), end; it != end; ++it)
-    out.push_back({(*it)[1], (*it)[2], (*it)[3]});
-  return out;
-}
-
-// One compressed inline binary DataArray body -> its values.
-template <class T>
-std::vector<T> decode(const std::string& body) {
-  // the header's length follows from its first word (the number of blocks)
-  const auto first = unbase64(body.substr(0, 8));
-  EXPECT_GE(first.size(), 4u);
-  if (first.size() < 4) return {};
-  std::uint32_t blocks = 0;
-  std::memcpy(&blocks, first.data(), 4);
-  const std::size_t header_bytes = 4 * (3 + std::size_t(blocks));
-  const std::size_t header_chars = 4 * ((header_bytes + 2) / 3);
-  const auto header_raw = unbase64(body.substr(0, header_chars));
-  EXPECT_EQ(header_raw.size(), header_bytes);
-  std::vector<std::uint32_t> h(3 + blocks);
-  std::memcpy(h.data(), header_raw.data(), header_bytes);
-  const std::uint32_t block = h[1], partial = h[2];
-  const auto packed = unbase64(body.substr(header_chars));
-  std::vector<unsigned char> raw;
-  std::size_t at = 0;
-  for (std::uint32_t b = 0; b < blocks; ++b) {
-    const uLongf want = (b + 1 == blocks && partial) ? partial : block;
-    std::vector<unsigned char> out(want);
-    uLongf got = want;
-    EXPECT_LE(at + h[3 + b], packed.size());
-    EXPECT_EQ(uncompress(out.data(), &got, packed.data() + at, h[3 + b]), Z_OK) << "block " << b;
-    EXPECT_EQ(got, want);
-    raw.insert(raw.end(), out.begin(), out.begin() + got);
-    at += h[3 + b];
-  }
-  EXPECT_EQ(at, packed.size());
-  EXPECT_EQ(raw.size() % sizeof(T), 0u);
-  std::vector<T> v(raw.size() / sizeof(T));
-  std::memcpy(v.data(), raw.data(), v.size() * sizeof(T));
-  return v;
 }
 
 std::string tmp(const std::string& name) {
