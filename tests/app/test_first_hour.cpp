@@ -359,3 +359,21 @@ TEST(VtkFrames, ARunsFramesReadBackWithTheirTimeSegmentsAndTheCylindersMask) {
   }
   fs::remove_all(d);
 }
+
+// Every shipped sweep (data/sweeps, README "swim screen") screens on the 1D tier with every
+// design succeeding; its 3D confirmation (--confirm, minutes) is the design loop's own test.
+TEST(ShippedSweeps, EachScreensOnThe1dTier) {
+  const fs::path d = swim::test::scratch_dir("swim_first_hour_sweeps");
+  for (const auto& e : fs::directory_iterator(SWIM_SOURCE_DIR "/data/sweeps")) {
+    if (e.path().extension() != ".json") continue;
+    SCOPED_TRACE(e.path().filename().string());
+    const fs::path out = d / e.path().stem();
+    const Cli c = swim("screen \"" + e.path().string() + "\" --quiet --jobs 2 --out \"" + out.string() + "\"", d);
+    EXPECT_EQ(c.code, 0) << c.err;
+    const json s = json::parse(slurp(out / "screen.json"));
+    EXPECT_EQ(s["status"], "ok");
+    EXPECT_EQ(s["failed"], 0);
+    EXPECT_GT(s["designs"].get<int>(), 1);
+  }
+  fs::remove_all(d);
+}
