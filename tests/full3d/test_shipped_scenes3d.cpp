@@ -193,5 +193,10 @@ TEST(ShippedScenes3d, DescriptionsStateTrueFigures) {
       EXPECT_NEAR(v, p.duration / p.dt, 0.5);
     }
     if (number(d, R"(first ([\d.]+) ms)", v)) EXPECT_NEAR(v * 1e-3, p.duration, 1e-12);
+    if (number(d, R"(eps = ([\d.]+))", v)) EXPECT_NEAR(v, p.R0 / p.L, 0.005 * v);
+    if (number(d, R"(([\d.]+)x the static load)", v)) {
+      ASSERT_TRUE(sc["protocol"].contains("load_factor"));
+      EXPECT_NEAR(v, sc["protocol"]["load_factor"].get<double>(), 1e-9);
+    }
   }
 }
