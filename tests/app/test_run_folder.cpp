@@ -417,7 +417,7 @@ TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
 TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimit) {
   const fs::path d = tmpdir("runtime_limit_3d");
   const fs::path out = d / "run";
-  const std::uintmax_t limit = 2000000;  // frames of this scene: 266 kB each
+  const std::uintmax_t limit = 2000000;  // compressed frames of this scene: about 75 kB each
   const Cli c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() +
                              "\" --set full3d.dt='\"1 ms\"' --set full3d.output.vtk_interval='\"1 ms\"'"
                              " --set time.duration=auto --set output.max_bytes=" + std::to_string(limit),

@@ -193,7 +193,7 @@ TEST(Run3d, AResumedRunStopsAtTheOutputLimitWhereTheUninterruptedRunDid) {
   const Scene s = tiny(sets);  // time.duration auto: no estimate before the run
   RunControl ctl;
   ctl.progress = 0;
-  ctl.max_output_bytes = 1450000;  // frames of 266 kB: the sixth (step 10) passes it
+  ctl.max_output_bytes = 1450000;  // compressed frames of about 75 kB: one a few tens of steps in passes it
   const std::string a = fresh_dir("limit_a"), b = fresh_dir("limit_b");
   const RunOutcome ra = run3d(s.p, s.resolved, a, ctl);
   ASSERT_TRUE(ra.failed);
