@@ -33,7 +33,7 @@ struct Cli {
 };
 
 // Runs the executable with `args` (shell syntax), stdout and stderr captured.
-Cli swim(const std::string& args, const fs::path& scratch) {
+Cli swim_cli(const std::string& args, const fs::path& scratch) {
   const fs::path o = scratch / "stdout.txt", e = scratch / "stderr.txt";
   const std::string cmd = "\"" SWIM_BINARY_DIR "/bin/swim\" " + args + " > \"" + o.string() + "\" 2> \"" +
                           e.string() + "\"";
@@ -79,7 +79,7 @@ TEST(ShippedScenesRun, EachSucceedsOnThe1dTierAsShipped) {
   for (const auto& scene : shipped_scenes()) {
     SCOPED_TRACE(scene.filename().string());
     const fs::path out = d / scene.stem();
-    const Cli c = swim("run \"" + scene.string() + "\" --quiet --out \"" + out.string() + "\"", d);
+    const Cli c = swim_cli("run \"" + scene.string() + "\" --quiet --out \"" + out.string() + "\"", d);
     EXPECT_EQ(c.code, 0) << c.err;
     const json s = summary_of(out);
     ASSERT_TRUE(s.is_object());
@@ -100,7 +100,7 @@ TEST(ShippedScenesRun, EachSucceedsOnThe3dTier) {
     SCOPED_TRACE(scene.filename().string());
     const fs::path out = d / scene.stem();
     const std::string shorten = fast_in_3d(scene) ? "" : " --set time.duration='\"4 ms\"' --set full3d.output.vtk=false";
-    const Cli c = swim("run \"" + scene.string() + "\" --tier 3d --quiet --threads 2 --out \"" + out.string() + "\"" +
+    const Cli c = swim_cli("run \"" + scene.string() + "\" --tier 3d --quiet --threads 2 --out \"" + out.string() + "\"" +
                            shorten,
                        d);
     EXPECT_EQ(c.code, 0) << c.err;
@@ -125,7 +125,7 @@ TEST(ShippedScenesRun, RoundWallScenesSucceedOnTheAxiTierAndOthersAreRefused) {
                        sc["full3d"]["membrane"].value("axisymmetric", false) &&
                        sc["container"].value("kind", std::string()) == "cylinder";
     const fs::path out = d / scene.stem();
-    const Cli c = swim("run \"" + scene.string() + "\" --tier axi --quiet --out \"" + out.string() +
+    const Cli c = swim_cli("run \"" + scene.string() + "\" --tier axi --quiet --out \"" + out.string() +
                            "\" --set time.duration='\"4 ms\"'",
                        d);
     if (round) {
@@ -158,7 +158,7 @@ TEST(Readme, EveryExampleRunsAsWritten) {
     SCOPED_TRACE(args);
     ++examples;
     const fs::path out = d / ("set" + std::to_string(n++));
-    const Cli c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + out.string() + "\" " + args, d);
+    const Cli c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + out.string() + "\" " + args, d);
     EXPECT_EQ(c.code, 0) << c.err;
     const json s = summary_of(out);
     ASSERT_TRUE(s.is_object());
@@ -174,7 +174,7 @@ TEST(Readme, EveryExampleRunsAsWritten) {
   const json minimal = json::parse(readme.substr(j0 + 8, j1 - j0 - 8));
   std::ofstream(d / "minimal.json") << minimal.dump(2);
   const fs::path out = d / "minimal";
-  Cli c = swim("run \"" + (d / "minimal.json").string() + "\" --quiet --out \"" + out.string() + "\"", d);
+  Cli c = swim_cli("run \"" + (d / "minimal.json").string() + "\" --quiet --out \"" + out.string() + "\"", d);
   EXPECT_EQ(c.code, 0) << c.err;
   const json s = summary_of(out);
   ASSERT_TRUE(s.is_object());
@@ -195,7 +195,7 @@ TEST(Readme, EveryExampleRunsAsWritten) {
   const std::string fluid = "--set full3d.output.fluid_fields=true";
   ASSERT_NE(readme.find(fluid), std::string::npos);
   const fs::path f = d / "fluid";
-  c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json\" --tier 3d --quiet --out \"" + f.string() + "\" " +
+  c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json\" --tier 3d --quiet --out \"" + f.string() + "\" " +
                fluid + " --set full3d.output.fluid_interval='\"10 ms\"'",
            d);
   EXPECT_EQ(c.code, 0) << c.err;
@@ -212,11 +212,11 @@ TEST(CommandLine, VersionIsTheProjectVersionInTheCliTheSummaryAndTheCitation) {
   const fs::path d = swim::test::scratch_dir("swim_first_hour_version");
   const std::string v = project_version();
   ASSERT_FALSE(v.empty());
-  Cli c = swim("--version", d);
+  Cli c = swim_cli("--version", d);
   EXPECT_EQ(c.code, 0) << c.err;
   EXPECT_EQ(c.out, "swim " + v + "\n");
   const fs::path out = d / "run";
-  c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + out.string() +
+  c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + out.string() +
                "\" --set time.duration='\"5 ms\"'",
            d);
   ASSERT_EQ(c.code, 0) << c.err;
@@ -227,16 +227,16 @@ TEST(CommandLine, VersionIsTheProjectVersionInTheCliTheSummaryAndTheCitation) {
 
 TEST(CommandLine, AnUnknownSubcommandIsNamedAndTheHelpNamesSwim) {
   const fs::path d = swim::test::scratch_dir("swim_first_hour_cli");
-  Cli c = swim("runn demo.json", d);
+  Cli c = swim_cli("runn demo.json", d);
   EXPECT_EQ(c.code, 2);
   EXPECT_NE(c.err.find("unknown subcommand runn"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("run, "), std::string::npos) << c.err;  // the subcommands that exist
-  c = swim("--help", d);
+  c = swim_cli("--help", d);
   EXPECT_EQ(c.code, 0);
   EXPECT_NE(c.out.find("swim [OPTIONS] SUBCOMMAND"), std::string::npos) << c.out;
   EXPECT_EQ(c.out.find(SWIM_BINARY_DIR), std::string::npos) << c.out;
   EXPECT_EQ(c.out.find("bin/swim"), std::string::npos) << c.out;
-  c = swim("run --help", d);
+  c = swim_cli("run --help", d);
   EXPECT_NE(c.out.find("swim run"), std::string::npos) << c.out;
   fs::remove_all(d);
 }
@@ -246,17 +246,17 @@ TEST(CommandLine, AnUnknownSubcommandIsNamedAndTheHelpNamesSwim) {
 TEST(CommandLine, RunAndCalibrateAcceptThreads) {
   const fs::path d = swim::test::scratch_dir("swim_first_hour_threads");
   const fs::path out = d / "run3d";
-  Cli c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json\" --tier 3d --quiet --threads 2 --out \"" +
+  Cli c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d.json\" --tier 3d --quiet --threads 2 --out \"" +
                    out.string() + "\" --set time.duration='\"3 ms\"'",
                d);
   EXPECT_EQ(c.code, 0) << c.err;
   EXPECT_EQ(summary_of(out)["scene"]["full3d"]["threads"], 2);
-  c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 2 --out \"" + (d / "run1d").string() + "\"", d);
+  c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 2 --out \"" + (d / "run1d").string() + "\"", d);
   EXPECT_EQ(c.code, 2);
   EXPECT_NE(c.err.find("--threads"), std::string::npos) << c.err;
   EXPECT_FALSE(fs::exists(d / "run1d"));
   // a calibration takes minutes: its --threads is parsed, then the missing scene is the refusal
-  c = swim("calibrate \"" + (d / "missing.json").string() + "\" --threads 2", d);
+  c = swim_cli("calibrate \"" + (d / "missing.json").string() + "\" --threads 2", d);
   EXPECT_EQ(c.code, 2);
   EXPECT_EQ(c.err.find("--threads"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("missing.json"), std::string::npos) << c.err;
@@ -271,14 +271,14 @@ TEST(RunPlot, TheSummaryListsRunPngAndARerunWithoutPlotSaysItWentAway) {
   const fs::path out = d / "run";
   const std::string args = "run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + out.string() +
                            "\" --set time.duration='\"20 ms\"'";
-  Cli c = swim(args + " --plot", d);
+  Cli c = swim_cli(args + " --plot", d);
   ASSERT_EQ(c.code, 0) << c.err;
   ASSERT_TRUE(fs::exists(out / "run.png"));
   bool listed = false;
   for (const auto& f : summary_of(out)["files"]) listed = listed || f["name"] == "run.png";
   EXPECT_TRUE(listed);
   EXPECT_EQ(swim::output::verify_folder(out.string(), {"run.png"}), "");
-  c = swim(args, d);
+  c = swim_cli(args, d);
   ASSERT_EQ(c.code, 0) << c.err;
   EXPECT_FALSE(fs::exists(out / "run.png"));
   EXPECT_NE(c.err.find("run.png"), std::string::npos) << c.err;
@@ -291,11 +291,11 @@ TEST(RunPlot, TheSummaryListsRunPngAndARerunWithoutPlotSaysItWentAway) {
 // cycles, prints its transit instead of "0 cycle(s)".
 TEST(Printouts, VolumesInOneUnitAndAPrescribedWavePrintsItsTransit) {
   const fs::path d = swim::test::scratch_dir("swim_first_hour_print");
-  const Cli f = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + (d / "f").string() + "\"", d);
+  const Cli f = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + (d / "f").string() + "\"", d);
   ASSERT_EQ(f.code, 0) << f.err;
   EXPECT_NE(f.out.find("\u00b5m\u00b3"), std::string::npos) << f.out;
   EXPECT_EQ(f.out.find("nm\u00b3"), std::string::npos) << f.out;
-  const Cli p = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + (d / "p").string() +
+  const Cli p = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + (d / "p").string() +
                          "\" --set wave.kind=step --set protocol=null",
                      d);
   ASSERT_EQ(p.code, 0) << p.err;
@@ -312,7 +312,7 @@ TEST(VtkFrames, ARunsFramesReadBackWithTheirTimeSegmentsAndTheCylindersMask) {
   using namespace swim::test::vtk_read;
   const fs::path d = swim::test::scratch_dir("swim_first_hour_vtk");
   const fs::path out = d / "run";
-  const Cli c = swim("run \"" SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json\" --tier 3d --quiet --threads 2 --out \"" +
+  const Cli c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json\" --tier 3d --quiet --threads 2 --out \"" +
                          out.string() +
                          "\" --set time.duration='\"4 ms\"' --set full3d.output.vtk_interval='\"2 ms\"'"
                          " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"2 ms\"'",
@@ -368,7 +368,7 @@ TEST(ShippedSweeps, EachScreensOnThe1dTier) {
     if (e.path().extension() != ".json") continue;
     SCOPED_TRACE(e.path().filename().string());
     const fs::path out = d / e.path().stem();
-    const Cli c = swim("screen \"" + e.path().string() + "\" --quiet --jobs 2 --out \"" + out.string() + "\"", d);
+    const Cli c = swim_cli("screen \"" + e.path().string() + "\" --quiet --jobs 2 --out \"" + out.string() + "\"", d);
     EXPECT_EQ(c.code, 0) << c.err;
     const json s = json::parse(slurp(out / "screen.json"));
     EXPECT_EQ(s["status"], "ok");
