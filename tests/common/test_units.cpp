@@ -56,7 +56,7 @@ TEST(SiFormat, PrefixesMantissasAndVolumes) {
   EXPECT_EQ(swim::si(-7.1823e-22, "m^3"), "-0.000718 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(3.82e-21, "m^3"), "0.00382 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(9.62e-22, "m^3"), "0.000962 \u00b5m\u00b3");
-  EXPECT_EQ(swim::si(3.4e-25, "m^3"), "0.00000034 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(3.4e-25, "m^3"), "3.4e-07 \u00b5m\u00b3");  // below 10⁻⁶ µm³
   EXPECT_EQ(swim::si(2.0e-18, "m^3"), "2 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(1.234567e-24, "m^3", 5), "0.0000012346 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(1.0e-27, "m^3"), "1e-09 \u00b5m\u00b3");

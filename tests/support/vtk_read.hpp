@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 #include <zlib.h>
 
+#include <cctype>
 #include <cstdint>
 #include <cstring>
 #include <regex>
@@ -44,11 +45,28 @@ struct Array {
   std::string type, name, body;
 };
 
+// Every DataArray of a file (a plain scan: std::regex recurses per character and would
+// overflow the stack on the long base64 bodies of real frames).
 inline std::vector<Array> arrays(const std::string& xml) {
+  const auto attribute = [](const std::string& tag, const std::string& name) {
+    const std::string key = " " + name + "=\"";
+    const std::size_t at = tag.find(key);
+    if (at == std::string::npos) return std::string();
+    const std::size_t from = at + key.size();
+    return tag.substr(from, tag.find('"', from) - from);
+  };
   std::vector<Array> out;
-  const std::regex da(R"re(<DataArray type="([A-Za-z0-9]+)"(?: Name="([^"]*)")?[^>]*format="binary">\s*([A-Za-z0-9+/=]*)\s*</DataArray>)re");
-  for (std::sregex_iterator it(xml.begin(), xml.end(), da), end; it != end; ++it)
-    out.push_back({(*it)[1], (*it)[2], (*it)[3]});
+  for (std::size_t at = xml.find("<DataArray"); at != std::string::npos; at = xml.find("<DataArray", at + 1)) {
+    const std::size_t close = xml.find('>', at);
+    const std::size_t end = xml.find("</DataArray>", close);
+    if (close == std::string::npos || end == std::string::npos) break;
+    const std::string tag = xml.substr(at, close - at);
+    if (attribute(tag, "format") != "binary") continue;
+    std::string body;
+    for (std::size_t k = close + 1; k < end; ++k)
+      if (!std::isspace(static_cast<unsigned char>(xml[k]))) body += xml[k];
+    out.push_back({attribute(tag, "type"), attribute(tag, "Name"), body});
+  }
   return out;
 }
 
