@@ -85,8 +85,9 @@ TEST(ShippedScenesRun, EachSucceedsOnThe1dTierAsShipped) {
     ASSERT_TRUE(s.is_object());
     EXPECT_EQ(s["status"], "ok");
     const json& sc = s["scene"];
-    if (sc["wave"]["kind"] == "force_driven" && sc["time"]["duration"] == "auto")
+    if (sc["wave"]["kind"] == "force_driven" && sc["time"]["duration"] == "auto") {
       EXPECT_EQ(s["cycles_completed"].get<int>(), sc["protocol"]["cycles"].get<int>());
+    }
     EXPECT_EQ(swim::output::verify_folder(out.string()), "");
   }
   fs::remove_all(d);
@@ -108,7 +109,7 @@ TEST(ShippedScenesRun, EachSucceedsOnThe3dTier) {
     ASSERT_TRUE(s.is_object());
     EXPECT_EQ(s["status"], "ok");
     EXPECT_GE(s["steps"].get<long>(), 4);
-    if (scene.stem() == "tiny_3d_cycle") EXPECT_EQ(s["cycles_completed"].get<int>(), 1);
+    if (scene.stem() == "tiny_3d_cycle") { EXPECT_EQ(s["cycles_completed"].get<int>(), 1); }
     EXPECT_EQ(swim::output::verify_folder(out.string()), "");
   }
   fs::remove_all(d);

@@ -179,21 +179,21 @@ TEST(ShippedScenes3d, DescriptionsStateTrueFigures) {
       EXPECT_EQ(std::stoi(m[3]), p.nz);
     }
     double v = 0;
-    if (number(d, R"(h = ([\d.]+) nm)", v)) EXPECT_NEAR(v, p.h * 1e9, 0.05);
-    if (number(d, R"((\d+) (membrane )?nodes)", v)) EXPECT_EQ(static_cast<int>(v), make_mesh(p).nodes());
+    if (number(d, R"(h = ([\d.]+) nm)", v)) { EXPECT_NEAR(v, p.h * 1e9, 0.05); }
+    if (number(d, R"((\d+) (membrane )?nodes)", v)) { EXPECT_EQ(static_cast<int>(v), make_mesh(p).nodes()); }
     EXPECT_EQ(d.find('~' + std::string("1000 nodes")), std::string::npos);
-    if (number(d, R"(R0 = ([\d.]+) um)", v)) EXPECT_NEAR(v * 1e-6, p.R0, 0.005 * p.R0);
-    if (number(d, R"(\bL = ([\d.]+) um)", v)) EXPECT_NEAR(v * 1e-6, p.L, 0.005 * p.L);
-    if (number(d, R"(R_f = ([\d.]+) R0)", v)) EXPECT_NEAR(v, resolved["wave"]["contracted_ratio"].get<double>(), 1e-9);
+    if (number(d, R"(R0 = ([\d.]+) um)", v)) { EXPECT_NEAR(v * 1e-6, p.R0, 0.005 * p.R0); }
+    if (number(d, R"(\bL = ([\d.]+) um)", v)) { EXPECT_NEAR(v * 1e-6, p.L, 0.005 * p.L); }
+    if (number(d, R"(R_f = ([\d.]+) R0)", v)) { EXPECT_NEAR(v, resolved["wave"]["contracted_ratio"].get<double>(), 1e-9); }
     const int cycles = resolved["protocol"]["cycles"].get<int>();
-    if (d.find("one cycle") != std::string::npos || d.find("one complete") != std::string::npos) EXPECT_EQ(cycles, 1);
-    if (d.find("ten force-driven cycles") != std::string::npos) EXPECT_EQ(cycles, 10);
+    if (d.find("one cycle") != std::string::npos || d.find("one complete") != std::string::npos) { EXPECT_EQ(cycles, 1); }
+    if (d.find("ten force-driven cycles") != std::string::npos) { EXPECT_EQ(cycles, 10); }
     if (number(d, R"((\d+) steps)", v)) {
       ASSERT_GT(p.duration, 0.0) << "a step count needs a fixed duration";
       EXPECT_NEAR(v, p.duration / p.dt, 0.5);
     }
-    if (number(d, R"(first ([\d.]+) ms)", v)) EXPECT_NEAR(v * 1e-3, p.duration, 1e-12);
-    if (number(d, R"(eps = ([\d.]+))", v)) EXPECT_NEAR(v, p.R0 / p.L, 0.005 * v);
+    if (number(d, R"(first ([\d.]+) ms)", v)) { EXPECT_NEAR(v * 1e-3, p.duration, 1e-12); }
+    if (number(d, R"(eps = ([\d.]+))", v)) { EXPECT_NEAR(v, p.R0 / p.L, 0.005 * v); }
     if (number(d, R"(([\d.]+)x the static load)", v)) {
       ASSERT_TRUE(sc["protocol"].contains("load_factor"));
       EXPECT_NEAR(v, sc["protocol"]["load_factor"].get<double>(), 1e-9);
