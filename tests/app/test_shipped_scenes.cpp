@@ -52,7 +52,8 @@ TEST(ShippedScenes, EachRunsToCompletionOnTheCoarse1DTier) {
     EXPECT_TRUE(std::isfinite(m.displacement_m));
     EXPECT_GT(m.displacement_m, 0.0) << "the swimmer must move against the wave (+z)";
     EXPECT_GT(m.pumped_volume_m3, 0.0) << "fluid is pumped backwards (-z)";
-    if (p.wave == swim::reduced1d::WaveKind::ForceDriven) {
+    // a scene with a fixed duration (tiny_3d: its first 30 ms) runs that span, not its cycles
+    if (p.wave == swim::reduced1d::WaveKind::ForceDriven && resolved["time"]["duration"] == "auto") {
       EXPECT_EQ(m.cycles_completed, p.protocol.cycles);
     }
   }
