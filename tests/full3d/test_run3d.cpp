@@ -293,7 +293,7 @@ TEST(Run3d, DrySwimmerBreathingPeriodAndEnergy) {
 TEST(Run3d, DryProtocolReachesTargetOnEverySegment) {
   const Scene s = tiny({"full3d.dry=true", "full3d.dt=\"2 us\"", "protocol.total_force=null", "protocol.load_factor=3",
                         "wave.contracted_ratio=0.82", "protocol.segments=3", "protocol.first_segment_ratio=1",
-                        "time.output_interval=\"2 us\"", "full3d.checkpoint_interval=\"1 s\""});
+                        "time.output_interval=\"2 us\"", "full3d.checkpoint_interval=\"1 s\"", "time.duration=\"auto\""});
   const std::string dir = fresh_dir("dry_protocol");
   RunControl ctl;
   ctl.progress = 0;
@@ -367,7 +367,7 @@ TEST(Run3d, FluidCoupledCycleCompletesAndSwimsForward) {
   const Scene s = tiny({"wave.contracted_ratio=0.82", "protocol.segments=3", "protocol.first_segment_ratio=1",
                         "protocol.total_force=null", "protocol.load_factor=2", "full3d.dt=\"1 ms\"",
                         "time.output_interval=\"5 ms\"", "full3d.time_limit=\"1.5 s\"",
-                        "full3d.checkpoint_interval=\"1 s\""});
+                        "full3d.checkpoint_interval=\"1 s\"", "time.duration=\"auto\""});
   EXPECT_EQ(s.p.recovery_end, "dead_band");
   const std::string dir = fresh_dir("fluid_cycle");
   RunControl ctl;
