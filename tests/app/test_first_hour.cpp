@@ -320,7 +320,8 @@ TEST(VtkFrames, ARunsFramesReadBackWithTheirTimeSegmentsAndTheCylindersMask) {
                          " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"2 ms\"'",
                      d);
   ASSERT_EQ(c.code, 0) << c.err;
-  const int segments = summary_of(out)["scene"]["protocol"]["segments"].get<int>();
+  const json summary = summary_of(out);
+  const int segments = summary["scene"]["protocol"]["segments"].get<int>();
   for (const std::string kind : {"membrane", "fluid"}) {
     SCOPED_TRACE(kind);
     const std::string pvd = slurp(out / (kind + ".pvd"));
@@ -348,13 +349,18 @@ TEST(VtkFrames, ARunsFramesReadBackWithTheirTimeSegmentsAndTheCylindersMask) {
         const auto mask = decode<std::int32_t>(by["inside_container"].body);
         const auto p = decode<float>(by["pressure_Pa"].body);
         ASSERT_EQ(mask.size(), p.size());
-        // the cylinder fills pi/4 of its square duct's cross-section
+        // the cylinder (Rc = 0.25 um, the scene's) fills pi Rc^2 of the duct's cross-section
+        // (grid cells ny x nz of size h, from summary.json), up to its staircase
         double inside = 0;
         for (auto m : mask) {
           EXPECT_TRUE(m == 0 || m == 1);
           inside += m;
         }
-        EXPECT_NEAR(inside / double(mask.size()), M_PI / 4, 0.03);
+        ASSERT_EQ(summary["scene"]["container"]["radius"], "0.25 um");
+        const double rc = 0.25e-6, h = summary["derived"]["cell_size_m"].get<double>();
+        const auto grid = summary["derived"]["grid"];
+        const double fraction = M_PI * rc * rc / (grid[1].get<double>() * grid[2].get<double>() * h * h);
+        EXPECT_NEAR(inside / double(mask.size()), fraction, 0.02);
       }
     }
     EXPECT_GE(frames, 2);
