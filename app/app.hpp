@@ -20,6 +20,7 @@ struct RunOptions {
   bool plot = false;
   std::string resume;  ///< 3D: continue the run whose output folder (with checkpoint.bin) is given
   bool overwrite = false;  ///< replace another run's results in the output folder
+  int threads = 0;  ///< 3D: threads of the run (full3d.threads); 0: the scene's
 };
 
 int run(const RunOptions& o);
@@ -35,8 +36,9 @@ int bench(const std::string& out, bool quick, bool paper_cycle, const std::strin
 int scenes();
 /// swim calibrate: C1 of the 1D tier from 3D uniform loads (validation/calibration.hpp).
 /// wet: also confirm one load with a fluid-coupled 3D run (minutes at the default grid).
+/// threads > 0: the 3D runs' threads (full3d.threads); 0: the scene's.
 int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out, bool wet,
-              bool overwrite);
+              bool overwrite, int threads = 0);
 
 /// swim validate: the 1D-vs-3D validation suite and its report (validation/suite.hpp).
 /// only: case filter (scene file names); empty: every case.

@@ -18,9 +18,10 @@
 namespace swim::app {
 
 int calibrate(const std::string& scene_path, const std::vector<std::string>& sets, const std::string& out_opt,
-              bool wet, bool overwrite) {
+              bool wet, bool overwrite, int threads) {
   scene::json sc = scene::load_file(scene_path);
   for (const auto& s : sets) scene::apply_override(sc, s);
+  if (threads > 0) scene::apply_override(sc, "full3d.threads=" + std::to_string(threads));
   scene::json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
   check_other_tier(sc, "3d");  // the whole scene, as a 3D run checks it

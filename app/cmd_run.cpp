@@ -3,11 +3,13 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
 
 #include "app/app.hpp"
 #include "app/scene_checks.hpp"
 #include "axi/run_axi.hpp"
 #include "axi/scene_axi.hpp"
+#include "common/atomic_file.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/run_folder.hpp"
@@ -32,25 +34,55 @@ std::string data_dir() {
 
 namespace {
 
+// A prescribed wave has no protocol cycles: its per-cycle figures are those of its one transit.
+bool is_transit(const scene::json& s) {
+  return s["cycles_completed"].get<int>() == 0 && s["mean_velocity_per_cycle_m_per_s"].is_number();
+}
+std::string cycles_text(const scene::json& s) {
+  if (is_transit(s)) return "one wave transit (prescribed wave, no protocol cycles)";
+  const int n = s["cycles_completed"].get<int>();
+  return std::to_string(n) + (n == 1 ? " cycle" : " cycles");
+}
+
+// run.png belongs to the run: listed in summary.json when drawn (the summary is committed again,
+// still last); a rerun without --plot says that the earlier run's plot went with its results.
+void plot_and_list(const std::string& out, bool plot_asked, bool had_plot) {
+  const fs::path png = fs::path(out) / "run.png";
+  if (!plot_asked) {
+    if (had_plot && !fs::exists(png))
+      std::fprintf(stderr, "swim: note: the earlier run.png in %s went with the earlier results; add --plot to draw this run\n",
+                   out.c_str());
+    return;
+  }
+  if (!plot("plot_run.py", {out}) || !output::adopt(png.string())) return;
+  const std::string path = (fs::path(out) / "summary.json").string();
+  std::ifstream in(path);
+  scene::json j = scene::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return;
+  for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
+  output::write_json(path, j);
+}
+
 // One human-readable line per 1D run, SI prefixes; per-cycle figures only when a cycle completed.
 void print_summary_1d(const std::string& name, const scene::json& s, double wall, const std::string& out) {
   std::string per_cycle;
+  const bool transit = is_transit(s);
   if (s["mean_velocity_per_cycle_m_per_s"].is_number()) {
     char b[160];
-    std::snprintf(b, sizeof b, "%s per cycle, %s (%.3g body lengths/s)",
-                  si(s["displacement_per_cycle_m"].get<double>(), "m").c_str(),
+    std::snprintf(b, sizeof b, "%s per %s, %s (%.3g body lengths/s)",
+                  si(s["displacement_per_cycle_m"].get<double>(), "m").c_str(), transit ? "wave transit" : "cycle",
                   si(s["mean_velocity_per_cycle_m_per_s"].get<double>(), "m/s").c_str(),
                   s["body_lengths_per_cycle_per_s"].get<double>());
     per_cycle = b;
   } else {
     per_cycle = "no per-cycle figures (" + s["per_cycle_absent_because"].get<std::string>() + ")";
   }
-  std::printf("%s (1d, %s): displacement %s; %s; %d cycle(s); pumped %s; thermal rms %s per cycle "
+  std::printf("%s (1d, %s): displacement %s; %s; %s; pumped %s; thermal rms %s per %s "
               "(directed/diffusive %.3g); wall time %s\n  -> %s/summary.json\n",
               name.c_str(), s["model"].get<std::string>().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(),
-              per_cycle.c_str(), s["cycles_completed"].get<int>(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(),
+              per_cycle.c_str(), cycles_text(s).c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(),
               si(s["brownian"]["thermal_rms_displacement_per_cycle_m"].get<double>(), "m").c_str(),
-              s["brownian"]["directed_to_diffusive_ratio"].get<double>(), si(wall, "s").c_str(), out.c_str());
+              transit ? "transit" : "cycle", s["brownian"]["directed_to_diffusive_ratio"].get<double>(), si(wall, "s").c_str(), out.c_str());
   for (const auto& w : s["implausible_because"])
     std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
 }
@@ -86,6 +118,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
     const std::string tier = output::RunFolder::tier_of(out);
     if (tier.empty() || tier == "3d") full3d::check_resumable(p, resolved, out);
   }
+  const bool had_plot = fs::exists(fs::path(out) / "run.png");
   output::RunFolder folder(out, {"3d", resolved, o.overwrite, !o.resume.empty(), o.resume.empty() ? "--out" : "--resume"});
   full3d::RunControl ctl;
   ctl.progress = o.progress;
@@ -121,7 +154,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
                  "grid, so the displacement depends on full3d.grid.cells_across; a wall stiff enough in bending "
                  "(full3d.membrane.bending_rigidity, docs/full3d.md \"Wall wrinkling\") keeps it round\n",
                  si(s["max_wrinkle_m"].get<double>(), "m").c_str(), s["max_wrinkle_over_h"].get<double>());
-  if (o.plot) plot("plot_run.py", {out});
+  plot_and_list(out, o.plot, had_plot);
   if (r.failed) {
     std::fprintf(stderr, "swim: %s\n  partial results and the last checkpoint kept in %s\n", r.message.c_str(),
                  out.c_str());
@@ -137,6 +170,7 @@ int run_axi(const RunOptions& o, const scene::json& sc) {
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
   check_other_tier(sc, "axi");
   const std::string out = o.out.empty() ? "out/" + p.name() + "-axi" : o.out;
+  const bool had_plot = fs::exists(fs::path(out) / "run.png");
   output::RunFolder folder(out, {"axi", resolved, o.overwrite, false, "--out"});
   axi::RunControlAxi ctl;
   ctl.progress = o.progress;
@@ -150,18 +184,18 @@ int run_axi(const RunOptions& o, const scene::json& sc) {
   const auto& s = r.summary;
   std::string per_cycle = "no cycle completed";
   if (s["mean_velocity_per_cycle_m_per_s"].is_number())
-    per_cycle = si(s["displacement_per_cycle_m"].get<double>(), "m") + " per cycle in " +
+    per_cycle = si(s["displacement_per_cycle_m"].get<double>(), "m") + (is_transit(s) ? " per wave transit in " : " per cycle in ") +
                 si(s["cycle_time_s"].get<double>(), "s") + ", " +
                 si(s["mean_velocity_per_cycle_m_per_s"].get<double>(), "m/s");
-  std::printf("%s (axi): displacement %s; %s; %d cycle(s); pumped %s; %ld steps on %d x %d cells (h = %s); wall time %s\n"
+  std::printf("%s (axi): displacement %s; %s; %s; pumped %s; %ld steps on %d x %d cells (h = %s); wall time %s\n"
               "  -> %s/summary.json\n",
               p.name().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(), per_cycle.c_str(),
-              s["cycles_completed"].get<int>(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps, p.nr,
+              cycles_text(s).c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps, p.nr,
               p.nx, si(p.h, "m").c_str(), si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
   std::fflush(stdout);
   for (const auto& w : s["implausible_because"])
     std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
-  if (o.plot) plot("plot_run.py", {out});
+  plot_and_list(out, o.plot, had_plot);
   if (r.failed) {
     std::fprintf(stderr, "swim: %s\n  partial results kept in %s\n", r.message.c_str(), out.c_str());
     return 3;
@@ -175,6 +209,12 @@ int run(const RunOptions& o) {
   // 1. Everything is read and validated before anything is written.
   scene::json sc = scene::load_file(o.scene);
   for (const auto& s : o.sets) scene::apply_override(sc, s);
+  if (o.threads > 0) {
+    if (o.tier != "3d")
+      throw InputError("--threads", std::to_string(o.threads),
+                       "only the 3D tier runs on several threads (full3d.threads); add --tier 3d or leave --threads out");
+    scene::apply_override(sc, "full3d.threads=" + std::to_string(o.threads));
+  }
   if (o.tier == "3d") return run3d(o, sc);
   if (o.tier == "axi") return run_axi(o, sc);
   if (!o.resume.empty()) throw InputError("--resume", o.resume, "only the 3D tier writes checkpoints; add --tier 3d");
@@ -187,6 +227,7 @@ int run(const RunOptions& o) {
 
   // 2. Take the folder, run: the series and radius samples stream to disk as they are
   // produced (nothing is buffered in memory).
+  const bool had_plot = fs::exists(fs::path(out) / "run.png");
   output::RunFolder folder(out, {"1d", resolved, o.overwrite, false, "--out"});
   const auto t0 = std::chrono::steady_clock::now();
   Progress progress("1d " + p.name, reduced1d::end_time(p), o.progress);
@@ -209,7 +250,7 @@ int run(const RunOptions& o) {
     fail_run(folder, e);
   }
   const double wall = summary["wall_time_s"].get<double>();
-  if (o.plot) plot("plot_run.py", {out});
+  plot_and_list(out, o.plot, had_plot);
   print_summary_1d(p.name, summary, wall, out);
   if (r.failure) {
     std::fprintf(stderr, "swim: %s\n  partial results kept in %s\n", r.failure->what(), out.c_str());

@@ -1,3 +1,5 @@
+#include <cctype>
+#include <cstdlib>
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
@@ -37,6 +39,33 @@ std::string csv_field(std::string s) {
   for (char& c : s)
     if (c == ',' || c == '\n') c = ';';
   return s;
+}
+
+// An SI base unit as UDUNITS spells it ("m", "m.s-1", "m-1.kg.s-1") in the column style of
+// series.csv: "m", "m_per_s", "kg_per_m_s".
+std::string unit_suffix(const std::string& unit) {
+  std::vector<std::string> up, down;
+  std::string token;
+  const auto flush = [&] {
+    if (token.empty()) return;
+    std::size_t k = 0;
+    while (k < token.size() && std::isalpha(static_cast<unsigned char>(token[k]))) ++k;
+    const std::string name = token.substr(0, k);
+    const int e = k < token.size() ? std::atoi(token.c_str() + k) : 1;
+    const std::string power = std::abs(e) > 1 ? std::to_string(std::abs(e)) : "";
+    (e < 0 ? down : up).push_back(name + power);
+    token.clear();
+  };
+  for (char c : unit) {
+    if (c == '.' || c == ' ' || c == '*') flush();
+    else token += c;
+  }
+  flush();
+  std::string out;
+  for (const auto& u : up) out += (out.empty() ? "" : "_") + u;
+  if (!down.empty()) out += out.empty() ? "per" : "_per";
+  for (const auto& d : down) out += "_" + d;
+  return out;
 }
 
 // Human-facing value of a metric: SI prefixes for lengths, velocities, times, volumes.
@@ -230,13 +259,19 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   bar.done();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 
-  // designs.csv: axis values as given and in SI, then every metric; failed designs keep
-  // their status and leave the metric cells empty (never NaN).
+  // designs.csv: axis values as given and, for a quantity, in SI with the unit in the column
+  // name as series.csv has it (swimmer.length, swimmer.length_m); a number or a choice
+  // ("step") has its one column. Then every metric; failed designs keep their status and
+  // leave the metric cells empty (never NaN).
   const auto& names = reduced1d::metric_names();
+  const auto has_si_column = [](const sweep::Axis& a) { return !a.si_unit.empty() && a.si_unit != "index"; };
   output::AtomicFile csv_file(out + "/designs.csv");  // published complete, or not at all
   std::ostream& csv = csv_file.stream();
   csv << "design";
-  for (const auto& a : sw.axes) csv << "," << a.key << "," << a.key << "_si" << (a.si_unit.empty() ? "" : "[" + a.si_unit + "]");
+  for (const auto& a : sw.axes) {
+    csv << "," << a.key;
+    if (has_si_column(a)) csv << "," << a.key << "_" << unit_suffix(a.si_unit);
+  }
   csv << ",status";
   for (const auto& m : names) csv << "," << m;
   csv << ",cycles_completed,wall_time_s\n";
@@ -246,7 +281,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     csv << k;
     for (size_t a = 0; a < sw.axes.size(); ++a) {
       const auto& v = sw.axes[a].values[idx[a]];
-      csv << "," << csv_field(v.is_string() ? v.get<std::string>() : v.dump()) << "," << sw.axes[a].si[idx[a]];
+      csv << "," << csv_field(v.is_string() ? v.get<std::string>() : v.dump());
+      if (has_si_column(sw.axes[a])) csv << "," << sw.axes[a].si[idx[a]];
     }
     const auto& r = results[k];
     csv << "," << (r.ok ? "ok" : "failed: " + csv_field(r.message));

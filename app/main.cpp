@@ -1,12 +1,14 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
-//   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--resume DIR] [--overwrite]
+//   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--plot] [--resume DIR] [--overwrite] [--threads N]
 //   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
 //   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|axi|all]
 //   swim scenes
 //   swim demo [--out DIR]
-//   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--overwrite]
+//   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--overwrite] [--threads N]
+//   swim validate [SUITE.json] [--out DIR] [--quick] [--threads N] [--case NAME ...]
+//   swim --version
 //
 // Exit codes: 0 success, 2 bad input (nothing written), 3 numerical failure or a result
 // file that could not be written (partial results kept, marked failed), 1 anything
@@ -14,10 +16,12 @@
 #include <CLI/CLI.hpp>
 #include <cstdio>
 #include <exception>
+#include <functional>
 
 #include "app/app.hpp"
 #include "app/ranks.hpp"
 #include "common/errors.hpp"
+#include "common/version.hpp"
 
 int main(int argc, char** argv) {
   using namespace swim;
@@ -28,9 +32,12 @@ int main(int argc, char** argv) {
     return 2;
   }
   if (app::ranks::rank() > 0) return app::ranks::serve(app::run_task);
-  CLI::App cli{"swim: design and check peristaltic elastic micro-swimmers (1D lubrication and 3D immersed-boundary tiers)"};
+  // named "swim" in the help, whatever path started it (a symlink, build/bin/swim)
+  CLI::App cli{"swim: design and check peristaltic elastic micro-swimmers (1D lubrication and 3D immersed-boundary tiers)",
+               "swim"};
   cli.require_subcommand(1);
   cli.set_help_all_flag("--help-all", "Help for every subcommand");
+  cli.set_version_flag("--version", std::string("swim ") + version(), "Print the version and exit");
 
   app::RunOptions ro;
   bool progress_on = false, progress_off = false;
@@ -48,6 +55,8 @@ int main(int argc, char** argv) {
   run->add_option("--resume", ro.resume, "3D: continue an interrupted run from the checkpoint in this output folder");
   run->add_flag("--overwrite", ro.overwrite,
                 "Replace the results of another run in the output folder (its files are removed first)");
+  run->add_option("--threads", ro.threads, "3D: threads of the run (sets full3d.threads; default: the scene's, 1)")
+      ->check(CLI::Range(1, 256));
   add_progress(run);
 
   std::string out;
@@ -104,6 +113,9 @@ int main(int argc, char** argv) {
   bool cal_overwrite = false;
   cal->add_flag("--overwrite", cal_overwrite,
                 "Replace another run's results in the output folder (its files are removed first)");
+  int cal_threads = 0;
+  cal->add_option("--threads", cal_threads, "Threads of the 3D runs (sets full3d.threads; default: the scene's, 1)")
+      ->check(CLI::Range(1, 256));
   cal->add_flag("--wet", cal_wet, "Also confirm the largest fitted load with a fluid-coupled 3D run, the wall held axisymmetric as in the static path (up to 4 000 steps: minutes)");
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
   std::string val_suite, val_out;
@@ -117,9 +129,25 @@ int main(int argc, char** argv) {
   val->add_option("--case", val_cases, "Run only this case (its scene file name); repeatable");
   add_progress(val);
 
+  // a mistyped subcommand is named as such (CLI11 alone would say "arguments were not expected")
+  if (argc > 1 && argv[1][0] != '-') {
+    std::string names;
+    bool known = false;
+    for (const CLI::App* c : cli.get_subcommands(std::function<bool(CLI::App*)>())) {
+      known = known || c->get_name() == argv[1];
+      names += (names.empty() ? "" : ", ") + c->get_name();
+    }
+    if (!known) {
+      std::fprintf(stderr, "swim: invalid input: unknown subcommand %s; one of %s (run 'swim --help' for usage)\n",
+                   argv[1], names.c_str());
+      return 2;
+    }
+  }
   try {
     cli.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {
+    return cli.exit(e);
+  } catch (const CLI::CallForVersion& e) {
     return cli.exit(e);
   } catch (const CLI::CallForAllHelp& e) {
     return cli.exit(e);
@@ -151,7 +179,7 @@ int main(int argc, char** argv) {
     if (*opt) return app::optimize(opt_spec, out, progress, opt_overwrite, !opt_no_confirm, threads3d);
     if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
     if (*sc) return app::scenes();
-    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite);
+    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite, cal_threads);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);
   } catch (const app::Interrupted& e) {
     std::fprintf(stderr, "swim: %s; the child process was stopped and nothing runs on\n", e.what());

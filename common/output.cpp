@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "common/errors.hpp"
+#include "common/version.hpp"
 
 namespace swim::output {
 
@@ -48,6 +49,7 @@ void write_json(const std::string& path, const json& value) {
     for (const auto& r : committed_files(dir))
       if (r.name != "summary.json" && r.name[0] != '.') files.push_back({{"name", r.name}, {"bytes", r.bytes}, {"fnv1a64", r.fnv1a64}});
     with_files["files"] = files;
+    with_files["swim_version"] = version();
     out = &with_files;
   }
   AtomicFile f(path);

@@ -8,9 +8,9 @@ namespace swim {
 
 /// `value` in the SI `unit` ("m", "m/s", "N", "s", "m^3"), rescaled by the SI prefix
 /// (f, p, n, µ, m, -, k, M, G) that puts the mantissa in [1, 1000), with `digits`
-/// significant digits. Volumes ("m^3") keep the cubic unit of the prefixed length, written
-/// "µm³", with a mantissa in [10⁻³, 10⁶) spelled out in groups of three ("718 000 nm³").
-/// Zero prints as "0 <unit>"; non-finite values print as "n/a".
+/// significant digits. Volumes ("m^3") always print in µm³, the swimmers' scale, in plain
+/// decimals down to 10⁻⁶ µm³ ("0.000718 µm³", "2 µm³"), so that every printout of a volume
+/// has one unit. Zero prints as "0 <unit>"; non-finite values print as "n/a".
 std::string si(double value, const std::string& unit, int digits = 3);
 
 }  // namespace swim

@@ -4,8 +4,11 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <algorithm>
 #include <fstream>
 #include <stdexcept>
+
+#include <zlib.h>
 
 #include "common/atomic_file.hpp"
 #include "common/errors.hpp"
@@ -40,11 +43,25 @@ std::string base64(const unsigned char* p, std::size_t n) {
 
 std::string encode_block(const void* data, std::size_t bytes) {
   if (bytes > 0xFFFFFFFFull) throw std::length_error("VTK array larger than 4 GiB");
-  std::vector<unsigned char> buf(4 + bytes);
-  const std::uint32_t header = static_cast<std::uint32_t>(bytes);  // little-endian host (x86-64, aarch64)
-  std::memcpy(buf.data(), &header, 4);
-  if (bytes) std::memcpy(buf.data() + 4, data, bytes);
-  return base64(buf.data(), buf.size());
+  const auto* in = static_cast<const unsigned char*>(data);
+  const std::size_t blocks = (bytes + kBlockBytes - 1) / kBlockBytes;
+  // header (little-endian host: x86-64, aarch64): blocks, block size, partial last block, sizes
+  std::vector<std::uint32_t> header = {static_cast<std::uint32_t>(blocks), static_cast<std::uint32_t>(kBlockBytes),
+                                       static_cast<std::uint32_t>(bytes % kBlockBytes)};
+  std::vector<unsigned char> packed;
+  packed.reserve(compressBound(static_cast<uLong>(std::min(bytes, kBlockBytes))) * std::max<std::size_t>(blocks, 1));
+  for (std::size_t b = 0; b < blocks; ++b) {
+    const std::size_t n = std::min(kBlockBytes, bytes - b * kBlockBytes);
+    uLongf size = compressBound(static_cast<uLong>(n));
+    const std::size_t at = packed.size();
+    packed.resize(at + size);
+    if (compress2(packed.data() + at, &size, in + b * kBlockBytes, static_cast<uLong>(n), Z_DEFAULT_COMPRESSION) != Z_OK)
+      throw std::runtime_error("zlib could not compress a VTK array");
+    packed.resize(at + size);
+    header.push_back(static_cast<std::uint32_t>(size));
+  }
+  return base64(reinterpret_cast<const unsigned char*>(header.data()), header.size() * sizeof(std::uint32_t)) +
+         base64(packed.data(), packed.size());
 }
 
 std::string float32_block(const std::vector<double>& v, const std::string& what) {
@@ -66,17 +83,38 @@ void float_array(std::ostream& out, const std::string& name, int components, con
       << "\n</DataArray>\n";
 }
 
-void int_array(std::ostream& out, const std::string& name, const std::vector<std::int32_t>& v) {
-  out << "<DataArray type=\"Int32\" Name=\"" << name << "\" format=\"binary\">\n"
-      << encode_block(v.data(), v.size() * sizeof(std::int32_t)) << "\n</DataArray>\n";
+void int_array(std::ostream& out, const std::string& name, const std::vector<std::int32_t>& v, int components = 1) {
+  out << "<DataArray type=\"Int32\" Name=\"" << name << "\" NumberOfComponents=\"" << components
+      << "\" format=\"binary\">\n" << encode_block(v.data(), v.size() * sizeof(std::int32_t)) << "\n</DataArray>\n";
+}
+
+void data_array(std::ostream& out, const PointArray& a) {
+  if (!a.integer) return float_array(out, a.name, a.components, a.values);
+  std::vector<std::int32_t> v(a.values.size());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!(std::abs(a.values[i]) < 2147483647.0) || a.values[i] != std::round(a.values[i]))
+      throw std::logic_error("VTK integer array " + a.name + " holds a value that is not a 32-bit integer");
+    v[i] = static_cast<std::int32_t>(a.values[i]);
+  }
+  int_array(out, a.name, v, a.components);
+}
+
+// The frame's time as ParaView and VTK read it: FieldData TimeValue (one Float64).
+void time_value(std::ostream& out, double time_s) {
+  if (std::isnan(time_s)) return;
+  if (!std::isfinite(time_s)) throw NumericalError("non-finite frame time in a VTK file", "reduce the time step");
+  out << "<FieldData>\n<DataArray type=\"Float64\" Name=\"TimeValue\" NumberOfTuples=\"1\" format=\"binary\">\n"
+      << encode_block(&time_s, sizeof time_s) << "\n</DataArray>\n</FieldData>\n";
 }
 
 const char* kHeader = "<?xml version=\"1.0\"?>\n";
+const char* kCompressed = "byte_order=\"LittleEndian\" header_type=\"UInt32\" compressor=\"vtkZLibDataCompressor\"";
 
 }  // namespace
 
 void write_polydata(const std::string& path, const std::vector<double>& xyz,
-                    const std::vector<std::array<int, 3>>& triangles, const std::vector<PointArray>& arrays) {
+                    const std::vector<std::array<int, 3>>& triangles, const std::vector<PointArray>& arrays,
+                    double time_s) {
   const size_t n = xyz.size() / 3;
   for (const auto& a : arrays)
     if (a.values.size() != n * static_cast<size_t>(a.components))
@@ -84,11 +122,12 @@ void write_polydata(const std::string& path, const std::vector<double>& xyz,
   output::AtomicFile file(path);
   std::ostream& out = file.stream();
   out << kHeader
-      << "<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n<PolyData>\n"
-      << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
+      << "<VTKFile type=\"PolyData\" version=\"1.0\" " << kCompressed << ">\n<PolyData>\n";
+  time_value(out, time_s);
+  out << "<Piece NumberOfPoints=\"" << n << "\" NumberOfVerts=\"0\" NumberOfLines=\"0\" NumberOfStrips=\"0\" "
       << "NumberOfPolys=\"" << triangles.size() << "\">\n";
   out << "<PointData>\n";
-  for (const auto& a : arrays) float_array(out, a.name, a.components, a.values);
+  for (const auto& a : arrays) data_array(out, a);
   out << "</PointData>\n<Points>\n";
   float_array(out, "", 3, xyz);
   out << "</Points>\n<Polys>\n";
@@ -106,7 +145,7 @@ void write_polydata(const std::string& path, const std::vector<double>& xyz,
 }
 
 void write_image_data(const std::string& path, std::array<int, 3> cells, double spacing,
-                      const std::vector<PointArray>& cell_arrays) {
+                      const std::vector<PointArray>& cell_arrays, double time_s) {
   const size_t n = size_t(cells[0]) * cells[1] * cells[2];
   for (const auto& a : cell_arrays)
     if (a.values.size() != n * static_cast<size_t>(a.components))
@@ -118,10 +157,12 @@ void write_image_data(const std::string& path, std::array<int, 3> cells, double 
   const std::string extent = "0 " + std::to_string(cells[0]) + " 0 " + std::to_string(cells[1]) + " 0 " +
                              std::to_string(cells[2]);
   out << kHeader
-      << "<VTKFile type=\"ImageData\" version=\"0.1\" byte_order=\"LittleEndian\">\n"
+      << "<VTKFile type=\"ImageData\" version=\"1.0\" " << kCompressed << ">\n"
       << "<ImageData WholeExtent=\"" << extent << "\" Origin=\"0 0 0\" Spacing=\"" << h << " " << h << " " << h
-      << "\">\n<Piece Extent=\"" << extent << "\">\n<CellData>\n";
-  for (const auto& a : cell_arrays) float_array(out, a.name, a.components, a.values);
+      << "\">\n";
+  time_value(out, time_s);
+  out << "<Piece Extent=\"" << extent << "\">\n<CellData>\n";
+  for (const auto& a : cell_arrays) data_array(out, a);
   out << "</CellData>\n</Piece>\n</ImageData>\n</VTKFile>\n";
   file.commit();
 }

@@ -72,9 +72,9 @@ void RunOutput::write_membrane_frame(const Stepper& stepper) {
   vtk::PointArray act{"actuation_force_N", 3, std::vector<double>(Fe.data(), Fe.data() + 3 * nn)};
   const Eigen::VectorXd r = node_radii(mesh, s.X);
   vtk::PointArray rad{"radius_m", 1, std::vector<double>(r.data(), r.data() + nn)};
-  vtk::PointArray seg{"segment", 1, std::vector<double>(nn)};
+  vtk::PointArray seg{"segment", 1, std::vector<double>(nn), true};
   for (int i = 0; i < nn; ++i) seg.values[i] = protocol.segment_of(i);
-  vtk::write_polydata(dir_ + "/" + name, xyz, mesh.triangles, {vel, act, rad, seg});
+  vtk::write_polydata(dir_ + "/" + name, xyz, mesh.triangles, {vel, act, rad, seg}, s.t);
   pvd_.add(s.t, name);
   pvd_.write();
   count_frame(0, name, s.t);
@@ -100,7 +100,21 @@ void RunOutput::write_fluid_frame(const Stepper& stepper) {
         vel.values[q++] = 0.5 * (s.u.c[2][MacGrid::index(dw, i, j, k)] + s.u.c[2][MacGrid::index(dw, i, j, kp)]);
       }
   vtk::PointArray pr{"pressure_Pa", 1, stepper.pressure().v};
-  vtk::write_image_data(dir_ + "/" + name, {nx, ny, nz}, g.h(), {vel, pr});
+  std::vector<vtk::PointArray> arrays = {vel, pr};
+  if (run_.p.container == "cylinder") {
+    // the fluid domain of the fictitious-domain cylinder: 1 where the cell centre lies inside
+    // r <= Rc, 0 in the fictitious region around it (ParaView: Threshold on inside_container)
+    vtk::PointArray inside{"inside_container", 1, std::vector<double>(std::size_t(nx) * ny * nz), true};
+    const double h = g.h(), yc = 0.5 * g.length(1), zc = 0.5 * g.length(2), rc = run_.p.container_radius;
+    std::size_t c = 0;
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j) {
+        const bool in = std::hypot((j + 0.5) * h - yc, (k + 0.5) * h - zc) <= rc;
+        for (int i = 0; i < nx; ++i) inside.values[c++] = in ? 1.0 : 0.0;
+      }
+    arrays.push_back(std::move(inside));
+  }
+  vtk::write_image_data(dir_ + "/" + name, {nx, ny, nz}, g.h(), arrays, s.t);
   fluid_pvd_.add(s.t, name);
   fluid_pvd_.write();
   count_frame(1, name, s.t);

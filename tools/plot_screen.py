@@ -57,13 +57,29 @@ def label(name, unit_label):
     return f"{text} [{unit_label}]" if unit_label else text
 
 
+def value(col, row):
+    """A design's value on a swept key: its number, or a choice's position."""
+    if isinstance(col, tuple):
+        return float(col[1].index(row[col[0]]))
+    return float(row[col])
+
+
 def main(csv_path, png, metric, name, keys):
     with open(csv_path) as f:
         rows = list(csv.DictReader(f))
     swept = {}
     for k in keys:
-        col = next(c for c in rows[0] if c.startswith(k + "_si"))
-        vals = sorted({float(r[col]) for r in rows})
+        # a quantity has its SI column next to the values as given (swimmer.length,
+        # swimmer.length_m); a number or a choice ("step") has one column
+        names = list(rows[0])
+        col = names[names.index(k) + 1] if names.index(k) + 1 < len(names) and \
+            names[names.index(k) + 1].startswith(k + "_") else k
+        try:
+            vals = sorted({float(r[col]) for r in rows})
+        except ValueError:  # choices: their positions in the order first met
+            order = list(dict.fromkeys(r[col] for r in rows))
+            col = (col, order)
+            vals = list(range(len(order)))
         if len(vals) > 1:
             swept[k] = (col, vals)
     varying = list(swept)
@@ -82,7 +98,7 @@ def main(csv_path, png, metric, name, keys):
             for r in rows:
                 if not r[m]:
                     continue
-                key = (float(r[cx]), float(r[cy]))
+                key = (value(cx, r), value(cy, r))
                 best[key] = max(best.get(key, -1e300), float(r[m]) * mf)
             grid = [[best.get((x, y), float("nan")) for x in xs] for y in ys]
             pos = [v for row in grid for v in row if math.isfinite(v) and v > 0]
@@ -95,7 +111,7 @@ def main(csv_path, png, metric, name, keys):
         elif len(varying) == 1:
             cx, xs = swept[varying[0]]
             xf, xu = si_scale(xs, LABELS.get(varying[0], ("", ""))[1])
-            pts = sorted((float(r[cx]) * xf, float(r[m]) * mf) for r in rows if r[m])
+            pts = sorted((value(cx, r) * xf, float(r[m]) * mf) for r in rows if r[m])
             ax.plot([p[0] for p in pts], [p[1] for p in pts], "o-")
             ax.set(xlabel=label(varying[0], xu), ylabel=label(m, mu))
         ax.set_title(LABELS.get(m, (m,))[0])

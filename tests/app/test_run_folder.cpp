@@ -417,10 +417,10 @@ TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
 TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimit) {
   const fs::path d = tmpdir("runtime_limit_3d");
   const fs::path out = d / "run";
-  const std::uintmax_t limit = 2000000;  // frames of this scene: 266 kB each
+  const std::uintmax_t limit = 2000000;  // compressed frames of this scene: about 75 kB each
   const Cli c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() +
                              "\" --set full3d.dt='\"1 ms\"' --set full3d.output.vtk_interval='\"1 ms\"'"
-                             " --set output.max_bytes=" + std::to_string(limit),
+                             " --set time.duration=auto --set output.max_bytes=" + std::to_string(limit),
                          d);
   EXPECT_EQ(c.code, 3) << c.err;
   EXPECT_NE(c.err.find("output.max_bytes = " + std::to_string(limit)), std::string::npos) << c.err;
@@ -454,7 +454,8 @@ TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimi
   const Cli f = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + fluid.string() +
                              "\" --set full3d.dt='\"1 ms\"' --set full3d.output.vtk=false"
                              " --set full3d.output.fluid_fields=true --set full3d.output.vtk_interval='\"1 ms\"'"
-                             " --set full3d.output.fluid_interval='\"1 ms\"' --set output.max_bytes=600000",
+                             " --set full3d.output.fluid_interval='\"1 ms\"' --set time.duration=auto"
+                             " --set output.max_bytes=600000",
                          d);
   EXPECT_EQ(f.code, 3) << f.err;
   EXPECT_NE(f.err.find("fluid frames"), std::string::npos) << f.err;

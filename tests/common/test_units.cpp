@@ -43,18 +43,22 @@ TEST(Units, ToBaseGivesSIValueAndUnit) {
 }
 
 // Human-facing numbers: the SI prefix that puts the mantissa in [1, 1000), µ (not u), and
-// volumes in the cube of a prefixed length, spelled out rather than in e-notation.
+// volumes in one unit, µm³, in plain decimals rather than in e-notation.
 TEST(SiFormat, PrefixesMantissasAndVolumes) {
   EXPECT_EQ(swim::si(4.32e-8, "m"), "43.2 nm");
   EXPECT_EQ(swim::si(1.31e-7, "m/s"), "131 nm/s");
   EXPECT_EQ(swim::si(2.5e-6, "m/s"), "2.5 \u00b5m/s");
   EXPECT_EQ(swim::si(-3.2e-15, "N"), "-3.2 fN");
   EXPECT_EQ(swim::si(0.134, "s"), "134 ms");
-  EXPECT_EQ(swim::si(0.0, "m^3"), "0 m\u00b3");
-  EXPECT_EQ(swim::si(7.1823e-22, "m^3"), "718 000 nm\u00b3");  // 7.18e5 nm³, not "7.18e+05 nm^3"
-  EXPECT_EQ(swim::si(-7.1823e-22, "m^3"), "-718 000 nm\u00b3");
-  EXPECT_EQ(swim::si(3.4e-25, "m^3"), "340 nm\u00b3");
+  // volumes: one unit, µm³, for every printout (two runs' pumped volumes compare at a glance)
+  EXPECT_EQ(swim::si(0.0, "m^3"), "0 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(7.1823e-22, "m^3"), "0.000718 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(-7.1823e-22, "m^3"), "-0.000718 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(3.82e-21, "m^3"), "0.00382 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(9.62e-22, "m^3"), "0.000962 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(3.4e-25, "m^3"), "3.4e-07 \u00b5m\u00b3");  // below 10⁻⁶ µm³
   EXPECT_EQ(swim::si(2.0e-18, "m^3"), "2 \u00b5m\u00b3");
-  EXPECT_EQ(swim::si(1.234567e-24, "m^3", 5), "1 235 nm\u00b3");
+  EXPECT_EQ(swim::si(1.234567e-24, "m^3", 5), "0.0000012346 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(1.0e-27, "m^3"), "1e-09 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(std::nan(""), "m"), "n/a");
 }

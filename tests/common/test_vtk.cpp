@@ -1,6 +1,9 @@
-// VTK XML output (common/vtk.hpp): well-formed XML whose inline binary arrays (base64 of a
-// UInt32 byte count and little-endian values) decode to the written values, in the layout
-// VTK 9 / ParaView 5.11 read (file version 0.1: UInt32 block headers; Float32 fields, Int32 connectivity).
+// VTK XML output (common/vtk.hpp): well-formed XML whose inline binary arrays decode, with a
+// decoder written here from VTK's file-format description, to the written values, in the layout
+// VTK 9 / ParaView 5.11 read: zlib-compressed blocks (compressor="vtkZLibDataCompressor",
+// header_type="UInt32": base64 of the header [blocks, block size, partial last block size,
+// compressed sizes], then base64 of the zlib streams), Float32 fields, Int32 connectivity and
+// integer fields, the frame's time as FieldData TimeValue.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -17,36 +20,15 @@
 
 #include "common/errors.hpp"
 #include "common/vtk.hpp"
+#include "tests/support/vtk_read.hpp"
+
+#include <zlib.h>
 
 using namespace swim;
 
 namespace {
 
-std::vector<unsigned char> unbase64(const std::string& s) {
-  auto val = [](char c) -> int {
-    if (c >= 'A' && c <= 'Z') return c - 'A';
-    if (c >= 'a' && c <= 'z') return c - 'a' + 26;
-    if (c >= '0' && c <= '9') return c - '0' + 52;
-    if (c == '+') return 62;
-    if (c == '/') return 63;
-    return -1;
-  };
-  std::vector<unsigned char> out;
-  std::uint32_t acc = 0;
-  int bits = 0;
-  for (char c : s) {
-    if (c == '=') break;
-    const int v = val(c);
-    if (v < 0) continue;  // whitespace
-    acc = (acc << 6) | std::uint32_t(v);
-    bits += 6;
-    if (bits >= 8) {
-      bits -= 8;
-      out.push_back(static_cast<unsigned char>((acc >> bits) & 0xFF));
-    }
-  }
-  return out;
-}
+using namespace swim::test::vtk_read;
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path);
@@ -71,30 +53,6 @@ bool balanced(const std::string& xml) {
   return stack.empty();
 }
 
-struct Array {
-  std::string type, name, body;
-};
-
-std::vector<Array> arrays(const std::string& xml) {
-  std::vector<Array> out;
-  const std::regex da(R"re(<DataArray type="([A-Za-z0-9]+)"(?: Name="([^"]*)")?[^>]*format="binary">\s*([A-Za-z0-9+/=]*)\s*</DataArray>)re");
-  for (std::sregex_iterator it(xml.begin(), xml.end(), da), end; it != end; ++it)
-    out.push_back({(*it)[1], (*it)[2], (*it)[3]});
-  return out;
-}
-
-template <class T>
-std::vector<T> decode(const std::string& body) {
-  const auto bytes = unbase64(body);
-  EXPECT_GE(bytes.size(), 4u);
-  std::uint32_t n = 0;
-  std::memcpy(&n, bytes.data(), 4);
-  EXPECT_EQ(n, bytes.size() - 4);
-  std::vector<T> v(n / sizeof(T));
-  std::memcpy(v.data(), bytes.data() + 4, n);
-  return v;
-}
-
 std::string tmp(const std::string& name) {
   const std::string d = std::string(SWIM_BINARY_DIR) + "/tests/out_vtk";
   std::filesystem::create_directories(d);
@@ -117,15 +75,18 @@ TEST(Vtk, PolyDataDecodesToTheWrittenValues) {
   const vtk::PointArray r{"radius_m", 1, {1.0e-7, 2.5e-7, -3.0, 4.0}};
   const vtk::PointArray v{"velocity_m_per_s", 3, std::vector<double>(12, 1.5e-9)};
   const std::string path = tmp("poly.vtp");
-  vtk::write_polydata(path, xyz, tri, {r, v});
+  vtk::PointArray seg{"segment", 1, {0, 1, 5, 2}};
+  seg.integer = true;
+  vtk::write_polydata(path, xyz, tri, {r, v, seg}, 0.0125);
   const std::string xml = slurp(path);
   EXPECT_TRUE(balanced(xml));
-  EXPECT_NE(xml.find("version=\"0.1\""), std::string::npos);  // UInt32 block headers (the 0.1 default)
+  EXPECT_NE(xml.find("compressor=\"vtkZLibDataCompressor\""), std::string::npos);
+  EXPECT_NE(xml.find("header_type=\"UInt32\""), std::string::npos);
   EXPECT_NE(xml.find("NumberOfPoints=\"4\""), std::string::npos);
   EXPECT_NE(xml.find("NumberOfPolys=\"2\""), std::string::npos);
   EXPECT_EQ(xml.find("ascii"), std::string::npos);
   const auto a = arrays(xml);
-  ASSERT_EQ(a.size(), 5u);  // two point arrays, the points, connectivity, offsets
+  ASSERT_EQ(a.size(), 7u);  // the time, three point arrays, the points, connectivity, offsets
   std::map<std::string, Array> by;
   for (const auto& x : a) by[x.name] = x;
   EXPECT_EQ(by["radius_m"].type, "Float32");
@@ -139,6 +100,45 @@ TEST(Vtk, PolyDataDecodesToTheWrittenValues) {
   EXPECT_EQ(by["connectivity"].type, "Int32");
   EXPECT_EQ(decode<std::int32_t>(by["connectivity"].body), (std::vector<std::int32_t>{0, 1, 2, 0, 2, 3}));
   EXPECT_EQ(decode<std::int32_t>(by["offsets"].body), (std::vector<std::int32_t>{3, 6}));
+  EXPECT_EQ(by["segment"].type, "Int32");
+  EXPECT_EQ(decode<std::int32_t>(by["segment"].body), (std::vector<std::int32_t>{0, 1, 5, 2}));
+  EXPECT_EQ(by["TimeValue"].type, "Float64");
+  EXPECT_NE(xml.find("<FieldData>"), std::string::npos);
+  EXPECT_EQ(decode<double>(by["TimeValue"].body), (std::vector<double>{0.0125}));
+}
+
+// Arrays longer than one block (32 KiB) are split into blocks, each its own zlib stream, the
+// last one partial; smooth fields compress.
+TEST(Vtk, LargeArraysSplitIntoCompressedBlocks) {
+  const std::array<int, 3> n = {40, 30, 20};  // 24 000 cells: 96 000 bytes of Float32 per scalar
+  vtk::PointArray p{"pressure_Pa", 1, std::vector<double>(24000)};
+  for (int i = 0; i < 24000; ++i) p.values[i] = std::sin(1e-3 * i);
+  vtk::PointArray mask{"inside_container", 1, std::vector<double>(24000)};
+  for (int i = 0; i < 24000; ++i) mask.values[i] = (i / 40) % 3 == 0;
+  mask.integer = true;
+  const std::string path = tmp("large.vti");
+  vtk::write_image_data(path, n, 1e-8, {p, mask}, 2.5);
+  const std::string xml = slurp(path);
+  EXPECT_TRUE(balanced(xml));
+  const auto a = arrays(xml);
+  ASSERT_EQ(a.size(), 3u);
+  std::map<std::string, Array> by;
+  for (const auto& x : a) by[x.name] = x;
+  const auto first = unbase64(by["pressure_Pa"].body.substr(0, 8));
+  std::uint32_t blocks = 0;
+  std::memcpy(&blocks, first.data(), 4);
+  EXPECT_EQ(blocks, 3u);  // 96 000 bytes = 2 full blocks and a partial one
+  const auto v = decode<float>(by["pressure_Pa"].body);
+  ASSERT_EQ(v.size(), 24000u);
+  for (int i = 0; i < 24000; i += 997) EXPECT_EQ(v[i], static_cast<float>(p.values[i]));
+  const auto m = decode<std::int32_t>(by["inside_container"].body);
+  ASSERT_EQ(m.size(), 24000u);
+  for (int i = 0; i < 24000; i += 101) EXPECT_EQ(m[i], static_cast<std::int32_t>(mask.values[i]));
+  EXPECT_LT(by["inside_container"].body.size(), 96000u / 10);  // a mask compresses well
+  EXPECT_EQ(decode<double>(by["TimeValue"].body), (std::vector<double>{2.5}));
+  vtk::PointArray bad{"segment", 1, std::vector<double>(24000, 0.5)};
+  bad.integer = true;
+  EXPECT_THROW(vtk::write_image_data(tmp("bad.vti"), n, 1e-8, {bad}), std::logic_error);
 }
 
 TEST(Vtk, ImageDataDecodesAndRejectsNonFinite) {

@@ -189,11 +189,11 @@ TEST(Run3d, AResumedRunListsEveryFrameAndRefusesAMissingOne) {
 // frame, with the same message, as the uninterrupted run.
 TEST(Run3d, AResumedRunStopsAtTheOutputLimitWhereTheUninterruptedRunDid) {
   const std::vector<std::string> sets = {"full3d.dt=\"1 ms\"", "full3d.output.vtk_interval=\"2 ms\"",
-                                         "full3d.checkpoint_interval=\"5 ms\""};
+                                         "full3d.checkpoint_interval=\"5 ms\"", "time.duration=\"auto\""};
   const Scene s = tiny(sets);  // time.duration auto: no estimate before the run
   RunControl ctl;
   ctl.progress = 0;
-  ctl.max_output_bytes = 1450000;  // frames of 266 kB: the sixth (step 10) passes it
+  ctl.max_output_bytes = 1450000;  // compressed frames of about 75 kB: one a few tens of steps in passes it
   const std::string a = fresh_dir("limit_a"), b = fresh_dir("limit_b");
   const RunOutcome ra = run3d(s.p, s.resolved, a, ctl);
   ASSERT_TRUE(ra.failed);
@@ -293,7 +293,7 @@ TEST(Run3d, DrySwimmerBreathingPeriodAndEnergy) {
 TEST(Run3d, DryProtocolReachesTargetOnEverySegment) {
   const Scene s = tiny({"full3d.dry=true", "full3d.dt=\"2 us\"", "protocol.total_force=null", "protocol.load_factor=3",
                         "wave.contracted_ratio=0.82", "protocol.segments=3", "protocol.first_segment_ratio=1",
-                        "time.output_interval=\"2 us\"", "full3d.checkpoint_interval=\"1 s\""});
+                        "time.output_interval=\"2 us\"", "full3d.checkpoint_interval=\"1 s\"", "time.duration=\"auto\""});
   const std::string dir = fresh_dir("dry_protocol");
   RunControl ctl;
   ctl.progress = 0;
@@ -367,7 +367,7 @@ TEST(Run3d, FluidCoupledCycleCompletesAndSwimsForward) {
   const Scene s = tiny({"wave.contracted_ratio=0.82", "protocol.segments=3", "protocol.first_segment_ratio=1",
                         "protocol.total_force=null", "protocol.load_factor=2", "full3d.dt=\"1 ms\"",
                         "time.output_interval=\"5 ms\"", "full3d.time_limit=\"1.5 s\"",
-                        "full3d.checkpoint_interval=\"1 s\""});
+                        "full3d.checkpoint_interval=\"1 s\"", "time.duration=\"auto\""});
   EXPECT_EQ(s.p.recovery_end, "dead_band");
   const std::string dir = fresh_dir("fluid_cycle");
   RunControl ctl;

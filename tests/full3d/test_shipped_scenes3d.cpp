@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <regex>
 
 #include "common/errors.hpp"
 #include "common/scene.hpp"
@@ -151,5 +152,51 @@ TEST(ShippedScenes3d, BendingRigidityIsTheSameWallOnEveryGrid) {
     ADD_FAILURE() << "bending_rigidity with bending_constant accepted";
   } catch (const InputError& err) {
     EXPECT_NE(std::string(err.what()).find("full3d.membrane.bending_rigidity"), std::string::npos) << err.what();
+  }
+}
+
+// Every figure a shipped scene's description states is the scene's own: the grid (NxMxK), the
+// cell size (h = N nm), the membrane's node count, R0, L, R_f, the number of cycles and, for
+// a scene with a fixed duration, its steps.
+TEST(ShippedScenes3d, DescriptionsStateTrueFigures) {
+  const auto number = [](const std::string& text, const std::string& pattern, double& v) {
+    std::smatch m;
+    if (!std::regex_search(text, m, std::regex(pattern))) return false;
+    v = std::stod(m[1]);
+    return true;
+  };
+  for (const auto& f : shipped_scenes()) {
+    SCOPED_TRACE(f);
+    const scene::json sc = scene::load_file(f);
+    const std::string d = sc.value("description", std::string());
+    ASSERT_FALSE(d.empty()) << "every shipped scene describes itself (swim scenes lists it)";
+    scene::json resolved;
+    const Params3d p = read_scene3d(sc, resolved);
+    std::smatch m;
+    if (std::regex_search(d, m, std::regex(R"((\d+)x(\d+)x(\d+))"))) {
+      EXPECT_EQ(std::stoi(m[1]), p.nx);
+      EXPECT_EQ(std::stoi(m[2]), p.ny);
+      EXPECT_EQ(std::stoi(m[3]), p.nz);
+    }
+    double v = 0;
+    if (number(d, R"(h = ([\d.]+) nm)", v)) { EXPECT_NEAR(v, p.h * 1e9, 0.05); }
+    if (number(d, R"((\d+) (membrane )?nodes)", v)) { EXPECT_EQ(static_cast<int>(v), make_mesh(p).nodes()); }
+    EXPECT_EQ(d.find('~' + std::string("1000 nodes")), std::string::npos);
+    if (number(d, R"(R0 = ([\d.]+) um)", v)) { EXPECT_NEAR(v * 1e-6, p.R0, 0.005 * p.R0); }
+    if (number(d, R"(\bL = ([\d.]+) um)", v)) { EXPECT_NEAR(v * 1e-6, p.L, 0.005 * p.L); }
+    if (number(d, R"(R_f = ([\d.]+) R0)", v)) { EXPECT_NEAR(v, resolved["wave"]["contracted_ratio"].get<double>(), 1e-9); }
+    const int cycles = resolved["protocol"]["cycles"].get<int>();
+    if (d.find("one cycle") != std::string::npos || d.find("one complete") != std::string::npos) { EXPECT_EQ(cycles, 1); }
+    if (d.find("ten force-driven cycles") != std::string::npos) { EXPECT_EQ(cycles, 10); }
+    if (number(d, R"((\d+) steps)", v)) {
+      ASSERT_GT(p.duration, 0.0) << "a step count needs a fixed duration";
+      EXPECT_NEAR(v, p.duration / p.dt, 0.5);
+    }
+    if (number(d, R"(first ([\d.]+) ms)", v)) { EXPECT_NEAR(v * 1e-3, p.duration, 1e-12); }
+    if (number(d, R"(eps = ([\d.]+))", v)) { EXPECT_NEAR(v, p.R0 / p.L, 0.005 * v); }
+    if (number(d, R"(([\d.]+)x the static load)", v)) {
+      ASSERT_TRUE(sc["protocol"].contains("load_factor"));
+      EXPECT_NEAR(v, sc["protocol"]["load_factor"].get<double>(), 1e-9);
+    }
   }
 }
