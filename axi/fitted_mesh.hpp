@@ -32,32 +32,34 @@
 // are narrow (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free
 // rims then sees elements refined in both directions.
 //
-// Axial positions: vertical lines where the wall is a gentle graph, lines that leave a steep
-// wall across it. Along the wall line (membrane and gap, periodic) let a_k in [0, pi] be the
-// angle of segment k = (W_k, W_{k+1}) with the +x axis (0 along the axis, pi/2 radial, beyond
-// pi/2 turned back), l_k its length, dx_k its axial width, and s_k = s(a_k) its steepness,
-// s(a) = smoothstep((a - a0)/(a1 - a0)) (C^1; 0 for a <= a0 = atan 0.7, 1 for a >= a1 = atan 3).
-//   Far positions xi_c: the columns' lines end (at the axis and at the container) at axial
-//   positions with increments dxi_k = dx_k + e_k - g_k, where e_k = gamma s_k l_k (gamma = 1/2:
-//   a steep segment is given half its length of axial room) and the extra is taken back from the
-//   gentle segments nearby: each e_m is shared among the segments k = m - M..m + M (M = 24) in
-//   proportion to (1 - s_k) max(dx_k, 0) (M + 1 - |k - m|), which shrinks them (the gap's wide
-//   columns, next to the rims, give most of it). The offsets o_c = xi_c - x_c, summed from the
-//   column farthest from any steep segment (o = 0 there), are then zero outside the windows.
-//   Tilt psi_c = psi_max s(|phi_c|) sign(phi_c), phi_c in (-pi, pi] the angle of the chord
-//   W_{c+1} - W_{c-1} with the +x axis, psi_max = 60 deg: the line leaves W_c along the chord's
-//   normal turned at most 60 deg from the radial direction, (-sin psi, cos psi) outwards and
-//   (sin psi, -cos psi) inwards, so that it enters the fluid on the correct side even where the
-//   wall stands radially or turns back.
-//   Band b_c = min(max(3 l_c, 1.5 |o_c|), 0.9 d) on each side (l_c the longer adjacent wall-line
-//   segment, d the distance from W_c to the axis or to the container).
-// With u = |r_{c,j} - rho_c| / b_c the vertex's x is the cubic Hermite
-//   x_{c,j} = x_c + o_c h01(u) -/+ b_c tan(psi_c) h10(u)   (u < 1; - outside, + inside)
-//   x_{c,j} = xi_c                                          (u >= 1)
-// (h01 = 3u^2 - 2u^3, h10 = u - 2u^2 + u^3): it leaves W_c with the tilt psi_c and meets the
-// vertical x = xi_c with a vertical tangent. The radii are those above in every case. Where no
-// wall-line segment within M + 1 columns is steeper than a0, psi_c = 0 and o_c = 0: the line is
-// exactly vertical (x = x_c), and a gentle graph wall gets the vertical-line mesh.
+// Axial positions: vertical lines where the wall is a gentle graph, lines that lean and fan out
+// where it is steep. Along the wall line (membrane and gap, periodic) segment k = (W_k, W_{k+1})
+// has the axial width dx_k, rise dr_k, length l_k, angle a_k = atan2(|dr_k|, dx_k) in [0, pi]
+// with the axis, and the steepness s_k = smoothstep((a_k - a0)/(a1 - a0)) (C^1; 0 for a <= a0 =
+// atan 0.7, 1 for a >= a1 = atan 3). Two terms, both zero on a gentle wall:
+//   Far offsets o_c (one outside, one inside the wall). Far from the wall (at the axis and the
+//   container) the lines end at x_c + o_c, spaced across segment k by dx_k + e_k - g_k:
+//   e_k = s_k (gamma l_k + (|dx_k| - dx_k)/2) (gamma = 1/2; |dx| rounded at 0.1 l) is the room
+//   a steep or turned-back segment gets, g_k what the gentle segments give back. Each e_m is
+//   shared among the segments met walking away from m (up to 48 gentle ones, counting a segment
+//   as 1 - s of one, or fewer once their axial widths reach 4 times the whole wall line's
+//   extra) in proportion to (1 - s_k) max(dx_k, 0): outside, from the side the wall's outward
+//   normal faces (before m where the wall rises, dr_m > 0; after it where it falls), inside
+//   from the other side. o_c is the running sum of e - g from the column farthest from any
+//   steep segment (o = 0 there; zero again past the donors).
+//   Lean lambda_c. The straight line through W_c with direction angle beta enters the fluid on
+//   the correct side of both adjacent segments (angles a_in, a_out, signed) iff
+//   max(a_in, a_out) < beta < min(a_in, a_out) + pi. beta = pi/2 unless the vertical is within
+//   15 deg of either bound; the lean (beta - pi/2) is then the shortfall, through a C^1 ramp
+//   over 10 deg, at most 75 deg; the leans are spread to the neighbours (largest within 2
+//   columns, then two [1 2 1]/4 passes; each sign separately, never below a column's own
+//   need). lambda = -tan(lean) = dx/dr of the line at the wall.
+// With u = |r_{c,j} - rho_c| / b (band b = min(max(2 |o|, 3 d / rows), 0.9 d), d the distance
+// from W_c to the axis or the container, rows that side's row count):
+//   x_{c,j} = x_c + lambda (r_{c,j} - rho_c) (1 - u^2)^2 + o u (2 - u)   (u < 1)
+//   x_{c,j} = x_c + o                                                     (u >= 1).
+// The radii are those above in every case. Where no segment is steeper than a0 (and none within
+// 15 deg of radial), o = lambda = 0: the lines are exactly vertical (x = x_c to the bit).
 //
 // Every element (c, j), j = 0..Ny-1, is the quadrilateral with straight edges through its four
 // vertices; the geometry map is bilinear (Q1). Its Jacobian is checked at the four corners of
