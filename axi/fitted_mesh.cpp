@@ -324,31 +324,54 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
   }
 
   // Jacobian x_xi r_eta - x_eta r_xi at the four corners of every element (bilinear map:
-  // positive at the corners implies positive everywhere).
-  min_jac_ = INFINITY;
-  for (int c = 0; c < nc_; ++c) {
-    for (int j = 0; j < ny_; ++j) {
-      double x[4], r[4];
-      corners(element(c, j), x, r);
-      double worst = INFINITY;
-      for (int i = 0; i < 4; ++i) {
-        // derivatives at corner i (times 2): along xi the edge (0,1) at eta = -1 or (3,2) at
-        // eta = +1; along eta the edge (0,3) at xi = -1 or (1,2) at xi = +1
-        const double xx = i <= 1 ? x[1] - x[0] : x[2] - x[3], rx = i <= 1 ? r[1] - r[0] : r[2] - r[3];
-        const bool left = i == 0 || i == 3;
-        const double xe = left ? x[3] - x[0] : x[2] - x[1], re = left ? r[3] - r[0] : r[2] - r[1];
-        worst = std::min(worst, 0.25 * (xx * re - xe * rx));
+  // positive at the corners implies positive everywhere); the first element where it is not
+  // positive (-1 when none).
+  auto check = [&](int& bad_c, int& bad_j) {
+    min_jac_ = INFINITY;
+    for (int c = 0; c < nc_; ++c)
+      for (int j = 0; j < ny_; ++j) {
+        double x[4], r[4];
+        corners(element(c, j), x, r);
+        double worst = INFINITY;
+        for (int i = 0; i < 4; ++i) {
+          // derivatives at corner i (times 2): along xi the edge (0,1) at eta = -1 or (3,2) at
+          // eta = +1; along eta the edge (0,3) at xi = -1 or (1,2) at xi = +1
+          const double xx = i <= 1 ? x[1] - x[0] : x[2] - x[3], rx = i <= 1 ? r[1] - r[0] : r[2] - r[3];
+          const bool left = i == 0 || i == 3;
+          const double xe = left ? x[3] - x[0] : x[2] - x[1], re = left ? r[3] - r[0] : r[2] - r[1];
+          worst = std::min(worst, 0.25 * (xx * re - xe * rx));
+        }
+        min_jac_ = std::min(min_jac_, worst);
+        if (!(worst > 0.0)) {
+          bad_c = c;
+          bad_j = j;
+          return false;
+        }
       }
-      min_jac_ = std::min(min_jac_, worst);
-      if (!(worst > 0.0)) {
-        const int k = c < n_ ? c : (c - n_ < (nc_ - n_) / 2 ? n_ - 1 : 0);
-        throw NumericalError("element (column " + std::to_string(c) + ", row " + std::to_string(j) +
-                                 ") of the fitted mesh has a non-positive Jacobian, near membrane vertex " +
-                                 std::to_string(k) + " at (" + fmt(xcol_[c]) + ", " + fmt(rho_[c]) +
-                                 ") m: the mesh cannot follow the wall's shape there",
-                             "reduce the time step or refine axi.grid; change axi.fitted.gap_columns or "
-                             "axi.fitted.gap_growth");
+    return true;
+  };
+  int bad_c = -1, bad_j = -1;
+  if (!check(bad_c, bad_j)) {
+    // Where the tilted lines cross but the wall line still advances along the axis (x strictly
+    // increasing), the vertical-line mesh is valid: use it.
+    bool increasing = true;
+    for (int c = 0; c < nc_; ++c) increasing = increasing && seg_dx(c) > 0.0;
+    int c2 = -1, j2 = -1;
+    if (increasing) {
+      for (int c = 0; c < nc_; ++c) {
+        vertical_[c] = 1;
+        for (int j = 0; j <= ny_; ++j) vx_[size_t(c) * (ny_ + 1) + j] = xcol_[c];
       }
+    }
+    if (!increasing || !check(c2, j2)) {
+      const int c = bad_c, j = bad_j;
+      const int k = c < n_ ? c : (c - n_ < (nc_ - n_) / 2 ? n_ - 1 : 0);
+      throw NumericalError("element (column " + std::to_string(c) + ", row " + std::to_string(j) +
+                               ") of the fitted mesh has a non-positive Jacobian, near membrane vertex " +
+                               std::to_string(k) + " at (" + fmt(xcol_[c]) + ", " + fmt(rho_[c]) +
+                               ") m: the mesh cannot follow the wall's shape there",
+                           "reduce the time step or refine axi.grid; change axi.fitted.gap_columns or "
+                           "axi.fitted.gap_growth");
     }
   }
   fitted_ = true;

@@ -64,7 +64,9 @@
 // Every element (c, j), j = 0..Ny-1, is the quadrilateral with straight edges through its four
 // vertices; the geometry map is bilinear (Q1). Its Jacobian is checked at the four corners of
 // every element (bilinear: positive there implies positive everywhere); a non-positive one is
-// the mesh's only geometric rejection (the wall shape it cannot follow).
+// the mesh's only geometric rejection (the wall shape it cannot follow). When the tilted lines
+// fail that check and the wall line's x is strictly increasing, all lines are made vertical
+// (x = x_c; valid for any such wall) and checked again.
 //
 // Q2 nodes: (2 NC) x (2 Ny + 1), index I = 0..2NC-1 along the columns (periodic; I = 2c is
 // vertex column c, I odd a column of midside/centre nodes), J = 0..2Ny along r (J = 2j the vertex
