@@ -94,6 +94,23 @@ std::string fmt(double v) {
   return b;
 }
 
+// Centre and scales of an element's pressure basis {1, (x - xc)/hx, (r - rc)/hr}: the mean of
+// its corners, the mean length of its two xi-edges and its mean eta-extent. Positive for any
+// valid element, whatever the tilt of its sides; on an element with vertical sides hx is its
+// width when the top and bottom edges are level. The scaling does not change the pressure space.
+void pressure_scales(const double cx[4], const double cr[4], double& xc, double& rc, double& hx, double& hr) {
+  xc = 0.25 * (cx[0] + cx[1] + cx[2] + cx[3]);
+  rc = 0.25 * (cr[0] + cr[1] + cr[2] + cr[3]);
+  const bool vertical = cx[0] == cx[3] && cx[1] == cx[2];
+  if (vertical) {  // the vertical-line mesh: its width and mean height
+    hx = cx[1] - cx[0];
+    hr = 0.5 * ((cr[3] - cr[0]) + (cr[2] - cr[1]));
+    return;
+  }
+  hx = 0.5 * (std::hypot(cx[1] - cx[0], cr[1] - cr[0]) + std::hypot(cx[2] - cx[3], cr[2] - cr[3]));
+  hr = 0.5 * (std::hypot(cx[3] - cx[0], cr[3] - cr[0]) + std::hypot(cx[2] - cx[1], cr[2] - cr[1]));
+}
+
 }  // namespace
 
 // Per-element quadrature data: physical gradients of the 9 Q2 shape functions, position and
@@ -108,10 +125,7 @@ void FittedStokes::element_geometry(int e, Geometry& g) const {
   const RefTables& T = ref();
   double cx[4], cr[4];
   mesh_.corners(e, cx, cr);
-  g.xc = 0.25 * (cx[0] + cx[1] + cx[2] + cx[3]);
-  g.rc = 0.25 * (cr[0] + cr[1] + cr[2] + cr[3]);
-  g.hx = cx[1] - cx[0];
-  g.hr = 0.5 * ((cr[3] - cr[0]) + (cr[2] - cr[1]));
+  pressure_scales(cx, cr, g.xc, g.rc, g.hx, g.hr);
   for (int q = 0; q < 9; ++q) {
     const double xi = T.xi[q], eta = T.eta[q];
     double x = 0, r = 0, xx = 0, xe = 0, rx = 0, re = 0;
@@ -276,8 +290,9 @@ void FittedStokes::transfer_weights() {
   const int edges = closed ? nm : nm - 1;
   for (int k = 0; k < edges; ++k) {
     const int l = (k + 1) % nm;
-    const double dx = mesh_.column_x(k + 1) - mesh_.column_x(k);  // column k+1 = vertex l (+P when wrapped)
-    const double r0 = mesh_.interface_radius(k), r1 = mesh_.interface_radius(k + 1);
+    const int ci = mesh_.params().cells_inner;  // the wall vertices (column k+1 = vertex l, +P when wrapped)
+    const double dx = mesh_.vertex_x(k + 1, ci) - mesh_.vertex_x(k, ci);
+    const double r0 = mesh_.vertex_r(k, ci), r1 = mesh_.vertex_r(k + 1, ci);
     const double len = std::hypot(dx, r1 - r0);
     for (int q = 0; q < 3; ++q) {
       const double t = kGp[q], r = 0.5 * (r0 * (1 - t) + r1 * (1 + t));
@@ -701,8 +716,8 @@ Eigen::Vector2d FittedStokes::eval_velocity(int e, double xi, double eta) const 
 double FittedStokes::eval_pressure(int e, double x, double r) const {
   double cx[4], cr[4];
   mesh_.corners(e, cx, cr);
-  const double xc = 0.25 * (cx[0] + cx[1] + cx[2] + cx[3]), rc = 0.25 * (cr[0] + cr[1] + cr[2] + cr[3]);
-  const double hx = cx[1] - cx[0], hr = 0.5 * ((cr[3] - cr[0]) + (cr[2] - cr[1]));
+  double xc, rc, hx, hr;
+  pressure_scales(cx, cr, xc, rc, hx, hr);
   const int* L = &loc_[std::size_t(e) * kLoc];
   return ps_ * (dof_value(L[18]) + dof_value(L[19]) * (x - xc) / hx + dof_value(L[20]) * (r - rc) / hr) - p_mean_;
 }
@@ -724,19 +739,30 @@ double FittedStokes::pressure(double x, double r) const {
 double FittedStokes::end_disc_flux(int end, double frame_velocity) const {
   if (!solved_) throw std::logic_error("FittedStokes::end_disc_flux before solve()");
   if (end != 0 && end != 1) throw std::invalid_argument("FittedStokes::end_disc_flux: end must be 0 or 1");
+  // Flux through the vertex column's line from the axis to the rim, relative to the frame:
+  // int 2 pi r (u_x dr - u_r dx) along the line minus U pi r_rim^2 (the frame's flux through any
+  // surface spanning the rim circle). Each edge is straight and u is quadratic along it: 3-point
+  // Gauss is exact.
   const int c = end == 0 ? 0 : mesh_.membrane_nodes() - 1;
   double s = 0.0;
   for (int j = 0; j < mesh_.params().cells_inner; ++j) {
     const double r0 = mesh_.vertex_r(c, j), r1 = mesh_.vertex_r(c, j + 1);
-    double u[3];
-    for (int m = 0; m < 3; ++m) u[m] = dof_value(dof_x_[mesh_.node(2 * c, 2 * j + m)]);
+    const double dx = mesh_.vertex_x(c, j + 1) - mesh_.vertex_x(c, j);
+    double ux[3], ur[3];
+    for (int m = 0; m < 3; ++m) {
+      const int node = mesh_.node(2 * c, 2 * j + m);
+      ux[m] = dof_value(dof_x_[node]);
+      ur[m] = dx != 0.0 ? dof_value(dof_r_[node]) : 0.0;
+    }
     for (int q = 0; q < 3; ++q) {
       const double t = kGp[q], r = 0.5 * (r0 * (1 - t) + r1 * (1 + t));
-      const double ux = lag(0, t) * u[0] + lag(1, t) * u[1] + lag(2, t) * u[2];
-      s += kGw[q] * kTwoPi * r * (ux - frame_velocity) * 0.5 * (r1 - r0);
+      const double vx = lag(0, t) * ux[0] + lag(1, t) * ux[1] + lag(2, t) * ux[2];
+      const double vr = lag(0, t) * ur[0] + lag(1, t) * ur[1] + lag(2, t) * ur[2];
+      s += kGw[q] * kTwoPi * r * (vx * 0.5 * (r1 - r0) - vr * 0.5 * dx);
     }
   }
-  return s;
+  const double rim = mesh_.vertex_r(c, mesh_.params().cells_inner);
+  return s - frame_velocity * std::numbers::pi * rim * rim;
 }
 
 double FittedStokes::element_divergence(int e) const {

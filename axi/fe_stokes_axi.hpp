@@ -17,14 +17,16 @@
 // velocity on the bilinear (Q1) geometry map (subparametric: the midside and centre nodes at the
 // bilinear images of the reference midpoints and centre), pressure discontinuous, linear in
 // PHYSICAL coordinates per element with the basis {1, (x - x_c)/h_x, (r - r_c)/h_r} (x_c, r_c the
-// mean of the element's corners, h_x its width, h_r its mean height; the scaling does not change
-// the space). Being discontinuous, the pressure may jump across the membrane, and the constant
+// mean of the element's corners, h_x and h_r the mean lengths of its xi- and eta-edges (on an
+// element with vertical sides: its width and mean height); the scaling does not change the
+// space). Being discontinuous, the pressure may jump across the membrane, and the constant
 // in each element makes every element conserve mass: int_e div u dV = 0 (to round-off).
 //
-// Quadrature: 3x3 Gauss-Legendre (exact to degree 5 per direction). With the bilinear map's
-// Jacobian det J = x_xi r_eta (the sides of every element are vertical), the divergence terms
-// det J (r dr v_r + v_r + r dx v_x) are polynomials of degree <= 3 per direction, so b(., .) and
-// the element mass balances are EXACT; on rectangles every term of a(., .) except the hoop term
+// Quadrature: 3x3 Gauss-Legendre (exact to degree 5 per direction). For any bilinear map
+// (vertical or tilted sides) the divergence terms det J (r dr v_r + v_r + r dx v_x) =
+// r (cofactors of J) . (reference derivatives) + v_r det J are polynomials of degree <= 3 per
+// direction, and times the pressure basis (bilinear in the reference coordinates) <= 4, so
+// b(., .) and the element mass balances are EXACT; on rectangles every term of a(., .) except the hoop term
 // u_r v_r / r is of degree <= 5 (exact), and the hoop term is exact in the axis row (u_r = r g
 // there). Elsewhere the integrands are rational (1/r, 1/r_eta) and smooth on the element; the
 // rule's error is O(h^6) per unit volume, far below the O(h^3) of the Q2 velocity. A body force
@@ -177,10 +179,12 @@ class FittedStokes {
   /// The P1 pressure of the element containing the point (on a shared edge either side), Pa,
   /// zero volume mean.
   double pressure(double x, double r) const;
-  /// Volume flux through the disc r < r_end spanned by end vertex `end` (0: rear, vertex 0;
-  /// 1: front, vertex n-1) relative to a frame moving axially at frame_velocity, m^3/s:
-  /// int_0^{r_end} 2 pi r (u_x - V) dr, exact (3-point Gauss on the Q2 traces of the vertex
-  /// column's edges). Positive: fluid crossing the disc towards +x.
+  /// Volume flux through the surface spanning the rim circle of end vertex `end` (0: rear,
+  /// vertex 0; 1: front, vertex n-1) relative to a frame moving axially at frame_velocity, m^3/s:
+  /// the surface of revolution of the vertex column's line from the axis to the rim (a disc
+  /// when the line is vertical), int 2 pi r (u_x dr - u_r dx) - V pi r_end^2, exact (3-point
+  /// Gauss on the Q2 traces of the line's straight edges). For a divergence-free field it is
+  /// the flux through any surface spanning the rim circle. Positive: fluid crossing towards +x.
   double end_disc_flux(int end, double frame_velocity) const;
   /// max over elements |int_e div u dV| / (vol_e max|u| / h_e), h_e = sqrt(area_e); a
   /// dimensionless mass-conservation residual (round-off for a correct solve).

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 
@@ -76,17 +77,38 @@ FittedMesh::FittedMesh(const FittedMeshParams& p, int membrane_nodes) : p_(p), n
   xcol_.assign(nc_ + 1, 0.0);
   rho_.assign(nc_, 0.0);
   frac_.assign(size_t(nc_) * (ny_ + 1), 0.0);
+  vx_.assign(size_t(nc_) * (ny_ + 1), 0.0);
+  vr_.assign(size_t(nc_) * (ny_ + 1), 0.0);
+  vertical_.assign(nc_, 1);
 }
 
-double FittedMesh::vertex_r(int c, int j) const {
-  c %= nc_;
-  const double rho = rho_[c];
-  const int ci = p_.cells_inner;
-  if (j == ny_) return p_.Rc;
-  const double f = frac_[size_t(c) * (ny_ + 1) + j];
-  if (j <= ci) return rho * f;
-  return rho + (p_.Rc - rho) * f;
+namespace {
+
+constexpr double kA0 = 0.6107259643892086;  // atan(0.7): steeper wall-line segments tilt the lines
+constexpr double kA1 = 1.2490457723982544;  // atan(3): fully steep
+constexpr double kBandOffsets = 2.0;  // band height per offset
+constexpr double kBandRows = 3.0;     // and in uniform rows (the side's distance over its row count)
+constexpr double kLeanMargin = 0.2617993877991494;  // 15 deg
+constexpr double kLeanRamp = 0.17453292519943295;   // 10 deg
+constexpr double kLeanMax = 1.3089969389957472;     // 75 deg
+constexpr double kGamma = 0.5;                  // axial room given to a steep segment, per length
+constexpr double kWindow = 48;                  // at most this many gentle segments give the room back,
+constexpr double kCapacity = 4.0;               // or as many as have kCapacity times the room
+
+double steepness(double a) {
+  const double t = std::clamp((a - kA0) / (kA1 - kA0), 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
 }
+
+// Width of a wall-line segment for sizing the gap's first columns and the rows graded towards
+// the wall: its axial extent, or 0.8 of its length when that is larger (a segment steeper than
+// 37 degrees, whose elements along the wall are that long).
+double sizing_width(double dx, double dr) {
+  const double l = 0.8 * std::hypot(dx, dr);
+  return dx >= l ? dx : l;
+}
+
+}  // namespace
 
 void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
   if (X.cols() != n_)
@@ -105,18 +127,16 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
                                "reached the container",
                            "reduce the load or the time step; the fitted mesh (axi.fitted.cells_inner, "
                            "axi.fitted.cells_outer) needs the wall strictly inside the container");
-    if (k > 0 && !(x > X(0, k - 1)))
-      throw NumericalError("membrane vertices " + std::to_string(k - 1) + " and " + std::to_string(k) +
-                               " are not in increasing axial order (x = " + fmt(X(0, k - 1)) + ", " + fmt(x) +
-                               " m): the meridian folded back",
-                           "reduce the time step; the fitted mesh (axi.fitted.*) needs x strictly increasing "
-                           "along the wall");
   }
   const double span = X(0, n_ - 1) - X(0, 0);
   if (!(span < P))
     throw NumericalError("the tube (length " + fmt(span) + " m) does not fit the period " + fmt(P) + " m",
                          "increase container.period; the fitted mesh (axi.fitted.gap_columns) needs a gap "
                          "between the tube's ends");
+  if (!(span > 0.0))
+    throw NumericalError("the tube's front end (x = " + fmt(X(0, n_ - 1)) + " m) is not ahead of its rear end (x = " +
+                             fmt(X(0, 0)) + " m): the meridian folded back over its whole length",
+                         "reduce the time step");
 
   const double x0 = X(0, 0);
   for (int k = 0; k < n_; ++k) {
@@ -126,7 +146,8 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
   if (!p_.closed) {
     const int m = p_.gap_columns;
     const double G = x0 + P - X(0, n_ - 1);
-    const auto w = gap_widths(G, m, X(0, n_ - 1) - X(0, n_ - 2), X(0, 1) - X(0, 0), p_.gap_growth);
+    const auto w = gap_widths(G, m, sizing_width(X(0, n_ - 1) - X(0, n_ - 2), X(1, n_ - 1) - X(1, n_ - 2)),
+                              sizing_width(X(0, 1) - X(0, 0), X(1, 1) - X(1, 0)), p_.gap_growth);
     const double xa = X(0, n_ - 1), ra = X(1, n_ - 1), rb = X(1, 0);
     double x = xa;
     for (int i = 0; i < m - 1; ++i) {
@@ -138,6 +159,10 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     }
   }
   xcol_[nc_] = x0 + P;
+  // wall-line segment c (vertex columns c, c + 1): axial width, radial rise
+  auto seg_dx = [&](int c) { return xcol_[c + 1] - xcol_[c]; };
+  auto seg_dr = [&](int c) { return rho_[(c + 1) % nc_] - rho_[c]; };
+  auto seg_w = [&](int c) { return sizing_width(seg_dx(c), seg_dr(c)); };
 
   // row fractions: uniform, or graded from the membrane line (heights w_i = eta q^i away from it)
   const int ci = p_.cells_inner, co = p_.cells_outer;
@@ -146,8 +171,8 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
     for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
     if (!(p_.wall_row_aspect > 0.0)) continue;
-    const double wl = xcol_[c] - (c > 0 ? xcol_[c - 1] : xcol_[nc_ - 1] - P);
-    const double wr = xcol_[c + 1] - xcol_[c];
+    const double wl = seg_w(c > 0 ? c - 1 : nc_ - 1);
+    const double wr = seg_w(c);
     const double eta = p_.wall_row_aspect * std::min(wl, wr);
     const double in = rho_[c], out = Rc - rho_[c];
     const auto hi = gap_widths(in, ci, eta, INFINITY, 4.0), ho = gap_widths(out, co, eta, INFINITY, 4.0);
@@ -162,21 +187,191 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
       f[ci + 1 + i] = i == co - 1 ? 1.0 : acc / out;
     }
   }
-
-  // Jacobian x_xi r_eta at the four corners of every element (x_xi = half the column width,
-  // r_eta = half the vertical side of the corner).
-  min_jac_ = INFINITY;
+  // radii (the lines' radii do not depend on their tilt)
   for (int c = 0; c < nc_; ++c) {
-    const double hx = 0.5 * (xcol_[c + 1] - xcol_[c]);
-    for (int j = 0; j < ny_; ++j) {
-      const double dl = 0.5 * (vertex_r(c, j + 1) - vertex_r(c, j));
-      const double dr = 0.5 * (vertex_r(c + 1, j + 1) - vertex_r(c + 1, j));
-      const double jac = hx * std::min(dl, dr);
-      min_jac_ = std::min(min_jac_, jac);
-      if (!(jac > 0.0))
-        throw NumericalError("element (column " + std::to_string(c) + ", row " + std::to_string(j) +
-                                 ") of the fitted mesh has a non-positive Jacobian",
-                             "change axi.fitted.gap_columns, axi.fitted.gap_growth or reduce the time step");
+    const double rho = rho_[c];
+    const double* f = &frac_[size_t(c) * (ny_ + 1)];
+    double* vr = &vr_[size_t(c) * (ny_ + 1)];
+    for (int j = 0; j < ny_; ++j) vr[j] = j <= ci ? rho * f[j] : rho + (Rc - rho) * f[j];
+    vr[ny_] = Rc;
+  }
+
+  // Steepness of the wall-line segments and the extra axial room they get (see the header).
+  std::vector<double> st(nc_), extra(nc_, 0.0);
+  bool steep = false;
+  for (int c = 0; c < nc_; ++c) {
+    st[c] = steepness(std::atan2(std::abs(seg_dr(c)), seg_dx(c)));
+    if (st[c] > 0.0) {
+      steep = true;
+      // gamma l, plus the axial width a turned-back segment loses (smoothly: (|dx| - dx)/2 with
+      // |dx| rounded at 0.1 l)
+      const double l = std::hypot(seg_dx(c), seg_dr(c));
+      extra[c] = st[c] * (kGamma * l + 0.5 * (std::hypot(seg_dx(c), 0.1 * l) - seg_dx(c)));
+    }
+  }
+  auto wrap = [&](int c) { return ((c % nc_) + nc_) % nc_; };
+  const double M = kWindow;
+  double etot = 0.0;
+  for (double e : extra) etot += e;
+  // Offsets of the lines' far positions, outside (side 1) and inside (side 0). A steep segment's
+  // room is taken back from the gentle segments on the side its normal points to on that side of
+  // the wall: outside, where the wall rises (dr > 0) the outward normal points to -x, so from the
+  // segments before it; inside, from those after it (and the reverse where the wall falls).
+  std::vector<double> off[2] = {std::vector<double>(nc_, 0.0), std::vector<double>(nc_, 0.0)};
+  if (steep) {
+    int start = 0, best = -1;  // the column farthest from any steep segment
+    for (int c = 0; c < nc_; ++c) {
+      int dist = nc_;
+      for (int m = 0; m < nc_; ++m)
+        if (extra[m] > 0.0) dist = std::min({dist, wrap(c - m), wrap(m + 1 - c)});
+      if (dist > best) {
+        best = dist;
+        start = c;
+      }
+    }
+    for (int side = 0; side < 2; ++side) {
+      std::vector<double> back(nc_, 0.0);
+      for (int m = 0; m < nc_; ++m) {
+        if (extra[m] == 0.0) continue;
+        const double dr = seg_dr(m);
+        const bool before = side ? dr > 0.0 : dr < 0.0;
+        // the donors: the segments met walking away from m until M gentle ones (counting a
+        // segment as 1 - s of one) have been passed or their axial widths reach kCapacity times
+        // the whole wall line's extra room
+        double tot = 0.0, gentle = 0.0;
+        int steps = 0;
+        for (int i = 1; i < nc_ && gentle < M && tot < kCapacity * etot; ++i, ++steps) {
+          const int k = wrap(before ? m - i : m + i);
+          gentle += 1.0 - st[k];
+          tot += (1.0 - st[k]) * std::max(seg_dx(k), 0.0);
+        }
+        if (!(tot > 0.0))
+          throw NumericalError("the wall line near vertex column " + std::to_string(m) +
+                                   " has no gentle segment to give room to its steep ones",
+                               "reduce the time step or refine axi.grid");
+        for (int i = 1; i <= steps; ++i) {
+          const int k = wrap(before ? m - i : m + i);
+          back[k] += extra[m] * (1.0 - st[k]) * std::max(seg_dx(k), 0.0) / tot;
+        }
+      }
+      double o = 0.0;
+      for (int i = 0; i < nc_; ++i) {
+        const int c = wrap(start + i);
+        off[side][c] = o;
+        o += extra[c] - back[c];
+      }
+    }
+  }
+  // Lean of the lines at the wall. The straight line through W_c with direction angle beta
+  // (from +x) enters the fluid on the correct side of both adjacent segments (angles a_in,
+  // a_out) when max(a_in, a_out) < beta < min(a_in, a_out) + pi. beta = pi/2 (vertical) unless
+  // that is within kLeanMargin of either bound; then it is pushed away from the bound (C^1
+  // ramp). The leans are then spread to the neighbours (the largest within 2 columns, then two
+  // [1 2 1]/4 passes; each sign separately), so that neighbouring lines stay nearly parallel;
+  // the spread lean is never smaller than the vertex's own.
+  std::vector<double> lean_pos(nc_, 0.0), lean_neg(nc_, 0.0);
+  bool leaning = false;
+  {
+    auto ramp = [](double z) {
+      return z <= 0.0 ? 0.0 : z < kLeanRamp ? 0.5 * z * z / kLeanRamp : z - 0.5 * kLeanRamp;
+    };
+    const double half_pi = 0.5 * std::numbers::pi;
+    for (int c = 0; c < nc_; ++c) {
+      const int cm = c > 0 ? c - 1 : nc_ - 1;
+      const double a_in = std::atan2(seg_dr(cm), seg_dx(cm)), a_out = std::atan2(seg_dr(c), seg_dx(c));
+      lean_pos[c] = ramp(std::max(a_in, a_out) + kLeanMargin - half_pi);
+      lean_neg[c] = ramp(half_pi + kLeanMargin - (std::min(a_in, a_out) + std::numbers::pi));
+      leaning = leaning || lean_pos[c] > 0.0 || lean_neg[c] > 0.0;
+    }
+    if (leaning)
+      for (auto* v : {&lean_pos, &lean_neg}) {
+        std::vector<double> t(nc_);
+        for (int c = 0; c < nc_; ++c) {
+          double m = 0.0;
+          for (int i = -2; i <= 2; ++i) m = std::max(m, (*v)[wrap(c + i)]);
+          t[c] = m;
+        }
+        for (int pass = 0; pass < 2; ++pass) {
+          for (int c = 0; c < nc_; ++c) (*v)[c] = 0.25 * (t[wrap(c - 1)] + 2.0 * t[c] + t[wrap(c + 1)]);
+          t = *v;
+        }
+      }
+  }
+  // The lines: x = x_c + lambda (r - rho) (1 - u^2)^2 + o u (2 - u), u = |r - rho| / b < 1;
+  // x_c + o beyond.
+  for (int c = 0; c < nc_; ++c) {
+    const double xc = xcol_[c], rho = rho_[c];
+    double* vx = &vx_[size_t(c) * (ny_ + 1)];
+    const double* vr = &vr_[size_t(c) * (ny_ + 1)];
+    const double lean = std::clamp(lean_pos[c] - lean_neg[c], -kLeanMax, kLeanMax);
+    const double lambda = -std::tan(lean);
+    vertical_[c] = (off[0][c] == 0.0 && off[1][c] == 0.0 && lambda == 0.0);
+    if (vertical_[c]) {
+      for (int j = 0; j <= ny_; ++j) vx[j] = xc;
+      continue;
+    }
+    for (int side = 0; side < 2; ++side) {  // 0 inside, 1 outside
+      const double o = off[side][c];
+      const double d = side ? Rc - rho : rho, first = d / (side ? co : ci);
+      const double b = std::min(std::max(kBandOffsets * std::abs(o), kBandRows * first), 0.9 * d);
+      const int j0 = side ? ci + 1 : 0, j1 = side ? ny_ : ci - 1;
+      for (int j = j0; j <= j1; ++j) {
+        const double u = std::abs(vr[j] - rho) / b;
+        vx[j] = u >= 1.0 ? xc + o : xc + lambda * (vr[j] - rho) * (1.0 - u * u) * (1.0 - u * u) + o * u * (2.0 - u);
+      }
+    }
+    vx[ci] = xc;
+  }
+
+  // Jacobian x_xi r_eta - x_eta r_xi at the four corners of every element (bilinear map:
+  // positive at the corners implies positive everywhere); the first element where it is not
+  // positive (-1 when none).
+  auto check = [&](int& bad_c, int& bad_j) {
+    min_jac_ = INFINITY;
+    for (int c = 0; c < nc_; ++c)
+      for (int j = 0; j < ny_; ++j) {
+        double x[4], r[4];
+        corners(element(c, j), x, r);
+        double worst = INFINITY;
+        for (int i = 0; i < 4; ++i) {
+          // derivatives at corner i (times 2): along xi the edge (0,1) at eta = -1 or (3,2) at
+          // eta = +1; along eta the edge (0,3) at xi = -1 or (1,2) at xi = +1
+          const double xx = i <= 1 ? x[1] - x[0] : x[2] - x[3], rx = i <= 1 ? r[1] - r[0] : r[2] - r[3];
+          const bool left = i == 0 || i == 3;
+          const double xe = left ? x[3] - x[0] : x[2] - x[1], re = left ? r[3] - r[0] : r[2] - r[1];
+          worst = std::min(worst, 0.25 * (xx * re - xe * rx));
+        }
+        min_jac_ = std::min(min_jac_, worst);
+        if (!(worst > 0.0)) {
+          bad_c = c;
+          bad_j = j;
+          return false;
+        }
+      }
+    return true;
+  };
+  int bad_c = -1, bad_j = -1;
+  if (!check(bad_c, bad_j)) {
+    // Where the tilted lines cross but the wall line still advances along the axis (x strictly
+    // increasing), the vertical-line mesh is valid: use it.
+    bool increasing = true;
+    for (int c = 0; c < nc_; ++c) increasing = increasing && seg_dx(c) > 0.0;
+    int c2 = -1, j2 = -1;
+    if (increasing) {
+      for (int c = 0; c < nc_; ++c) {
+        vertical_[c] = 1;
+        for (int j = 0; j <= ny_; ++j) vx_[size_t(c) * (ny_ + 1) + j] = xcol_[c];
+      }
+    }
+    if (!increasing || !check(c2, j2)) {
+      const int c = bad_c, j = bad_j;
+      const int k = c < n_ ? c : (c - n_ < (nc_ - n_) / 2 ? n_ - 1 : 0);
+      throw NumericalError("element (column " + std::to_string(c) + ", row " + std::to_string(j) +
+                               ") of the fitted mesh has a non-positive Jacobian, near membrane vertex " +
+                               std::to_string(k) + " at (" + fmt(xcol_[c]) + ", " + fmt(rho_[c]) +
+                               ") m: the mesh cannot follow the wall's shape there",
+                           "reduce the time step or refine axi.grid; change axi.fitted.gap_columns or "
+                           "axi.fitted.gap_growth");
     }
   }
   fitted_ = true;
@@ -184,8 +379,10 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
 
 void FittedMesh::corners(int e, double x[4], double r[4]) const {
   const int c = element_column(e), j = element_row(e);
-  x[0] = x[3] = xcol_[c];
-  x[1] = x[2] = xcol_[c + 1];
+  x[0] = vertex_x(c, j);
+  x[1] = vertex_x(c + 1, j);
+  x[2] = vertex_x(c + 1, j + 1);
+  x[3] = vertex_x(c, j + 1);
   r[0] = vertex_r(c, j);
   r[1] = vertex_r(c + 1, j);
   r[2] = vertex_r(c + 1, j + 1);
@@ -195,10 +392,11 @@ void FittedMesh::corners(int e, double x[4], double r[4]) const {
 Eigen::Vector2d FittedMesh::node_position(int I, int J) const {
   const int c = I / 2, j = J / 2;
   const bool mx = I % 2, mr = J % 2;
-  const double x = mx ? 0.5 * (xcol_[c] + xcol_[c + 1]) : xcol_[c];
-  auto rcol = [&](int cc) { return mr ? 0.5 * (vertex_r(cc, j) + vertex_r(cc, j + 1)) : vertex_r(cc, j); };
-  const double r = mx ? 0.5 * (rcol(c) + rcol(c + 1)) : rcol(c);
-  return {x, r};
+  auto at = [&](int cc) -> Eigen::Vector2d {
+    if (!mr) return {vertex_x(cc, j), vertex_r(cc, j)};
+    return {0.5 * (vertex_x(cc, j) + vertex_x(cc, j + 1)), 0.5 * (vertex_r(cc, j) + vertex_r(cc, j + 1))};
+  };
+  return mx ? Eigen::Vector2d(0.5 * (at(c) + at(c + 1))) : at(c);
 }
 
 int FittedMesh::locate(double& x, double r, double& xi, double& eta) const {
@@ -206,22 +404,70 @@ int FittedMesh::locate(double& x, double r, double& xi, double& eta) const {
   if (!std::isfinite(x) || !(r >= 0.0 && r <= p_.Rc))
     throw std::invalid_argument("FittedMesh::locate: the point (x = " + fmt(x) + " m, r = " + fmt(r) +
                                 " m) is outside 0 <= r <= Rc");
-  const double P = p_.period, x0 = xcol_[0];
+  // x of vertex column c's line (piecewise linear in r between its vertices) at radius r
+  auto line_x = [&](int c) {
+    int lo = 0, hi = ny_;
+    while (hi - lo > 1) {
+      const int mid = (lo + hi) / 2;
+      (vertex_r(c, mid) <= r ? lo : hi) = mid;
+    }
+    const double r0 = vertex_r(c, lo), r1 = vertex_r(c, lo + 1);
+    const double t = std::clamp((r - r0) / (r1 - r0), 0.0, 1.0);
+    return vertex_x(c, lo) + t * (vertex_x(c, lo + 1) - vertex_x(c, lo));
+  };
+  const double P = p_.period, x0 = line_x(0);
   x = x0 + (x - x0) - P * std::floor((x - x0) / P);
   if (x >= x0 + P) x -= P;
-  int c = int(std::upper_bound(xcol_.begin(), xcol_.end(), x) - xcol_.begin()) - 1;
-  c = std::clamp(c, 0, nc_ - 1);
-  const double t = (x - xcol_[c]) / (xcol_[c + 1] - xcol_[c]);
-  xi = 2.0 * t - 1.0;
-  auto line = [&](int j) { return vertex_r(c, j) * (1.0 - t) + vertex_r(c + 1, j) * t; };
-  int lo = 0, hi = ny_;  // find j with line(j) <= r <= line(j + 1)
+  int lo = 0, hi = nc_;  // column strip: line_x(lo) <= x < line_x(hi), line_x(nc_) = x0 + P
   while (hi - lo > 1) {
     const int mid = (lo + hi) / 2;
-    (line(mid) <= r ? lo : hi) = mid;
+    (line_x(mid) <= x ? lo : hi) = mid;
   }
-  const double rb = line(lo), rt = line(lo + 1);
-  eta = std::clamp(2.0 * (r - rb) / (rt - rb) - 1.0, -1.0, 1.0);
-  return element(c, lo);
+  const int c = lo;
+  // row: the point lies above (to the left of, along xi) row line j between (c, j) and (c+1, j)
+  auto above = [&](int j) {
+    const double ax = vertex_x(c, j), ar = vertex_r(c, j);
+    const double bx = vertex_x(c + 1, j), br = vertex_r(c + 1, j);
+    return (bx - ax) * (r - ar) - (br - ar) * (x - ax) >= 0.0;
+  };
+  int jl = 0, jh = ny_;
+  while (jh - jl > 1) {
+    const int mid = (jl + jh) / 2;
+    (above(mid) ? jl : jh) = mid;
+  }
+  const int e = element(c, jl);
+  double cx[4], cr[4];
+  corners(e, cx, cr);
+  if (column_vertical(c) && column_vertical(c + 1)) {  // vertical sides: explicit
+    const double t = (x - cx[0]) / (cx[1] - cx[0]);
+    xi = 2.0 * t - 1.0;
+    const double rb = cr[0] * (1.0 - t) + cr[1] * t, rt = cr[3] * (1.0 - t) + cr[2] * t;
+    eta = std::clamp(2.0 * (r - rb) / (rt - rb) - 1.0, -1.0, 1.0);
+    return e;
+  }
+  // Newton on the bilinear map
+  static constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
+  xi = 0.0;
+  eta = 0.0;
+  for (int it = 0; it < 50; ++it) {
+    double fx = -x, fr = -r, xx = 0, xe = 0, rx = 0, re = 0;
+    for (int i = 0; i < 4; ++i) {
+      const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
+      const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
+      fx += m * cx[i];
+      fr += m * cr[i];
+      xx += mx * cx[i];
+      xe += me * cx[i];
+      rx += mx * cr[i];
+      re += me * cr[i];
+    }
+    const double det = xx * re - xe * rx;
+    const double dxi = (re * fx - xe * fr) / det, deta = (-rx * fx + xx * fr) / det;
+    xi = std::clamp(xi - dxi, -1.0, 1.0);
+    eta = std::clamp(eta - deta, -1.0, 1.0);
+    if (std::abs(dxi) + std::abs(deta) < 1e-14) break;
+  }
+  return e;
 }
 
 }  // namespace swim::axi

@@ -3,44 +3,75 @@
 // (axi/fe_stokes_axi.hpp).
 //
 // Domain: 0 <= r <= Rc, x periodic with period P. The membrane is the meridian polygon through
-// the vertices X_k = (x_k, r_k), k = 0..n-1, x strictly increasing, 0 < r_k < Rc, an open tube
-// (two free ends) with x_{n-1} - x_0 < P.
+// the vertices X_k = (x_k, r_k), k = 0..n-1, 0 < r_k < Rc, an open tube (two free ends) with
+// x_0 < x_{n-1} < x_0 + P. x need not increase along the wall: a segment may stand radially or
+// turn back, as long as the mesh below can be built with positive Jacobians.
 //
-// Vertex columns (vertical lines x = const, periodic, numbered c = 0..NC-1):
-//   c = 0..n-1          the membrane vertices, x = x_c;
+// Vertex columns (periodic, numbered c = 0..NC-1), each a line from the axis (row 0) through
+// its wall-line point W_c (row cells_inner) to the container (row Ny):
+//   c = 0..n-1          the membrane vertices, W_c = X_c;
 //   c = n..n+m-2        the m-1 interior lines of the gap (m = gap_columns) from x_{n-1} to
 //                       x_0 + P. Gap column widths (i = 0..m-1, from x_{n-1} on):
 //                         w_i(q) = min(w_L q^i, w_R q^(m-1-i)),
-//                       w_L = x_{n-1} - x_{n-2} and w_R = x_1 - x_0 the adjacent membrane segments,
-//                       with the common ratio q in [1, gap_growth] that fills the gap
-//                       (sum_i w_i(q) = G = x_0 + P - x_{n-1}, by bisection; the ratio of
-//                       neighbouring widths is then <= q). When no such q exists (the gap is
+//                       w_L, w_R the axial widths of the adjacent membrane segments (for a
+//                       steep end segment, where its axial width is below half its length,
+//                       half its length), with the common ratio q in [1, gap_growth] that fills
+//                       the gap (sum_i w_i(q) = G = x_0 + P - x_{n-1}, by bisection; the ratio
+//                       of neighbouring widths is then <= q). When no such q exists (the gap is
 //                       shorter than m min(w_L, w_R), or longer than the widths at q =
-//                       gap_growth can reach) the gap is divided uniformly, w_i = G/m.
+//                       gap_growth can reach) the gap is divided uniformly, w_i = G/m. The
+//                       gap's wall-line radius is linear in x between r_{n-1} and r_0.
 // Element column c lies between vertex columns c and c+1 (column NC is column 0 shifted by P):
 // NC = n - 1 + m element columns (closed test mode: NC = n, no gap, the last column from x_{n-1}
 // to x_0 + P).
 //
-// Interface radius rho_c of each vertex column: r_c on the membrane columns; in the gap linear in
-// x between r_{n-1} and r_0. Vertex rows j = 0..Ny, Ny = cells_inner + cells_outer, at radius
+// Radii. Vertex rows j = 0..Ny, Ny = cells_inner + cells_outer; vertex (c, j) is at radius
 //   r_{c,j} = rho_c j / cells_inner                                  (j <= cells_inner)
 //   r_{c,j} = rho_c + (Rc - rho_c)(j - cells_inner) / cells_outer   (j >= cells_inner)
-// (uniform rows), or graded towards the membrane line where the columns are narrow
-// (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free rims then
-// sees elements refined in both directions.
-// The membrane is the mesh line j = cells_inner between the vertex columns 0 and n-1 (closed:
-// all columns). Every element (c, j), j = 0..Ny-1, is the quadrilateral with the vertical sides
-// x = x_c, x = x_{c+1} and straight top and bottom edges; the geometry map is bilinear (Q1):
-//   x(xi) = x_c (1 - xi)/2 + x_{c+1} (1 + xi)/2,
-//   r(xi, eta) = sum of the four corner radii times the Q1 shape functions, xi, eta in [-1, 1].
-// Its Jacobian is x_xi r_eta, positive when the rows are increasing (always, for 0 < rho < Rc)
-// and the columns are increasing; it is checked anyway at the four corners (bilinear: positive
-// there implies positive everywhere).
+// (rho_c the radius of W_c; uniform rows), or graded towards the membrane line where the columns
+// are narrow (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free
+// rims then sees elements refined in both directions.
 //
-// Q2 nodes: (2 NC) x (2 Ny + 1), index I = 0..2NC-1 along x (periodic; I = 2c is vertex column
-// c, I odd a column of midside/centre nodes), J = 0..2Ny along r (J = 2j the vertex row j); node
-// (I, J) has the global index I (2Ny + 1) + J. A midside or centre node sits at the bilinear
-// image of the reference midpoint or centre. Membrane vertex k is node (2k, 2 cells_inner).
+// Axial positions: vertical lines where the wall is a gentle graph, lines that lean and fan out
+// where it is steep. Along the wall line (membrane and gap, periodic) segment k = (W_k, W_{k+1})
+// has the axial width dx_k, rise dr_k, length l_k, angle a_k = atan2(|dr_k|, dx_k) in [0, pi]
+// with the axis, and the steepness s_k = smoothstep((a_k - a0)/(a1 - a0)) (C^1; 0 for a <= a0 =
+// atan 0.7, 1 for a >= a1 = atan 3). Two terms, both zero on a gentle wall:
+//   Far offsets o_c (one outside, one inside the wall). Far from the wall (at the axis and the
+//   container) the lines end at x_c + o_c, spaced across segment k by dx_k + e_k - g_k:
+//   e_k = s_k (gamma l_k + (|dx_k| - dx_k)/2) (gamma = 1/2; |dx| rounded at 0.1 l) is the room
+//   a steep or turned-back segment gets, g_k what the gentle segments give back. Each e_m is
+//   shared among the segments met walking away from m (up to 48 gentle ones, counting a segment
+//   as 1 - s of one, or fewer once their axial widths reach 4 times the whole wall line's
+//   extra) in proportion to (1 - s_k) max(dx_k, 0): outside, from the side the wall's outward
+//   normal faces (before m where the wall rises, dr_m > 0; after it where it falls), inside
+//   from the other side. o_c is the running sum of e - g from the column farthest from any
+//   steep segment (o = 0 there; zero again past the donors).
+//   Lean lambda_c. The straight line through W_c with direction angle beta enters the fluid on
+//   the correct side of both adjacent segments (angles a_in, a_out, signed) iff
+//   max(a_in, a_out) < beta < min(a_in, a_out) + pi. beta = pi/2 unless the vertical is within
+//   15 deg of either bound; the lean (beta - pi/2) is then the shortfall, through a C^1 ramp
+//   over 10 deg, at most 75 deg; the leans are spread to the neighbours (largest within 2
+//   columns, then two [1 2 1]/4 passes; each sign separately, never below a column's own
+//   need). lambda = -tan(lean) = dx/dr of the line at the wall.
+// With u = |r_{c,j} - rho_c| / b (band b = min(max(2 |o|, 3 d / rows), 0.9 d), d the distance
+// from W_c to the axis or the container, rows that side's row count):
+//   x_{c,j} = x_c + lambda (r_{c,j} - rho_c) (1 - u^2)^2 + o u (2 - u)   (u < 1)
+//   x_{c,j} = x_c + o                                                     (u >= 1).
+// The radii are those above in every case. Where no segment is steeper than a0 (and none within
+// 15 deg of radial), o = lambda = 0: the lines are exactly vertical (x = x_c to the bit).
+//
+// Every element (c, j), j = 0..Ny-1, is the quadrilateral with straight edges through its four
+// vertices; the geometry map is bilinear (Q1). Its Jacobian is checked at the four corners of
+// every element (bilinear: positive there implies positive everywhere); a non-positive one is
+// the mesh's only geometric rejection (the wall shape it cannot follow). When the tilted lines
+// fail that check and the wall line's x is strictly increasing, all lines are made vertical
+// (x = x_c; valid for any such wall) and checked again.
+//
+// Q2 nodes: (2 NC) x (2 Ny + 1), index I = 0..2NC-1 along the columns (periodic; I = 2c is
+// vertex column c, I odd a column of midside/centre nodes), J = 0..2Ny along r (J = 2j the vertex
+// row j); node (I, J) has the global index I (2Ny + 1) + J. A midside or centre node sits at the
+// bilinear image of the reference midpoint or centre. Membrane vertex k is node (2k, 2 cells_inner).
 //
 // The topology (node and element numbering, and so every sparsity pattern) depends only on
 // (n, params), never on X.
@@ -79,8 +110,9 @@ class FittedMesh {
 
   /// Places the mesh on the membrane X (3 x n; row 0 axial x_k, row 1 radius r_k, row 2 ignored).
   /// Throws std::invalid_argument when X does not have n columns; swim::NumericalError (cause and
-  /// remedy) for a non-finite vertex, x not strictly increasing, r outside (0, Rc), a tube that
-  /// does not fit the period (x_{n-1} - x_0 >= P) or a non-positive element Jacobian.
+  /// remedy) for a non-finite vertex, r outside (0, Rc), a tube that does not fit the period
+  /// (not x_0 < x_{n-1} < x_0 + P) or a non-positive element Jacobian (the wall shape the mesh
+  /// cannot follow, naming the element and the nearest wall vertex).
   void fit(const Eigen::Matrix3Xd& X);
 
   const FittedMeshParams& params() const { return p_; }
@@ -110,31 +142,42 @@ class FittedMesh {
 
   // ---- geometry (valid after fit())
   bool fitted() const { return fitted_; }
-  /// x of vertex column c = 0..NC (column NC = column 0 + P).
+  /// x of the wall-line point W_c of vertex column c = 0..NC (column NC = column 0 + P); the
+  /// column's x everywhere when its line is vertical.
   double column_x(int c) const { return xcol_[c]; }
   const std::vector<double>& column_xs() const { return xcol_; }
-  /// Interface radius of vertex column c = 0..NC (periodic).
+  /// Interface radius of vertex column c = 0..NC (periodic): the radius of W_c.
   double interface_radius(int c) const { return rho_[c % nc_]; }
   /// Radius of vertex (c, j), c = 0..NC (periodic), j = 0..Ny.
-  double vertex_r(int c, int j) const;
+  double vertex_r(int c, int j) const { return vr_[size_t(c % nc_) * (ny_ + 1) + j]; }
+  /// Axial position of vertex (c, j), c = 0..NC (column NC = column 0 + P), j = 0..Ny.
+  double vertex_x(int c, int j) const {
+    return c >= nc_ ? vx_[size_t(c - nc_) * (ny_ + 1) + j] + p_.period : vx_[size_t(c) * (ny_ + 1) + j];
+  }
+  /// Whether vertex column c's line is vertical (x = column_x(c) on every row).
+  bool column_vertical(int c) const { return vertical_[c % nc_] != 0; }
   /// The four corners of element e: (x, r) of (xi, eta) = (-1,-1), (1,-1), (1,1), (-1,1).
   void corners(int e, double x[4], double r[4]) const;
-  /// Physical position of Q2 node (I, J) (I = 0..2NC-1; for the periodic image use column_x).
+  /// Physical position of Q2 node (I, J) (I = 0..2NC-1; the periodic image is P further).
   Eigen::Vector2d node_position(int I, int J) const;
-  /// The element containing (x, r) (x wrapped by P into [x_0, x_0 + P); 0 <= r <= Rc, else
-  /// std::invalid_argument) and the reference coordinates there; returns the element index.
-  /// x is returned wrapped. On a shared edge either neighbour may be returned.
+  /// The element containing (x, r) (x wrapped by P into [x(r), x(r) + P), x(r) the axial
+  /// position of vertex column 0's line at radius r; 0 <= r <= Rc, else std::invalid_argument)
+  /// and the reference coordinates there (the bilinear map inverted by Newton's method);
+  /// returns the element index. x is returned wrapped. On a shared edge either neighbour may be
+  /// returned.
   int locate(double& x, double r, double& xi, double& eta) const;
-  /// Smallest and largest element Jacobian x_xi r_eta over the corners (for diagnostics).
+  /// Smallest element Jacobian x_xi r_eta - x_eta r_xi over the corners (for diagnostics).
   double min_jacobian() const { return min_jac_; }
 
  private:
   FittedMeshParams p_;
   int n_, nc_, ny_;
   bool fitted_ = false;
-  std::vector<double> xcol_;  ///< NC + 1
-  std::vector<double> rho_;   ///< NC
+  std::vector<double> xcol_;  ///< NC + 1: x of the wall-line points
+  std::vector<double> rho_;   ///< NC: radius of the wall-line points
   std::vector<double> frac_;  ///< NC x (Ny + 1): r_{c,j} = frac (0..1 of rho_c inside; of Rc - rho_c outside)
+  std::vector<double> vx_, vr_;  ///< NC x (Ny + 1): vertex positions
+  std::vector<char> vertical_;   ///< NC: the column's line is vertical
   double min_jac_ = 0;
 };
 

@@ -239,15 +239,20 @@ class Runner {
       step_heun();
   }
 
-  /// Why the fitted mesh cannot follow the wall's shape X (empty when it can): a ring's axial
-  /// position not beyond its neighbour's, or a ring outside (0, Rc).
+  /// Why the fitted mesh cannot follow the wall's shape X (empty when it can): a ring outside
+  /// (0, Rc), or the mesh fitted to X is not valid (a non-positive element Jacobian, the tube's
+  /// ends crossed, ...; FittedMesh::fit's cause).
   std::string fold(const Eigen::Matrix3Xd& X) const {
     const int n = wall_.nodes();
-    for (int k = 0; k < n; ++k) {
+    for (int k = 0; k < n; ++k)
       if (!(X(1, k) > 0.0 && X(1, k) < b_.container_radius))
         return "ring " + std::to_string(k) + " at radius " + num(X(1, k)) + " m, outside (0, Rc)";
-      if (k > 0 && !(X(0, k) > X(0, k - 1)))
-        return "rings " + std::to_string(k - 1) + " and " + std::to_string(k) + " crossed along the axis";
+    if (!fitted_) return {};
+    try {
+      FittedMesh probe(fitted_mesh_params(), n);
+      probe.fit(X);
+    } catch (const NumericalError& e) {
+      return e.cause();
     }
     return {};
   }
