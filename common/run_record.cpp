@@ -243,6 +243,19 @@ CycleFigures cycle_figures(const RunRecord& r) {
     c.cycle_times_s.push_back(e.cycle_end_s[k] - e.cycle_start_s[k]);
     c.cycle_displacements_m.push_back(x_at(e.x_at_cycle_end_m, k) - x_at(e.x_at_cycle_start_m, k));
   }
+  for (std::size_t k = 0; k < n; ++k) {
+    std::vector<double> b = {e.cycle_start_s[k]};
+    for (double t : e.segment_reached_s)
+      if (t > e.cycle_start_s[k] && t < e.cycle_end_s[k]) b.push_back(t);
+    std::sort(b.begin() + 1, b.end());
+    b.push_back(e.cycle_end_s[k]);
+    if (k == 0) c.phase_times_s.assign(b.size() - 1, 0.0);
+    if (b.size() - 1 != c.phase_times_s.size()) {
+      c.phase_times_s.clear();
+      break;
+    }
+    for (std::size_t i = 0; i + 1 < b.size(); ++i) c.phase_times_s[i] += (b[i + 1] - b[i]) / double(n);
+  }
   if (n > 0) {
     double T = 0, d = 0;
     for (double v : c.cycle_times_s) T += v;

@@ -196,6 +196,11 @@ struct CycleFigures {
   int cycles_completed = 0;
   std::vector<double> cycle_times_s, cycle_displacements_m;
   double displacement_per_cycle_m = 0, cycle_time_s = 0, mean_velocity_per_cycle_m_per_s = 0;
+  /// The protocol's phases, s, averaged over the completed cycles: from a cycle's start to the
+  /// first segment reaching R_f, between successive segments reaching it, and from the last one
+  /// to the cycle's end (the recovery); they sum to cycle_time_s. Empty when no cycle completed
+  /// from events or the cycles do not all have the same number of phases.
+  std::vector<double> phase_times_s;
 };
 CycleFigures cycle_figures(const RunRecord& r);
 

@@ -191,6 +191,12 @@ def order_text(e):
     """'observed order 0.82' / 'not asymptotic' for an extrapolation's legend entry."""
     if e is None:
         return "no extrapolation"
+    if e.get("phases"):
+        orders = ", ".join(f"{q['observed_order']:.2f}" if q.get("observed_order") is not None else "—"
+                           for q in e["phases"])
+        return f"sum of {len(e['phases'])} phases extrapolated apart (orders {orders})"
+    if e.get("direct") is not None:
+        return "displacement over the phases' cycle time"
     obs = e.get("observed_order")
     if e.get("asymptotic") and e.get("order"):
         return f"order {e['order']:.2f}" + ("" if obs is not None else " (assumed)")
@@ -664,6 +670,12 @@ def reference_markdown(c):
         out.append(f"- {words}: {si(e['value'], unit)} ± {si(e['error'], unit)}"
                    f"{'' if rel is None else f' (± {100 * rel:.2g} %)'}; {order_text(e)}; "
                    f"{'converged' if e.get('converged') else 'not converged'}; {e.get('note', '')}")
+        for q in e.get("phases", []):
+            out.append(f"  - {q['phase']}: {si(q['value'], unit)} ± {si(q['error'], unit)}; {order_text(q)}")
+        for alt, words_alt in (("whole_cycle", "the whole cycle's series"), ("direct", "extrapolated directly")):
+            w = e.get(alt)
+            if w:
+                out.append(f"  - {words_alt}: {si(w['value'], unit)} ± {si(w['error'], unit)}; {order_text(w)}")
     cmp = c.get("comparison_3d_vs_reference") or {}
     if cmp:
         out += ["", "3D extrapolation against the axisymmetric reference (agree when |Δ| ≤ e_3d + e_ref):", "",

@@ -146,4 +146,33 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
   return e;
 }
 
+SumExtrapolation richardson_sum(const std::vector<double>& h, const std::vector<std::vector<double>>& parts,
+                                double assumed_order, OrderRange range, double target) {
+  if (parts.size() != h.size() || parts.empty())
+    throw InputError("validation grids", std::to_string(parts.size()), "one list of parts per grid");
+  const std::size_t np = parts.front().size();
+  for (const auto& p : parts)
+    if (p.size() != np || np < 2)
+      throw InputError("parts of a figure", std::to_string(p.size()), "the same number (two or more) on every grid");
+  SumExtrapolation s;
+  for (std::size_t k = 0; k < np; ++k) {
+    std::vector<double> f;
+    for (const auto& p : parts) f.push_back(p[k]);
+    s.parts.push_back(richardson(h, f, assumed_order, range));
+    s.value += s.parts.back().value;
+    s.error += std::abs(s.parts.back().error);
+  }
+  s.relative_error = std::abs(s.value) > 0 ? s.error / std::abs(s.value) : std::numeric_limits<double>::infinity();
+  bool each = true;
+  s.asymptotic = true;
+  for (const Extrapolation& e : s.parts) {
+    const bool ordered = e.asymptotic && std::isfinite(e.observed_order);
+    const bool negligible = std::abs(e.error) <= 0.1 * target * std::abs(s.value);
+    each = each && (ordered || negligible);
+    s.asymptotic = s.asymptotic && e.asymptotic;
+  }
+  s.converged = each && s.relative_error <= target;
+  return s;
+}
+
 }  // namespace swim::validation

@@ -64,4 +64,26 @@ double bracketed_root(const std::function<double(double)>& f, double lo, double 
 Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order = 1.0,
                          OrderRange range = kImmersedBoundaryOrders);
 
+/// A figure that is the sum of parts that converge differently (the cycle time as the sum of
+/// the protocol's phases), each part extrapolated on its own with richardson(). Where the
+/// parts' errors have opposite signs and different orders, the sum's own series can show no
+/// order although each part has one.
+struct SumExtrapolation {
+  double value = 0;          ///< sum of the parts' values
+  double error = 0;          ///< sum of the parts' |errors|
+  double relative_error = 0; ///< error / |value|
+  bool asymptotic = false;   ///< every part asymptotic
+  /// relative_error <= target, and every part either asymptotic with an observed order or
+  /// carrying an error of at most a tenth of the target (relative to the sum): a part too
+  /// short for its grid differences to show an order cannot spoil the sum
+  bool converged = false;
+  std::vector<Extrapolation> parts;
+};
+
+/// h: grid spacings; parts[g]: the parts on grid g (the same number on every grid, two or
+/// more), target: the relative error the sum must reach. Throws InputError as richardson(),
+/// and for parts that differ in number or are fewer than two.
+SumExtrapolation richardson_sum(const std::vector<double>& h, const std::vector<std::vector<double>>& parts,
+                                double assumed_order, OrderRange range, double target);
+
 }  // namespace swim::validation

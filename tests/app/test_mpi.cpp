@@ -169,10 +169,12 @@ TEST(MpiScreen, AKilledRankIsReportedItsRunsRedoneOrTheRestartReusesTheFinishedR
                              (d / "restarted").string() + "\"",
                          d, "aborted");
   EXPECT_NE(aborted.code, 0);
-  // rank 0 says why it stopped (and names the runs in flight when it was handing them out);
-  // mpirun names the rank that died
+  // the user is told the job was stopped: by rank 0 when mpirun's SIGTERM reaches it before the
+  // SIGKILL that follows (not guaranteed on a loaded machine), by mpirun in any case; mpirun
+  // names the rank that died
   EXPECT_TRUE(aborted.err.find("swim: stopped by") != std::string::npos ||
-              aborted.err.find("interrupted by SIGTERM") != std::string::npos)
+              aborted.err.find("interrupted by SIGTERM") != std::string::npos ||
+              aborted.err.find("the job has been aborted") != std::string::npos)
       << aborted.err;
   EXPECT_TRUE(aborted.err.find(",1]") != std::string::npos || aborted.err.find("rank 1") != std::string::npos)
       << aborted.err;

@@ -130,6 +130,28 @@ TEST(RunRecord, EventsTakeTheDisplacementInterpolatedBetweenTheRowsAroundThem) {
   EXPECT_NEAR(s["min_radius_m"].get<double>(), 9e-8, 1e-22);
 }
 
+// The cycle's protocol phases: start -> first segment at R_f -> ... -> last -> end, averaged
+// over the cycles; they sum to the cycle time. Cycles with different phase counts give none.
+TEST(RunRecord, CyclePhasesRunBetweenTheSegmentEventsAndSumToTheCycleTime) {
+  RunRecord r("axi", "m", 1e-7, columns(), {0.0});
+  r.cycle_started(0.0);
+  r.add_row(row_at(0.0));
+  r.events.segment_reached_s = {0.1, 0.25, 0.6, 0.72};  // two per cycle, the second cycle's later
+  r.cycle_ended(0.5);
+  r.cycle_started(0.5);
+  r.add_row(row_at(0.5));
+  r.cycle_ended(1.1);
+  r.add_row(row_at(1.1));
+  const CycleFigures c = cycle_figures(r);
+  ASSERT_EQ(c.phase_times_s.size(), 3u);
+  EXPECT_NEAR(c.phase_times_s[0], (0.1 + 0.1) / 2, 1e-15);
+  EXPECT_NEAR(c.phase_times_s[1], (0.15 + 0.12) / 2, 1e-15);
+  EXPECT_NEAR(c.phase_times_s[2], (0.25 + 0.38) / 2, 1e-15);
+  EXPECT_NEAR(c.phase_times_s[0] + c.phase_times_s[1] + c.phase_times_s[2], c.cycle_time_s, 1e-15);
+  r.events.segment_reached_s = {0.1, 0.25, 0.6};  // the second cycle has one event only
+  EXPECT_TRUE(cycle_figures(r).phase_times_s.empty());
+}
+
 TEST(RunRecord, NoCompletedCycleGivesNullPerCycleFiguresWithTheReason) {
   RunRecord r("3d", "m", 1e-7, columns(), {0.0});
   r.cycle_started(0.0);

@@ -45,6 +45,44 @@ TEST(Richardson, NonMonotoneSequenceIsReportedNotExtrapolated) {
   EXPECT_DOUBLE_EQ(e.error, 2.0);
 }
 
+// A sum of two parts with errors of opposite sign and different orders (order 1.5 from below,
+// 3 from above, as a first contraction and the rest of a cycle): the sum's own series shows no
+// order, the parts extrapolated apart recover the limit and both orders.
+TEST(Richardson, ASumOfPartsIsExtrapolatedPartByPart) {
+  const std::vector<double> h = {0.06, 0.04, 0.03};
+  std::vector<std::vector<double>> parts;
+  std::vector<double> sum;
+  for (double x : h) {
+    parts.push_back({0.110 - 0.2 * std::pow(x, 1.5), 0.211 + 10.0 * std::pow(x, 3.0)});
+    sum.push_back(parts.back()[0] + parts.back()[1]);
+  }
+  EXPECT_FALSE(richardson(h, sum, 1.0, kSharpInterfaceOrders).asymptotic);
+  const SumExtrapolation s = richardson_sum(h, parts, 1.0, kSharpInterfaceOrders, 0.01);
+  ASSERT_EQ(s.parts.size(), 2u);
+  EXPECT_NEAR(s.parts[0].order, 1.5, 1e-8);
+  EXPECT_NEAR(s.parts[1].order, 3.0, 1e-8);
+  EXPECT_NEAR(s.value, 0.321, 1e-12);
+  EXPECT_NEAR(s.error, std::abs(s.parts[0].value - parts[2][0]) + std::abs(s.parts[1].value - parts[2][1]), 1e-15);
+  EXPECT_TRUE(s.asymptotic);
+  EXPECT_TRUE(s.converged);                                   // 0.41 % <= 1 %
+  EXPECT_FALSE(richardson_sum(h, parts, 1.0, kSharpInterfaceOrders, 0.003).converged);  // > 0.3 %
+  // a third part without an order: harmless when its spread is below a tenth of the target,
+  // fatal when it is not
+  auto with_third = [&](std::vector<double> third) {
+    auto p = parts;
+    for (std::size_t g = 0; g < p.size(); ++g) p[g].push_back(third[g]);
+    return richardson_sum(h, p, 1.0, kSharpInterfaceOrders, 0.01);
+  };
+  const SumExtrapolation tiny = with_third({0.001, 0.001001, 0.0010005});
+  EXPECT_FALSE(tiny.asymptotic);
+  EXPECT_TRUE(tiny.converged);
+  EXPECT_FALSE(with_third({0.001, 0.002, 0.0015}).converged);
+  // parts that differ in number from grid to grid are refused
+  auto bad = parts;
+  bad[1].push_back(0.0);
+  EXPECT_THROW(richardson_sum(h, bad, 1.0, kSharpInterfaceOrders, 0.01), InputError);
+}
+
 // Two grids: the assumed order is used. f = 1 + h: from h = 2, 1 the limit is 1.
 TEST(Richardson, TwoGridsUseTheAssumedOrder) {
   const Extrapolation e = richardson({2, 1}, {3.0, 2.0}, 1.0);
