@@ -4,6 +4,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 
 #include "app/app.hpp"
 #include "app/scene_checks.hpp"
@@ -54,13 +55,26 @@ void plot_and_list(const std::string& out, bool plot_asked, bool had_plot) {
                    out.c_str());
     return;
   }
-  if (!plot("plot_run.py", {out}) || !output::adopt(png.string())) return;
   const std::string path = (fs::path(out) / "summary.json").string();
-  std::ifstream in(path);
-  scene::json j = scene::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return;
-  for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
-  output::write_json(path, j);
+  // the summary committed again (still last), after `change`
+  auto rewrite_summary = [&](const std::function<void(scene::json&)>& change) {
+    std::ifstream in(path);
+    scene::json j = scene::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object()) return;
+    for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
+    change(j);
+    output::write_json(path, j);
+  };
+  try {
+    if (!plot("plot_run.py", {out}) || !output::adopt(png.string())) return;
+  } catch (const Interrupted& e) {
+    // the results are complete; the command is not: the status says so, and run.png is not listed
+    rewrite_summary([&](scene::json& j) {
+      j["status"] = std::string(e.what()) + "; the results are complete, run.png was not written";
+    });
+    throw;
+  }
+  rewrite_summary([](scene::json&) {});
 }
 
 // One human-readable line per 1D run, SI prefixes; per-cycle figures only when a cycle completed.

@@ -29,14 +29,14 @@ const json& section_or_empty(const json& sc, const char* key) {
 const json& section_keys() {
   static const json keys = {{"axi",
                              {{"method", "choice:fitted|immersed_boundary"},
-                              {"grid", {{"cells_across", "integer"}, {"cell_size", "quantity:m"}}},
-                              {"spacing_factor", "number"},
-                              {"rim_refinement", "number"},
-                              {"tolerance", "number"},
-                              {"dt_max", "quantity:s"},
-                              {"dt_min", "quantity:s"},
-                              {"event_dt", "quantity:s"},
-                              {"time_limit", "quantity:s"}}}};
+                              {"grid", {{"cells_across", "integer@[8,8192]"}, {"cell_size", "quantity:m@positive"}}},
+                              {"spacing_factor", "number@(0,2]"},  // (0, 1) for the immersed boundary
+                              {"rim_refinement", "number@positive"},
+                              {"tolerance", "number@(0,1)"},
+                              {"dt_max", "quantity:s@positive"},
+                              {"dt_min", "quantity:s@positive"},
+                              {"event_dt", "quantity:s@positive"},
+                              {"time_limit", "quantity:s@positive"}}}};
   return keys;
 }
 

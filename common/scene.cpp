@@ -236,6 +236,26 @@ void Reader::pass_through(const std::string& key) {
   if (has(key)) (*resolved_)[key] = node_->at(key);
 }
 
+namespace {
+/// The range of a schema kind's "@<range>" suffix: "positive", "non_negative", or an interval
+/// "(a,b)", "[a,b]", "(a,b]", "[a,b)"; none: any finite value.
+Range schema_range(const std::string& spec, const std::string& key) {
+  if (spec.empty()) return {};
+  if (spec == "positive") return Range::positive();
+  if (spec == "non_negative") return Range::non_negative();
+  const size_t comma = spec.find(',');
+  if (spec.size() < 5 || comma == std::string::npos || (spec.front() != '(' && spec.front() != '[') ||
+      (spec.back() != ')' && spec.back() != ']'))
+    throw std::logic_error("internal: bad range '" + spec + "' in the section schema of " + key);
+  Range r;
+  r.lo = std::stod(spec.substr(1, comma - 1));
+  r.hi = std::stod(spec.substr(comma + 1, spec.size() - comma - 2));
+  r.lo_open = spec.front() == '(';
+  r.hi_open = spec.back() == ')';
+  return r;
+}
+}  // namespace
+
 void check_section(const json& node, const std::string& path, const json& schema) {
   if (!node.is_object()) throw InputError(path, show(node), "must be a JSON object");
   std::vector<std::string> keys;
@@ -250,16 +270,23 @@ void check_section(const json& node, const std::string& path, const json& schema
       check_section(v, key, kind);
       continue;
     }
-    const std::string k = kind.get<std::string>();
+    const std::string spec = kind.get<std::string>();
+    const size_t at = spec.find('@');
+    const std::string k = spec.substr(0, at);
+    const Range range = schema_range(at == std::string::npos ? "" : spec.substr(at + 1), key);
     if (k.rfind("quantity:", 0) == 0) {
       const std::string unit = k.substr(9);
       if (!v.is_string())
         throw InputError(key, show(v), "must be a string \"<number> <unit>\" with a unit convertible to " + unit);
-      units::parse(key, v.get<std::string>(), unit);
+      const auto q = units::parse(key, v.get<std::string>(), unit);
+      if (!range.contains(q.si))
+        throw InputError(key, show(v), range.describe(unit) + " (got " + fmt(q.si) + " " + unit + ")");
     } else if (k == "number") {
       if (!v.is_number()) throw InputError(key, show(v), "must be a number (dimensionless)");
+      if (!range.contains(v.get<double>())) throw InputError(key, show(v), range.describe(""));
     } else if (k == "integer") {
       if (!v.is_number_integer()) throw InputError(key, show(v), "must be an integer");
+      if (!range.contains(v.get<double>())) throw InputError(key, show(v), range.describe(""));
     } else if (k == "boolean") {
       if (!v.is_boolean()) throw InputError(key, show(v), "must be true or false");
     } else if (k == "text") {

@@ -79,7 +79,9 @@ std::string show(const json& value);
 /// passes the section through still rejects a malformed one (the resolved scene must run on
 /// both tiers). `schema` is an object: key -> nested object (a sub-section) or a kind
 /// string: "quantity:<SI unit>", "number", "integer", "boolean", "text" or
-/// "choice:<a>|<b>|...". Values are checked for kind, unit and choice, not for range.
+/// "choice:<a>|<b>|...". A quantity, number or integer may end in "@<range>": "@positive",
+/// "@non_negative", or an interval "@(a,b)", "@[a,b]", "@(a,b]", "@[a,b)" (SI values), the
+/// range the owning tier's reader accepts. Values are checked for kind, unit, choice and range.
 /// Throws InputError naming the full key (`path`.key).
 void check_section(const json& node, const std::string& path, const json& schema);
 

@@ -57,15 +57,11 @@ struct Interrupted {
   std::string out, err;
 };
 
-/// Starts `swim screen` on a two-design sweep, sends `sig` to swim alone once its plotting child
-/// runs, and waits for swim.
-Interrupted interrupt_screen(const fs::path& dir, int sig) {
-  const json sweep = {{"base", SWIM_SOURCE_DIR "/data/scenes/demo.json"},
-                      {"vary", {{"wave.contracted_ratio", {{"values", {0.5, 0.6}}}}}}};
-  std::ofstream(dir / "sweep.json") << sweep.dump();
+/// Starts swim with `args` (after the executable), sends `sig` to swim alone once its plotting
+/// child runs, and waits for swim.
+Interrupted interrupt_plot(const fs::path& dir, std::vector<std::string> args, int sig) {
   const std::string swim = SWIM_BINARY_DIR "/bin/swim";
-  const std::string sweep_path = (dir / "sweep.json").string(), out = (dir / "out").string();
-  std::vector<std::string> args = {swim, "screen", sweep_path, "--out", out, "--jobs", "1", "--quiet"};
+  args.insert(args.begin(), swim);
   std::vector<char*> argv;
   for (auto& a : args) argv.push_back(a.data());
   argv.push_back(nullptr);
@@ -98,7 +94,36 @@ Interrupted interrupt_screen(const fs::path& dir, int sig) {
   return r;
 }
 
+/// `swim screen` on a two-design sweep, interrupted while it plots.
+Interrupted interrupt_screen(const fs::path& dir, int sig) {
+  const json sweep = {{"base", SWIM_SOURCE_DIR "/data/scenes/demo.json"},
+                      {"vary", {{"wave.contracted_ratio", {{"values", {0.5, 0.6}}}}}}};
+  std::ofstream(dir / "sweep.json") << sweep.dump();
+  return interrupt_plot(dir, {"screen", (dir / "sweep.json").string(), "--out", (dir / "out").string(), "--jobs", "1",
+                              "--quiet"},
+                        sig);
+}
+
 }  // namespace
+
+// `swim run --plot` likewise: the results are complete, the command is not; summary.json says
+// interrupted and does not list run.png.
+TEST(Signals, AnInterruptDuringARunsPlotSaysInterruptedInItsSummary) {
+  const fs::path dir = tmpdir("run_plot");
+  const Interrupted r = interrupt_plot(
+      dir, {"run", SWIM_SOURCE_DIR "/data/scenes/demo.json", "--plot", "--out", (dir / "out").string(), "--quiet"}, SIGINT);
+  ASSERT_NE(r.child, 0) << "swim run never started its plotting child; stderr: " << slurp(dir / "stderr.txt");
+  ASSERT_TRUE(WIFEXITED(r.status)) << "swim was killed by signal " << WTERMSIG(r.status);
+  EXPECT_EQ(WEXITSTATUS(r.status), 128 + SIGINT) << r.err;
+  EXPECT_EQ(::kill(r.child, 0), -1);
+  const json summary = json::parse(slurp(dir / "out" / "summary.json"));
+  EXPECT_EQ(summary["status"].get<std::string>().rfind("interrupted by SIGINT", 0), 0u) << summary["status"];
+  EXPECT_NE(summary["status"].get<std::string>().find("the results are complete"), std::string::npos);
+  for (const auto& f : summary["files"]) EXPECT_NE(f["name"], "run.png");
+  EXPECT_TRUE(summary["displacement_per_cycle_m"].is_number());
+  EXPECT_NE(r.err.find("interrupted by SIGINT"), std::string::npos) << r.err;
+  fs::remove_all(dir);
+}
 
 TEST(Signals, AnInterruptDuringPlottingStopsTheChildAndTheCommandSaysInterrupted) {
   for (const int sig : {SIGINT, SIGTERM}) {

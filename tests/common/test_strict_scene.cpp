@@ -11,6 +11,7 @@
 #include <string>
 
 #include "app/scene_checks.hpp"
+#include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "common/scene.hpp"
 #include "common/strict_json.hpp"
@@ -329,4 +330,59 @@ TEST(StrictScene, SectionKeyListsMatchTheTierReaders) {
     EXPECT_EQ(msg.find("unknown key"), std::string::npos) << msg;
   }
   (void)junk;
+}
+
+// One scene, one validation: the range a section's schema states for a value is the range the
+// owning tier's reader accepts. For every ranged leaf of the 3D and axisymmetric sections, a
+// value just outside it is refused by the schema check (what a run of another tier applies)
+// and by the owning reader, both naming the key; a 1D run refuses `full3d.dt = -1 ms`.
+TEST(StrictScene, OtherTierValuesOutOfRangeAreRefusedAsByTheirOwnReader) {
+  std::vector<std::pair<std::string, std::string>> keys;
+  leaves(swim::full3d::section_keys(), "full3d", keys);
+  leaves(swim::axi::section_keys(), "", keys);
+  int ranged = 0;
+  for (const auto& [path, kind] : keys) {
+    const size_t at = kind.find('@');
+    if (at == std::string::npos) continue;
+    ++ranged;
+    const std::string spec = kind.substr(at + 1), base = kind.substr(0, at);
+    double bad = 0;
+    if (spec == "positive") bad = 0.0;
+    else if (spec == "non_negative") bad = -1.0;
+    else {
+      const double lo = std::stod(spec.substr(1, spec.find(',') - 1));
+      bad = spec.front() == '(' ? lo : lo - 1.0;
+    }
+    json value;
+    if (base.rfind("quantity:", 0) == 0) value = std::to_string(bad) + " " + base.substr(9);
+    else if (base == "integer") value = static_cast<long>(bad);
+    else value = bad;
+    const bool axi = path.rfind("axi.", 0) == 0;
+    // the axisymmetric tier reads round-wall scenes in the cylinder only
+    json sc = axi ? swim::scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json") : json::object();
+    if (axi) sc["full3d"]["membrane"]["axisymmetric"] = true;
+    json section = json::object();
+    swim::scene::apply_override(section, path + "=" + value.dump());
+    const std::string top = axi ? "axi" : "full3d";
+    std::string msg;
+    EXPECT_EQ(rejected_key([&] { swim::scene::check_section(section[top], top, axi ? swim::axi::section_keys()["axi"]
+                                                                                     : swim::full3d::section_keys()); },
+                           &msg),
+              path)
+        << value << ": " << msg;
+    sc.merge_patch(section);
+    json r;
+    EXPECT_EQ(rejected_key([&] {
+                if (axi) swim::axi::read_scene_axi(sc, r);
+                else swim::full3d::read_scene3d(sc, r);
+              }, &msg),
+              path)
+        << value << ": " << msg;
+  }
+  EXPECT_GE(ranged, 25);
+  // a 1D run checks the 3D section's values, not only their kinds
+  std::string msg;
+  EXPECT_EQ(read1d_key(json::parse(R"({"full3d": {"dt": "-1 ms"}})"), &msg), "full3d.dt") << msg;
+  EXPECT_NE(msg.find("must be > 0"), std::string::npos) << msg;
+  EXPECT_EQ(read1d_key(json::parse(R"({"axi": {"grid": {"cells_across": 4}}})"), &msg), "axi.grid.cells_across") << msg;
 }
