@@ -25,6 +25,7 @@
 #include "axi/scene_axi.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
+#include "full3d/scene3d_keys.hpp"
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
@@ -1096,10 +1097,21 @@ void check_suite(const json& s, const std::string& path, const std::string& data
     const std::string grid_key = cases[i].value("grid_key", std::string("full3d.grid.cells_across"));
     const json& grids = cases[i]["grids"];
     // the 3D reader builds the membrane mesh (up to seconds on a fine grid): the scene and its
-    // time-step variants are read at the first (coarsest) grid
+    // time-step variants are read at the first (coarsest) grid; the other grids' 3D sections
+    // are checked against the ranges the reader accepts (scene::check_section)
     json s0 = base;
     set_key(s0, grid_key, grids[0]);
     check_3d(s0, at + ".grids[0]", grid_key + " = " + grids[0].dump());
+    for (std::size_t g = 1; g < grids.size(); ++g) {
+      json sg = base;
+      set_key(sg, grid_key, grids[g]);
+      try {
+        if (sg.contains("full3d")) scene::check_section(sg["full3d"], "full3d", full3d::section_keys());
+      } catch (const InputError& e) {
+        throw InputError(at + ".grids[" + std::to_string(g) + "]", grid_key + " = " + grids[g].dump(),
+                         std::string("a scene the 3D tier runs; it refuses this one: ") + e.what());
+      }
+    }
     json resolved0;
     const double c1 = full3d::read_scene3d(s0, resolved0).c1_estimate();
     if (cases[i].contains("time_variants3d"))

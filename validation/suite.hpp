@@ -74,7 +74,10 @@ scene::json load_suite(const std::string& path, const std::string& data_dir = ""
 /// read by the 3D reader with its time-step variants, every 1D model's scene by the 1D
 /// reader (also at each of cells1d and rtol1d), the extremes' scene files, the references' scenes
 /// by the axi reader. The 3D reader reads each case (and its time-step variants) at its first
-/// grid: it builds the membrane mesh, seconds on a fine grid; the other grids are read as they run.
+/// grid: it builds the membrane mesh, seconds on a fine grid; on the other grids the case's
+/// `full3d` section is checked against the ranges the reader accepts (a grid out of range is
+/// an InputError naming suite.cases[i].grids[g]), and rules that join several keys are checked
+/// as they run.
 void check_suite(const scene::json& suite, const std::string& path, const std::string& data_dir, bool scenes = true);
 
 }  // namespace swim::validation

@@ -157,6 +157,17 @@ TEST(SuiteFile, MalformedSuitesNameTheKey) {
              "calibration_grid");
   expect_key(R"({"cases": [{"scene": "x.json", "grids": [32, 40]}], )" + models + "}", "thresholds");
   expect_key(R"({"cases": [{"grids": [32, 40]}], )" + models + ", " + th + "}", "scene");
+  // every grid of a case, not only the first, is one the 3D tier accepts
+  const std::string data = SWIM_SOURCE_DIR "/data";
+  std::ofstream(path) << R"({"cases": [{"scene": "paper_amplitude_0.82.json", "grids": [32, 40, 5000]}], )" + models +
+                             ", " + th + "}";
+  try {
+    load_suite(path, data);
+    ADD_FAILURE() << "accepted a third grid of 5000 cells across";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "suite.cases[0].grids[2]") << e.what();
+    EXPECT_NE(std::string(e.what()).find("full3d.grid.cells_across"), std::string::npos) << e.what();
+  }
 }
 
 // The shipped suites are well formed.
