@@ -1,11 +1,13 @@
 // The quick validation suite end to end (swim validate --quick, without the figures): three
 // coarse 3D grids of the small duct scene, the calibration, every 1D model, the report; the
 // cache of runs (other output settings, an older resolution, an interrupted run).
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -200,4 +202,23 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   EXPECT_EQ(c5["runs3d"][0]["displacement_per_cycle_m"], c["runs3d"][0]["displacement_per_cycle_m"]);
   EXPECT_EQ(c5["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
   EXPECT_EQ(c5["models1d"][0]["displacement_per_cycle_m"], c["models1d"][0]["displacement_per_cycle_m"]);
+
+  // through the command line: a damaged cached run is rejected, named, recomputed, and the
+  // command exits 0 with a report whose figures are those of the first suite
+  change_digit(fs::path(stopped) / "series.csv", "\n");
+  const std::string log = out + "/validate.txt";
+  const std::string cmd = std::string("\"") + SWIM_BINARY_DIR + "/bin/swim\" validate \"" + o.suite + "\" --out \"" + out +
+                          "\" --threads 1 --quiet > \"" + log + "\" 2>&1";
+  const int status = std::system(cmd.c_str());
+  std::ifstream in(log);
+  std::stringstream printed;
+  printed << in.rdbuf();
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 0) << printed.str();
+  EXPECT_NE(printed.str().find("1 rejected and recomputed"), std::string::npos) << printed.str();
+  EXPECT_NE(printed.str().find("series.csv: changed"), std::string::npos) << printed.str();
+  std::ifstream rin(out + "/report.json");
+  const scene::json r6 = scene::json::parse(rin);
+  EXPECT_EQ(r6["cache"]["rejected"], 1) << r6["cache"].dump();
+  EXPECT_EQ(r6["cases"][0]["runs3d"][0]["displacement_per_cycle_m"], c["runs3d"][0]["displacement_per_cycle_m"]);
 }
