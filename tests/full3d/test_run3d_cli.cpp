@@ -3,18 +3,26 @@
 // --resume of a finished run folder, a damaged checkpoint refused (exit 2, folder untouched)
 // and a checkpoint that cannot be written (exit 3 naming it).
 #include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
+#include <thread>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 #include <sstream>
 
+#include "common/atomic_file.hpp"
+#include "common/run_folder.hpp"
+
 namespace fs = std::filesystem;
 
 namespace {
-int swim(const std::string& args) {
+int swim_cli(const std::string& args) {
   const int s = std::system((std::string("\"") + SWIM_BINARY_DIR + "/bin/swim\" " + args + " > /dev/null 2>&1").c_str());
   return WIFEXITED(s) ? WEXITSTATUS(s) : -1;
 }
@@ -50,7 +58,7 @@ std::string dir(const std::string& n) {
 
 TEST(SwimRun3d, WritesContractFiles) {
   const std::string d = dir("ok");
-  ASSERT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d +
+  ASSERT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d +
                  "\" --set full3d.dt='\"1 ms\"' --set time.duration='\"12 ms\"' --set full3d.output.vtk_interval='\"5 ms\"'"
                  " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"10 ms\"'"),
             0);
@@ -72,7 +80,7 @@ TEST(SwimRun3d, WritesContractFiles) {
   std::getline(csv, header);
   EXPECT_EQ(header.rfind("t_s,x_center_m,velocity_m_per_s,energy_J,min_radius_m,max_radius_m", 0), 0u);
   // a finished run resumes to the same end (nothing left to do)
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --resume \"" + d +
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --resume \"" + d +
                  "\" --set full3d.dt='\"1 ms\"' --set time.duration='\"12 ms\"' --set full3d.output.vtk_interval='\"5 ms\"'"
                  " --set full3d.output.fluid_fields=true --set full3d.output.fluid_interval='\"10 ms\"'"),
             0);
@@ -80,18 +88,18 @@ TEST(SwimRun3d, WritesContractFiles) {
 
 TEST(SwimRun3d, BadInputExits2AndWritesNothing) {
   const std::string d = dir("bad");
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.kind='\"cylinder\"'"
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.kind='\"cylinder\"'"
                  " --set full3d.scheme='\"bogus\"'"), 2);
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.bogus=1"), 2);
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.radius='\"0.15 um\"'"), 2);
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.bogus=1"), 2);
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.radius='\"0.15 um\"'"), 2);
   EXPECT_FALSE(fs::exists(d));
 }
 
 TEST(SwimRun3d, UnstableTimeStepExits3WithPartialResults) {
   const std::string d = dir("unstable");
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d +
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d +
                  "\" --set full3d.dt='\"50 ms\"' --set time.duration='\"2 s\"'"),
             3);
   std::ifstream in(d + "/summary.json");
@@ -103,7 +111,7 @@ TEST(SwimRun3d, UnstableTimeStepExits3WithPartialResults) {
 TEST(SwimRun3d, ADamagedCheckpointIsExitTwoAndTheFolderIsUntouched) {
   const std::string d = dir("damaged");
   const std::string sets = " --set full3d.dt='\"1 ms\"' --set time.duration='\"6 ms\"' --set full3d.checkpoint_interval='\"2 ms\"'";
-  ASSERT_EQ(swim("run " + kScene + " --tier 3d --quiet --out \"" + d + "\"" + sets), 0);
+  ASSERT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\"" + sets), 0);
   const std::string ck = d + "/checkpoint.bin";
   std::string bytes = snapshot(d)["checkpoint.bin"];
   ASSERT_GT(bytes.size(), 1000u);
@@ -117,7 +125,7 @@ TEST(SwimRun3d, ADamagedCheckpointIsExitTwoAndTheFolderIsUntouched) {
   EXPECT_NE(err.find("--overwrite"), std::string::npos) << err;
   EXPECT_EQ(snapshot(d), before);
   // as advised: the run again with --overwrite
-  EXPECT_EQ(swim("run " + kScene + " --tier 3d --quiet --overwrite --out \"" + d + "\"" + sets), 0);
+  EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --overwrite --out \"" + d + "\"" + sets), 0);
 }
 
 TEST(SwimRun3d, ACheckpointWriteFailureIsExitThreeNamingTheFile) {
@@ -134,4 +142,63 @@ TEST(SwimRun3d, ACheckpointWriteFailureIsExitThreeNamingTheFile) {
   if (in) {
     EXPECT_EQ(nlohmann::json::parse(in)["status"].get<std::string>().rfind("failed: ", 0), 0u);
   }
+}
+
+// SIGTERM sent to a running `swim run --tier 3d` just after it wrote a checkpoint: the folder
+// says "running", and its summary.json lists checkpoint.bin (and every file of the checkpoint)
+// with the size and checksum on disk; `--resume` finishes the run, its folder verifies as a
+// whole, and series.csv is byte-identical to the uninterrupted run's.
+TEST(SwimRun3d, ASigtermedRunsFolderDescribesItsCheckpointAndItsResumeEqualsTheWholeRun) {
+  const std::string sets = " --set full3d.dt='\"1 ms\"' --set time.duration='\"400 ms\"' --set time.output_interval='\"1 ms\"'"
+                           " --set full3d.checkpoint_interval='\"20 ms\"' --set full3d.output.vtk_interval='\"50 ms\"'";
+  const std::string whole = dir("sigterm_whole"), cut = dir("sigterm_cut");
+  ASSERT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + whole + "\"" + sets), 0);
+  const pid_t pid = ::fork();
+  ASSERT_GE(pid, 0);
+  if (pid == 0) {
+    const std::string exe = std::string(SWIM_BINARY_DIR) + "/bin/swim";
+    const std::string cmd = "exec \"" + exe + "\" run " + kScene + " --tier 3d --quiet --out \"" + cut + "\"" + sets +
+                            " > /dev/null 2>&1";
+    ::execl("/bin/sh", "sh", "-c", cmd.c_str(), static_cast<char*>(nullptr));
+    ::_exit(127);
+  }
+  // the first summary written at a checkpoint (status "running", checkpoint.bin listed)
+  bool at_checkpoint = false;
+  const auto t0 = std::chrono::steady_clock::now();
+  while (!at_checkpoint && std::chrono::steady_clock::now() - t0 < std::chrono::seconds(60)) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(2));
+    std::ifstream in(cut + "/summary.json");
+    const auto j = nlohmann::json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.contains("status") || j["status"].get<std::string>().rfind("running", 0) != 0) continue;
+    for (const auto& f : j["files"])
+      if (f["name"] == "checkpoint.bin") at_checkpoint = true;
+  }
+  ASSERT_TRUE(at_checkpoint) << "the run never wrote a checkpoint";
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  ::waitpid(pid, &status, 0);
+  ASSERT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << "the run ended before the signal: " << status;
+  // the folder as the signal left it: the summary describes the files of its checkpoint exactly
+  {
+    std::ifstream in(cut + "/summary.json");
+    const auto j = nlohmann::json::parse(in);
+    EXPECT_EQ(j["status"].get<std::string>().rfind("running", 0), 0u) << j["status"];
+    int exact = 0;
+    for (const auto& f : j["files"]) {
+      const std::string name = f["name"], path = cut + "/" + name;
+      ASSERT_TRUE(fs::exists(path)) << name;
+      if (name.size() > 5 && name.substr(name.size() - 5) == ".part") {
+        EXPECT_LE(f["bytes"].get<std::uintmax_t>(), fs::file_size(path)) << name;  // streamed on since
+        continue;
+      }
+      EXPECT_EQ(f["bytes"].get<std::uintmax_t>(), fs::file_size(path)) << name;
+      EXPECT_EQ(f["fnv1a64"], swim::output::file_checksum(path)) << name;
+      ++exact;
+    }
+    EXPECT_GE(exact, 2);  // checkpoint.bin and scene.resolved.json at least
+  }
+  ASSERT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --resume \"" + cut + "\"" + sets), 0);
+  EXPECT_EQ(swim::output::verify_folder(cut, {"series.csv", "radius.csv", "checkpoint.bin"}), "");
+  EXPECT_EQ(snapshot(cut)["series.csv"], snapshot(whole)["series.csv"]);
+  EXPECT_EQ(snapshot(cut)["radius.csv"], snapshot(whole)["radius.csv"]);
 }
