@@ -301,6 +301,22 @@ TEST(RunFolderCli, ARunWhoseOutputWouldExceedTheLimitIsRefused) {
   EXPECT_EQ(c.code, 2) << c.err;
   EXPECT_NE(c.err.find("'full3d.output.vtk_interval'"), std::string::npos) << c.err;
   EXPECT_FALSE(fs::exists(out));
+  // the 3D estimate bounds what the run writes (the frames' size before compression), and is
+  // not far above it (compression gains a factor of about 3.5 on the membrane frames)
+  const std::string frames = " --set full3d.output.vtk_interval='\"1 ms\"' --set full3d.output.fluid_fields=true"
+                             " --set full3d.output.fluid_interval='\"2 ms\"'";
+  c = swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() + "\"" + kTiny3dFast + frames +
+                   " --set output.max_bytes=1000",
+               d);
+  ASSERT_EQ(c.code, 2) << c.err;
+  ASSERT_TRUE(std::regex_search(c.err, m, std::regex(R"(about ([0-9.]+) (kB|MB|GB))"))) << c.err;
+  const double estimate3d = std::stod(m[1]) * (m[2] == "kB" ? 1e3 : m[2] == "MB" ? 1e6 : 1e9);
+  ASSERT_EQ(swim_cli("run \"" + kTiny3d + "\" --tier 3d --out \"" + out.string() + "\"" + kTiny3dFast + frames, d).code, 0);
+  double written = 0;
+  for (const auto& e : fs::recursive_directory_iterator(out))
+    if (e.is_regular_file() && e.path().extension() != ".bin") written += static_cast<double>(e.file_size());
+  EXPECT_GT(estimate3d, written);
+  EXPECT_LT(estimate3d, 6.0 * written);
   fs::remove_all(d);
 }
 
