@@ -142,6 +142,10 @@ def plot_tube_law(d, c):
     if t.get("buckling_load_Pa"):
         ax[0].axhline(t["buckling_load_Pa"], color="0.5", ls="--", lw=1,
                       label=f"buckling load {t['buckling_load_Pa'] * 1e3:.3g} mPa (ring mode n = {t['buckling_ring_mode']})")
+    if t.get("collapse_load_Pa"):
+        ax[0].axhline(t["collapse_load_Pa"], color="tab:red", ls=":", lw=1,
+                      label=f"free wall collapses between {t['round_up_to_Pa'] * 1e3:.3g} and "
+                            f"{t['collapse_load_Pa'] * 1e3:.3g} mPa")
     ax[0].set(xlabel="middle radius R_mid [\u00b5m]", ylabel="uniform inward load P [Pa]",
               title="load against radius (static equilibria)")
     ax[0].legend(fontsize="small", frameon=False)

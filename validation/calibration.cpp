@@ -592,12 +592,10 @@ TubeLawCalibration calibrate_tube_law(const full3d::Params3d& p, double c1, doub
   t0 = std::chrono::steady_clock::now();
   t.buckled_computed = true;
   {
-    Eigen::Matrix3Xd X = mesh.X0;
     const double tol = o.lbfgs_tolerance * mesh.node_area.maxCoeff();
-    double prev_P = 0;
-    for (double f : load_fractions) {
-      const double P = f * Pscale;
-      Eigen::Matrix3Xd start = X;
+    // one load from `from`: seeded, minimised; false (and the reason) when L-BFGS fails
+    auto relax = [&](double P, const Eigen::Matrix3Xd& from, Eigen::Matrix3Xd& X, LawPoint& lp) {
+      Eigen::Matrix3Xd start = from;
       const Eigen::Matrix3Xd er = full3d::radial_directions(mesh, start);
       for (Eigen::Index i = 0; i < start.cols(); ++i)
         start.col(i) +=
@@ -609,24 +607,52 @@ TubeLawCalibration calibrate_tube_law(const full3d::Params3d& p, double c1, doub
         std::snprintf(b, sizeof b, "L-BFGS did not reach the force tolerance %.3g N at %.4g Pa (residual %.3g N after %d "
                       "iterations)", tol * P, P, mz.residual, mz.iterations);
         t.buckled.stopped_because = b;
-        break;
+        return false;
       }
       X = mz.X;
-      const LawPoint lp = make_point(mesh, P, X, mz.residual, mz.iterations);
-      t.buckled.points.push_back(lp);
+      lp = make_point(mesh, P, X, mz.residual, mz.iterations);
       std::fprintf(stderr, "  buckled branch: P = %.4g Pa  R_mid/R0 = %.4f  spread/R0 = %.3g  %d iterations\n", P,
                    lp.mid_radius_m / R0, lp.radius_spread_m / R0, mz.iterations);
-      if (t.collapse_load_Pa == 0 && lp.radius_spread_m > 0.01 * R0) {
-        t.collapse_load_Pa = P;
-        t.round_up_to_Pa = prev_P;
+      return true;
+    };
+    auto collapsed = [&](const LawPoint& lp) { return lp.radius_spread_m > 0.01 * R0; };
+    Eigen::Matrix3Xd X = mesh.X0, Xround;
+    double prev_P = 0;
+    int after = 0;  // loads after the collapse
+    bool ok = true;
+    for (double f : load_fractions) {
+      const double P = f * Pscale;
+      LawPoint lp;
+      Eigen::Matrix3Xd Xn;
+      if (!(ok = relax(P, X, Xn, lp))) break;
+      if (t.collapse_load_Pa == 0 && collapsed(lp)) {
+        // bracket the collapse: bisect between the last round load and this one, each try
+        // from the last round state
+        double lo = prev_P, hi = P;
+        for (int k = 0; k < o.collapse_bisections && lo > 0; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          LawPoint lm;
+          Eigen::Matrix3Xd Xm;
+          if (!(ok = relax(mid, Xround, Xm, lm))) break;
+          t.buckled.points.push_back(lm);
+          if (collapsed(lm)) hi = mid;
+          else lo = mid, Xround = Xm;
+        }
+        if (!ok) break;
+        t.collapse_load_Pa = hi;
+        t.round_up_to_Pa = lo;
       }
+      X = Xn;
+      if (!collapsed(lp)) Xround = Xn;
+      t.buckled.points.push_back(lp);
       prev_P = P;
-      if (lp.mid_radius_m <= deepest) {
-        t.buckled.stopped_because = "reached R_mid <= deepest_ratio R0";
+      if (t.collapse_load_Pa > 0) ++after;
+      if (lp.mid_radius_m <= deepest && after >= o.loads_after_collapse) {
+        t.buckled.stopped_because = "reached R_mid <= deepest_ratio R0 with loads_after_collapse loads beyond the collapse";
         break;
       }
     }
-    if (t.buckled.stopped_because.empty()) t.buckled.stopped_because = "end of the load list";
+    if (ok && t.buckled.stopped_because.empty()) t.buckled.stopped_because = "end of the load list";
   }
   fit_branch(t.buckled, R0);
   t.buckled.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

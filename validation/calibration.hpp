@@ -136,9 +136,10 @@ struct TubeLawOptions {
   double deepest_ratio = 0.3;            ///< the series ends once R_mid <= this * R0
   double seed_amplitude_ratio = 1e-3;    ///< seeded ring mode at every load, fraction of R0
   double axis_contact_ratio = 0.01;      ///< the load fades within this * R0 of the axis
+  int collapse_bisections = 3;           ///< free wall: bisections of the load bracket of the collapse
+  int loads_after_collapse = 4;          ///< free wall: at least these loads beyond the collapse
   double lbfgs_tolerance = 1e-3;         ///< max nodal force / max nodal load P A_i
   int lbfgs_max_iterations = 20000;
-  int max_loads = 40;
   bool buckled = true;                   ///< also the free wall's branch
 };
 
