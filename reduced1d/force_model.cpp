@@ -185,7 +185,10 @@ bool ForceModel::unpack(const double* y, ModelState& s) const {
       s.V[i] = Vel_s * y[1 + stride * i + 1];
       s.p[i] = P_s * y[1 + stride * i + 2];
     } else {
-      s.p[i] = wall.law ? s.wv[i] + qi : C1 * (Ri - R0) + qi;
+      if (wall.law)
+        s.p[i] = s.wv[i] + qi;
+      else
+        s.p[i] = C1 * (Ri - R0) + qi;
     }
   }
   return ok;
@@ -537,8 +540,10 @@ int ForceModel::res(const double* y, const double* yp, double* F, ModelState& s)
     double T = tr_csum * y[k + 1];
     for (int j = 0; j < J; ++j) T -= tr_c[j] * y[k + 3 + j];
     F[k] = yp[k] - cu * R[i] * y[k + 1];
-    const double wi = wall.law ? s.wv[i] : C1 * (R[i] - R0);
-    F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (wi + s.q[i] + P_s * T - s.p[i]);
+    if (wall.law)
+      F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (s.wv[i] + s.q[i] + P_s * T - s.p[i]);
+    else  // (the linear tier's own expression, for its rounding)
+      F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (C1 * (R[i] - R0) + s.q[i] + P_s * T - s.p[i]);
     F[k + 2] = cp * ((s.Q[i + 1] - s.Q[i]) / h + A0 * yp[k]);
     if (J > 0) {
       const int km = i > 0 ? k - S : k, kp = i + 1 < N ? k + S : k;  // mirror ends

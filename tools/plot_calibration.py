@@ -141,7 +141,7 @@ def plot_tube_law(d, c):
     ax[0].plot([lo * 1e6, R0 * 1e6], [c1 * (R0 - lo), 0], "k:", lw=1, label=f"linear law, C1 = {c1 / 1e6:.4g} MPa/m")
     if t.get("buckling_load_Pa"):
         ax[0].axhline(t["buckling_load_Pa"], color="0.5", ls="--", lw=1,
-                      label=f"buckling load {t['buckling_load_Pa'] * 1e3:.3g} mPa (ring mode n = {t['buckling_ring_mode']})")
+                      label=f"round branch's ring-mode buckling load {t['buckling_load_Pa'] * 1e3:.3g} mPa (n = {t['buckling_ring_mode']})")
     if t.get("collapse_load_Pa"):
         ax[0].axhline(t["collapse_load_Pa"], color="tab:red", ls=":", lw=1,
                       label=f"free wall collapses between {t['round_up_to_Pa'] * 1e3:.3g} and "
