@@ -378,6 +378,8 @@ Minimised minimise_loaded_energy(const full3d::CylinderMesh& mesh, const full3d:
   std::vector<double> rho;
   Minimised out;
   int it = 0;
+  // SWIM_LBFGS_TRACE set: progress on stderr every 500 iterations (and the node of the largest
+  // force every 5 000 evaluations), a diagnostic of slow relaxations
   const bool trace = std::getenv("SWIM_LBFGS_TRACE") != nullptr;
   for (; it < max_iterations && maxf > tol_force; ++it) {
     if (trace && it % 500 == 0)
