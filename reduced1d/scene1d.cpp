@@ -94,15 +94,17 @@ std::shared_ptr<const TubeLaw> tube_law_from_calibration(const std::string& key,
     throw bad("calibration file must hold the tube law \"" + where +
               "\" (written by swim calibrate --tube-law) for wall.law = \"calibrated_" + branch + "\"");
   const json& b = j["tube_law"][branch];
-  std::vector<double> R, w;
-  for (const char* name : {"knots_radius_m", "knots_wall_pressure_Pa"}) {
+  auto numbers = [&](const std::string& name) {
     if (!b.contains(name) || !b[name].is_array())
       throw bad("calibration file must hold an array \"" + where + "." + name + "\"");
+    std::vector<double> out;
     for (const auto& v : b[name]) {
       if (!v.is_number()) throw bad("\"" + where + "." + name + "\" must hold numbers only");
-      (name[6] == 'r' ? R : w).push_back(v.get<double>());
+      out.push_back(v.get<double>());
     }
-  }
+    return out;
+  };
+  std::vector<double> R = numbers("knots_radius_m"), w = numbers("knots_wall_pressure_Pa");
   if (!R.empty() && !(std::abs(R.back() / R0 - 1.0) <= 1e-9))
     throw bad("the tube law was calibrated for a tube of radius " + fmt(R.back(), "m") +
               "; this scene's swimmer.radius is " + fmt(R0, "m") + " (calibrate the scene's own tube)");
