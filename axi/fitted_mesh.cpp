@@ -94,6 +94,7 @@ constexpr double kLeanMax = 1.3089969389957472;     // 75 deg
 constexpr double kGamma = 0.5;                  // axial room given to a steep segment, per length
 constexpr double kWindow = 48;                  // at most this many gentle segments give the room back,
 constexpr double kCapacity = 4.0;               // or as many as have kCapacity times the room
+constexpr int kRowWindow = 3;                   // rows near steep segments graded on the smallest width within 3 columns
 
 double steepness(double a) {
   const double t = std::clamp((a - kA0) / (kA1 - kA0), 0.0, 1.0);
@@ -164,18 +165,55 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
   auto seg_dr = [&](int c) { return rho_[(c + 1) % nc_] - rho_[c]; };
   auto seg_w = [&](int c) { return sizing_width(seg_dx(c), seg_dr(c)); };
 
-  // row fractions: uniform, or graded from the membrane line (heights w_i = eta q^i away from it)
+  // Steepness of the wall-line segments and the extra axial room they get (see the header).
+  std::vector<double> st(nc_), extra(nc_, 0.0);
+  bool steep = false;
+  for (int c = 0; c < nc_; ++c) {
+    st[c] = steepness(std::atan2(std::abs(seg_dr(c)), seg_dx(c)));
+    if (st[c] > 0.0) {
+      steep = true;
+      // gamma l, plus the axial width a turned-back segment loses (smoothly: (|dx| - dx)/2 with
+      // |dx| rounded at 0.1 l)
+      const double l = std::hypot(seg_dx(c), seg_dr(c));
+      extra[c] = st[c] * (kGamma * l + 0.5 * (std::hypot(seg_dx(c), 0.1 * l) - seg_dx(c)));
+    }
+  }
+  auto wrap = [&](int c) { return ((c % nc_) + nc_) % nc_; };
+  // row fractions: uniform, or graded from the membrane line (heights w_i = eta_c q^i away from it)
   const int ci = p_.cells_inner, co = p_.cells_outer;
+  std::vector<double> eta(nc_, 0.0);
+  if (p_.wall_row_aspect > 0.0) {
+    for (int c = 0; c < nc_; ++c) eta[c] = p_.wall_row_aspect * std::min(seg_w(wrap(c - 1)), seg_w(c));
+    // Near steep segments (where the lines lean and fan out) the rows are graded on the smallest
+    // width around: eta_c -> eta_c^(1 - tau_c) emin_c^tau_c, emin_c the smallest eta within
+    // kRowWindow columns, tau_c the largest steepness of the 2 kRowWindow segments around (both
+    // continuous in the shape; 0 on a gentle wall, whose rows are unchanged). Neighbouring
+    // columns there then have their rows at nearly equal distances from the wall line, so that
+    // lines leaning across them do not cross them, as they did on rows graded on each column's
+    // own width, 1.5 times apart per column at the refined rims.
+    std::vector<double> tau(nc_, 0.0);
+    bool any = false;
+    for (int c = 0; c < nc_; ++c) {
+      double t = 0.0;
+      for (int i = -kRowWindow; i < kRowWindow; ++i) t = std::max(t, st[wrap(c + i)]);
+      tau[c] = t;
+      any = any || t > 0.0;
+    }
+    if (any) {
+      std::vector<double> emin(nc_, INFINITY);
+      for (int c = 0; c < nc_; ++c)
+        for (int i = -kRowWindow; i <= kRowWindow; ++i) emin[c] = std::min(emin[c], eta[wrap(c + i)]);
+      for (int c = 0; c < nc_; ++c)
+        if (tau[c] > 0.0) eta[c] = std::exp((1.0 - tau[c]) * std::log(eta[c]) + tau[c] * std::log(emin[c]));
+    }
+  }
   for (int c = 0; c < nc_; ++c) {
     double* f = &frac_[size_t(c) * (ny_ + 1)];
     for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
     for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
     if (!(p_.wall_row_aspect > 0.0)) continue;
-    const double wl = seg_w(c > 0 ? c - 1 : nc_ - 1);
-    const double wr = seg_w(c);
-    const double eta = p_.wall_row_aspect * std::min(wl, wr);
     const double in = rho_[c], out = Rc - rho_[c];
-    const auto hi = gap_widths(in, ci, eta, INFINITY, 4.0), ho = gap_widths(out, co, eta, INFINITY, 4.0);
+    const auto hi = gap_widths(in, ci, eta[c], INFINITY, 4.0), ho = gap_widths(out, co, eta[c], INFINITY, 4.0);
     double acc = 0.0;  // inside: from the membrane line down to the axis
     for (int i = 0; i < ci; ++i) {
       acc += hi[i];
@@ -196,20 +234,6 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     vr[ny_] = Rc;
   }
 
-  // Steepness of the wall-line segments and the extra axial room they get (see the header).
-  std::vector<double> st(nc_), extra(nc_, 0.0);
-  bool steep = false;
-  for (int c = 0; c < nc_; ++c) {
-    st[c] = steepness(std::atan2(std::abs(seg_dr(c)), seg_dx(c)));
-    if (st[c] > 0.0) {
-      steep = true;
-      // gamma l, plus the axial width a turned-back segment loses (smoothly: (|dx| - dx)/2 with
-      // |dx| rounded at 0.1 l)
-      const double l = std::hypot(seg_dx(c), seg_dr(c));
-      extra[c] = st[c] * (kGamma * l + 0.5 * (std::hypot(seg_dx(c), 0.1 * l) - seg_dx(c)));
-    }
-  }
-  auto wrap = [&](int c) { return ((c % nc_) + nc_) % nc_; };
   const double M = kWindow;
   double etot = 0.0;
   for (double e : extra) etot += e;
@@ -230,7 +254,7 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
       }
     }
     for (int side = 0; side < 2; ++side) {
-      std::vector<double> back(nc_, 0.0);
+      std::vector<double> back(nc_, 0.0), donor;
       for (int m = 0; m < nc_; ++m) {
         if (extra[m] == 0.0) continue;
         const double dr = seg_dr(m);
@@ -238,20 +262,30 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
         // the donors: the segments met walking away from m until M gentle ones (counting a
         // segment as 1 - s of one) have been passed or their axial widths reach kCapacity times
         // the whole wall line's extra room
+        // The last donor counts with the fraction f of itself that reaches either limit exactly,
+        // so that the offsets are continuous in the shape (a donor enters or leaves with zero
+        // weight).
+        const double cap = kCapacity * etot;
         double tot = 0.0, gentle = 0.0;
-        int steps = 0;
-        for (int i = 1; i < nc_ && gentle < M && tot < kCapacity * etot; ++i, ++steps) {
+        donor.clear();
+        for (int i = 1; i < nc_ && gentle < M && tot < cap; ++i) {
           const int k = wrap(before ? m - i : m + i);
-          gentle += 1.0 - st[k];
-          tot += (1.0 - st[k]) * std::max(seg_dx(k), 0.0);
+          const double g = 1.0 - st[k], a = g * std::max(seg_dx(k), 0.0);
+          double f = 1.0;
+          if (gentle + g > M) f = std::min(f, (M - gentle) / g);
+          if (tot + a > cap) f = std::min(f, (cap - tot) / a);
+          gentle += f * g;
+          tot += f * a;
+          donor.push_back(f * a);
+          if (f < 1.0) break;
         }
         if (!(tot > 0.0))
           throw NumericalError("the wall line near vertex column " + std::to_string(m) +
                                    " has no gentle segment to give room to its steep ones",
                                "reduce the time step or refine axi.grid");
-        for (int i = 1; i <= steps; ++i) {
+        for (int i = 1; i <= int(donor.size()); ++i) {
           const int k = wrap(before ? m - i : m + i);
-          back[k] += extra[m] * (1.0 - st[k]) * std::max(seg_dx(k), 0.0) / tot;
+          back[k] += extra[m] * donor[i - 1] / tot;
         }
       }
       double o = 0.0;

@@ -30,7 +30,14 @@
 //   r_{c,j} = rho_c + (Rc - rho_c)(j - cells_inner) / cells_outer   (j >= cells_inner)
 // (rho_c the radius of W_c; uniform rows), or graded towards the membrane line where the columns
 // are narrow (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free
-// rims then sees elements refined in both directions.
+// rims then sees elements refined in both directions. The first row's height eta_c =
+// wall_row_aspect min(w_{c-1}, w_c) (w the sizing widths of the adjacent wall-line segments)
+// becomes eta_c^(1 - tau_c) emin_c^tau_c near steep segments: emin_c the smallest eta within 3
+// columns, tau_c the largest steepness s (below) of the 6 segments around W_c. Both are
+// continuous in the shape and tau = 0 on a gentle wall (rows unchanged). Near a steep stretch
+// the rows of neighbouring columns are then at nearly equal distances from the wall line; graded
+// on each column's own width they differ by the rims' ring ratio (1.5) per column, and the lines
+// leaning across them crossed them.
 //
 // Axial positions: vertical lines where the wall is a gentle graph, lines that lean and fan out
 // where it is steep. Along the wall line (membrane and gap, periodic) segment k = (W_k, W_{k+1})
@@ -43,9 +50,10 @@
 //   a steep or turned-back segment gets, g_k what the gentle segments give back. Each e_m is
 //   shared among the segments met walking away from m (up to 48 gentle ones, counting a segment
 //   as 1 - s of one, or fewer once their axial widths reach 4 times the whole wall line's
-//   extra) in proportion to (1 - s_k) max(dx_k, 0): outside, from the side the wall's outward
-//   normal faces (before m where the wall rises, dr_m > 0; after it where it falls), inside
-//   from the other side. o_c is the running sum of e - g from the column farthest from any
+//   extra; the last one counted by the fraction that reaches either limit exactly, so that the
+//   offsets are continuous in the shape) in proportion to (1 - s_k) max(dx_k, 0): outside,
+//   from the side the wall's outward normal faces (before m where the wall rises, dr_m > 0;
+//   after it where it falls), inside from the other side. o_c is the running sum of e - g from the column farthest from any
 //   steep segment (o = 0 there; zero again past the donors).
 //   Lean lambda_c. The straight line through W_c with direction angle beta enters the fluid on
 //   the correct side of both adjacent segments (angles a_in, a_out, signed) iff
