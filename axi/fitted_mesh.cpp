@@ -94,7 +94,13 @@ constexpr double kLeanMax = 1.3089969389957472;     // 75 deg
 constexpr double kGamma = 0.5;                  // axial room given to a steep segment, per length
 constexpr double kWindow = 48;                  // at most this many gentle segments give the room back,
 constexpr double kCapacity = 4.0;               // or as many as have kCapacity times the room
-constexpr int kRowWindow = 3;                   // rows near steep segments graded on the smallest width within 3 columns
+constexpr double kRowRatio = 1.1;               // where the lines tilt, the first rows grow by at most this per column
+constexpr double kTiltFull = 0.2;               // line slope |dx/dr| from which that limit holds fully
+
+double smoothstep01(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
 
 double steepness(double a) {
   const double t = std::clamp((a - kA0) / (kA1 - kA0), 0.0, 1.0);
@@ -179,61 +185,6 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     }
   }
   auto wrap = [&](int c) { return ((c % nc_) + nc_) % nc_; };
-  // row fractions: uniform, or graded from the membrane line (heights w_i = eta_c q^i away from it)
-  const int ci = p_.cells_inner, co = p_.cells_outer;
-  std::vector<double> eta(nc_, 0.0);
-  if (p_.wall_row_aspect > 0.0) {
-    for (int c = 0; c < nc_; ++c) eta[c] = p_.wall_row_aspect * std::min(seg_w(wrap(c - 1)), seg_w(c));
-    // Near steep segments (where the lines lean and fan out) the rows are graded on the smallest
-    // width around: eta_c -> eta_c^(1 - tau_c) emin_c^tau_c, emin_c the smallest eta within
-    // kRowWindow columns, tau_c the largest steepness of the 2 kRowWindow segments around (both
-    // continuous in the shape; 0 on a gentle wall, whose rows are unchanged). Neighbouring
-    // columns there then have their rows at nearly equal distances from the wall line, so that
-    // lines leaning across them do not cross them, as they did on rows graded on each column's
-    // own width, 1.5 times apart per column at the refined rims.
-    std::vector<double> tau(nc_, 0.0);
-    bool any = false;
-    for (int c = 0; c < nc_; ++c) {
-      double t = 0.0;
-      for (int i = -kRowWindow; i < kRowWindow; ++i) t = std::max(t, st[wrap(c + i)]);
-      tau[c] = t;
-      any = any || t > 0.0;
-    }
-    if (any) {
-      std::vector<double> emin(nc_, INFINITY);
-      for (int c = 0; c < nc_; ++c)
-        for (int i = -kRowWindow; i <= kRowWindow; ++i) emin[c] = std::min(emin[c], eta[wrap(c + i)]);
-      for (int c = 0; c < nc_; ++c)
-        if (tau[c] > 0.0) eta[c] = std::exp((1.0 - tau[c]) * std::log(eta[c]) + tau[c] * std::log(emin[c]));
-    }
-  }
-  for (int c = 0; c < nc_; ++c) {
-    double* f = &frac_[size_t(c) * (ny_ + 1)];
-    for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
-    for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
-    if (!(p_.wall_row_aspect > 0.0)) continue;
-    const double in = rho_[c], out = Rc - rho_[c];
-    const auto hi = gap_widths(in, ci, eta[c], INFINITY, 4.0), ho = gap_widths(out, co, eta[c], INFINITY, 4.0);
-    double acc = 0.0;  // inside: from the membrane line down to the axis
-    for (int i = 0; i < ci; ++i) {
-      acc += hi[i];
-      f[ci - 1 - i] = i == ci - 1 ? 0.0 : 1.0 - acc / in;
-    }
-    acc = 0.0;
-    for (int i = 0; i < co; ++i) {
-      acc += ho[i];
-      f[ci + 1 + i] = i == co - 1 ? 1.0 : acc / out;
-    }
-  }
-  // radii (the lines' radii do not depend on their tilt)
-  for (int c = 0; c < nc_; ++c) {
-    const double rho = rho_[c];
-    const double* f = &frac_[size_t(c) * (ny_ + 1)];
-    double* vr = &vr_[size_t(c) * (ny_ + 1)];
-    for (int j = 0; j < ny_; ++j) vr[j] = j <= ci ? rho * f[j] : rho + (Rc - rho) * f[j];
-    vr[ny_] = Rc;
-  }
-
   const double M = kWindow;
   double etot = 0.0;
   for (double e : extra) etot += e;
@@ -331,23 +282,91 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
         }
       }
   }
+  // The lines' tilt: lean lambda_c and, per side, the far offset o and its band b (see the header).
+  std::vector<double> lam(nc_), band[2] = {std::vector<double>(nc_), std::vector<double>(nc_)};
+  const int ci = p_.cells_inner, co = p_.cells_outer;
+  for (int c = 0; c < nc_; ++c) {
+    lam[c] = -std::tan(std::clamp(lean_pos[c] - lean_neg[c], -kLeanMax, kLeanMax));
+    for (int side = 0; side < 2; ++side) {
+      const double d = side ? Rc - rho_[c] : rho_[c], first = d / (side ? co : ci);
+      band[side][c] = std::min(std::max(kBandOffsets * std::abs(off[side][c]), kBandRows * first), 0.9 * d);
+    }
+  }
+  // row fractions: uniform, or graded from the membrane line (heights w_i = eta_c q^i away from it)
+  std::vector<double> eta(nc_, 0.0);
+  if (p_.wall_row_aspect > 0.0) {
+    for (int c = 0; c < nc_; ++c) eta[c] = p_.wall_row_aspect * std::min(seg_w(wrap(c - 1)), seg_w(c));
+    // Where the lines tilt, rows graded on each column's own width (1.5 times apart per column
+    // at the refined rims) are crossed by lines leaning or fanning across them. There the first
+    // rows' heights may grow by at most kRowRatio per column: eta_c = min over k of eta_k times
+    // the product of the ratios allowed between c and k, the ratio between columns c, c + 1 being
+    // kRowRatio 2^((1 - tau) / tau), tau = smoothstep(T / kTiltFull) of the larger line slope
+    // T = |lambda| + 2 max(|o| / b) of the two columns (unlimited for tau = 0, on vertical lines:
+    // a gentle wall's rows are unchanged). Continuous in the shape (a minimum over continuous
+    // terms, which grow without bound as tau -> 0).
+    std::vector<double> lr(nc_);  // log of the ratio allowed between columns c and c + 1
+    bool any = false;
+    auto slope = [&](int c) {
+      return std::abs(lam[c]) + 2.0 * std::max(std::abs(off[0][c]) / band[0][c], std::abs(off[1][c]) / band[1][c]);
+    };
+    for (int c = 0; c < nc_; ++c) {
+      const double T = std::max(slope(c), slope(wrap(c + 1)));
+      const double tau = smoothstep01(T / kTiltFull);
+      any = any || tau > 0.0;
+      lr[c] = tau > 0.0 ? std::log(kRowRatio) + std::log(2.0) * (1.0 - tau) / tau : INFINITY;
+    }
+    if (any) {
+      std::vector<double> le(nc_);
+      for (int c = 0; c < nc_; ++c) le[c] = std::log(eta[c]);
+      for (int round = 0; round < 2; ++round) {  // twice around the periodic line, each way
+        for (int c = 0; c < nc_; ++c) le[c] = std::min(le[c], le[wrap(c - 1)] + lr[wrap(c - 1)]);
+        for (int c = nc_ - 1; c >= 0; --c) le[c] = std::min(le[c], le[wrap(c + 1)] + lr[c]);
+      }
+      for (int c = 0; c < nc_; ++c)
+        if (le[c] < std::log(eta[c])) eta[c] = std::exp(le[c]);
+    }
+  }
+  for (int c = 0; c < nc_; ++c) {
+    double* f = &frac_[size_t(c) * (ny_ + 1)];
+    for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
+    for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
+    if (!(p_.wall_row_aspect > 0.0)) continue;
+    const double in = rho_[c], out = Rc - rho_[c];
+    const auto hi = gap_widths(in, ci, eta[c], INFINITY, 4.0), ho = gap_widths(out, co, eta[c], INFINITY, 4.0);
+    double acc = 0.0;  // inside: from the membrane line down to the axis
+    for (int i = 0; i < ci; ++i) {
+      acc += hi[i];
+      f[ci - 1 - i] = i == ci - 1 ? 0.0 : 1.0 - acc / in;
+    }
+    acc = 0.0;
+    for (int i = 0; i < co; ++i) {
+      acc += ho[i];
+      f[ci + 1 + i] = i == co - 1 ? 1.0 : acc / out;
+    }
+  }
+  // radii (the lines' radii do not depend on their tilt)
+  for (int c = 0; c < nc_; ++c) {
+    const double rho = rho_[c];
+    const double* f = &frac_[size_t(c) * (ny_ + 1)];
+    double* vr = &vr_[size_t(c) * (ny_ + 1)];
+    for (int j = 0; j < ny_; ++j) vr[j] = j <= ci ? rho * f[j] : rho + (Rc - rho) * f[j];
+    vr[ny_] = Rc;
+  }
+
   // The lines: x = x_c + lambda (r - rho) (1 - u^2)^2 + o u (2 - u), u = |r - rho| / b < 1;
   // x_c + o beyond.
   for (int c = 0; c < nc_; ++c) {
     const double xc = xcol_[c], rho = rho_[c];
     double* vx = &vx_[size_t(c) * (ny_ + 1)];
     const double* vr = &vr_[size_t(c) * (ny_ + 1)];
-    const double lean = std::clamp(lean_pos[c] - lean_neg[c], -kLeanMax, kLeanMax);
-    const double lambda = -std::tan(lean);
+    const double lambda = lam[c];
     vertical_[c] = (off[0][c] == 0.0 && off[1][c] == 0.0 && lambda == 0.0);
     if (vertical_[c]) {
       for (int j = 0; j <= ny_; ++j) vx[j] = xc;
       continue;
     }
     for (int side = 0; side < 2; ++side) {  // 0 inside, 1 outside
-      const double o = off[side][c];
-      const double d = side ? Rc - rho : rho, first = d / (side ? co : ci);
-      const double b = std::min(std::max(kBandOffsets * std::abs(o), kBandRows * first), 0.9 * d);
+      const double o = off[side][c], b = band[side][c];
       const int j0 = side ? ci + 1 : 0, j1 = side ? ny_ : ci - 1;
       for (int j = j0; j <= j1; ++j) {
         const double u = std::abs(vr[j] - rho) / b;

@@ -30,14 +30,15 @@
 //   r_{c,j} = rho_c + (Rc - rho_c)(j - cells_inner) / cells_outer   (j >= cells_inner)
 // (rho_c the radius of W_c; uniform rows), or graded towards the membrane line where the columns
 // are narrow (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free
-// rims then sees elements refined in both directions. The first row's height eta_c =
-// wall_row_aspect min(w_{c-1}, w_c) (w the sizing widths of the adjacent wall-line segments)
-// becomes eta_c^(1 - tau_c) emin_c^tau_c near steep segments: emin_c the smallest eta within 3
-// columns, tau_c the largest steepness s (below) of the 6 segments around W_c. Both are
-// continuous in the shape and tau = 0 on a gentle wall (rows unchanged). Near a steep stretch
-// the rows of neighbouring columns are then at nearly equal distances from the wall line; graded
-// on each column's own width they differ by the rims' ring ratio (1.5) per column, and the lines
-// leaning across them crossed them.
+// rims then sees elements refined in both directions. The first row's height is eta_c =
+// wall_row_aspect min(w_{c-1}, w_c) (w the sizing widths of the adjacent wall-line segments),
+// limited where the lines tilt (below): between columns c and c + 1 it may grow by at most
+// 1.1 x 2^((1 - tau) / tau), tau = smoothstep(T / 0.2) of the larger of the two lines' slopes
+// T = |lambda| + 2 max(|o| / b) (eta_c = min over k of eta_k times the allowed ratios between
+// k and c). T = 0 on vertical lines (no limit), so a gentle wall's rows are unchanged; the
+// limit is continuous in the shape (it binds only for tau above about 0.7, slopes above 0.14).
+// Graded on each column's own width, the rows at the refined rims differ by the rings' ratio
+// 1.5 per column, and lines leaning or fanning out across them crossed them.
 //
 // Axial positions: vertical lines where the wall is a gentle graph, lines that lean and fan out
 // where it is steep. Along the wall line (membrane and gap, periodic) segment k = (W_k, W_{k+1})

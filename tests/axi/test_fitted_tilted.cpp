@@ -299,9 +299,11 @@ TEST(FittedMeshTilted, EndFluxThroughATiltedRimLineBalancesTheLumen) {
 // radially inwards over its last four rings (ring 29 at -79 deg, the last two turned back by
 // tens of picometres). The rims' rings are graded (spacings 2.4 to 13 nm), so rows graded on
 // each column's own width sit at heights differing by 1.5 per column there, and the lines
-// leaning across them crossed (column 30, row 12: the run ended there). Graded on the smallest
-// width near the steep segments, every element's Jacobian is positive and the rings are the
-// wall's vertices. Fails with the per-column grading.
+// leaning and fanning across them crossed them (column 30, row 12: the run ended there; with
+// the rows equalised only within 3 columns of the steep segments, column 34, row 11). With the
+// first rows' heights growing by at most 1.1 per column where the lines tilt, every element's
+// Jacobian is positive and the rings are the wall's vertices. Fails with the per-column
+// grading.
 namespace {
 const double kFallingRim[][2] = {
     {9.1898358734378672e-07, 1.063346255123713e-07},
@@ -346,8 +348,13 @@ Eigen::Matrix3Xd falling_rim() {
   return X;
 }
 
-// The run's mesh: 8 + 8 rows (4 + 4 for h = 31 nm, one more per rim level), 28 gap columns.
-FittedMeshParams falling_rim_params() { return params(8, 8, 28, 2.0); }
+// The run's mesh: 8 + 8 rows (4 + 4 for h = 31 nm, one more per rim level), 28 gap columns
+// graded at a ratio up to 4 (axi::fitted_mesh_params).
+FittedMeshParams falling_rim_params() {
+  FittedMeshParams p = params(8, 8, 28, 2.0);
+  p.gap_growth = 4.0;
+  return p;
+}
 
 // Largest vertex displacement between two meshes of the same topology.
 double largest_move(const FittedMesh& a, const FittedMesh& b) {
@@ -373,8 +380,9 @@ TEST(FittedMeshTilted, MeshesAContractedRimThatFallsInwards) {
 
 // The mesh is a continuous (Lipschitz) function of the shape, as the implicit stepper needs:
 // on the falling rim, random perturbations of every ring by up to eps times the smallest ring
-// spacing move no vertex by more than 100 eps times that spacing, at eps = 1e-3 and 1e-7
-// alike (a jump would show as a ratio growing like 1/eps). And along a one-parameter family (the
+// spacing (2.4 nm) move no vertex by more than 1000 eps times that spacing, and by no more at
+// eps = 1e-7 than at 1e-3 (a jump would show as a ratio growing like 1/eps; measured: 445 at
+// both, the gap's graded columns, whose common ratio follows the rim segment's width). And along a one-parameter family (the
 // radially standing step stretched along the axis by 1.2 to 1.6 in 400 steps, so that the walks
 // that return the steep segments' room end on other donors), no step moves a
 // vertex by more than 10 times the largest ring move (measured: 1.01; 64 with a donor walk
@@ -390,17 +398,19 @@ TEST(FittedMeshTilted, IsContinuousInTheWallShape) {
     a.fit(X);
     std::mt19937 rng(11);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    for (double eps : {1e-3, 1e-7}) {
-      double worst = 0.0;
+    double worst[2] = {0.0, 0.0};
+    for (int i = 0; i < 2; ++i) {
+      const double eps = i ? 1e-7 : 1e-3;
       for (int t = 0; t < 20; ++t) {
         Eigen::Matrix3Xd Y = X;
         for (int k = 0; k < n; ++k) Y(0, k) += eps * dmin * u(rng), Y(1, k) += eps * dmin * u(rng);
         b.fit(Y);
-        worst = std::max(worst, largest_move(a, b) / (eps * dmin));
+        worst[i] = std::max(worst[i], largest_move(a, b) / (eps * dmin));
       }
-      std::printf("  falling rim, eps %.0e: largest vertex move / ring move bound %.2f\n", eps, worst);
-      EXPECT_LT(worst, 100.0) << "eps " << eps;
+      std::printf("  falling rim, eps %.0e: largest vertex move / ring move bound %.1f\n", eps, worst[i]);
     }
+    EXPECT_LT(worst[0], 1000.0);
+    EXPECT_LT(worst[1], 2.0 * worst[0]);
   }
   {
     const int n = 65, steps = 400;
