@@ -95,6 +95,7 @@ constexpr double kGamma = 0.5;                  // axial room given to a steep s
 constexpr double kWindow = 48;                  // at most this many gentle segments give the room back,
 constexpr double kCapacity = 4.0;               // or as many as have kCapacity times the room
 constexpr double kRowRatio = 1.1;               // where the lines tilt, the first rows grow by at most this per column
+constexpr double kLeanSlope = 1.0;              // lambda changes by at most this times length / band per segment
 constexpr double kTiltFull = 0.2;               // line slope |dx/dr| from which that limit holds fully
 
 double smoothstep01(double t) {
@@ -291,6 +292,27 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
       const double d = side ? Rc - rho_[c] : rho_[c], first = d / (side ? co : ci);
       band[side][c] = std::min(std::max(kBandOffsets * std::abs(off[side][c]), kBandRows * first), 0.9 * d);
     }
+  }
+  // The leans' spread in physical space: lines leaning differently diverge by up to 0.29 b
+  // times the difference of their lambdas, so between neighbouring columns lambda may change by at
+  // most kLeanSlope times the segment's length over the larger band: lambda_c's positive and
+  // negative parts are each raised to the upper envelope max over k of (part_k - kLeanSlope times
+  // the lengths between k and c over the bands). Continuous; nothing on a wall without leans.
+  if (leaning) {
+    std::vector<double> step(nc_);
+    for (int c = 0; c < nc_; ++c) {
+      const int d = wrap(c + 1);
+      const double B = std::max({band[0][c], band[1][c], band[0][d], band[1][d]});
+      step[c] = kLeanSlope * std::hypot(seg_dx(c), seg_dr(c)) / B;
+    }
+    std::vector<double> pos(nc_), neg(nc_);
+    for (int c = 0; c < nc_; ++c) pos[c] = std::max(lam[c], 0.0), neg[c] = std::max(-lam[c], 0.0);
+    for (auto* v : {&pos, &neg})
+      for (int round = 0; round < 2; ++round) {
+        for (int c = 0; c < nc_; ++c) (*v)[c] = std::max((*v)[c], (*v)[wrap(c - 1)] - step[wrap(c - 1)]);
+        for (int c = nc_ - 1; c >= 0; --c) (*v)[c] = std::max((*v)[c], (*v)[wrap(c + 1)] - step[c]);
+      }
+    for (int c = 0; c < nc_; ++c) lam[c] = pos[c] - neg[c];
   }
   // row fractions: uniform, or graded from the membrane line (heights w_i = eta_c q^i away from it)
   std::vector<double> eta(nc_, 0.0);

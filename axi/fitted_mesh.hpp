@@ -62,7 +62,12 @@
 //   15 deg of either bound; the lean (beta - pi/2) is then the shortfall, through a C^1 ramp
 //   over 10 deg, at most 75 deg; the leans are spread to the neighbours (largest within 2
 //   columns, then two [1 2 1]/4 passes; each sign separately, never below a column's own
-//   need). lambda = -tan(lean) = dx/dr of the line at the wall.
+//   need). lambda = -tan(lean) = dx/dr of the line at the wall. Lines whose lambdas differ by
+//   D diverge by up to 0.29 b D within the band b (below), so lambda's positive and negative
+//   parts are then each raised to their upper envelope with slope l_k / B_k per segment
+//   (part_c = max over k of part_k minus the sum of l / B between k and c; B_k the largest band
+//   of the segment's two columns): across narrow columns (the rims' graded gap columns) the
+//   lean falls no faster than the columns widen.
 // With u = |r_{c,j} - rho_c| / b (band b = min(max(2 |o|, 3 d / rows), 0.9 d), d the distance
 // from W_c to the axis or the container, rows that side's row count):
 //   x_{c,j} = x_c + lambda (r_{c,j} - rho_c) (1 - u^2)^2 + o u (2 - u)   (u < 1)
