@@ -86,7 +86,7 @@ namespace {
 
 constexpr double kA0 = 0.6107259643892086;  // atan(0.7): steeper wall-line segments tilt the lines
 constexpr double kA1 = 1.2490457723982544;  // atan(3): fully steep
-constexpr double kBandOffsets = 2.0;  // band height per offset
+constexpr double kBandOffsets = 3.0;  // band height per offset (initial slope 2/3 of the offset term)
 constexpr double kBandRows = 3.0;     // and in uniform rows (the side's distance over its row count)
 constexpr double kLeanMargin = 0.2617993877991494;  // 15 deg
 constexpr double kLeanRamp = 0.17453292519943295;   // 10 deg
@@ -312,6 +312,16 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
         for (int c = 0; c < nc_; ++c) (*v)[c] = std::max((*v)[c], (*v)[wrap(c - 1)] - step[wrap(c - 1)]);
         for (int c = nc_ - 1; c >= 0; --c) (*v)[c] = std::max((*v)[c], (*v)[wrap(c + 1)] - step[c]);
       }
+    // never beyond what the column's own segments admit (the line within kLeanMargin of either
+    // segment's direction), unless the column's own lean already is
+    for (int c = 0; c < nc_; ++c) {
+      const int cm = wrap(c - 1);
+      const double a_in = std::atan2(seg_dr(cm), seg_dx(cm)), a_out = std::atan2(seg_dr(c), seg_dx(c));
+      const double hp = std::tan(std::clamp(0.5 * std::numbers::pi - std::max(a_in, a_out) - kLeanMargin, 0.0, kLeanMax));
+      const double hn = std::tan(std::clamp(std::min(a_in, a_out) + 0.5 * std::numbers::pi - kLeanMargin, 0.0, kLeanMax));
+      pos[c] = std::min(pos[c], std::max(std::max(lam[c], 0.0), hp));
+      neg[c] = std::min(neg[c], std::max(std::max(-lam[c], 0.0), hn));
+    }
     for (int c = 0; c < nc_; ++c) lam[c] = pos[c] - neg[c];
   }
   // row fractions: uniform, or graded from the membrane line (heights w_i = eta_c q^i away from it)

@@ -67,8 +67,9 @@
 //   parts are then each raised to their upper envelope with slope l_k / B_k per segment
 //   (part_c = max over k of part_k minus the sum of l / B between k and c; B_k the largest band
 //   of the segment's two columns): across narrow columns (the rims' graded gap columns) the
-//   lean falls no faster than the columns widen.
-// With u = |r_{c,j} - rho_c| / b (band b = min(max(2 |o|, 3 d / rows), 0.9 d), d the distance
+//   lean falls no faster than the columns widen. The envelope never takes a column's line
+//   within 15 deg of its own segments' directions (unless its own lean did).
+// With u = |r_{c,j} - rho_c| / b (band b = min(max(3 |o|, 3 d / rows), 0.9 d), d the distance
 // from W_c to the axis or the container, rows that side's row count):
 //   x_{c,j} = x_c + lambda (r_{c,j} - rho_c) (1 - u^2)^2 + o u (2 - u)   (u < 1)
 //   x_{c,j} = x_c + o                                                     (u >= 1).

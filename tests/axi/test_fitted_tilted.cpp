@@ -307,7 +307,10 @@ TEST(FittedMeshTilted, EndFluxThroughATiltedRimLineBalancesTheLumen) {
 // grading. And 1 ms later, the last rings turned back by 10 degrees: the rim's lean
 // (lambda = 0.37) fell to 0.24 and 0.11 over the next two gap columns (2.8 and 3.9 nm wide), and
 // the lines, 50 nm tall, crossed (column 33, row 11); with the lean's change per column limited
-// by the column's width over the band, the mesh is valid. Fails without that limit.
+// by the column's width over the band, the mesh is valid. Fails without that limit. And 0.5 ms
+// later, the wall flared at 45 degrees before the rim: the inside lines, fanning out with the
+// slope 1 of a band twice the offset, ran parallel to the wall (column 25, row 7); with the band
+// three times the offset the mesh is valid. Fails with the band at twice the offset.
 namespace {
 const double kFallingRim[][2] = {
     {9.1898358734378672e-07, 1.063346255123713e-07},
@@ -383,6 +386,44 @@ const double kCurledBackRim[][2] = {
     {1.2498122507201686e-06, 6.1388392225197076e-08},
 };
 
+// 0.5 ms later again (t = 0.1260 s): the front segment flares outwards at 45 degrees before the
+// rim turns back by 15 degrees.
+const double kFlaredRim[][2] = {
+    {9.1708283420084397e-07, 1.0708872928689771e-07},
+    {9.2067542996653431e-07, 1.0592544532410633e-07},
+    {9.2602773400844103e-07, 1.0419004068385752e-07},
+    {9.3384945535555584e-07, 1.0152576130913481e-07},
+    {9.4516007830318707e-07, 9.6334453594148518e-08},
+    {9.5588295488108222e-07, 9.0097270195707045e-08},
+    {9.6661261535460347e-07, 8.3168896070313279e-08},
+    {9.7787649495735651e-07, 7.6776096392832351e-08},
+    {9.9291631600771833e-07, 7.2797598192547661e-08},
+    {1.0071196549161309e-06, 7.5364359610250887e-08},
+    {1.0198788317315952e-06, 7.8807903622377342e-08},
+    {1.0320721101167193e-06, 7.5569223189253268e-08},
+    {1.0441810526232032e-06, 6.8875118311787551e-08},
+    {1.0577923929064398e-06, 6.415953468630751e-08},
+    {1.0722173512842594e-06, 6.3062561963581911e-08},
+    {1.0863397146327636e-06, 6.3982143170111956e-08},
+    {1.1000739365526362e-06, 6.4725080711548695e-08},
+    {1.1136979238928517e-06, 6.4140044203012878e-08},
+    {1.1274693861397997e-06, 6.3243859367124287e-08},
+    {1.1413981050167128e-06, 6.340088210436176e-08},
+    {1.1552343097385399e-06, 6.4665235656143375e-08},
+    {1.1689825297743734e-06, 6.5823012068637922e-08},
+    {1.1829173294698079e-06, 6.5906206861395702e-08},
+    {1.1972814964532297e-06, 6.6074759178624558e-08},
+    {1.2116844683494051e-06, 6.9444704199283436e-08},
+    {1.2240872334022085e-06, 7.7580149804057826e-08},
+    {1.2342075070892993e-06, 8.7571152764742789e-08},
+    {1.2445329766074938e-06, 9.2098129701300637e-08},
+    {1.2507780821701101e-06, 8.2311662081601163e-08},
+    {1.2500062535271381e-06, 7.4877138505659201e-08},
+    {1.248790911366044e-06, 6.9834101876599768e-08},
+    {1.2478792187130191e-06, 6.6365299696297001e-08},
+    {1.2472728765983224e-06, 6.4015905235074481e-08},
+};
+
 template <std::size_t N>
 Eigen::Matrix3Xd shape_of(const double (&rings)[N][2]) {
   Eigen::Matrix3Xd X = Eigen::Matrix3Xd::Zero(3, int(N));
@@ -411,11 +452,11 @@ double largest_move(const FittedMesh& a, const FittedMesh& b) {
 }  // namespace
 
 TEST(FittedMeshTilted, MeshesAContractedRimThatFallsInwards) {
-  for (int which = 0; which < 2; ++which) {
-    const Eigen::Matrix3Xd X = which ? shape_of(kCurledBackRim) : falling_rim();
+  for (int which = 0; which < 3; ++which) {
+    const Eigen::Matrix3Xd X = which == 2 ? shape_of(kFlaredRim) : which ? shape_of(kCurledBackRim) : falling_rim();
     const int n = int(X.cols());
     FittedMesh m(falling_rim_params(), n);
-    const char* what = which ? "contracted rim curled back" : "contracted rim falling inwards";
+    const char* what = which == 2 ? "contracted rim flared" : which ? "contracted rim curled back" : "contracted rim falling inwards";
     ASSERT_NO_THROW(m.fit(X)) << what;
     expect_valid(m, what);
     for (int k = 0; k < n; ++k) {
