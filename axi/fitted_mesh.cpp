@@ -86,7 +86,7 @@ namespace {
 
 constexpr double kA0 = 0.6107259643892086;  // atan(0.7): steeper wall-line segments tilt the lines
 constexpr double kA1 = 1.2490457723982544;  // atan(3): fully steep
-constexpr double kBandOffsets = 2.0;  // band height per offset
+constexpr double kBandOffsets = 3.0;  // band height per offset (initial slope 2/3 of the offset term)
 constexpr double kBandRows = 3.0;     // and in uniform rows (the side's distance over its row count)
 constexpr double kLeanMargin = 0.2617993877991494;  // 15 deg
 constexpr double kLeanRamp = 0.17453292519943295;   // 10 deg
@@ -94,6 +94,14 @@ constexpr double kLeanMax = 1.3089969389957472;     // 75 deg
 constexpr double kGamma = 0.5;                  // axial room given to a steep segment, per length
 constexpr double kWindow = 48;                  // at most this many gentle segments give the room back,
 constexpr double kCapacity = 4.0;               // or as many as have kCapacity times the room
+constexpr double kRowRatio = 1.1;               // where the lines tilt, the first rows grow by at most this per column
+constexpr double kLeanSlope = 1.0;              // lambda changes by at most this times length / band per segment
+constexpr double kTiltFull = 0.2;               // line slope |dx/dr| from which that limit holds fully
+
+double smoothstep01(double t) {
+  t = std::clamp(t, 0.0, 1.0);
+  return t * t * (3.0 - 2.0 * t);
+}
 
 double steepness(double a) {
   const double t = std::clamp((a - kA0) / (kA1 - kA0), 0.0, 1.0);
@@ -164,38 +172,6 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
   auto seg_dr = [&](int c) { return rho_[(c + 1) % nc_] - rho_[c]; };
   auto seg_w = [&](int c) { return sizing_width(seg_dx(c), seg_dr(c)); };
 
-  // row fractions: uniform, or graded from the membrane line (heights w_i = eta q^i away from it)
-  const int ci = p_.cells_inner, co = p_.cells_outer;
-  for (int c = 0; c < nc_; ++c) {
-    double* f = &frac_[size_t(c) * (ny_ + 1)];
-    for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
-    for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
-    if (!(p_.wall_row_aspect > 0.0)) continue;
-    const double wl = seg_w(c > 0 ? c - 1 : nc_ - 1);
-    const double wr = seg_w(c);
-    const double eta = p_.wall_row_aspect * std::min(wl, wr);
-    const double in = rho_[c], out = Rc - rho_[c];
-    const auto hi = gap_widths(in, ci, eta, INFINITY, 4.0), ho = gap_widths(out, co, eta, INFINITY, 4.0);
-    double acc = 0.0;  // inside: from the membrane line down to the axis
-    for (int i = 0; i < ci; ++i) {
-      acc += hi[i];
-      f[ci - 1 - i] = i == ci - 1 ? 0.0 : 1.0 - acc / in;
-    }
-    acc = 0.0;
-    for (int i = 0; i < co; ++i) {
-      acc += ho[i];
-      f[ci + 1 + i] = i == co - 1 ? 1.0 : acc / out;
-    }
-  }
-  // radii (the lines' radii do not depend on their tilt)
-  for (int c = 0; c < nc_; ++c) {
-    const double rho = rho_[c];
-    const double* f = &frac_[size_t(c) * (ny_ + 1)];
-    double* vr = &vr_[size_t(c) * (ny_ + 1)];
-    for (int j = 0; j < ny_; ++j) vr[j] = j <= ci ? rho * f[j] : rho + (Rc - rho) * f[j];
-    vr[ny_] = Rc;
-  }
-
   // Steepness of the wall-line segments and the extra axial room they get (see the header).
   std::vector<double> st(nc_), extra(nc_, 0.0);
   bool steep = false;
@@ -230,7 +206,7 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
       }
     }
     for (int side = 0; side < 2; ++side) {
-      std::vector<double> back(nc_, 0.0);
+      std::vector<double> back(nc_, 0.0), donor;
       for (int m = 0; m < nc_; ++m) {
         if (extra[m] == 0.0) continue;
         const double dr = seg_dr(m);
@@ -238,20 +214,30 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
         // the donors: the segments met walking away from m until M gentle ones (counting a
         // segment as 1 - s of one) have been passed or their axial widths reach kCapacity times
         // the whole wall line's extra room
+        // The last donor counts with the fraction f of itself that reaches either limit exactly,
+        // so that the offsets are continuous in the shape (a donor enters or leaves with zero
+        // weight).
+        const double cap = kCapacity * etot;
         double tot = 0.0, gentle = 0.0;
-        int steps = 0;
-        for (int i = 1; i < nc_ && gentle < M && tot < kCapacity * etot; ++i, ++steps) {
+        donor.clear();
+        for (int i = 1; i < nc_ && gentle < M && tot < cap; ++i) {
           const int k = wrap(before ? m - i : m + i);
-          gentle += 1.0 - st[k];
-          tot += (1.0 - st[k]) * std::max(seg_dx(k), 0.0);
+          const double g = 1.0 - st[k], a = g * std::max(seg_dx(k), 0.0);
+          double f = 1.0;
+          if (gentle + g > M) f = std::min(f, (M - gentle) / g);
+          if (tot + a > cap) f = std::min(f, (cap - tot) / a);
+          gentle += f * g;
+          tot += f * a;
+          donor.push_back(f * a);
+          if (f < 1.0) break;
         }
         if (!(tot > 0.0))
           throw NumericalError("the wall line near vertex column " + std::to_string(m) +
                                    " has no gentle segment to give room to its steep ones",
                                "reduce the time step or refine axi.grid");
-        for (int i = 1; i <= steps; ++i) {
+        for (int i = 1; i <= int(donor.size()); ++i) {
           const int k = wrap(before ? m - i : m + i);
-          back[k] += extra[m] * (1.0 - st[k]) * std::max(seg_dx(k), 0.0) / tot;
+          back[k] += extra[m] * donor[i - 1] / tot;
         }
       }
       double o = 0.0;
@@ -297,23 +283,122 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
         }
       }
   }
+  // The lines' tilt: lean lambda_c and, per side, the far offset o and its band b (see the header).
+  std::vector<double> lam(nc_), band[2] = {std::vector<double>(nc_), std::vector<double>(nc_)};
+  const int ci = p_.cells_inner, co = p_.cells_outer;
+  for (int c = 0; c < nc_; ++c) {
+    lam[c] = -std::tan(std::clamp(lean_pos[c] - lean_neg[c], -kLeanMax, kLeanMax));
+    for (int side = 0; side < 2; ++side) {
+      const double d = side ? Rc - rho_[c] : rho_[c], first = d / (side ? co : ci);
+      band[side][c] = std::min(std::max(kBandOffsets * std::abs(off[side][c]), kBandRows * first), 0.9 * d);
+    }
+  }
+  // The leans' spread in physical space: lines leaning differently diverge by up to 0.29 b
+  // times the difference of their lambdas, so between neighbouring columns lambda may change by at
+  // most kLeanSlope times the segment's length over the larger band: lambda_c's positive and
+  // negative parts are each raised to the upper envelope max over k of (part_k - kLeanSlope times
+  // the lengths between k and c over the bands). Continuous; nothing on a wall without leans.
+  if (leaning) {
+    std::vector<double> step(nc_);
+    for (int c = 0; c < nc_; ++c) {
+      const int d = wrap(c + 1);
+      const double B = std::max({band[0][c], band[1][c], band[0][d], band[1][d]});
+      step[c] = kLeanSlope * std::hypot(seg_dx(c), seg_dr(c)) / B;
+    }
+    std::vector<double> pos(nc_), neg(nc_);
+    for (int c = 0; c < nc_; ++c) pos[c] = std::max(lam[c], 0.0), neg[c] = std::max(-lam[c], 0.0);
+    for (auto* v : {&pos, &neg})
+      for (int round = 0; round < 2; ++round) {
+        for (int c = 0; c < nc_; ++c) (*v)[c] = std::max((*v)[c], (*v)[wrap(c - 1)] - step[wrap(c - 1)]);
+        for (int c = nc_ - 1; c >= 0; --c) (*v)[c] = std::max((*v)[c], (*v)[wrap(c + 1)] - step[c]);
+      }
+    // never beyond what the column's own segments admit (the line within kLeanMargin of either
+    // segment's direction), unless the column's own lean already is
+    for (int c = 0; c < nc_; ++c) {
+      const int cm = wrap(c - 1);
+      const double a_in = std::atan2(seg_dr(cm), seg_dx(cm)), a_out = std::atan2(seg_dr(c), seg_dx(c));
+      const double hp = std::tan(std::clamp(0.5 * std::numbers::pi - std::max(a_in, a_out) - kLeanMargin, 0.0, kLeanMax));
+      const double hn = std::tan(std::clamp(std::min(a_in, a_out) + 0.5 * std::numbers::pi - kLeanMargin, 0.0, kLeanMax));
+      pos[c] = std::min(pos[c], std::max(std::max(lam[c], 0.0), hp));
+      neg[c] = std::min(neg[c], std::max(std::max(-lam[c], 0.0), hn));
+    }
+    for (int c = 0; c < nc_; ++c) lam[c] = pos[c] - neg[c];
+  }
+  // row fractions: uniform, or graded from the membrane line (heights w_i = eta_c q^i away from it)
+  std::vector<double> eta(nc_, 0.0);
+  if (p_.wall_row_aspect > 0.0) {
+    for (int c = 0; c < nc_; ++c) eta[c] = p_.wall_row_aspect * std::min(seg_w(wrap(c - 1)), seg_w(c));
+    // Where the lines tilt, rows graded on each column's own width (1.5 times apart per column
+    // at the refined rims) are crossed by lines leaning or fanning across them. There the first
+    // rows' heights may grow by at most kRowRatio per column: eta_c = min over k of eta_k times
+    // the product of the ratios allowed between c and k, the ratio between columns c, c + 1 being
+    // kRowRatio 2^((1 - tau) / tau), tau = smoothstep(T / kTiltFull) of the larger line slope
+    // T = |lambda| + 2 max(|o| / b) of the two columns (unlimited for tau = 0, on vertical lines:
+    // a gentle wall's rows are unchanged). Continuous in the shape (a minimum over continuous
+    // terms, which grow without bound as tau -> 0).
+    std::vector<double> lr(nc_);  // log of the ratio allowed between columns c and c + 1
+    bool any = false;
+    auto slope = [&](int c) {
+      return std::abs(lam[c]) + 2.0 * std::max(std::abs(off[0][c]) / band[0][c], std::abs(off[1][c]) / band[1][c]);
+    };
+    for (int c = 0; c < nc_; ++c) {
+      const double T = std::max(slope(c), slope(wrap(c + 1)));
+      const double tau = smoothstep01(T / kTiltFull);
+      any = any || tau > 0.0;
+      lr[c] = tau > 0.0 ? std::log(kRowRatio) + std::log(2.0) * (1.0 - tau) / tau : INFINITY;
+    }
+    if (any) {
+      std::vector<double> le(nc_);
+      for (int c = 0; c < nc_; ++c) le[c] = std::log(eta[c]);
+      for (int round = 0; round < 2; ++round) {  // twice around the periodic line, each way
+        for (int c = 0; c < nc_; ++c) le[c] = std::min(le[c], le[wrap(c - 1)] + lr[wrap(c - 1)]);
+        for (int c = nc_ - 1; c >= 0; --c) le[c] = std::min(le[c], le[wrap(c + 1)] + lr[c]);
+      }
+      for (int c = 0; c < nc_; ++c)
+        if (le[c] < std::log(eta[c])) eta[c] = std::exp(le[c]);
+    }
+  }
+  for (int c = 0; c < nc_; ++c) {
+    double* f = &frac_[size_t(c) * (ny_ + 1)];
+    for (int j = 0; j <= ci; ++j) f[j] = double(j) / ci;
+    for (int j = ci + 1; j <= ny_; ++j) f[j] = double(j - ci) / co;
+    if (!(p_.wall_row_aspect > 0.0)) continue;
+    const double in = rho_[c], out = Rc - rho_[c];
+    const auto hi = gap_widths(in, ci, eta[c], INFINITY, 4.0), ho = gap_widths(out, co, eta[c], INFINITY, 4.0);
+    double acc = 0.0;  // inside: from the membrane line down to the axis
+    for (int i = 0; i < ci; ++i) {
+      acc += hi[i];
+      f[ci - 1 - i] = i == ci - 1 ? 0.0 : 1.0 - acc / in;
+    }
+    acc = 0.0;
+    for (int i = 0; i < co; ++i) {
+      acc += ho[i];
+      f[ci + 1 + i] = i == co - 1 ? 1.0 : acc / out;
+    }
+  }
+  // radii (the lines' radii do not depend on their tilt)
+  for (int c = 0; c < nc_; ++c) {
+    const double rho = rho_[c];
+    const double* f = &frac_[size_t(c) * (ny_ + 1)];
+    double* vr = &vr_[size_t(c) * (ny_ + 1)];
+    for (int j = 0; j < ny_; ++j) vr[j] = j <= ci ? rho * f[j] : rho + (Rc - rho) * f[j];
+    vr[ny_] = Rc;
+  }
+
   // The lines: x = x_c + lambda (r - rho) (1 - u^2)^2 + o u (2 - u), u = |r - rho| / b < 1;
   // x_c + o beyond.
   for (int c = 0; c < nc_; ++c) {
     const double xc = xcol_[c], rho = rho_[c];
     double* vx = &vx_[size_t(c) * (ny_ + 1)];
     const double* vr = &vr_[size_t(c) * (ny_ + 1)];
-    const double lean = std::clamp(lean_pos[c] - lean_neg[c], -kLeanMax, kLeanMax);
-    const double lambda = -std::tan(lean);
+    const double lambda = lam[c];
     vertical_[c] = (off[0][c] == 0.0 && off[1][c] == 0.0 && lambda == 0.0);
     if (vertical_[c]) {
       for (int j = 0; j <= ny_; ++j) vx[j] = xc;
       continue;
     }
     for (int side = 0; side < 2; ++side) {  // 0 inside, 1 outside
-      const double o = off[side][c];
-      const double d = side ? Rc - rho : rho, first = d / (side ? co : ci);
-      const double b = std::min(std::max(kBandOffsets * std::abs(o), kBandRows * first), 0.9 * d);
+      const double o = off[side][c], b = band[side][c];
       const int j0 = side ? ci + 1 : 0, j1 = side ? ny_ : ci - 1;
       for (int j = j0; j <= j1; ++j) {
         const double u = std::abs(vr[j] - rho) / b;

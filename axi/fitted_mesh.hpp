@@ -30,7 +30,15 @@
 //   r_{c,j} = rho_c + (Rc - rho_c)(j - cells_inner) / cells_outer   (j >= cells_inner)
 // (rho_c the radius of W_c; uniform rows), or graded towards the membrane line where the columns
 // are narrow (wall_row_aspect > 0, see FittedMeshParams): the singular flow at the tube's free
-// rims then sees elements refined in both directions.
+// rims then sees elements refined in both directions. The first row's height is eta_c =
+// wall_row_aspect min(w_{c-1}, w_c) (w the sizing widths of the adjacent wall-line segments),
+// limited where the lines tilt (below): between columns c and c + 1 it may grow by at most
+// 1.1 x 2^((1 - tau) / tau), tau = smoothstep(T / 0.2) of the larger of the two lines' slopes
+// T = |lambda| + 2 max(|o| / b) (eta_c = min over k of eta_k times the allowed ratios between
+// k and c). T = 0 on vertical lines (no limit), so a gentle wall's rows are unchanged; the
+// limit is continuous in the shape (it binds only for tau above about 0.7, slopes above 0.14).
+// Graded on each column's own width, the rows at the refined rims differ by the rings' ratio
+// 1.5 per column, and lines leaning or fanning out across them crossed them.
 //
 // Axial positions: vertical lines where the wall is a gentle graph, lines that lean and fan out
 // where it is steep. Along the wall line (membrane and gap, periodic) segment k = (W_k, W_{k+1})
@@ -43,9 +51,10 @@
 //   a steep or turned-back segment gets, g_k what the gentle segments give back. Each e_m is
 //   shared among the segments met walking away from m (up to 48 gentle ones, counting a segment
 //   as 1 - s of one, or fewer once their axial widths reach 4 times the whole wall line's
-//   extra) in proportion to (1 - s_k) max(dx_k, 0): outside, from the side the wall's outward
-//   normal faces (before m where the wall rises, dr_m > 0; after it where it falls), inside
-//   from the other side. o_c is the running sum of e - g from the column farthest from any
+//   extra; the last one counted by the fraction that reaches either limit exactly, so that the
+//   offsets are continuous in the shape) in proportion to (1 - s_k) max(dx_k, 0): outside,
+//   from the side the wall's outward normal faces (before m where the wall rises, dr_m > 0;
+//   after it where it falls), inside from the other side. o_c is the running sum of e - g from the column farthest from any
 //   steep segment (o = 0 there; zero again past the donors).
 //   Lean lambda_c. The straight line through W_c with direction angle beta enters the fluid on
 //   the correct side of both adjacent segments (angles a_in, a_out, signed) iff
@@ -53,8 +62,14 @@
 //   15 deg of either bound; the lean (beta - pi/2) is then the shortfall, through a C^1 ramp
 //   over 10 deg, at most 75 deg; the leans are spread to the neighbours (largest within 2
 //   columns, then two [1 2 1]/4 passes; each sign separately, never below a column's own
-//   need). lambda = -tan(lean) = dx/dr of the line at the wall.
-// With u = |r_{c,j} - rho_c| / b (band b = min(max(2 |o|, 3 d / rows), 0.9 d), d the distance
+//   need). lambda = -tan(lean) = dx/dr of the line at the wall. Lines whose lambdas differ by
+//   D diverge by up to 0.29 b D within the band b (below), so lambda's positive and negative
+//   parts are then each raised to their upper envelope with slope l_k / B_k per segment
+//   (part_c = max over k of part_k minus the sum of l / B between k and c; B_k the largest band
+//   of the segment's two columns): across narrow columns (the rims' graded gap columns) the
+//   lean falls no faster than the columns widen. The envelope never takes a column's line
+//   within 15 deg of its own segments' directions (unless its own lean did).
+// With u = |r_{c,j} - rho_c| / b (band b = min(max(3 |o|, 3 d / rows), 0.9 d), d the distance
 // from W_c to the axis or the container, rows that side's row count):
 //   x_{c,j} = x_c + lambda (r_{c,j} - rho_c) (1 - u^2)^2 + o u (2 - u)   (u < 1)
 //   x_{c,j} = x_c + o                                                     (u >= 1).

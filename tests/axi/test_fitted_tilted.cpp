@@ -7,8 +7,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstddef>
 #include <cstdio>
 #include <functional>
+#include <iterator>
 #include <numbers>
 #include <random>
 #include <vector>
@@ -291,4 +293,235 @@ TEST(FittedMeshTilted, EndFluxThroughATiltedRimLineBalancesTheLumen) {
   EXPECT_GT(std::abs(q_front), 1e-3 * scale);
   EXPECT_LT(std::abs(q_rear - q_front + q_wall), 1e-9 * scale);
   EXPECT_LT(std::abs(q_front - q_disc), 1e-3 * std::abs(q_front));
+}
+
+// The wall of `paper_amplitude_0.35` under 1.2 Pa on 16 cells across (33 rings, the mesh
+// parameters of that run) at t = 0.1245 s, where the contracted front segment's rim falls
+// radially inwards over its last four rings (ring 29 at -79 deg, the last two turned back by
+// tens of picometres). The rims' rings are graded (spacings 2.4 to 13 nm), so rows graded on
+// each column's own width sit at heights differing by 1.5 per column there, and the lines
+// leaning and fanning across them crossed them (column 30, row 12: the run ended there; with
+// the rows equalised only within 3 columns of the steep segments, column 34, row 11). With the
+// first rows' heights growing by at most 1.1 per column where the lines tilt, every element's
+// Jacobian is positive and the rings are the wall's vertices. Fails with the per-column
+// grading. And 1 ms later, the last rings turned back by 10 degrees: the rim's lean
+// (lambda = 0.37) fell to 0.24 and 0.11 over the next two gap columns (2.8 and 3.9 nm wide), and
+// the lines, 50 nm tall, crossed (column 33, row 11); with the lean's change per column limited
+// by the column's width over the band, the mesh is valid. Fails without that limit. And 0.5 ms
+// later, the wall flared at 45 degrees before the rim: the inside lines, fanning out with the
+// slope 1 of a band twice the offset, ran parallel to the wall (column 25, row 7); with the band
+// three times the offset the mesh is valid. Fails with the band at twice the offset.
+namespace {
+const double kFallingRim[][2] = {
+    {9.1898358734378672e-07, 1.063346255123713e-07},
+    {9.2244249099500561e-07, 1.0476022516881915e-07},
+    {9.276060435413878e-07, 1.0241542831085457e-07},
+    {9.3519635772018127e-07, 9.8821930167361859e-08},
+    {9.4623354338489692e-07, 9.2108391651347686e-08},
+    {9.5701650667112735e-07, 8.491360903462214e-08},
+    {9.6807714090649971e-07, 7.7633860656162702e-08},
+    {9.7983691457074308e-07, 7.1323294137291379e-08},
+    {9.952608410093097e-07, 6.8103867269733413e-08},
+    {1.0092666824342904e-06, 7.1416897642932914e-08},
+    {1.0218345700269555e-06, 7.4782079319290866e-08},
+    {1.0340264451181849e-06, 7.1441401913853004e-08},
+    {1.0464892190300547e-06, 6.5723903349564481e-08},
+    {1.0602433624964718e-06, 6.2479528373638154e-08},
+    {1.0744379024361952e-06, 6.2131744551796915e-08},
+    {1.0880690997649667e-06, 6.3256118162278316e-08},
+    {1.1011769720473983e-06, 6.3961476421662761e-08},
+    {1.1141741851398664e-06, 6.338297052459092e-08},
+    {1.127405612761849e-06, 6.2542232470978959e-08},
+    {1.1408788974791095e-06, 6.2586695849208203e-08},
+    {1.1542133570696381e-06, 6.3532023286607991e-08},
+    {1.1673565721764042e-06, 6.4422612073707433e-08},
+    {1.1805850226823893e-06, 6.423444313023883e-08},
+    {1.1942057814027013e-06, 6.3344663034540162e-08},
+    {1.2083583651110623e-06, 6.4386935085268473e-08},
+    {1.2217184587730077e-06, 6.9671280235234733e-08},
+    {1.2333220428087261e-06, 7.7686278131685077e-08},
+    {1.2443654289979717e-06, 8.216844365526992e-08},
+    {1.2533001998069682e-06, 7.5037645982934456e-08},
+    {1.2546339766520727e-06, 6.819842018887248e-08},
+    {1.2547489895161033e-06, 6.3241742141627054e-08},
+    {1.2547063462372857e-06, 5.9757974057078463e-08},
+    {1.2546771590981517e-06, 5.7355931127614224e-08},
+};
+
+// The same run 1 ms later (t = 0.1255 s, meshed with the rows above): the last four rings
+// turned back by 10 degrees.
+const double kCurledBackRim[][2] = {
+    {9.1781484415785135e-07, 1.069046472672673e-07},
+    {9.2136340980707757e-07, 1.0559695597265581e-07},
+    {9.2665330543787143e-07, 1.0364748639080958e-07},
+    {9.3439291781587509e-07, 1.0065933712331123e-07},
+    {9.4559369278877994e-07, 9.4885947538072359e-08},
+    {9.5630601480900526e-07, 8.8269950069456331e-08},
+    {9.6711816865660604e-07, 8.1186664574607018e-08},
+    {9.7852220592026679e-07, 7.4790811869026396e-08},
+    {9.9369343736034341e-07, 7.1045512506543639e-08},
+    {1.0078419179924444e-06, 7.3901489191466737e-08},
+    {1.0205347349131265e-06, 7.7370733319748938e-08},
+    {1.0327095589611383e-06, 7.4074447744769666e-08},
+    {1.0449360709935537e-06, 6.7680481044258801e-08},
+    {1.0586004119158932e-06, 6.3520316768125009e-08},
+    {1.07290313776619e-06, 6.277588706211853e-08},
+    {1.0868259435241418e-06, 6.3741445077463838e-08},
+    {1.1003469912859121e-06, 6.4438022754824171e-08},
+    {1.1137583301553459e-06, 6.3838109598535097e-08},
+    {1.1273238429218864e-06, 6.2952608112794602e-08},
+    {1.1410544626752326e-06, 6.3052014442972277e-08},
+    {1.1546884284280626e-06, 6.4188049126621246e-08},
+    {1.1682147471694414e-06, 6.5236231568169975e-08},
+    {1.1818948529910193e-06, 6.5163320153628532e-08},
+    {1.1960059614200146e-06, 6.4842438159878825e-08},
+    {1.210373387224645e-06, 6.7294933092353197e-08},
+    {1.2231811874413987e-06, 7.442524478510632e-08},
+    {1.2338014582511374e-06, 8.3815016922090514e-08},
+    {1.244338580944939e-06, 8.8431475385986927e-08},
+    {1.2516242788123751e-06, 7.9604963014291486e-08},
+    {1.2516074067266621e-06, 7.2307461933711938e-08},
+    {1.2508461062090661e-06, 6.7250903308778651e-08},
+    {1.2502265519246192e-06, 6.3762694922961207e-08},
+    {1.2498122507201686e-06, 6.1388392225197076e-08},
+};
+
+// 0.5 ms later again (t = 0.1260 s): the front segment flares outwards at 45 degrees before the
+// rim turns back by 15 degrees.
+const double kFlaredRim[][2] = {
+    {9.1708283420084397e-07, 1.0708872928689771e-07},
+    {9.2067542996653431e-07, 1.0592544532410633e-07},
+    {9.2602773400844103e-07, 1.0419004068385752e-07},
+    {9.3384945535555584e-07, 1.0152576130913481e-07},
+    {9.4516007830318707e-07, 9.6334453594148518e-08},
+    {9.5588295488108222e-07, 9.0097270195707045e-08},
+    {9.6661261535460347e-07, 8.3168896070313279e-08},
+    {9.7787649495735651e-07, 7.6776096392832351e-08},
+    {9.9291631600771833e-07, 7.2797598192547661e-08},
+    {1.0071196549161309e-06, 7.5364359610250887e-08},
+    {1.0198788317315952e-06, 7.8807903622377342e-08},
+    {1.0320721101167193e-06, 7.5569223189253268e-08},
+    {1.0441810526232032e-06, 6.8875118311787551e-08},
+    {1.0577923929064398e-06, 6.415953468630751e-08},
+    {1.0722173512842594e-06, 6.3062561963581911e-08},
+    {1.0863397146327636e-06, 6.3982143170111956e-08},
+    {1.1000739365526362e-06, 6.4725080711548695e-08},
+    {1.1136979238928517e-06, 6.4140044203012878e-08},
+    {1.1274693861397997e-06, 6.3243859367124287e-08},
+    {1.1413981050167128e-06, 6.340088210436176e-08},
+    {1.1552343097385399e-06, 6.4665235656143375e-08},
+    {1.1689825297743734e-06, 6.5823012068637922e-08},
+    {1.1829173294698079e-06, 6.5906206861395702e-08},
+    {1.1972814964532297e-06, 6.6074759178624558e-08},
+    {1.2116844683494051e-06, 6.9444704199283436e-08},
+    {1.2240872334022085e-06, 7.7580149804057826e-08},
+    {1.2342075070892993e-06, 8.7571152764742789e-08},
+    {1.2445329766074938e-06, 9.2098129701300637e-08},
+    {1.2507780821701101e-06, 8.2311662081601163e-08},
+    {1.2500062535271381e-06, 7.4877138505659201e-08},
+    {1.248790911366044e-06, 6.9834101876599768e-08},
+    {1.2478792187130191e-06, 6.6365299696297001e-08},
+    {1.2472728765983224e-06, 6.4015905235074481e-08},
+};
+
+template <std::size_t N>
+Eigen::Matrix3Xd shape_of(const double (&rings)[N][2]) {
+  Eigen::Matrix3Xd X = Eigen::Matrix3Xd::Zero(3, int(N));
+  for (std::size_t k = 0; k < N; ++k) X(0, k) = rings[k][0], X(1, k) = rings[k][1];
+  return X;
+}
+
+Eigen::Matrix3Xd falling_rim() { return shape_of(kFallingRim); }
+
+// The run's mesh: 8 + 8 rows (4 + 4 for h = 31 nm, one more per rim level), 28 gap columns
+// graded at a ratio up to 4 (axi::fitted_mesh_params).
+FittedMeshParams falling_rim_params() {
+  FittedMeshParams p = params(8, 8, 28, 2.0);
+  p.gap_growth = 4.0;
+  return p;
+}
+
+// Largest vertex displacement between two meshes of the same topology.
+double largest_move(const FittedMesh& a, const FittedMesh& b) {
+  double m = 0.0;
+  for (int c = 0; c <= a.columns(); ++c)
+    for (int j = 0; j <= a.rows(); ++j)
+      m = std::max(m, std::hypot(a.vertex_x(c, j) - b.vertex_x(c, j), a.vertex_r(c, j) - b.vertex_r(c, j)));
+  return m;
+}
+}  // namespace
+
+TEST(FittedMeshTilted, MeshesAContractedRimThatFallsInwards) {
+  for (int which = 0; which < 3; ++which) {
+    const Eigen::Matrix3Xd X = which == 2 ? shape_of(kFlaredRim) : which ? shape_of(kCurledBackRim) : falling_rim();
+    const int n = int(X.cols());
+    FittedMesh m(falling_rim_params(), n);
+    const char* what = which == 2 ? "contracted rim flared" : which ? "contracted rim curled back" : "contracted rim falling inwards";
+    ASSERT_NO_THROW(m.fit(X)) << what;
+    expect_valid(m, what);
+    for (int k = 0; k < n; ++k) {
+      EXPECT_EQ(m.vertex_x(k, m.params().cells_inner), X(0, k));
+      EXPECT_EQ(m.vertex_r(k, m.params().cells_inner), X(1, k));
+    }
+  }
+}
+
+// The mesh is a continuous (Lipschitz) function of the shape, as the implicit stepper needs:
+// on the falling rim, random perturbations of every ring by up to eps times the smallest ring
+// spacing (2.4 nm) move no vertex by more than 1000 eps times that spacing, and by no more at
+// eps = 1e-7 than at 1e-3 (a jump would show as a ratio growing like 1/eps; measured: 445 at
+// both, the gap's graded columns, whose common ratio follows the rim segment's width). And along a one-parameter family (the
+// radially standing step stretched along the axis by 1.2 to 1.6 in 400 steps, so that the walks
+// that return the steep segments' room end on other donors), no step moves a
+// vertex by more than 10 times the largest ring move (measured: 1.01; 64 with a donor walk
+// that counts its last donor whole, whose far offsets jump by a fraction of that segment's
+// room). Fails with such a jump.
+TEST(FittedMeshTilted, IsContinuousInTheWallShape) {
+  {
+    const Eigen::Matrix3Xd X = falling_rim();
+    const int n = int(X.cols());
+    double dmin = INFINITY;
+    for (int k = 1; k < n; ++k) dmin = std::min(dmin, std::hypot(X(0, k) - X(0, k - 1), X(1, k) - X(1, k - 1)));
+    FittedMesh a(falling_rim_params(), n), b(falling_rim_params(), n);
+    a.fit(X);
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<double> u(-1.0, 1.0);
+    double worst[2] = {0.0, 0.0};
+    for (int i = 0; i < 2; ++i) {
+      const double eps = i ? 1e-7 : 1e-3;
+      for (int t = 0; t < 20; ++t) {
+        Eigen::Matrix3Xd Y = X;
+        for (int k = 0; k < n; ++k) Y(0, k) += eps * dmin * u(rng), Y(1, k) += eps * dmin * u(rng);
+        b.fit(Y);
+        worst[i] = std::max(worst[i], largest_move(a, b) / (eps * dmin));
+      }
+      std::printf("  falling rim, eps %.0e: largest vertex move / ring move bound %.1f\n", eps, worst[i]);
+    }
+    EXPECT_LT(worst[0], 1000.0);
+    EXPECT_LT(worst[1], 2.0 * worst[0]);
+  }
+  {
+    const int n = 65, steps = 400;
+    const FittedMeshParams p = params(6, 6, 16, 2.0);
+    FittedMesh a(p, n), b(p, n);
+    auto shape = [&](double stretch) {
+      Eigen::Matrix3Xd X = step_wall(n, 0.5 * kPi);
+      const double x0 = X(0, 0);
+      for (int k = 0; k < n; ++k) X(0, k) = x0 + (X(0, k) - x0) * stretch;
+      return X;
+    };
+    Eigen::Matrix3Xd X = shape(1.2);
+    a.fit(X);
+    double worst = 0.0;
+    for (int i = 1; i <= steps; ++i) {
+      const Eigen::Matrix3Xd Y = shape(1.2 + 0.4 * i / steps);
+      b.fit(Y);
+      const double ring = (Y - X).colwise().norm().maxCoeff();
+      worst = std::max(worst, largest_move(a, b) / ring);
+      std::swap(a, b);
+      X = Y;
+    }
+    std::printf("  stretched step: largest vertex move / ring move %.2f\n", worst);
+    EXPECT_LT(worst, 10.0);
+  }
 }
