@@ -1,0 +1,183 @@
+"""The figures' choices, checked on small synthetic inputs: each plotting script exposes
+`figure(...)` returning the matplotlib figure and a dict of what it chose.
+
+Run by CTest (label unit) with /usr/bin/python3; exits 77 (skipped) without matplotlib.
+"""
+import csv
+import importlib.util
+import json
+import os
+import sys
+import tempfile
+import unittest
+
+try:
+    import matplotlib  # noqa: F401
+except ImportError:
+    print("matplotlib not importable by", sys.executable)
+    sys.exit(77)
+
+TOOLS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools")
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(name, os.path.join(TOOLS, name + ".py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def write_csv(path, header, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+
+
+def legend_outside(fig, ax, legend):
+    """True when the legend's box does not overlap the axes' box (display coordinates)."""
+    fig.canvas.draw()
+    lb = legend.get_window_extent()
+    ab = ax.get_window_extent()
+    return lb.x0 >= ab.x1 or lb.x1 <= ab.x0 or lb.y0 >= ab.y1 or lb.y1 <= ab.y0
+
+
+def run_folder(d, tier="1d", status="ok"):
+    R0, L = 125e-9, 400e-9
+    ts = [i * 0.01 for i in range(20)]
+    write_csv(f"{d}/series.csv", ["t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m"],
+              [[t, t * 1e-7, 1e-7, 1e-21 * t, R0 * (1 - 0.4 * t), R0 * 1.05] for t in ts])
+    write_csv(f"{d}/radius.csv", ["t_s", "z_m", "radius_m"],
+              [[t, z * 1e-7, R0 * (1 - 0.4 * t * z / 4)] for t in ts for z in range(5)])
+    with open(f"{d}/summary.json", "w") as f:
+        json.dump({"tier": tier, "model": "force_free_confined" if tier == "1d" else "immersed_boundary",
+                   "status": status, "scene": {"name": "my_scene"}, "swimmer_length_m": L,
+                   "derived": {"contracted_ratio": 0.55, "aspect_ratio_R0_over_L": R0 / L},
+                   "segment_reached_s": [0.12, 0.05, -1], "cycle_start_times_s": [0.0, 0.15],
+                   "cycle_end_times_s": [0.15]}, f)
+
+
+class RunFigure(unittest.TestCase):
+    def setUp(self):
+        self.mod = load("plot_run")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_title_names_the_scene_and_rf_and_events_are_marked(self):
+        run_folder(self.d)
+        fig, c = self.mod.figure(self.d)
+        self.assertIn("my_scene", c["title"])
+        self.assertNotIn("FAILED", c["title"])
+        self.assertAlmostEqual(c["R_f_m"], 0.55 * 125e-9)
+        ax = c["axes"][1, 0]
+        rf = [ln for ln in ax.get_lines() if ln.get_label().startswith("R_f")]
+        self.assertEqual(len(rf), 1)
+        self.assertAlmostEqual(rf[0].get_ydata()[0], 0.55 * 125)  # nm
+        # segment 1 at 50 ms, segment 0 at 120 ms, a cycle end and start at 150 ms; -1: not reached
+        self.assertEqual([round(t, 3) for t, _ in c["events"]], [0.05, 0.12, 0.15, 0.15])
+        self.assertIn("segment reaches R_f", [ln.get_label() for ln in ax.get_lines()])
+        for leg, a in zip(c["legends"], (c["axes"][0, 0], c["axes"][0, 1], c["axes"][1, 0])):
+            self.assertTrue(legend_outside(fig, a, leg))
+
+    def test_failed_run_is_marked_failed(self):
+        run_folder(self.d, status="failed: numerical failure: CFL 0.9 exceeds 0.5")
+        fig, c = self.mod.figure(self.d)
+        self.assertTrue(c["failed"])
+        self.assertIn("FAILED: numerical failure", c["title"])
+        self.assertEqual(fig._suptitle.get_color(), "tab:red")
+
+    def test_3d_node_minimum_is_told_apart_from_the_ring_mean_map(self):
+        run_folder(self.d, tier="3d")
+        _, c = self.mod.figure(self.d)
+        self.assertIn("node minimum", c["min_label"])
+        self.assertIn("ring-mean", c["map_title"])
+
+
+class ScreenFigure(unittest.TestCase):
+    def setUp(self):
+        self.mod = load("plot_screen")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.csv = os.path.join(self.tmp.name, "designs.csv")
+        rows, i = [], 0
+        for L in (2e-7, 4e-7, 8e-7):
+            for e in (0.35, 0.6, 0.85):
+                v = 1e-8 * (1 + 10 * (L == 4e-7) * (e == 0.6)) + 1e-9 * i
+                rows.append([i, f"{L * 1e6:g} um", L, e, "ok", v * 2, v])
+                i += 1
+        write_csv(self.csv, ["design", "swimmer.length", "swimmer.length_m", "wave.contracted_ratio", "status",
+                             "displacement_m", "mean_velocity_m_per_s"], rows)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_best_design_marked_and_ticks_at_swept_values(self):
+        fig, c = self.mod.figure(self.csv, "mean_velocity_m_per_s", "s", ["swimmer.length", "wave.contracted_ratio"])
+        self.assertEqual(c["best"]["design"], "4")
+        self.assertAlmostEqual(c["best_xy"][0], 400.0)  # nm
+        self.assertAlmostEqual(c["best_xy"][1], 0.6)
+        self.assertEqual([round(v) for v in c["xticks"]], [200, 400, 800])
+        self.assertEqual(c["yticks"], [0.35, 0.6, 0.85])
+        self.assertEqual(list(c["axes"][0].get_xticks()), c["xticks"])
+        stars = [ln for ln in c["axes"][-1].get_lines() if ln.get_marker() == "*"]
+        self.assertEqual(len(stars), 1)
+        self.assertIn("best design 4", fig._suptitle.get_text())
+
+    def test_goal_min_marks_the_smallest(self):
+        _, c = self.mod.figure(self.csv, "mean_velocity_m_per_s", "s", ["swimmer.length", "wave.contracted_ratio"],
+                               goal="min")
+        self.assertEqual(c["best"]["design"], "0")
+
+
+class CalibrationFigure(unittest.TestCase):
+    def setUp(self):
+        self.mod = load("plot_calibration")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write(self, status="ok"):
+        pts = []
+        for i, P in enumerate((0.002, 0.02, 0.2)):
+            k = (5e-10, -1e-8, -3e-8)[i]
+            pts.append({"pressure_Pa": P, "displacement_m": P / 4e6 * (1 + 0.001 * i), "secant_C1_Pa_per_m": 4e6 * (1 - 0.001 * i),
+                        "in_linear_range": i < 2, "stable_to_ring_buckling": k > 0,
+                        "ring_mode_stiffness_N_per_m": [k, k * 1.1], "softest_ring_mode": 2 + i,
+                        "softest_ring_mode_stiffness_N_per_m": k})
+        with open(f"{self.d}/calibration.json", "w") as f:
+            json.dump({"load_points": pts, "C1_Pa_per_m": 4e6, "C1_spring_network_Pa_per_m": 3.98e6,
+                       "scene": {"name": "cal_scene"}, "grid": {"membrane_nodes": 100}, "status": status}, f)
+
+    def test_scales_band_and_legends(self):
+        self.write()
+        fig, c = self.mod.figure(self.d)
+        self.assertIn("cal_scene", c["title"])
+        self.assertTrue(c["symlog"])
+        self.assertEqual(c["axes"][2].get_yscale(), "symlog")
+        self.assertTrue(c["loglog"])
+        self.assertEqual(len(c["axes"][1].patches), 0)  # no filled band
+        lo, hi = c["secant_ylim"]
+        self.assertFalse(lo <= c["band"][0] and c["band"][1] <= hi)  # the axis follows the data
+        for a, leg in zip(c["axes"], c["legends"]):
+            self.assertTrue(legend_outside(fig, a, leg))
+        self.assertFalse(c["failed"])
+
+    def test_failed_hydraulic_measurement_looks_failed(self):
+        self.write("failed: hydraulic radii: numerical failure: slipping")
+        fig, c = self.mod.figure(self.d)
+        self.assertTrue(c["failed"])
+        self.assertIn("hydraulic radii FAILED", c["title"])
+        self.assertEqual(fig._suptitle.get_color(), "tab:red")
+
+    def test_symlog_only_for_both_signs_over_decades(self):
+        self.assertTrue(self.mod.spans_signs_and_decades([1.0, -100.0]))
+        self.assertFalse(self.mod.spans_signs_and_decades([1.0, 100.0]))
+        self.assertFalse(self.mod.spans_signs_and_decades([-2.0, 3.0]))
+
+
+if __name__ == "__main__":
+    unittest.main()
