@@ -179,5 +179,87 @@ class CalibrationFigure(unittest.TestCase):
         self.assertFalse(self.mod.spans_signs_and_decades([-2.0, 3.0]))
 
 
+def vtp_compressed(path, pts):
+    """A membrane frame as swim writes it: Float32 points, zlib-compressed inline binary."""
+    import base64
+    import struct
+    import zlib
+    raw = struct.pack(f"<{3 * len(pts)}f", *[c for p in pts for c in p])
+    packed = zlib.compress(raw)
+    header = struct.pack("<4I", 1, len(raw), len(raw), len(packed))
+    body = base64.b64encode(header).decode() + base64.b64encode(packed).decode()
+    with open(path, "w") as f:
+        f.write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+                'header_type="UInt32" compressor="vtkZLibDataCompressor">\n<PolyData>\n<Piece>\n<Points>\n'
+                f'<DataArray type="Float32" NumberOfComponents="3" format="binary">\n{body}\n</DataArray>\n'
+                '</Points>\n</Piece>\n</PolyData>\n</VTKFile>\n')
+
+
+class ValidationFigures(unittest.TestCase):
+    def setUp(self):
+        sys.path.insert(0, TOOLS)  # plot_validation imports plot_calibration
+        self.mod = load("plot_validation")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+        self.closed = []
+        self.mod.plt.close = self.closed.append  # keep the figure for inspection
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def membrane_case(self):
+        import math
+        R0, n_theta, rings = 125e-9, 4, 3
+        pts = [(i * 1e-7, R0 * math.cos(2 * math.pi * k / n_theta), R0 * math.sin(2 * math.pi * k / n_theta))
+               for i in range(rings) for k in range(n_theta)]
+        os.makedirs(f"{self.d}/vtk")
+        for n in range(2):
+            vtp_compressed(f"{self.d}/vtk/m{n}.vtp", pts)
+        with open(f"{self.d}/membrane.pvd", "w") as f:
+            f.write('<Collection><DataSet timestep="0" file="vtk/m0.vtp"/><DataSet timestep="0.1" file="vtk/m1.vtp"/>'
+                    '</Collection>')
+        with open(f"{self.d}/summary.json", "w") as f:
+            json.dump({"derived": {"n_theta": n_theta, "aspect_ratio_R0_over_L": R0 / 4e-7}}, f)
+        return pts, {"name": "c", "length_m": 4e-7, "runs3d": [
+            {"membrane_frames": 2, "has_cycle": True, "folder": self.d, "cycle_time_s": 0.1, "cell_size_m": 3e-8}]}
+
+    def test_compressed_membrane_frames_are_read(self):
+        pts, _ = self.membrane_case()
+        got = self.mod.read_vtp_points(f"{self.d}/vtk/m0.vtp")
+        self.assertEqual(len(got), len(pts))
+        self.assertAlmostEqual(got[5][1], pts[5][1], delta=1e-12)
+
+    def test_membrane_plot_draws_outlines_with_y_ticks(self):
+        _, case = self.membrane_case()
+        self.assertTrue(self.mod.membrane_figure(case, f"{self.d}/m.png"))
+        ax = self.closed[-1].axes[0]
+        outlines = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 3]
+        self.assertEqual(len(outlines), 4)  # top and bottom of two snapshots
+        self.assertEqual(len(ax.get_yticks()), 6)  # -R0, 0, +R0 about each snapshot
+        self.assertIn("125", [t.get_text() for t in ax.get_yticklabels()])
+
+    def test_coarse_grids_are_told_apart(self):
+        s = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-8, 0]}
+        case = {"name": "c", "models1d": [], "runs3d": [
+            {"has_cycle": True, "series": s, "cycle_time_s": 1.0, "cell_size_m": h} for h in (4e-8, 3.2e-8, 2.7e-8)]}
+        self.mod.velocity_figure(case, f"{self.d}/v.png")
+        lines = [ln for ln in self.closed[-1].axes[0].get_lines() if ln.get_label().startswith("3D")]
+        styles = {(str(ln.get_color()), ln.get_linestyle()) for ln in lines}
+        self.assertEqual(len(styles), 3)
+
+    def test_pareto_labels_do_not_overlap(self):
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots()
+        ax.plot([1, 1.0001, 10], [1, 1, 1])
+        texts = [ax.annotate(f"rtol = 1e-0{k}", (1 + 1e-4 * k, 1), xytext=(4, -10), textcoords="offset points",
+                             fontsize=7) for k in range(3)]
+        self.assertGreater(self.mod.declutter(fig, texts), 0)
+        fig.canvas.draw()
+        boxes = [t.get_window_extent() for t in texts]
+        for i in range(len(boxes)):
+            for j in range(i):
+                self.assertFalse(boxes[i].overlaps(boxes[j]))
+
+
 if __name__ == "__main__":
     unittest.main()
