@@ -275,6 +275,9 @@ def reference_convergence_figure(case, path):
     return True
 
 
+GRID_MARKERS = ("o", "s", "^", "D", "v", "P")
+
+
 def convergence_figure(case, path):
     if case.get("reference"):
         return reference_convergence_figure(case, path)
@@ -284,7 +287,10 @@ def convergence_figure(case, path):
     fig, ax = plt.subplots(figsize=(9.5, 4.6))
     h = [r["cell_size_m"] * 1e9 for r in runs]
     d = [r["displacement_per_cycle_m"] * 1e9 for r in runs]
-    ax.plot(h, d, "ko-", label="3D runs")
+    ax.plot(h, d, "k-", lw=1, label="3D runs")
+    for k, (hk, dk) in enumerate(zip(h, d)):  # each grid its own marker, its cell size beside it
+        ax.plot([hk], [dk], GRID_MARKERS[k % len(GRID_MARKERS)], color="k", ms=6)
+        ax.annotate(f"h = {hk:.3g} nm", (hk, dk), xytext=(6, 4), textcoords="offset points", fontsize=7)
     ref = case["reference3d"].get("displacement_per_cycle_m")
     if ref:
         rng = case["reference3d"].get("order_range")
@@ -306,8 +312,10 @@ def convergence_figure(case, path):
         ax.axhline(paper * 1e9, color="0.4", ls=":", lw=1.2, label="paper: maximum displacement over the cycle")
     ax.set(xlabel="cell size h [nm]", ylabel="displacement per cycle [nm]",
            title=f"{case['name']}: 3D grid convergence")
-    ax.set_xlim(left=-0.05 * max(h))
-    legend_right(ax)
+    ax.set_xlim(left=-0.05 * max(h), right=1.2 * max(h))
+    handles, labels = ax.get_legend_handles_labels()
+    ax.legend(handles, [textwrap.fill(t, 48) for t in labels], loc="center left", bbox_to_anchor=(1.0, 0.5),
+              fontsize="small", frameon=False)
     save(fig, path)
     return True
 

@@ -247,6 +247,21 @@ class ValidationFigures(unittest.TestCase):
         styles = {(str(ln.get_color()), ln.get_linestyle()) for ln in lines}
         self.assertEqual(len(styles), 3)
 
+    def test_convergence_grids_apart_and_not_asymptotic_said(self):
+        runs = [{"has_cycle": True, "cell_size_m": h, "displacement_per_cycle_m": d}
+                for h, d in ((4e-8, 7e-10), (3.2e-8, 2.7e-9), (2.67e-8, 3.7e-9))]
+        case = {"name": "c", "runs3d": runs, "models1d": [], "reference3d": {
+            "order_range": [0.5, 2], "displacement_per_cycle_m": {
+                "value": 3.7e-9, "error": 3e-9, "asymptotic": False, "observed_order": 2.94, "order": None}}}
+        self.assertTrue(self.mod.convergence_figure(case, f"{self.d}/c.png"))
+        ax = self.closed[-1].axes[0]
+        markers = {ln.get_marker() for ln in ax.get_lines() if len(ln.get_xdata()) == 1 and ln.get_color() == "k"}
+        self.assertEqual(len(markers), 3)
+        self.assertIn("h = 40 nm", [t.get_text() for t in ax.texts])
+        legend = " ".join(t.get_text() for t in ax.get_legend().get_texts())
+        self.assertIn("not asymptotic", legend)
+        self.assertIn("observed order 2.94", legend.replace("\n", " "))
+
     def test_pareto_labels_do_not_overlap(self):
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots()
