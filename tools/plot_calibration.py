@@ -119,6 +119,7 @@ def figure(d):
                            va="bottom" if above else "top")
         prev = p["softest_ring_mode"]
     ax[2].axhline(0, color="k", lw=1)
+    ax[2].margins(y=0.14)  # room for the n labels inside the axes, clear of the title and ticks
     ax[2].set(xlabel="pressure [mPa] (log scale)",
               ylabel="ring-mode stiffness [pN/m]" + (" (symlog)" if symlog else ""),
               title="ring buckling: unstable below zero")

@@ -158,6 +158,13 @@ class CalibrationFigure(unittest.TestCase):
         self.assertIn("cal_scene", c["title"])
         self.assertTrue(c["symlog"])
         self.assertEqual(c["axes"][2].get_yscale(), "symlog")
+        # room for the n labels: the axis reaches well past the softest mode's extremes
+        ax2 = c["axes"][2]
+        lo2, hi2 = ax2.get_ylim()
+        t = ax2.transScale
+        ys = [t.transform((1, v))[1] for v in (lo2, hi2, -3e4, 5e2)]  # pN/m, in the symlog's space
+        self.assertGreater(ys[2] - ys[0], 0.1 * (ys[1] - ys[0]))
+        self.assertGreater(ys[1] - ys[3], 0.1 * (ys[1] - ys[0]))
         self.assertTrue(c["loglog"])
         self.assertEqual(len(c["axes"][1].patches), 0)  # no filled band
         lo, hi = c["secant_ylim"]
