@@ -20,7 +20,7 @@
 namespace swim::app {
 
 int calibrate(const std::string& scene_path, const std::vector<std::string>& sets, const std::string& out_opt,
-              bool wet, bool overwrite, int threads, int progress_mode) {
+              bool wet, bool overwrite, int threads, bool tube_law, int progress_mode) {
   scene::json sc = scene::load_file(scene_path);
   for (const auto& s : sets) scene::apply_override(sc, s);
   if (threads > 0) scene::apply_override(sc, "full3d.threads=" + std::to_string(threads));
@@ -30,8 +30,9 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   const std::string out = out_opt.empty() ? "out/" + p.name + "-calibration" : out_opt;
   // The folder belongs to this calibration from the start: a folder in use, or holding another
   // run's results (without --overwrite), is refused before minutes of 3D runs.
-  output::RunFolder folder(out, {"calibration", {{"scene", resolved}, {"wet", wet}}, overwrite, false, "--out",
-                                 "calibration.json"});
+  scene::json identity = {{"scene", resolved}, {"wet", wet}};
+  if (tube_law) identity["tube_law"] = true;  // (absent without it: earlier folders stay this calibration's)
+  output::RunFolder folder(out, {"calibration", identity, overwrite, false, "--out", "calibration.json"});
   const auto t0 = std::chrono::steady_clock::now();
   const auto loads = validation::default_loads(p);
   // progress in steps: the loads, then the hydraulic radii and the towed tube (one each)
@@ -65,6 +66,8 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
                  out.c_str());
     return 3;
   }
+  validation::TubeLawCalibration law;
+  if (tube_law) law = validation::calibrate_tube_law(p, c.fit.c1, c.fit.c1_stderr);
   // wet confirmation at the largest load of the fit
   validation::WetConfirmation w;
   const validation::LoadPoint* confirm = nullptr;
@@ -81,6 +84,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   hj.erase("wall_time_s");
   j.update(hj);
   j.update(tow.json);
+  if (tube_law) j["tube_law"] = validation::to_json(law, p.R0);
   if (wet && confirm)
     j["wet_confirmation"] = {{"pressure_Pa", w.pressure_Pa},
                              {"displacement_m", w.displacement_m},
@@ -134,6 +138,21 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
                 si(tt.drag_coefficient_N_s_per_m, "N s/m", 4).c_str(),
                 si(tt.drag_coefficient_uncertainty_N_s_per_m, "N s/m").c_str(), tt.cg_iterations,
                 si(tt.wall_time_s, "s").c_str(), tow.nominal.note.c_str());
+  if (tube_law) {
+    std::printf("  tube law, round branch: %zu loads to R_mid = %.3f R0 (%s), slope at R0 %s (C1 %+.3f %%), closed form "
+                "of the ring of springs within %.2f %%\n",
+                law.round.points.size(), law.round.knots_R.front() / p.R0, law.round.stopped_because.c_str(),
+                si(law.round.slope_at_R0, "Pa/m", 5).c_str(), 100.0 * (law.round.slope_at_R0 / c.fit.c1 - 1.0),
+                100.0 * law.round_max_rel_dev_closed_form);
+    if (law.buckled_computed)
+      std::printf("  tube law, buckled branch: buckling load %s (ring mode n = %d); %zu loads to R_mid = %.3f R0 (%s); "
+                  "leave-one-out residual max %s\n",
+                  si(law.buckling_load_Pa, "Pa").c_str(), law.buckling_mode, law.buckled.points.size(),
+                  law.buckled.knots_R.front() / p.R0, law.buckled.stopped_because.c_str(),
+                  si(law.buckled.loo_max_abs_Pa, "Pa").c_str());
+    else
+      std::printf("  tube law, buckled branch: absent (%s)\n", law.buckled_absent_because.c_str());
+  }
   if (wet && confirm)
     std::printf("  wet confirmation at %s (axisymmetric wall): displacement %s against %s static (%+.2f %%), %s after %d "
                 "steps of %s\n",

@@ -76,6 +76,7 @@ WallSpec read_wall(Reader& top, double R0) {
     w.value = r.quantity("spring_constant", "N/m", "5.5e-8 N/m", Range::positive());
   else
     w.calibration = r.text("calibration", "");
+  if (r.has("law")) w.law = r.choice("law", "linear", {"linear", "calibrated_round", "calibrated_buckled"});
   if (one_of(r, {"mass_per_area", "mass_per_length"}, "mass_per_length") == "mass_per_area")
     w.mass_per_area = r.quantity("mass_per_area", "kg/m^2", "", Range::positive());
   else  // source-equations.md §1: mass per unit length m_l = 2 pi R0 m
@@ -120,11 +121,12 @@ WaveSpec read_wave(Reader& top, double R0, double L) {
   return s;
 }
 
-ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1) {
+ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1, double static_load) {
   ProtocolSpec p;
   Reader r = top.child("protocol");
   const double area = 2.0 * M_PI * R0 * L;
-  const double q_needed = C1 * (R0 - R_f);  // static load that holds the wall at R_f
+  // static load that holds the wall at R_f (a nonlinear law's own, when given)
+  const double q_needed = static_load > 0 ? static_load : C1 * (R0 - R_f);
   const std::string act = one_of(r, {"pressure", "total_force", "load_factor"}, "total_force");
   if (act == "pressure")
     p.q = r.quantity("pressure", "Pa", "", Range::positive());
@@ -140,7 +142,8 @@ ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double 
   r.finish();
   if (!(p.q > 1.02 * q_needed))
     throw InputError(r.path(act), format_quantity(p.q, "Pa") + " (as pressure)",
-                     "cannot contract the wall to the contracted radius: the static load C1 (R0 - R_f) = " +
+                     std::string("cannot contract the wall to the contracted radius: the static load ") +
+                         (static_load > 0 ? "of the calibrated tube law at R_f" : "C1 (R0 - R_f)") + " = " +
                          format_quantity(q_needed, "Pa") +
                          " must be exceeded by at least 2%; raise the actuation, use protocol.load_factor, or "
                          "raise wave.contracted_ratio");

@@ -43,6 +43,11 @@ struct WallSpec {
   double value = 0;         ///< C1 [Pa/m] or k_s [N/m]; 0 for a calibration file
   std::string calibration;  ///< path, for "calibration"
   double mass_per_area = 0; ///< [kg/m^2] (mass_per_length converted with 2 pi R0, source-equations.md §1)
+  /// wall.law: "linear" (the default, and when the key is absent: not echoed, so scenes without
+  /// it resolve as before), "calibrated_round" or "calibrated_buckled" (the 1D tier's static
+  /// tube law from the calibration file's tube_law section, docs/tube-law.md; the 3D tier's
+  /// wall is the membrane itself and ignores it)
+  std::string law = "linear";
 };
 /// Reads (and finishes) the wall section.
 WallSpec read_wall(Reader& top, double R0);
@@ -81,6 +86,8 @@ struct ProtocolSpec {
 };
 /// Reads (and finishes) the protocol section of a force-driven wave. C1 [Pa/m] is the wall
 /// stiffness used to check that the actuation can reach R_f (static load C1 (R0 - R_f)).
-ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1);
+/// `static_load` > 0: the static load that holds R_f under a nonlinear wall law, in place of
+/// C1 (R0 - R_f).
+ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1, double static_load = 0.0);
 
 }  // namespace swim::scene

@@ -407,7 +407,7 @@ Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::VectorXd& r) {
 }
 
 PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
-                                      double tol_force, int max_iterations) {
+                                      double tol_force, int max_iterations, const Eigen::Matrix3Xd* start) {
   // The mesh is invariant under rotation by 2 pi / n_theta about the axis and under the
   // mirror theta -> -theta, and so is the load; the equilibrium therefore has every ring a
   // circle of radius r_k at axial position x_k, each node at its reference angle. The
@@ -458,6 +458,10 @@ PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembranePa
 
   Eigen::VectorXd rk = Eigen::VectorXd::Constant(nr, mesh.radius), xk(nr);
   for (int k = 0; k < nr; ++k) xk[k] = mesh.X0(0, mesh.node(k, 0)) - mesh.axis_start.x();
+  if (start) {
+    rk = ring_radii(mesh, *start);
+    for (int k = 0; k < nr; ++k) xk[k] = (*start)(0, mesh.node(k, 0)) - mesh.axis_start.x();
+  }
   Eigen::Matrix3Xd G = gradient(positions(rk, xk));
   Eigen::VectorXd res = generalised(G);
   const int nu = 2 * nr - 1;  // unknowns r_0..r_{nr-1}, x_1..x_{nr-1}; equations likewise

@@ -137,7 +137,10 @@ struct PressureResponse {
 };
 /// Throws swim::NumericalError when Newton does not reach tol_force (N, the largest nodal
 /// force imbalance on the full mesh; <= 0 selects 1e-7 of the largest nodal load).
+/// `start`: a stack of circular rings to start Newton from (its ring radii and axial
+/// positions; the undeformed tube when null), for a continuation in the load.
 PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
-                                      double tol_force = 0.0, int max_iterations = 50);
+                                      double tol_force = 0.0, int max_iterations = 50,
+                                      const Eigen::Matrix3Xd* start = nullptr);
 
 }  // namespace swim::full3d

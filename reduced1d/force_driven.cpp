@@ -236,7 +236,16 @@ void EventLoop::start() {
     throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
   }
   check_end_radii(0.0);
-  if (!fixed_ && P_.protocol.q <= M_.C1 * (M_.R0 - P_.protocol.R_f)) {
+  if (!fixed_ && M_.wall.law && P_.protocol.q <= -M_.wall(P_.protocol.R_f)) {
+    throw NumericalError(
+        "the actuation cannot contract the tube to R_f: under the actuation pressure q = " + fmt(P_.protocol.q) +
+            " Pa the static radius of the calibrated tube law, " + fmt(M_.wall.static_radius(P_.protocol.q)) +
+            " m, is not below R_f = " + fmt(P_.protocol.R_f) + " m",
+        "raise the actuation (protocol.pressure) above the law's static load at R_f, " +
+            fmt(-M_.wall(P_.protocol.R_f)) + " Pa, or raise wave.contracted_ratio",
+        0.0);
+  }
+  if (!fixed_ && !M_.wall.law && P_.protocol.q <= M_.C1 * (M_.R0 - P_.protocol.R_f)) {
     throw NumericalError(
         "the actuation cannot contract the tube to R_f: under the actuation pressure q = " + fmt(P_.protocol.q) +
             " Pa the static radius R0 - q/C1 = " + fmt(M_.R0 - P_.protocol.q / M_.C1) +
@@ -310,6 +319,16 @@ void EventLoop::install_laws() {
 void EventLoop::check_end_radii(double t) const {
   double lo0, loL;
   M_.end_radius_range(lo0, loL);
+  if ((lo0 < collapse_ || loL < collapse_) && M_.wall.law) {
+    const bool left = lo0 < collapse_;
+    throw NumericalError(
+        "tube radius collapsed to zero at z = " + fmt(left ? 0.0 : M_.L) +
+            " m: under its actuation the open end's static radius on the calibrated tube law, " +
+            fmt(left ? lo0 : loL) + " m, is below the collapse radius " + fmt(collapse_) + " m",
+        "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) below the law's "
+        "static load at the collapse radius, " + fmt(-M_.wall(collapse_)) + " Pa",
+        t);
+  }
   if (lo0 < collapse_ || loL < collapse_) {
     const bool left = lo0 < collapse_;
     throw NumericalError(

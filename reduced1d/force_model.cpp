@@ -38,6 +38,7 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
       stride(dae ? 3 + J : 1),
       Rb0_static(R0),
       RbL_static(R0) {
+  wall = wall_law(P);
   // Layout [V_rear, cell 0, ..., cell N-1, V_front, D, X]: V_rear/V_front sit next to the
   // end cells they depend on, so their couplings are inside the band of the Newton matrix
   // and BDF keeps the linear invariant h sum A_i - V_rear + V_front exactly.
@@ -83,6 +84,10 @@ ModelState ForceModel::make_state() const {
   s.dq.assign(N, 0.0);
   s.Rb0 = R0;
   s.RbL = R0;
+  if (wall.law) {
+    s.wv.assign(N, 0.0);
+    s.dw.assign(N, 0.0);
+  }
   s.r.assign(N + 1, 0.0);
   s.Q.assign(N + 1, 0.0);
   s.cond.assign(N + 1, 0.0);
@@ -119,15 +124,15 @@ void ForceModel::set_actuation(const ProtocolMachine& mc, const std::vector<Prot
   // The end cells lie inside the first/last segment (h <= shortest segment): pure laws.
   end0_seg = seg_law[seg_a[0]] != nullptr;
   endL_seg = seg_law[seg_a[N - 1]] != nullptr;
-  Rb0_static = law[0].a->rest_radius(R0, C1);
-  RbL_static = law[N - 1].a->rest_radius(R0, C1);
+  Rb0_static = law[0].a->rest_radius(wall);
+  RbL_static = law[N - 1].a->rest_radius(wall);
 }
 
 void ForceModel::end_radius_range(double& lo0, double& loL) const {
   lo0 = Rb0_static;
   loL = RbL_static;
-  if (end0_seg) lo0 = law[0].a->rest_radius(R0, C1, seg_law[seg_a[0]]->operator()(1e300));
-  if (endL_seg) loL = law[N - 1].a->rest_radius(R0, C1, seg_law[seg_a[N - 1]]->operator()(1e300));
+  if (end0_seg) lo0 = law[0].a->rest_radius(wall, seg_law[seg_a[0]]->operator()(1e300));
+  if (endL_seg) loL = law[N - 1].a->rest_radius(wall, seg_law[seg_a[N - 1]]->operator()(1e300));
 }
 
 bool ForceModel::unpack(const double* y, ModelState& s) const {
@@ -160,19 +165,30 @@ bool ForceModel::unpack(const double* y, ModelState& s) const {
     s.Rbar[k] = sum / seg_w[k];
     s.qs[k] = seg_law[k]->eval(s.Rbar[k], s.dqs[k]);
   }
-  s.Rb0 = end0_seg ? law[0].a->rest_radius(R0, C1, s.qs[seg_a[0]]) : Rb0_static;
-  s.RbL = endL_seg ? law[N - 1].a->rest_radius(R0, C1, s.qs[seg_a[N - 1]]) : RbL_static;
+  s.Rb0 = end0_seg ? law[0].a->rest_radius(wall, s.qs[seg_a[0]]) : Rb0_static;
+  s.RbL = endL_seg ? law[N - 1].a->rest_radius(wall, s.qs[seg_a[N - 1]]) : RbL_static;
+  if (wall.law) {  // d Rb / d qs = -1 / w'(Rb) (the end cell of a held segment has no own ramp)
+    double d;
+    wall.eval(s.Rb0, d);
+    s.dRb0 = -1.0 / d;
+    wall.eval(s.RbL, d);
+    s.dRbL = -1.0 / d;
+  }
   for (int i = 0; i < N; ++i) {
     const double Ri = R[i];
     double qi = law[i].eval(Ri, s.dq[i]);
     if (seg_law[seg_a[i]]) qi += frac[i] * s.qs[seg_a[i]];
     if (seg_b[i] != seg_a[i] && seg_law[seg_b[i]]) qi += (1.0 - frac[i]) * s.qs[seg_b[i]];
     s.q[i] = qi;
+    if (wall.law) s.wv[i] = wall.law->eval(Ri, s.dw[i]);
     if (dae) {
       s.V[i] = Vel_s * y[1 + stride * i + 1];
       s.p[i] = P_s * y[1 + stride * i + 2];
     } else {
-      s.p[i] = C1 * (Ri - R0) + qi;
+      if (wall.law)
+        s.p[i] = s.wv[i] + qi;
+      else
+        s.p[i] = C1 * (Ri - R0) + qi;
     }
   }
   return ok;
@@ -243,7 +259,13 @@ disc::PressureIntegrals ForceModel::integrals(const ModelState& st) const {
 }
 
 double ForceModel::energy(const ModelState& s) const {
-  double e = disc::elastic_energy(s.R.data(), N, R0, C1, h);
+  double e = 0;
+  if (wall.law) {
+    for (int i = 0; i < N; ++i) e += wall.law->energy(s.R[i]);
+    e *= 2.0 * pi * R0 * h;
+  } else {
+    e = disc::elastic_energy(s.R.data(), N, R0, C1, h);
+  }
   if (inertia) {
     double k = 0;
     for (int i = 0; i < N; ++i) k += s.V[i] * s.V[i];
@@ -305,7 +327,9 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
   s.QR.assign(N + 1, 0.0);
   // point radii and dPi/dR at the points (ends: Pi = 0 fixed)
   auto Rp = [&](int k) { return k == 0 ? st.Rb0 : (k == N + 1 ? st.RbL : R[k - 1]); };
-  auto dPi = [&](int k) { return (k == 0 || k == N + 1 || !with_pressure) ? 0.0 : C1 + st.dq[k - 1]; };
+  auto dPi = [&](int k) {
+    return (k == 0 || k == N + 1 || !with_pressure) ? 0.0 : wall_slope(st, k - 1) + st.dq[k - 1];
+  };
   if (confined) {
     const outer::ConfinedSystem& sys = *st.sys;
     s.g1a.assign(N + 1, 0.0), s.g1b.assign(N + 1, 0.0), s.g1pi.assign(N + 1, 0.0);
@@ -441,8 +465,8 @@ int ForceModel::jacobian(const Linearisation& s, const Band& band, std::vector<d
       else if (j == N) dQ[N] = u(N - 1) * cond[N];
       else dQ[j] = -(u(j) - u(j - 1)) * cond[j];
     }
-    if (end0_seg && seg_a[0] == k) dQ[0] += s.Qb0 * (-1.0 / C1);
-    if (endL_seg && seg_a[N - 1] == k) dQ[N] += s.QbL * (-1.0 / C1);
+    if (end0_seg && seg_a[0] == k) dQ[0] += s.Qb0 * end_sensitivity(st, false);
+    if (endL_seg && seg_a[N - 1] == k) dQ[N] += s.QbL * end_sensitivity(st, true);
     const std::size_t off = Ul.size();
     Ul.resize(off + n, 0.0);
     Vt.resize(off + n, 0.0);
@@ -456,8 +480,13 @@ int ForceModel::jacobian(const Linearisation& s, const Band& band, std::vector<d
         g1 += dg1pi[i] * u(i);
         g2 += dg2pi[i] * u(i);
       }
-      if (end0_seg && seg_a[0] == k) g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
-      if (endL_seg && seg_a[N - 1] == k) g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
+      if (wall.law) {
+        if (end0_seg && seg_a[0] == k) g1 += s.g1a[0] * st.dRb0, g2 += s.g2a[0] * st.dRb0;
+        if (endL_seg && seg_a[N - 1] == k) g1 += s.g1b[N] * st.dRbL, g2 += s.g2b[N] * st.dRbL;
+      } else {
+        if (end0_seg && seg_a[0] == k) g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
+        if (endL_seg && seg_a[N - 1] == k) g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
+      }
       seg_x.push_back({-(Gi[0][0] * g1 + Gi[0][1] * g2), -(Gi[1][0] * g1 + Gi[1][1] * g2), off});
     }
     ++rank;
@@ -472,8 +501,8 @@ int ForceModel::jacobian(const Linearisation& s, const Band& band, std::vector<d
     std::copy(fu.begin(), fu.end(), Ul.begin() + off + n);
     for (int i = 0; i < N; ++i) {
       const double dRda = 0.5 * R0 * R0 / R[i];
-      const double g1 = (s.g1b[i] + s.g1a[i + 1] + dg1pi[i] * (C1 + st.dq[i])) * dRda;
-      const double g2 = (s.g2b[i] + s.g2a[i + 1] + dg2pi[i] * (C1 + st.dq[i])) * dRda;
+      const double g1 = (s.g1b[i] + s.g1a[i + 1] + dg1pi[i] * (wall_slope(st, i) + st.dq[i])) * dRda;
+      const double g2 = (s.g2b[i] + s.g2a[i + 1] + dg2pi[i] * (wall_slope(st, i) + st.dq[i])) * dRda;
       Vt[off + 1 + i] = -(Gi[0][0] * g1 + Gi[0][1] * g2);
       Vt[off + n + 1 + i] = -(Gi[1][0] * g1 + Gi[1][1] * g2);
     }
@@ -511,7 +540,10 @@ int ForceModel::res(const double* y, const double* yp, double* F, ModelState& s)
     double T = tr_csum * y[k + 1];
     for (int j = 0; j < J; ++j) T -= tr_c[j] * y[k + 3 + j];
     F[k] = yp[k] - cu * R[i] * y[k + 1];
-    F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (C1 * (R[i] - R0) + s.q[i] + P_s * T - s.p[i]);
+    if (wall.law)
+      F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (s.wv[i] + s.q[i] + P_s * T - s.p[i]);
+    else  // (the linear tier's own expression, for its rounding)
+      F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (C1 * (R[i] - R0) + s.q[i] + P_s * T - s.p[i]);
     F[k + 2] = cp * ((s.Q[i + 1] - s.Q[i]) / h + A0 * yp[k]);
     if (J > 0) {
       const int km = i > 0 ? k - S : k, kp = i + 1 < N ? k + S : k;  // mirror ends
@@ -547,7 +579,7 @@ void ForceModel::ida_band(const Linearisation& s, const double* y, double cj, co
     band(k, k, cj - cu * y[k + 1] * dRda(i));
     band(k, k + 1, -cu * R[i]);
     // F_V = [V'] + cv (C1 (R - R0) + q + P_s T - p)
-    band(k + 1, k, cv * (C1 + st.dq[i]) * dRda(i));
+    band(k + 1, k, cv * (wall_slope(st, i) + st.dq[i]) * dRda(i));
     if (inertia) band(k + 1, k + 1, cj);
     if (J > 0) band(k + 1, k + 1, cv * P_s * tr_csum);
     band(k + 1, k + 2, -cv * P_s);
@@ -616,17 +648,23 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
       Vt[off + 1 + S * i] = st.dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
     }
     double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii
-    if (endL_seg && seg_a[N - 1] == k) {  // Q_N depends on RbL = R0 - qs/C1
-      const double dQN = s.QbL * (-1.0 / C1);
+    if (endL_seg && seg_a[N - 1] == k) {  // Q_N depends on RbL (linear law: R0 - qs/C1)
+      const double dQN = s.QbL * end_sensitivity(st, true);
       Ul[off + 1 + S * (N - 1) + 2] += cp * dQN / h;
       Ul[off + iVf] += -dQN / V_s;
-      if (confined) g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
+      if (confined) {
+        if (wall.law) g1 += s.g1b[N] * st.dRbL, g2 += s.g2b[N] * st.dRbL;
+        else g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
+      }
     }
     if (end0_seg && seg_a[0] == k) {
-      const double dQ0 = s.Qb0 * (-1.0 / C1);
+      const double dQ0 = s.Qb0 * end_sensitivity(st, false);
       Ul[off + 1 + 2] += -cp * dQ0 / h;
       Ul[off + iVr] += -dQ0 / V_s;
-      if (confined) g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
+      if (confined) {
+        if (wall.law) g1 += s.g1a[0] * st.dRb0, g2 += s.g2a[0] * st.dRb0;
+        else g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
+      }
     }
     if (confined && (g1 != 0.0 || g2 != 0.0))
       seg_x.push_back({-(Gi[0][0] * g1 + Gi[0][1] * g2), -(Gi[1][0] * g1 + Gi[1][1] * g2), off});

@@ -55,6 +55,10 @@ struct ModelState {
   std::vector<double> q, dq;          ///< total actuation and d(own law)/dR per cell
   std::vector<double> Rbar, qs, dqs;  ///< per segment (only where a segment law is held)
   double Rb0 = 0, RbL = 0;            ///< end radii
+  /// calibrated wall law only: w(R_i), dw/dR per cell, and d Rb / d qs of each end (the
+  /// linear law: -1 / C1)
+  std::vector<double> wv, dw;
+  double dRb0 = 0, dRbL = 0;
   std::vector<double> r, Q;           ///< face resistances and fluxes (faces j = 0..N)
   std::vector<double> cond;           ///< dQ_j / d(-dPi_j): 1 / r_j, or 1 / (r_in + r_out) when confined
   double U = 0;                       ///< swimmer velocity at the last fluxes() [m/s]
@@ -102,8 +106,12 @@ struct AddToBandMatrix {
 
 struct ForceModel {
   // ---- configuration (fixed)
+  // The wall law enters as w(R_i) in place of C1 (R_i - R0) and dw/dR in place of C1 (its
+  // value at each cell: wall_slope); with the linear law the expressions are the linear
+  // tier's own.
   int N;
   double L, h, R0, C1, m, mu;
+  WallLaw wall;  // the static wall law (linear C1 (R - R0) unless wall.law)
   bool inertia, flow_closure;
   bool force_free, confined;  // force-free model; confined outer flow
   double a_in, a_out;
@@ -204,6 +212,13 @@ struct ForceModel {
   /// pressure): one per held segment, and with the confined outer flow the two closure terms
   /// dF/dW (dW/dy)^T + dF/dU (dU/dy)^T, d(W, U)/dy = -G^{-1} dg/dy. Same layout as jacobian().
   int residual_low_rank(const Linearisation& lin, std::vector<double>& Ul, std::vector<double>& Vt) const;
+
+ /// dw/dR of cell i at the state (C1 for the linear law).
+  double wall_slope(const ModelState& s, int i) const { return wall.law ? s.dw[i] : C1; }
+  /// d Rb / d qs of the left (right) end: -1 / w'(Rb).
+  double end_sensitivity(const ModelState& s, bool right) const {
+    return wall.law ? (right ? s.dRbL : s.dRb0) : -1.0 / C1;
+  }
 
  private:
   /// d r / d a and d r / d b for the resistance r(d, a, b) of disc::resistance.

@@ -39,7 +39,13 @@ void RootFunctions::eval(const double* y, double* g) {
   if (machine->phase() == 0) {
     g[1] = (machine->segment_mean(machine->active(), Rbuf.data()) - Rf) / M->R0;
   } else {
-    double E = disc::elastic_energy(Rbuf.data(), N, M->R0, M->C1, M->h);
+    double E = 0;
+    if (M->wall.law) {
+      for (int i = 0; i < N; ++i) E += M->wall.law->energy(Rbuf[i]);
+      E *= 2.0 * pi * M->R0 * M->h;
+    } else {
+      E = disc::elastic_energy(Rbuf.data(), N, M->R0, M->C1, M->h);
+    }
     if (M->inertia) {
       double k = 0;
       for (int i = 0; i < N; ++i) {

@@ -26,10 +26,13 @@
 //               lubrication pressure gradient of the flow closure.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace swim::reduced1d {
+
+class TubeLaw;  // reduced1d/tube_law.hpp
 
 /// How the radius wave R(z,t) is produced.
 enum class WaveKind {
@@ -90,6 +93,10 @@ struct Wall {
   double C1 = 4.06e6;    ///< wall stiffness: pressure per unit radial displacement [Pa/m]
   double m = 1.0e-3;     ///< wall mass per unit wall area [kg/m^2]
   bool inertia = false;  ///< keep m R_tt in the wall equation (force-driven wave only)
+  /// Nonlinear static tube law w(R) in place of C1 (R - R0) (wall.law, docs/tube-law.md);
+  /// nullptr: the linear law. Force-free model, force-driven wave only. C1 then is the law's
+  /// calibrated small-load stiffness and sets the scales (time, pressure) only.
+  std::shared_ptr<const TubeLaw> law;
 };
 
 /// Prescribed smoothed step, eq. (53): R = R_min + (R0 - R_min) H((z*(t) - z)/w),

@@ -10,6 +10,7 @@ namespace swim::reduced1d::detail {
 
 double reference_energy(const Params& p) {
   const double R0 = p.geometry.R0, d = R0 - p.protocol.R_f;
+  if (p.wall.law) return p.wall.law->energy(p.protocol.R_f) * 2.0 * std::numbers::pi * R0 * p.geometry.L;
   return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
 }
 
@@ -33,6 +34,29 @@ double ActuationLaw::rest_radius(double R0, double C1, double extra) const {
     }
   }
   return R0 - (y[n - 1] + extra) / C1;  // right constant piece
+}
+
+double ActuationLaw::rest_radius(const WallLaw& wall, double extra) const {
+  if (!wall.law) return rest_radius(wall.R0, wall.C1, extra);
+  // g(R) = w(R) + q(R) + extra: continuous and strictly increasing (w strictly, q
+  // non-decreasing); constant pieces by the law's own inversion, ramps by bisection
+  if (n == 0) return wall.static_radius(c + extra);
+  {
+    const double R = wall.static_radius(y[0] + extra);
+    if (R <= x[0]) return R;
+  }
+  for (int k = 1; k < n; ++k) {
+    const auto g = [&](double R) { return wall(R) + (*this)(R) + extra; };
+    if (g(x[k - 1]) <= 0 && g(x[k]) >= 0) {
+      double a = x[k - 1], b = x[k];
+      for (int it = 0; it < 200 && b - a > 1e-15 * (std::abs(a) + std::abs(b)); ++it) {
+        const double m = 0.5 * (a + b);
+        (g(m) < 0 ? a : b) = m;
+      }
+      return 0.5 * (a + b);
+    }
+  }
+  return wall.static_radius(y[n - 1] + extra);
 }
 
 namespace {

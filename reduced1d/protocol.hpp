@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "reduced1d/params.hpp"
+#include "reduced1d/tube_law.hpp"
 
 namespace swim::reduced1d::detail {
 
@@ -75,6 +76,8 @@ struct ActuationLaw {
   /// Radius where C1 (R - R0) + q(R) + extra = 0 (the tube law at p = 0; unique since q is
   /// non-decreasing).
   double rest_radius(double R0, double C1, double extra = 0.0) const;
+  /// The same for the wall law: w(R) + q(R) + extra = 0 (the linear law: the overload above).
+  double rest_radius(const WallLaw& wall, double extra = 0.0) const;
 };
 
 class ProtocolMachine {
@@ -166,8 +169,12 @@ class ProtocolMachine {
   bool cycle_completed_ = false;
 };
 
-/// E_ref = (1/2) C1 (R0 - R_f)^2 2 pi R0 L: elastic energy of the tube uniformly at R_f.
+/// E_ref = (1/2) C1 (R0 - R_f)^2 2 pi R0 L: elastic energy of the tube uniformly at R_f
+/// (with a calibrated law, int_{R0}^{R_f} w dR 2 pi R0 L).
 double reference_energy(const Params& p);
+
+/// The wall law of the parameters (linear when p.wall.law is null).
+inline WallLaw wall_law(const Params& p) { return {p.geometry.R0, p.wall.C1, p.wall.law.get()}; }
 
 /// Radius below which the tube counts as collapsed: 1e-3 R0.
 /// Radius at which the tube counts as collapsed: the lumen (R - a_in in the force-free model)

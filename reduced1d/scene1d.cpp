@@ -12,6 +12,7 @@
 #include "common/scene_shared.hpp"
 #include "common/units.hpp"
 #include "reduced1d/outer_flow.hpp"
+#include "reduced1d/tube_law.hpp"
 
 namespace swim::reduced1d {
 
@@ -82,6 +83,39 @@ double c1_from_calibration(const std::string& key, const std::string& path, cons
   return c1;
 }
 
+std::shared_ptr<const TubeLaw> tube_law_from_calibration(const std::string& key, const std::string& path,
+                                                         const std::string& scene_dir, const std::string& branch,
+                                                         double R0) {
+  const json j = load_calibration(key, path, scene_dir);
+  const std::string where = "tube_law." + branch;
+  auto bad = [&](const std::string& what) { return InputError(key, "\"" + path + "\"", what); };
+  if (!j.is_object() || !j.contains("tube_law") || !j["tube_law"].is_object() || !j["tube_law"].contains(branch) ||
+      !j["tube_law"][branch].is_object())
+    throw bad("calibration file must hold the tube law \"" + where +
+              "\" (written by swim calibrate --tube-law) for wall.law = \"calibrated_" + branch + "\"");
+  const json& b = j["tube_law"][branch];
+  auto numbers = [&](const std::string& name) {
+    if (!b.contains(name) || !b[name].is_array())
+      throw bad("calibration file must hold an array \"" + where + "." + name + "\"");
+    std::vector<double> out;
+    for (const auto& v : b[name]) {
+      if (!v.is_number()) throw bad("\"" + where + "." + name + "\" must hold numbers only");
+      out.push_back(v.get<double>());
+    }
+    return out;
+  };
+  std::vector<double> R = numbers("knots_radius_m"), w = numbers("knots_wall_pressure_Pa");
+  if (!R.empty() && !(std::abs(R.back() / R0 - 1.0) <= 1e-9))
+    throw bad("the tube law was calibrated for a tube of radius " + fmt(R.back(), "m") +
+              "; this scene's swimmer.radius is " + fmt(R0, "m") + " (calibrate the scene's own tube)");
+  if (!R.empty()) R.back() = R0;  // the undeformed knot is the scene's R0
+  try {
+    return std::make_shared<const TubeLaw>(R0, std::move(R), std::move(w));
+  } catch (const InputError& e) {
+    throw bad(std::string("the tube law \"") + where + "\" is not a valid monotone law: " + e.what());
+  }
+}
+
 Params read_scene(const json& scene, json& resolved, const std::string& scene_dir) {
   Params p;
   resolved = json::object();
@@ -117,6 +151,15 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     else
       p.wall.C1 = c1_from_calibration("wall.calibration", w.calibration, scene_dir);
     p.wall.m = w.mass_per_area;
+    if (w.law != "linear") {
+      if (w.stiffness != "calibration")
+        throw InputError("wall.law", "\"" + w.law + "\"",
+                         "a calibrated tube law is read from the calibration file: give wall.calibration (a "
+                         "calibration.json written by swim calibrate --tube-law) instead of wall." + w.stiffness +
+                         ", or use wall.law = \"linear\"");
+      p.wall.law = tube_law_from_calibration("wall.calibration", w.calibration, scene_dir,
+                                             w.law == "calibrated_round" ? "round" : "buckled", R0);
+    }
   }
 
   double R_f = 0;
@@ -139,7 +182,8 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   if (!forced && top.has("protocol"))
     throw InputError("protocol", scene::show(scene.at("protocol")), "is only used when wave.kind = \"force_driven\"");
   if (forced) {
-    const scene::ProtocolSpec r = scene::read_protocol(top, R0, L, R_f, p.wall.C1);
+    const scene::ProtocolSpec r =
+        scene::read_protocol(top, R0, L, R_f, p.wall.C1, p.wall.law ? -(*p.wall.law)(R_f) : 0.0);
     p.protocol.R_f = R_f;
     p.protocol.q = r.q;
     p.protocol.segments = r.segments;
@@ -195,6 +239,10 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
                            : ExternalDrag::None;
       q.finish();
     }
+    if (p.wall.law && (p.swimmer.model != SwimmerModel::ForceFree || !forced))
+      throw InputError("wall.law", "\"" + std::string(scene.at("wall").at("law").get<std::string>()) + "\"",
+                       "a calibrated tube law is available for the force-free model (model1d.model = "
+                       "\"force_free\") with wave.kind = \"force_driven\"; use wall.law = \"linear\" here");
     p.wall.inertia = m.boolean("wall_inertia", false);
     if (p.wall.inertia && p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.outer == OuterFlow::Confined)
       throw InputError(m.path("wall_inertia"), "true",

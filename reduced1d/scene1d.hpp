@@ -3,6 +3,7 @@
 // section (full3d) is passed through unchanged. Every value used is echoed into `resolved`.
 #pragma once
 
+#include <memory>
 #include <string>
 #include <utility>
 
@@ -25,5 +26,11 @@ double c1_from_spring_constant(double k_s, double R0);
 std::pair<double, double> hydraulic_offsets_from_calibration(const std::string& key, const std::string& path,
                                                              const std::string& scene_dir);
 double c1_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir);
+/// Read the static tube law of `branch` ("round" or "buckled") from a calibration.json
+/// (tube_law.<branch>.knots_radius_m, knots_wall_pressure_Pa; docs/tube-law.md), for a tube of
+/// radius R0. Throws InputError for `key`.
+std::shared_ptr<const TubeLaw> tube_law_from_calibration(const std::string& key, const std::string& path,
+                                                         const std::string& scene_dir, const std::string& branch,
+                                                         double R0);
 
 }  // namespace swim::reduced1d

@@ -7,6 +7,9 @@
 
 #include "reduced1d/internal.hpp"
 #include "reduced1d/outer_flow.hpp"
+#include "reduced1d/protocol.hpp"
+#include "reduced1d/tube_law.hpp"
+#include "common/errors.hpp"
 
 namespace swim::reduced1d {
 
@@ -33,6 +36,12 @@ void validate(const Params& p) {
   require(p.fluid.rho >= 0 && std::isfinite(p.fluid.rho), "fluid.density", p.fluid.rho, "must be >= 0");
   require(p.wall.C1 > 0 && std::isfinite(p.wall.C1), "wall.C1", p.wall.C1, "must be positive");
   require(p.wall.m > 0 && std::isfinite(p.wall.m), "wall.mass_per_area", p.wall.m, "must be positive");
+  if (p.wall.law && (p.swimmer.model != SwimmerModel::ForceFree || p.wave != WaveKind::ForceDriven))
+    throw InputError("wall.law", "a calibrated tube law",
+                     "is available for the force-free model with the force-driven wave only");
+  if (p.wall.law && !(std::abs(p.wall.law->R0() / R0 - 1.0) <= 1e-12))
+    throw InputError("wall.law", "a tube law of R0 = " + std::to_string(p.wall.law->R0()) + " m",
+                     "the law's undeformed radius must be swimmer.radius");
   require(p.numerics.cells >= 2, "numerics1d.cells", p.numerics.cells, "must be >= 2");
   require(p.numerics.rtol > 0 && p.numerics.rtol < 1, "numerics1d.rtol", p.numerics.rtol,
           "must be in (0, 1)");
@@ -151,7 +160,7 @@ double end_time(const Params& p) {
       // the radius: on the segment scale k = pi n / L that adds 4 mu pi n / (C1 L).
       if (p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.short_wave_traction)
         tau += 4.0 * p.fluid.mu * M_PI * p.protocol.segments / (p.wall.C1 * p.geometry.L);
-      const double need = p.wall.C1 * (R0 - Rf);
+      const double need = p.wall.law ? -detail::wall_law(p)(Rf) : p.wall.C1 * (R0 - Rf);
       const double margin = need / std::max(p.protocol.q - need, 1e-12 * need);
       return p.protocol.cycles * 5.0 * tau * (1.0 + std::log1p(std::min(margin, 1e6)));
     }

@@ -10,6 +10,10 @@ stiffness on a symmetric-log axis when it spans both signs and more than a decad
 +-1 % band of the secant stiffness as two dashed lines (the axis follows the data);
 legends below the axes.
 
+With a tube law (swim calibrate --tube-law) also DIR/tube_law.png: both branches of the static
+law, the loads against the middle radius with the monotone Steffen interpolant through them,
+and the law's slope against the radius.
+
 usage: plot_calibration.py DIR   (reads DIR/calibration.json, writes DIR/calibration.png)
 `figure(DIR)` returns (matplotlib figure, choices dict) for tests.
 """
@@ -137,6 +141,79 @@ def figure(d):
 def main(d):
     fig, _ = figure(d)
     fig.savefig(f"{d}/calibration.png", dpi=110)
+    if "tube_law" in c:
+        plot_tube_law(d, c)
+
+
+def steffen(xk, yk, x):
+    """Steffen's monotone cubic (GSL gsl_interp_steffen) and its derivative; linear beyond the knots."""
+    n = len(xk)
+    h = [xk[i + 1] - xk[i] for i in range(n - 1)]
+    s = [(yk[i + 1] - yk[i]) / h[i] for i in range(n - 1)]
+    d = [0.0] * n
+    for i in range(1, n - 1):
+        p = (s[i - 1] * h[i] + s[i] * h[i - 1]) / (h[i - 1] + h[i])
+        sg = (1 if s[i - 1] > 0 else -1 if s[i - 1] < 0 else 0) + (1 if s[i] > 0 else -1 if s[i] < 0 else 0)
+        d[i] = sg * min(abs(s[i - 1]), abs(s[i]), 0.5 * abs(p))
+    d[0], d[-1] = s[0], s[-1]  # GSL's end slopes: the end secants (Steffen's simplest choice)
+    lo = d[0] if d[0] > 0 else s[0]
+    hi = d[-1] if d[-1] > 0 else s[-1]
+    y, dy = [], []
+    for v in x:
+        if v <= xk[0]:
+            y.append(yk[0] + lo * (v - xk[0])), dy.append(lo)
+            continue
+        if v >= xk[-1]:
+            y.append(yk[-1] + hi * (v - xk[-1])), dy.append(hi)
+            continue
+        i = max(k for k in range(n - 1) if xk[k] <= v)
+        t = v - xk[i]
+        a = (d[i] + d[i + 1] - 2 * s[i]) / h[i] ** 2
+        b = (3 * s[i] - 2 * d[i] - d[i + 1]) / h[i]
+        y.append(yk[i] + t * (d[i] + t * (b + t * a)))
+        dy.append(d[i] + t * (2 * b + 3 * a * t))
+    return y, dy
+
+
+def plot_tube_law(d, c):
+    t = c["tube_law"]
+    R0 = t["round"]["knots_radius_m"][-1]
+    name = c["scene"].get("name", d)
+    fig, ax = plt.subplots(1, 2, figsize=(13, 4.8))
+    fig.suptitle(f"Static tube law from uniform loads: {name} (R\u2080 = {R0 * 1e6:.4g} \u00b5m, "
+                 f"{c['grid']['membrane_nodes']} membrane nodes)")
+    lo = min(t["round"]["knots_radius_m"][0], t.get("buckled", t["round"])["knots_radius_m"][0])
+    branches = [("round", "round (axisymmetric) wall", "tab:blue", "o")]
+    if "buckled" in t:
+        branches.append(("buckled", "paper's wall, free to buckle", "tab:red", "s"))
+    for key, label, col, mk in branches:
+        b = t[key]
+        pts = b["load_points"]
+        ax[0].plot([p["mid_radius_m"] * 1e6 for p in pts], [p["pressure_Pa"] for p in pts], mk, color=col,
+                   mfc="none", label=f"{label}: loads")
+        xk, yk = b["knots_radius_m"], b["knots_wall_pressure_Pa"]
+        xs = [lo + (R0 - lo) * i / 400 for i in range(401)]
+        y, dy = steffen(xk, yk, xs)
+        ax[0].plot([v * 1e6 for v in xs], [-v for v in y], "-", color=col, lw=1, label=f"{label}: monotone law")
+        ax[1].plot([v * 1e6 for v in xs], [v / 1e6 for v in dy], "-", color=col, lw=1, label=label)
+    c1 = t["C1_small_load_fit_Pa_per_m"]
+    ax[0].plot([lo * 1e6, R0 * 1e6], [c1 * (R0 - lo), 0], "k:", lw=1, label=f"linear law, C1 = {c1 / 1e6:.4g} MPa/m")
+    if t.get("buckling_load_Pa"):
+        ax[0].axhline(t["buckling_load_Pa"], color="0.5", ls="--", lw=1,
+                      label=f"round branch's ring-mode buckling load {t['buckling_load_Pa'] * 1e3:.3g} mPa (n = {t['buckling_ring_mode']})")
+    if t.get("collapse_load_Pa"):
+        ax[0].axhline(t["collapse_load_Pa"], color="tab:red", ls=":", lw=1,
+                      label=f"free wall collapses between {t['round_up_to_Pa'] * 1e3:.3g} and "
+                            f"{t['collapse_load_Pa'] * 1e3:.3g} mPa")
+    ax[0].set(xlabel="middle radius R_mid [\u00b5m]", ylabel="uniform inward load P [Pa]",
+              title="load against radius (static equilibria)")
+    ax[0].legend(fontsize="small", frameon=False)
+    ax[1].axhline(c1 / 1e6, color="k", ls=":", lw=1, label="C1 (small-load fit)")
+    ax[1].set(xlabel="middle radius R_mid [\u00b5m]", ylabel="law slope dP/dR [MPa/m]", yscale="log",
+              title="stiffness of the law")
+    ax[1].legend(fontsize="small", frameon=False)
+    fig.tight_layout()
+    fig.savefig(f"{d}/tube_law.png", dpi=110)
 
 
 if __name__ == "__main__":

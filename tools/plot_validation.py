@@ -672,7 +672,7 @@ def markdown(report, figs):
                 "U(t) phase corr. | verdicts | wall time |", "|---|---|---|---|---|---|---|---|---|---|"]
         for m in c["models1d"]:
             if not m.get("has_cycle"):
-                out.append(f"| {m['label']} | {m.get('status', '')[:80]} {m.get('no_cycle_reason', '')} "
+                out.append(f"| {m['label']} | {m.get('status', '')[:200]} {m.get('no_cycle_reason', '')} "
                            "| | | | | | | | |")
                 continue
             e = m.get("relative_error_vs_reference", {})
@@ -684,8 +684,14 @@ def markdown(report, figs):
 
             def vs(k):
                 err = re_.get(k)
-                return pct(e.get(k)) + ("" if err is None or e.get(k) is None else f" ± {100 * err:.0f} %")
-            out.append(f"| {m['label']} | {si(m['displacement_per_cycle_m'], 'm')} | {vs('displacement_per_cycle')} | "
+                return pct(e.get(k)) + ("" if err is None or e.get(k) is None else f" ± {100 * err:.2g} %")
+            # a result no Stokes swimmer can give (faster than its wave: more than its length per
+            # cycle) is marked, not only failed
+            length = c.get("length_m")
+            faster = length is not None and abs(m["displacement_per_cycle_m"]) > length
+            label = m['label'] + (" (**implausible**: more than its length per cycle, which no Stokes swimmer does)"
+                                  if faster or not m.get("plausible", True) else "")
+            out.append(f"| {label} | {si(m['displacement_per_cycle_m'], 'm')} | {vs('displacement_per_cycle')} | "
                        f"{si(m['cycle_time_s'], 's')} | {vs('cycle_time')} | "
                        f"{si(m['mean_velocity_per_cycle_m_per_s'], 'm/s')} | {vs('mean_velocity_per_cycle')} | "
                        f"{'—' if corr is None else f'{corr:.2f}'}{'' if spread is None else f' ± {spread:.2f}'} | "

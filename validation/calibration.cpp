@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <cstdlib>
 #include <cmath>
 
 #include "common/errors.hpp"
@@ -14,6 +15,10 @@
 #include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/run3d.hpp"
+#include "reduced1d/tube_law.hpp"
+
+#include <array>
+#include <cstdio>
 
 namespace swim::validation {
 
@@ -289,6 +294,429 @@ scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const
                {"nodes_per_ring", c.n_theta},
                {"rings", c.n_rings}};
   j["scene"] = resolved;
+  return j;
+}
+
+}  // namespace swim::validation
+
+// ---- The whole static tube law ---------------------------------------------------------------
+
+namespace swim::validation {
+
+namespace {
+
+struct MidMeasures {
+  double mean = 0, area = 0, spread = 0, min_node = 0;
+};
+// Middle ring(s): mean node radius, area-equivalent radius (shoelace in the cross-section
+// plane, nodes in their ring order), spread of the node radii; smallest node radius overall.
+MidMeasures mid_measures(const full3d::CylinderMesh& mesh, const Eigen::Matrix3Xd& X) {
+  MidMeasures m;
+  const Eigen::VectorXd r = full3d::node_radii(mesh, X);
+  m.min_node = r.minCoeff();
+  const int r0 = (mesh.n_rings - 1) / 2, r1 = mesh.n_rings / 2;
+  double lo = 1e300, hi = -1e300;
+  for (int ring : {r0, r1}) {
+    double mean = 0, area = 0;
+    for (int i = 0; i < mesh.n_theta; ++i) {
+      const int a = mesh.node(ring, i), b = mesh.node(ring, (i + 1) % mesh.n_theta);
+      mean += r[a] / mesh.n_theta;
+      const double ya = X(1, a) - mesh.axis_start.y(), za = X(2, a) - mesh.axis_start.z();
+      const double yb = X(1, b) - mesh.axis_start.y(), zb = X(2, b) - mesh.axis_start.z();
+      area += 0.5 * (ya * zb - yb * za);
+      lo = std::min(lo, r[a]);
+      hi = std::max(hi, r[a]);
+    }
+    m.mean += 0.5 * mean;
+    m.area += 0.5 * std::sqrt(std::max(area, 0.0) / M_PI);
+  }
+  m.spread = hi - lo;
+  return m;
+}
+
+// Minimise E(X) + P sum A_i r_i over every node position by L-BFGS (memory 20), in scaled
+// variables x = X / R0, energy / (k_s R0^2). The loaded energy is a sum of many small terms and
+// its changes near the minimum fall below its round-off, so the line search works on the
+// directional derivative phi'(alpha) = g(x + alpha d) . d (secant steps until
+// |phi'(alpha)| <= 0.9 |phi'(0)|, the strong Wolfe curvature condition), with the energy
+// required not to rise beyond its round-off.
+}  // namespace
+
+Minimised minimise_loaded_energy(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& mp, double P,
+                                 const Eigen::Matrix3Xd& start, double tol_force, int max_iterations, double eps) {
+  const double R0 = mesh.radius, fs = mp.ks * R0 * R0, gs = mp.ks * R0;
+  const Eigen::Index n = start.size();
+  long calls = 0;
+  auto evaluate = [&](const Eigen::VectorXd& x, Eigen::VectorXd& g, double& maxf) {
+    const Eigen::Map<const Eigen::Matrix3Xd> Xs(x.data(), 3, start.cols());
+    const Eigen::Matrix3Xd X = Xs * R0;
+    std::array<double, 2> e{};
+    Eigen::Matrix3Xd G = -full3d::elastic_forces(mesh, X, mp, 1, &e);
+    const Eigen::VectorXd r = full3d::node_radii(mesh, X);
+    double load = 0;
+    for (Eigen::Index i = 0; i < X.cols(); ++i) {
+      // sqrt(r^2 + eps^2) - eps: the load fades within eps of the axis (the walls' contact there)
+      const double re = std::sqrt(r[i] * r[i] + eps * eps);
+      load += mesh.node_area[i] * (re - eps);
+      if (re > 0) {
+        const double y = X(1, i) - mesh.axis_start.y(), z = X(2, i) - mesh.axis_start.z();
+        G(1, i) += P * mesh.node_area[i] * y / re;
+        G(2, i) += P * mesh.node_area[i] * z / re;
+      }
+    }
+    Eigen::Index imax = 0;
+    maxf = G.colwise().norm().maxCoeff(&imax);
+    if (std::getenv("SWIM_LBFGS_TRACE") && ++calls % 5000 == 0)
+      std::fprintf(stderr, "    max-force node %ld: r/R0 %.4g, |F|/(P A) %.3g; min r/R0 %.4g\n", long(imax), r[imax] / R0,
+                   maxf / (P * mesh.node_area[imax]), r.minCoeff() / R0);
+    g = Eigen::Map<const Eigen::VectorXd>(G.data(), n) / gs;
+    return (e[0] + e[1] + P * load) / fs;
+  };
+  Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(start.data(), n) / R0, g(n), gn(n);
+  double maxf = 0;
+  double f = evaluate(x, g, maxf);
+  constexpr int m = 20;
+  std::vector<Eigen::VectorXd> S, Y;
+  std::vector<double> rho;
+  Minimised out;
+  int it = 0;
+  // SWIM_LBFGS_TRACE set: progress on stderr every 500 iterations (and the node of the largest
+  // force every 5 000 evaluations), a diagnostic of slow relaxations
+  const bool trace = std::getenv("SWIM_LBFGS_TRACE") != nullptr;
+  for (; it < max_iterations && maxf > tol_force; ++it) {
+    if (trace && it % 500 == 0)
+      std::fprintf(stderr, "    L-BFGS %6d: max force / tolerance %.3g, energy %.15g\n", it, maxf / tol_force, f);
+    // two-loop recursion
+    Eigen::VectorXd d = -g;
+    std::vector<double> a(S.size());
+    for (int k = int(S.size()) - 1; k >= 0; --k) {
+      a[k] = rho[k] * S[k].dot(d);
+      d -= a[k] * Y[k];
+    }
+    const double gamma = S.empty() ? 1e-3 / std::max(g.lpNorm<Eigen::Infinity>(), 1e-300)
+                                   : S.back().dot(Y.back()) / Y.back().squaredNorm();
+    d *= gamma;
+    for (std::size_t k = 0; k < S.size(); ++k) d += S[k] * (a[k] - rho[k] * Y[k].dot(d));
+    double d0 = g.dot(d);
+    if (!(d0 < 0)) {  // not a descent direction: restart from steepest descent
+      S.clear(), Y.clear(), rho.clear();
+      d = -g * 1e-3 / std::max(g.lpNorm<Eigen::Infinity>(), 1e-300);
+      d0 = g.dot(d);
+    }
+    double alpha = 1.0, fn = 0, maxfn = 0;
+    bool ok = false;
+    double lo = 0, dlo = d0;  // bracket [lo, alpha] on phi'
+    for (int ls = 0; ls < 30; ++ls) {
+      fn = evaluate(x + alpha * d, gn, maxfn);
+      const double da = gn.dot(d);
+      const bool energy_ok = std::isfinite(fn) && fn <= f + 1e-4 * alpha * d0 + 1e-12 * std::abs(f);
+      if (energy_ok && std::abs(da) <= 0.9 * std::abs(d0)) {
+        ok = true;
+        break;
+      }
+      if (energy_ok && da < 0) {  // still descending: extrapolate (secant, at most 4x)
+        const double next = alpha - da * (alpha - lo) / (da - dlo);
+        lo = alpha, dlo = da;
+        alpha = std::isfinite(next) ? std::min(std::max(next, 1.1 * alpha), 4.0 * alpha) : 2.0 * alpha;
+        continue;
+      }
+      // overshot (phi' > 0 or the energy rose): secant inside [lo, alpha]
+      double next = (std::isfinite(fn) && da > 0) ? lo - dlo * (alpha - lo) / (da - dlo) : 0.5 * (lo + alpha);
+      next = std::min(std::max(next, lo + 0.1 * (alpha - lo)), lo + 0.9 * (alpha - lo));
+      alpha = next;
+    }
+    if (!ok) {
+      if (!S.empty()) {  // lose the memory once, then give up
+        S.clear(), Y.clear(), rho.clear();
+        continue;
+      }
+      break;
+    }
+    const Eigen::VectorXd s = alpha * d, y = gn - g;
+    const double sy = s.dot(y);
+    if (sy > 1e-300) {
+      if (int(S.size()) == m) S.erase(S.begin()), Y.erase(Y.begin()), rho.erase(rho.begin());
+      S.push_back(s), Y.push_back(y), rho.push_back(1.0 / sy);
+    }
+    x += s;
+    g = gn;
+    f = fn;
+    maxf = maxfn;
+  }
+  out.X = Eigen::Map<const Eigen::Matrix3Xd>(x.data(), 3, start.cols()) * R0;
+  out.iterations = it;
+  out.residual = maxf;
+  out.converged = maxf <= tol_force;
+  return out;
+}
+
+namespace {
+
+LawPoint make_point(const full3d::CylinderMesh& mesh, double P, const Eigen::Matrix3Xd& X, double residual,
+                    int iterations) {
+  LawPoint lp;
+  lp.pressure_Pa = P;
+  const MidMeasures m = mid_measures(mesh, X);
+  lp.mid_radius_m = m.mean;
+  lp.area_radius_m = m.area;
+  lp.radius_spread_m = m.spread;
+  lp.min_node_radius_m = m.min_node;
+  lp.residual_force_N = residual;
+  lp.iterations = iterations;
+  return lp;
+}
+
+}  // namespace
+
+double round_closed_form_c1(const full3d::CylinderMesh& mesh, double ks) {
+  return 2.0 * ks * std::sin(M_PI / mesh.n_theta) / (mesh.radius * mesh.ring_spacing);
+}
+
+void fit_branch(LawBranch& b, double R0) {
+  std::vector<LawPoint> pts = b.points;
+  std::sort(pts.begin(), pts.end(), [](const LawPoint& a, const LawPoint& c) { return a.pressure_Pa > c.pressure_Pa; });
+  b.knots_R.clear();
+  b.knots_w.clear();
+  b.dropped_non_monotone = 0;
+  for (const auto& lp : pts) {  // deepest first: R ascending, w = -P ascending
+    const double R = lp.mid_radius_m, w = -lp.pressure_Pa;
+    if (!b.knots_R.empty() && !(R > b.knots_R.back() && w > b.knots_w.back())) {
+      ++b.dropped_non_monotone;
+      continue;
+    }
+    if (!(R < R0)) {
+      ++b.dropped_non_monotone;
+      continue;
+    }
+    b.knots_R.push_back(R);
+    b.knots_w.push_back(w);
+  }
+  b.knots_R.push_back(R0);
+  b.knots_w.push_back(0.0);
+  const std::size_t K = b.knots_R.size();
+  if (K < 3) throw NumericalError("the tube law has fewer than three monotone knots", "add loads");
+  b.slope_at_R0 = reduced1d::TubeLaw(R0, b.knots_R, b.knots_w).slope_at_R0();
+  double sum2 = 0;
+  int cnt = 0;
+  b.loo_max_abs_Pa = b.loo_max_rel = 0;
+  for (std::size_t k = 1; k + 1 < K; ++k) {
+    std::vector<double> R = b.knots_R, w = b.knots_w;
+    R.erase(R.begin() + std::ptrdiff_t(k));
+    w.erase(w.begin() + std::ptrdiff_t(k));
+    if (R.size() < 3) continue;
+    const reduced1d::TubeLaw law(R0, R, w);
+    const double res = law(b.knots_R[k]) - b.knots_w[k];
+    b.loo_max_abs_Pa = std::max(b.loo_max_abs_Pa, std::abs(res));
+    b.loo_max_rel = std::max(b.loo_max_rel, std::abs(res / b.knots_w[k]));
+    sum2 += res * res;
+    ++cnt;
+    if (k == K - 2) b.slope_at_R0_loo = law.slope_at_R0();
+  }
+  b.loo_rms_Pa = cnt ? std::sqrt(sum2 / cnt) : 0.0;
+}
+
+TubeLawCalibration calibrate_tube_law(const full3d::Params3d& p, double c1, double c1_stderr,
+                                      const TubeLawOptions& o) {
+  TubeLawCalibration t;
+  t.c1_fit = c1;
+  t.c1_fit_stderr = c1_stderr;
+  const full3d::CylinderMesh mesh = full3d::make_mesh(p);
+  const double R0 = mesh.radius;
+  t.closed_form_c1 = round_closed_form_c1(mesh, p.membrane.ks);
+  const double Pscale = p.c1_estimate() * R0;
+  const double deepest = o.deepest_ratio * R0;
+  const std::vector<double> load_fractions = {0.01, 0.02, 0.03, 0.04, 0.05, 0.06, 0.075, 0.1, 0.125, 0.15, 0.2,
+                                              0.3,  0.4,  0.5,  0.6,  0.7,  0.75, 0.8, 0.85,  0.9};
+  // ---- round branch
+  auto t0 = std::chrono::steady_clock::now();
+  std::vector<Eigen::Matrix3Xd> round_X;
+  {
+    Eigen::Matrix3Xd prev;
+    for (double f : load_fractions) {
+      const double P = f * Pscale;
+      full3d::PressureResponse r;
+      try {
+        r = full3d::relax_under_pressure(mesh, p.membrane, P, 0.0, 50, prev.size() ? &prev : nullptr);
+      } catch (const NumericalError& e) {
+        char b[80];
+        std::snprintf(b, sizeof b, "no static state at %.4g Pa: ", P);
+        t.round.stopped_because = b + std::string(e.what());
+        break;
+      }
+      prev = r.X;
+      LawPoint lp = make_point(mesh, P, r.X, r.max_residual_force, r.iterations);
+      const std::vector<double> k = ring_mode_stiffness(mesh, p.membrane, P, r.X);
+      const auto soft = std::min_element(k.begin(), k.end());
+      lp.softest_ring_mode = int(soft - k.begin()) + 2;
+      lp.softest_ring_mode_stiffness_N_per_m = *soft;
+      t.round.points.push_back(lp);
+      round_X.push_back(r.X);
+      if (lp.mid_radius_m <= deepest) {
+        t.round.stopped_because = "reached R_mid <= deepest_ratio R0";
+        break;
+      }
+    }
+    if (t.round.stopped_because.empty()) t.round.stopped_because = "end of the load list";
+  }
+  for (const auto& lp : t.round.points) {
+    const double dev = std::abs(lp.pressure_Pa / (t.closed_form_c1 * (R0 - lp.mid_radius_m)) - 1.0);
+    t.round_max_rel_dev_closed_form = std::max(t.round_max_rel_dev_closed_form, dev);
+  }
+  fit_branch(t.round, R0);
+  t.round.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // ---- buckling load: the softest ring-mode stiffness crosses zero
+  int first_unstable = -1;
+  for (std::size_t i = 0; i < t.round.points.size(); ++i)
+    if (t.round.points[i].softest_ring_mode_stiffness_N_per_m < 0) {
+      first_unstable = int(i);
+      break;
+    }
+  if (first_unstable < 0) {
+    t.buckled_absent_because = "no ring mode turns unstable on the round branch over the loads";
+    return t;
+  }
+  {
+    const LawPoint& b = t.round.points[first_unstable];
+    t.buckling_mode = b.softest_ring_mode;
+    if (first_unstable == 0) {
+      t.buckling_load_Pa = b.pressure_Pa;  // at or below the smallest load
+    } else {
+      const LawPoint& a = t.round.points[first_unstable - 1];
+      const double ka = a.softest_ring_mode_stiffness_N_per_m, kb = b.softest_ring_mode_stiffness_N_per_m;
+      t.buckling_load_Pa = a.pressure_Pa + (b.pressure_Pa - a.pressure_Pa) * ka / (ka - kb);
+    }
+  }
+  if (!o.buckled) {
+    t.buckled_absent_because = "not computed (TubeLawOptions::buckled = false)";
+    return t;
+  }
+  // ---- buckled branch: every node free, the same loads in increasing order, each from the
+  // previous equilibrium plus a small seeded ring mode of the buckling n (uniform along the
+  // tube), until R_mid <= deepest_ratio R0
+  t0 = std::chrono::steady_clock::now();
+  t.buckled_computed = true;
+  {
+    const double tol = o.lbfgs_tolerance * mesh.node_area.maxCoeff();
+    // one load from `from`: seeded, minimised; false (and the reason) when L-BFGS fails
+    auto relax = [&](double P, const Eigen::Matrix3Xd& from, Eigen::Matrix3Xd& X, LawPoint& lp) {
+      Eigen::Matrix3Xd start = from;
+      const Eigen::Matrix3Xd er = full3d::radial_directions(mesh, start);
+      for (Eigen::Index i = 0; i < start.cols(); ++i)
+        start.col(i) +=
+            o.seed_amplitude_ratio * R0 * std::cos(t.buckling_mode * std::atan2(er(2, i), er(1, i))) * er.col(i);
+      const Minimised mz =
+          minimise_loaded_energy(mesh, p.membrane, P, start, tol * P, o.lbfgs_max_iterations, o.axis_contact_ratio * R0);
+      if (!mz.converged) {
+        char b[200];
+        std::snprintf(b, sizeof b, "L-BFGS did not reach the force tolerance %.3g N at %.4g Pa (residual %.3g N after %d "
+                      "iterations)", tol * P, P, mz.residual, mz.iterations);
+        t.buckled.stopped_because = b;
+        return false;
+      }
+      X = mz.X;
+      lp = make_point(mesh, P, X, mz.residual, mz.iterations);
+      std::fprintf(stderr, "  buckled branch: P = %.4g Pa  R_mid/R0 = %.4f  spread/R0 = %.3g  %d iterations\n", P,
+                   lp.mid_radius_m / R0, lp.radius_spread_m / R0, mz.iterations);
+      return true;
+    };
+    auto collapsed = [&](const LawPoint& lp) { return lp.radius_spread_m > 0.01 * R0; };
+    Eigen::Matrix3Xd X = mesh.X0, Xround;
+    double prev_P = 0;
+    int after = 0;  // loads after the collapse
+    bool ok = true;
+    for (double f : load_fractions) {
+      const double P = f * Pscale;
+      LawPoint lp;
+      Eigen::Matrix3Xd Xn;
+      if (!(ok = relax(P, X, Xn, lp))) break;
+      if (t.collapse_load_Pa == 0 && collapsed(lp)) {
+        // bracket the collapse: bisect between the last round load and this one, each try
+        // from the last round state
+        double lo = prev_P, hi = P;
+        for (int k = 0; k < o.collapse_bisections && lo > 0; ++k) {
+          const double mid = 0.5 * (lo + hi);
+          LawPoint lm;
+          Eigen::Matrix3Xd Xm;
+          if (!(ok = relax(mid, Xround, Xm, lm))) break;
+          t.buckled.points.push_back(lm);
+          if (collapsed(lm)) hi = mid;
+          else lo = mid, Xround = Xm;
+        }
+        if (!ok) break;
+        t.collapse_load_Pa = hi;
+        t.round_up_to_Pa = lo;
+      }
+      X = Xn;
+      if (!collapsed(lp)) Xround = Xn;
+      t.buckled.points.push_back(lp);
+      prev_P = P;
+      if (t.collapse_load_Pa > 0) ++after;
+      if (lp.mid_radius_m <= deepest && after >= o.loads_after_collapse) {
+        t.buckled.stopped_because = "reached R_mid <= deepest_ratio R0 with loads_after_collapse loads beyond the collapse";
+        break;
+      }
+    }
+    if (ok && t.buckled.stopped_because.empty()) t.buckled.stopped_because = "end of the load list";
+  }
+  fit_branch(t.buckled, R0);
+  t.buckled.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return t;
+}
+
+scene::json to_json(const TubeLawCalibration& t, double R0) {
+  auto branch = [&](const LawBranch& b) {
+    scene::json pts = scene::json::array();
+    for (const auto& lp : b.points)
+      pts.push_back({{"pressure_Pa", lp.pressure_Pa},
+                     {"mid_radius_m", lp.mid_radius_m},
+                     {"area_radius_m", lp.area_radius_m},
+                     {"radius_spread_m", lp.radius_spread_m},
+                     {"min_node_radius_m", lp.min_node_radius_m},
+                     {"softest_ring_mode", lp.softest_ring_mode},
+                     {"softest_ring_mode_stiffness_N_per_m", lp.softest_ring_mode_stiffness_N_per_m},
+                     {"residual_force_N", lp.residual_force_N},
+                     {"iterations", lp.iterations}});
+    return scene::json{{"load_points", pts},
+                       {"knots_radius_m", b.knots_R},
+                       {"knots_wall_pressure_Pa", b.knots_w},
+                       {"slope_at_R0_Pa_per_m", b.slope_at_R0},
+                       {"slope_at_R0_without_smallest_load_Pa_per_m", b.slope_at_R0_loo},
+                       {"leave_one_out_max_abs_Pa", b.loo_max_abs_Pa},
+                       {"leave_one_out_rms_Pa", b.loo_rms_Pa},
+                       {"leave_one_out_max_relative", b.loo_max_rel},
+                       {"dropped_non_monotone_points", b.dropped_non_monotone},
+                       {"deepest_radius_m", b.knots_R.front()},
+                       {"deepest_radius_over_R0", b.knots_R.front() / R0},
+                       {"stopped_because", b.stopped_because},
+                       {"wall_time_s", b.wall_time_s}};
+  };
+  scene::json j = {
+      {"method",
+       "uniform inward loads on the 3D membrane, relaxed in increasing order from the previous equilibrium; law "
+       "w(R) = -P(R) through the knots (mean node radius of the middle ring(s), load), monotone Steffen "
+       "interpolation (GSL gsl_interp_steffen), linear beyond the knots with the end slopes"},
+      {"radius_measure", "mean node radius of the middle ring(s)"},
+      {"C1_small_load_fit_Pa_per_m", t.c1_fit},
+      {"C1_small_load_fit_stderr_Pa_per_m", t.c1_fit_stderr},
+      {"C1_round_closed_form_Pa_per_m", t.closed_form_c1},
+      {"round_max_relative_deviation_from_closed_form", t.round_max_rel_dev_closed_form},
+      {"round", branch(t.round)}};
+  j["buckling_load_Pa"] = t.buckling_load_Pa > 0 ? scene::json(t.buckling_load_Pa) : scene::json(nullptr);
+  j["buckling_ring_mode"] = t.buckling_mode;
+  j["buckling_load_method"] = "round branch: the softest ring mode cos(n phi) (uniform along the tube) reaches zero "
+                              "stiffness, interpolated between the loads";
+  if (t.buckled_computed) {
+    j["buckled"] = branch(t.buckled);
+    j["buckled"]["seed"] = "every load from the previous equilibrium plus the ring mode cos(n phi) e_r of the round "
+                           "branch's buckling n, amplitude 1e-3 R0, uniform along the tube; every node free (L-BFGS on "
+                           "the loaded energy, force tolerance 1e-3 of the largest nodal load)";
+    j["buckled"]["axis_contact"] = "the load P A_i e_r fades as r / sqrt(r^2 + eps^2) within eps = 0.01 R0 of the axis, "
+                                   "where the collapsing wall meets itself (the membrane has no self-contact)";
+    j["collapse_load_Pa"] = t.collapse_load_Pa > 0 ? scene::json(t.collapse_load_Pa) : scene::json(nullptr);
+    j["round_up_to_Pa"] = t.round_up_to_Pa;
+  } else {
+    j["buckled_absent_because"] = t.buckled_absent_because;
+  }
   return j;
 }
 

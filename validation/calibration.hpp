@@ -14,7 +14,10 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
+
 #include "common/scene.hpp"
+#include "full3d/membrane.hpp"
 #include "full3d/scene3d.hpp"
 
 namespace swim::validation {
@@ -91,6 +94,103 @@ struct WetConfirmation {
 };
 WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,
                             bool axisymmetric_wall = true);
+
+// ---- The whole static tube law (docs/tube-law.md) -------------------------------------------
+//
+// Uniform inward loads P, relaxed to equilibrium on the 3D membrane, in increasing order with
+// each load starting from the previous equilibrium (continuation), until the middle radius is
+// at most `deepest_ratio` R0. Two branches:
+//  - round: the symmetric stack of circular rings (relax_under_pressure), the branch of a wall
+//    held axisymmetric (full3d.membrane.axisymmetric = true); nothing buckles. Checked against
+//    the spring network's closed form for a ring of springs (round_closed_form_c1);
+//  - buckled: the paper's free wall. The full mesh (every node free) is relaxed by minimising the
+//    loaded energy (L-BFGS) at the same loads in increasing order, each from the previous
+//    equilibrium plus a seeded ring mode cos(n phi) e_r of the round branch's buckling n
+//    (amplitude seed_amplitude_ratio R0, uniform along the tube). The load fades within
+//    axis_contact_ratio R0 of the axis (minimise_loaded_energy), where a collapsing wall meets
+//    itself (the membrane has no self-contact).
+// The radius is the mean node radius of the middle ring(s), as for C1.
+struct LawPoint {
+  double pressure_Pa = 0;
+  double mid_radius_m = 0;      ///< mean node radius of the middle ring(s)
+  double area_radius_m = 0;     ///< sqrt(area enclosed by the middle ring / pi)
+  double radius_spread_m = 0;   ///< max - min node radius on the middle ring(s) (0: round)
+  double min_node_radius_m = 0; ///< smallest node radius on the whole mesh
+  double softest_ring_mode_stiffness_N_per_m = 0;  ///< round branch: < 0 from the buckling load on
+  int softest_ring_mode = 0;
+  double residual_force_N = 0;  ///< largest nodal force imbalance at the accepted equilibrium
+  int iterations = 0;
+};
+
+/// The monotone law of one branch: knots (R ascending, w = -P; the last knot (R0, 0)), the
+/// Steffen interpolant's slope at R0, and leave-one-out residuals (each interior knot left out,
+/// the law rebuilt and evaluated there).
+struct LawBranch {
+  std::vector<LawPoint> points;
+  std::vector<double> knots_R, knots_w;
+  double slope_at_R0 = 0;          ///< Pa/m
+  double slope_at_R0_loo = 0;      ///< the same with the smallest-load knot left out
+  double loo_max_abs_Pa = 0, loo_rms_Pa = 0, loo_max_rel = 0;
+  int dropped_non_monotone = 0;    ///< points that broke strict monotonicity (left out)
+  std::string stopped_because;     ///< why the load series ended
+  double wall_time_s = 0;
+};
+
+struct TubeLawOptions {
+  double deepest_ratio = 0.3;            ///< the series ends once R_mid <= this * R0
+  double seed_amplitude_ratio = 1e-3;    ///< seeded ring mode at every load, fraction of R0
+  double axis_contact_ratio = 0.01;      ///< the load fades within this * R0 of the axis
+  int collapse_bisections = 3;           ///< free wall: bisections of the load bracket of the collapse
+  int loads_after_collapse = 4;          ///< free wall: at least these loads beyond the collapse
+  double lbfgs_tolerance = 1e-3;         ///< max nodal force / max nodal load P A_i
+  int lbfgs_max_iterations = 20000;
+  bool buckled = true;                   ///< also the free wall's branch
+};
+
+struct TubeLawCalibration {
+  LawBranch round, buckled;
+  double c1_fit = 0, c1_fit_stderr = 0;  ///< C1 from the small loads (StaticCalibration)
+  double closed_form_c1 = 0;             ///< 2 k_s sin(pi/n) / (R0 dx): the ring of springs
+  double round_max_rel_dev_closed_form = 0;  ///< round points against P = C1_closed (R0 - R)
+  double buckling_load_Pa = 0;           ///< round branch: softest ring-mode stiffness crosses zero (interpolated)
+  int buckling_mode = 0;                 ///< its n
+  double collapse_load_Pa = 0;           ///< free wall: first load whose equilibrium is not round (spread > 0.01 R0)
+  double round_up_to_Pa = 0;             ///< free wall: the load before it (still round)
+  bool buckled_computed = false;
+  std::string buckled_absent_because;
+};
+
+/// Minimum of the loaded energy E(X) + P sum A_i r_i over every node position from `start`
+/// (L-BFGS, memory 20, line search on the directional derivative), until the largest nodal
+/// force is at most tol_force (N) or max_iterations.
+struct Minimised {
+  Eigen::Matrix3Xd X;
+  int iterations = 0;
+  double residual = 0;  ///< largest nodal force, N
+  bool converged = false;
+};
+/// eps > 0: the load potential P A_i (sqrt(r_i^2 + eps^2) - eps), which fades within eps of
+/// the axis: the membrane has no self-contact, and a collapsing wall's nodes would otherwise
+/// sit on the axis's cone point, where no force balance exists.
+Minimised minimise_loaded_energy(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& mp, double P,
+                                 const Eigen::Matrix3Xd& start, double tol_force, int max_iterations,
+                                 double eps = 0.0);
+
+/// The spring network's closed form for the round branch: each ring a regular polygon of n
+/// springs (chord 2 r sin(pi/n)), the diagonals to the neighbouring rings at their rest length
+/// (the free ends let the tube lengthen), load P A_i on the node area A_i = c0 dx of an interior
+/// node: P = 2 k_s sin(pi/n) / (R0 dx) (R0 - r), exactly linear down to r = 0.
+double round_closed_form_c1(const full3d::CylinderMesh& mesh, double ks);
+
+/// Loads: increasing, each from the previous equilibrium; the round branch first. `c1`, `c1_stderr`: the
+/// small-load fit the law's slope at R0 is compared with.
+TubeLawCalibration calibrate_tube_law(const full3d::Params3d& p, double c1, double c1_stderr,
+                                      const TubeLawOptions& o = {});
+/// Knots and leave-one-out residuals of a branch from its points (fills the LawBranch fields
+/// after `points`).
+void fit_branch(LawBranch& b, double R0);
+/// calibration.json's "tube_law" section.
+scene::json to_json(const TubeLawCalibration& t, double R0);
 
 /// calibration.json: the fit, the load points, the wall mass per area, the grid and the scene.
 scene::json to_json(const StaticCalibration& c, const full3d::Params3d& p, const scene::json& resolved);

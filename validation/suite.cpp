@@ -923,18 +923,11 @@ class StandInCalibration {
   std::string path_;
 };
 
-/// A 1D model's scene as the suite runs it (calibrated: wall.calibration instead of the scene's
-/// stiffness), read by the 1D tier's reader; a refusal names `at`.
-void check_1d(json s, const json& model, const std::string& cal, const std::string& scene_dir, const std::string& at,
-              const std::string& what) {
-  apply_sets(s, model.value("set", json()));
-  if (model.value("calibrated", false)) {
-    if (s.contains("wall") && s["wall"].is_object()) {
-      s["wall"].erase("spring_constant");
-      s["wall"].erase("C1");
-    }
-    set_key(s, "wall.calibration", cal);
-  }
+/// A 1D model's scene as the suite runs it (model_scene), read by the 1D tier's reader; a
+/// refusal names `at`.
+void check_1d(const json& base, const json& model, const std::string& cal, const std::string& scene_dir,
+              const std::string& at, const std::string& what) {
+  const json s = model_scene(base, model, cal);
   try {
     json resolved;
     reduced1d::read_scene(s, resolved, scene_dir);
@@ -944,6 +937,18 @@ void check_1d(json s, const json& model, const std::string& cal, const std::stri
 }
 
 }  // namespace
+
+json model_scene(json s, const json& model, const std::string& cal) {
+  apply_sets(s, model.value("set", json()));
+  if (model.value("calibrated", false)) {
+    if (s.contains("wall") && s["wall"].is_object()) {
+      s["wall"].erase("spring_constant");
+      s["wall"].erase("C1");
+    }
+    set_key(s, "wall.calibration", cal);
+  }
+  return s;
+}
 
 json load_suite(const std::string& path, const std::string& data_dir) {
   const json s = scene::load_file(path);
@@ -1507,23 +1512,14 @@ json run_suite(const SuiteOptions& o) {
     json models_j = json::array();
     for (const json& m : suite["models1d"]) {
       const std::string label = m["label"];
-      json s = base;
-      apply_sets(s, m.value("set", json()));
       const bool calibrated = m.value("calibrated", false);
       json entry;
       Run1d r;
       if (calibrated && cal_file.empty()) {
         r.record = {{"label", label}, {"status", "not run: the calibration failed"}};
       } else {
-        if (calibrated) {
-          if (s.contains("wall")) {
-            s["wall"].erase("spring_constant");
-            s["wall"].erase("C1");
-          }
-          set_key(s, "wall.calibration", fs::absolute(cal_file).string());
-        }
         say(tag + ": 1D " + label);
-        r = run_1d(s, label, scene_dir);
+        r = run_1d(model_scene(base, m, calibrated ? fs::absolute(cal_file).string() : ""), label, scene_dir);
       }
       entry = r.record;
       entry["calibrated"] = calibrated;
@@ -1593,13 +1589,9 @@ json run_suite(const SuiteOptions& o) {
                          {"displacement_per_cycle_error", std::abs(d - d_ref) / std::abs(d_ref)}});
       };
       auto model0 = [&](const std::string& key, const json& value) -> std::optional<Run1d> {
-        json s = base;
-        apply_sets(s, m0.value("set", json()));
-        if (m0.value("calibrated", false)) {
-          if (cal_file.empty()) return std::nullopt;
-          if (s.contains("wall")) s["wall"].erase("spring_constant");
-          set_key(s, "wall.calibration", fs::absolute(cal_file).string());
-        }
+        const bool calibrated = m0.value("calibrated", false);
+        if (calibrated && cal_file.empty()) return std::nullopt;
+        json s = model_scene(base, m0, calibrated ? fs::absolute(cal_file).string() : "");
         set_key(s, key, value);
         return run_1d(s, m0["label"], scene_dir);
       };

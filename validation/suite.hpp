@@ -63,6 +63,11 @@ scene::json plan_runs(const SuiteOptions& o);
 /// Runs one job of plan_runs into the cache (a finished one is reused); returns {"status", ...}.
 scene::json run_planned(const scene::json& job);
 
+/// A 1D model's scene as the suite runs it: the case's scene `s` with the model's `set` and, for
+/// a calibrated model (`"calibrated": true`), the calibration file `cal` in place of the scene's
+/// own wall stiffness (its `wall.spring_constant` or `wall.C1`).
+scene::json model_scene(scene::json s, const scene::json& model, const std::string& cal);
+
 /// Reads and checks a suite file (InputError naming the key on any problem). The scene of a
 /// case with a `reference` is looked up (as given, beside the suite, in data_dir/scenes when
 /// data_dir is not empty) and read by the axi tier on every reference grid: a scene the tier

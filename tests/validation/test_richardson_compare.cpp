@@ -170,6 +170,23 @@ TEST(SuiteFile, MalformedSuitesNameTheKey) {
   }
 }
 
+// A calibrated model's scene takes the calibration file in place of the scene's own stiffness,
+// whichever key the scene states it by; an uncalibrated one keeps it; the model's set applies.
+TEST(SuiteFile, ACalibratedModelsSceneReplacesTheScenesOwnStiffness) {
+  using scene::json;
+  const json model = {{"label", "m"}, {"calibrated", true}, {"set", {{"model1d.outer_flow", "unbounded"}}}};
+  for (const char* key : {"C1", "spring_constant"}) {
+    json s = {{"wall", {{key, "1 Pa/m"}}}};
+    const json m = model_scene(s, model, "/tmp/cal.json");
+    EXPECT_FALSE(m["wall"].contains(key)) << key;
+    EXPECT_EQ(m["wall"]["calibration"], "/tmp/cal.json");
+    EXPECT_EQ(m["model1d"]["outer_flow"], "unbounded");
+    json plain = model;
+    plain["calibrated"] = false;
+    EXPECT_EQ(model_scene(s, plain, "/tmp/cal.json")["wall"], s["wall"]) << key;
+  }
+}
+
 // The shipped suites are well formed.
 TEST(SuiteFile, ShippedSuitesLoad) {
   for (const char* s : {"quick.json", "default.json"})
