@@ -141,6 +141,8 @@ def figure(d):
 def main(d):
     fig, _ = figure(d)
     fig.savefig(f"{d}/calibration.png", dpi=110)
+    with open(f"{d}/calibration.json") as f:
+        c = json.load(f)
     if "tube_law" in c:
         plot_tube_law(d, c)
 

@@ -173,6 +173,11 @@ class CalibrationFigure(unittest.TestCase):
             self.assertTrue(legend_outside(fig, a, leg))
         self.assertFalse(c["failed"])
 
+    def test_main_writes_the_png(self):
+        self.write()
+        self.mod.main(self.d)
+        self.assertTrue(os.path.exists(f"{self.d}/calibration.png"))
+
     def test_failed_hydraulic_measurement_looks_failed(self):
         self.write("failed: hydraulic radii: numerical failure: slipping")
         fig, c = self.mod.figure(self.d)
