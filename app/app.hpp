@@ -38,8 +38,9 @@ int scenes();
 /// wet: also confirm one load with a fluid-coupled 3D run (minutes at the default grid).
 /// threads > 0: the 3D runs' threads (full3d.threads); 0: the scene's.
 /// tube_law: also the whole static tube law on both branches (calibration.json "tube_law").
+/// progress: -1 on a terminal, 0 never, 1 always (a line per load on stderr).
 int calibrate(const std::string& scene, const std::vector<std::string>& sets, const std::string& out, bool wet,
-              bool overwrite, int threads = 0, bool tube_law = false);
+              bool overwrite, int threads = 0, bool tube_law = false, int progress = -1);
 
 /// swim validate: the 1D-vs-3D validation suite and its report (validation/suite.hpp).
 /// only: case filter (scene file names); empty: every case.

@@ -3,11 +3,13 @@
 // drag of the towed tube).
 #include <chrono>
 #include <cstdio>
+#include <string>
 
 #include "app/app.hpp"
 #include "app/scene_checks.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/progress.hpp"
 #include "common/run_folder.hpp"
 #include "common/scene.hpp"
 #include "common/si_format.hpp"
@@ -18,7 +20,7 @@
 namespace swim::app {
 
 int calibrate(const std::string& scene_path, const std::vector<std::string>& sets, const std::string& out_opt,
-              bool wet, bool overwrite, int threads, bool tube_law) {
+              bool wet, bool overwrite, int threads, bool tube_law, int progress_mode) {
   scene::json sc = scene::load_file(scene_path);
   for (const auto& s : sets) scene::apply_override(sc, s);
   if (threads > 0) scene::apply_override(sc, "full3d.threads=" + std::to_string(threads));
@@ -33,13 +35,23 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   output::RunFolder folder(out, {"calibration", identity, overwrite, false, "--out", "calibration.json"});
   const auto t0 = std::chrono::steady_clock::now();
   const auto loads = validation::default_loads(p);
-  const validation::StaticCalibration c = validation::calibrate_static(p, loads);
+  // progress in steps: the loads, then the hydraulic radii and the towed tube (one each)
+  const std::size_t steps = loads.size() + 2;
+  Progress progress("calibrate " + p.name, double(steps), progress_mode);
+  const validation::StaticCalibration c =
+      validation::calibrate_static(p, loads, [&](std::size_t done) {
+        progress.step(done, steps, "load " + std::to_string(done) + "/" + std::to_string(loads.size()));
+      });
   validation::HydraulicRadii hr;
   validation::TowedCalibration tow;
   try {
     hr = validation::measure_hydraulic_radii(p);
+    progress.step(loads.size() + 1, steps, "hydraulic radii");
     tow = validation::calibrate_towed(p, hr);
+    progress.step(steps, steps, "towed tube");
+    progress.done();
   } catch (const NumericalError& e) {
+    progress.done();
     // the wall stiffness is measured: keep it, say the offsets are missing and why (exit 3)
     output::make_dir(out);
     scene::json j = validation::to_json(c, p, resolved);

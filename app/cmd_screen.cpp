@@ -317,7 +317,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     summary["best_metric_value"] = reduced1d::metric_value(results[best].metrics, sw.metric);
     summary["best_scene"] = sw.design(best);
   }
-  std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name};
+  std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name,
+                                        std::string("--goal=") + (sw.maximize ? "max" : "min")};
   for (const auto& a : sw.axes) plot_args.push_back(a.key);
   try {
     plot("plot_screen.py", plot_args);

@@ -6,7 +6,7 @@
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|axi|all]
 //   swim scenes
 //   swim demo [--out DIR]
-//   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--tube-law] [--overwrite] [--threads N]
+//   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--tube-law] [--overwrite] [--threads N] [--progress|--quiet]
 //   swim validate [SUITE.json] [--out DIR] [--quick] [--threads N] [--case NAME ...]
 //   swim --version
 //
@@ -121,6 +121,7 @@ int main(int argc, char** argv) {
   cal->add_flag("--tube-law", cal_law,
                 "Also measure the whole static tube law P(R) down to 0.3 R0 on the round and the buckled branch "
                 "(docs/tube-law.md; minutes at the default grid)");
+  add_progress(cal);
   CLI::App* val = cli.add_subcommand("validate", "Run the 1D-vs-3D validation suite and write its report");
   std::string val_suite, val_out;
   bool val_quick = false;
@@ -183,7 +184,7 @@ int main(int argc, char** argv) {
     if (*opt) return app::optimize(opt_spec, out, progress, opt_overwrite, !opt_no_confirm, threads3d);
     if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
     if (*sc) return app::scenes();
-    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite, cal_threads, cal_law);
+    if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite, cal_threads, cal_law, progress);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);
   } catch (const app::Interrupted& e) {
     std::fprintf(stderr, "swim: %s; the child process was stopped and nothing runs on\n", e.what());

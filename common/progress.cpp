@@ -28,6 +28,18 @@ void Progress::update(double t) {
   std::fflush(stderr);
 }
 
+void Progress::step(std::size_t done, std::size_t total, const std::string& what) {
+  if (!on_ || total == 0) return;
+  const auto now = std::chrono::steady_clock::now();
+  last_ = now;
+  const double wall = std::chrono::duration<double>(now - start_).count();
+  const double frac = double(done) / double(total);
+  const double left = frac > 0 ? wall * (1.0 - frac) / frac : 0.0;
+  std::fprintf(stderr, tty_ ? "\r%s: %5.1f%%  %s  ~%.0f s left   " : "%s: %5.1f%%  %s  ~%.0f s left\n",
+               label_.c_str(), 100.0 * frac, what.c_str(), left);
+  std::fflush(stderr);
+}
+
 void Progress::done() {
   if (on_ && !finished_) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();

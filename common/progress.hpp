@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <cstddef>
 #include <string>
 
 namespace swim {
@@ -15,6 +16,9 @@ class Progress {
   Progress(std::string label, double t_end, int enabled = -1);
   ~Progress();
   void update(double t);
+  /// Coarse steps (each seconds long): "label: 23.1%  what  ~N s left" at step done of total, every step
+  /// written (rewritten in place on a terminal).
+  void step(std::size_t done, std::size_t total, const std::string& what);
   void done();
 
  private:

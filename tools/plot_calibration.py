@@ -2,16 +2,25 @@
 of the middle ring, with the C1 fit through the origin, the secant stiffness against the load,
 and the ring's stiffness against its modes cos(n phi) (ring buckling where it turns negative).
 A load at which the wall found no static state (the series stops there) is marked on all
-three panels, and its reason is printed under them.
+three panels, and its reason is printed under them. A failed measurement (status
+"failed: ...", e.g. the hydraulic radii) turns the title red and prints the reason.
+
+Scales: pressure and displacement on log axes (the loads span decades); the ring-mode
+stiffness on a symmetric-log axis when it spans both signs and more than a decade; the
++-1 % band of the secant stiffness as two dashed lines (the axis follows the data);
+legends below the axes.
 
 With a tube law (swim calibrate --tube-law) also DIR/tube_law.png: both branches of the static
 law, the loads against the middle radius with the monotone Steffen interpolant through them,
 and the law's slope against the radius.
 
 usage: plot_calibration.py DIR   (reads DIR/calibration.json, writes DIR/calibration.png)
+`figure(DIR)` returns (matplotlib figure, choices dict) for tests.
 """
 import json
+import math
 import sys
+import textwrap
 
 import matplotlib
 
@@ -19,7 +28,13 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 
-def main(d):
+def spans_signs_and_decades(values):
+    """True when values have both signs and their magnitudes span more than a decade."""
+    nz = [abs(v) for v in values if v != 0]
+    return any(v > 0 for v in values) and any(v < 0 for v in values) and bool(nz) and max(nz) > 10 * min(nz)
+
+
+def figure(d):
     with open(f"{d}/calibration.json") as f:
         c = json.load(f)
     pts = c["load_points"]
@@ -28,60 +43,106 @@ def main(d):
     fitted = [p["in_linear_range"] and p["stable_to_ring_buckling"] for p in pts]
     unstable = [not p["stable_to_ring_buckling"] for p in pts]
     nonlin = [not f and not u for f, u in zip(fitted, unstable)]
-    fig, ax = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig, ax = plt.subplots(1, 3, figsize=(15, 5.6))
     name = c["scene"].get("name", d)
-    fig.suptitle(f"Wall stiffness from uniform loads: {name} ({c['grid']['membrane_nodes']} membrane nodes)")
+    status = str(c.get("status", "ok"))
+    failed = status.startswith("failed")
+    title = f"Wall stiffness from uniform loads: {name} ({c['grid']['membrane_nodes']} membrane nodes)"
+    if failed:
+        title += "\nC1 measured; " + status.split(":", 2)[1].strip() + " FAILED (no offsets written)" \
+            if status.count(":") >= 2 else "\nFAILED"
+    fig.suptitle(title, color="tab:red" if failed else "black")
+    notes = []
+    if failed:
+        notes.append(("tab:red", status))
 
     def sel(v, m):
         return [a for a, b in zip(v, m) if b]
 
+    positive = all(v > 0 for v in x + y)
     ax[0].plot(sel(x, fitted), sel(y, fitted), "o", label="fitted (linear, stable)")
     if any(nonlin):
         ax[0].plot(sel(x, nonlin), sel(y, nonlin), "s", mfc="none", label="beyond 1 % of linear")
     if any(unstable):
         ax[0].plot(sel(x, unstable), sel(y, unstable), "x", ms=8, label="unstable to ring buckling")
-    xm = max(x)
-    ax[0].plot([0, xm], [0, c["C1_Pa_per_m"] * xm * 1e-9 * 1e3], "k-", lw=1,
+    xs = [min(x) if positive else 0, max(x)]
+    ax[0].plot(xs, [c["C1_Pa_per_m"] * v * 1e-9 * 1e3 for v in xs], "k-", lw=1,
                label=f"C1 = {c['C1_Pa_per_m'] / 1e6:.4g} MPa/m (fit)")
-    ax[0].plot([0, xm], [0, c["C1_spring_network_Pa_per_m"] * xm * 1e-9 * 1e3], "k:", lw=1,
+    ax[0].plot(xs, [c["C1_spring_network_Pa_per_m"] * v * 1e-9 * 1e3 for v in xs], "k:", lw=1,
                label=f"2 k\u209b / (\u221a3 R\u2080\u00b2) = {c['C1_spring_network_Pa_per_m'] / 1e6:.4g} MPa/m")
+    if positive:
+        ax[0].set_xscale("log")
+        ax[0].set_yscale("log")
     lost = c.get("loads_without_static_state")
     if lost:
         p_lost = lost["from_Pa"] * 1e3
         ax[0].axhline(p_lost, color="tab:red", ls="--", lw=1, label=f"no static state at {p_lost:.3g} mPa")
         for a in ax[1:]:
             a.axvline(p_lost, color="tab:red", ls="--", lw=1, label=f"no static state at {p_lost:.3g} mPa")
-        import textwrap
-        fig.text(0.01, 0.01, "\n".join(textwrap.wrap(f"No static state from {p_lost:.3g} mPa: {lost['reason']}", 190)),
-                 fontsize=8, color="tab:red", va="bottom")
-    ax[0].set(xlabel="radial displacement R\u2080 \u2212 R_mid [nm]", ylabel="pressure [mPa]",
+        notes.append(("tab:red", f"No static state from {p_lost:.3g} mPa: {lost['reason']}"))
+    log = " (log scale)" if positive else ""
+    ax[0].set(xlabel=f"radial displacement R\u2080 \u2212 R_mid [nm]{log}", ylabel=f"pressure [mPa]{log}",
               title="pressure against displacement")
-    ax[0].legend(loc="lower right", fontsize="small", frameon=False)
 
     P = [p["pressure_Pa"] * 1e3 for p in pts]
     sec = [p["secant_C1_Pa_per_m"] / 1e6 for p in pts]
+    spring = c["C1_spring_network_Pa_per_m"] / 1e6
     ax[1].semilogx(P, sec, "o-", label="secant P / (R\u2080 \u2212 R_mid)")
-    ax[1].axhspan(sec[0] * 0.99, sec[0] * 1.01, color="0.9", label="\u00b11 % of the smallest load's")
-    ax[1].axhline(c["C1_spring_network_Pa_per_m"] / 1e6, color="k", ls=":", lw=1, label="spring-network value")
+    ax[1].axhline(spring, color="k", ls=":", lw=1, label="spring-network value")
+    shown = sec + [spring]
+    pad = 0.15 * (max(shown) - min(shown)) or 0.01 * abs(sec[0])
+    ylim = (min(shown) - pad, max(shown) + pad)
+    band = (sec[0] * 0.99, sec[0] * 1.01)
+    for i, b in enumerate(band):
+        ax[1].axhline(b, color="0.5", ls="--", lw=0.8, label="\u00b11 % of the smallest load's" if i == 0 else None)
+    ax[1].set_ylim(*ylim)
+    if not (ylim[0] <= band[0] and band[1] <= ylim[1]):  # say where the band lies when off the axis
+        off = [f"{b:.4g}" for b in band if not ylim[0] <= b <= ylim[1]]
+        ax[1].text(0.02, 0.02, f"\u00b11 % lines off the axis at {', '.join(off)} MPa/m", transform=ax[1].transAxes,
+                   fontsize="x-small", color="0.35")
     ax[1].set(xlabel="pressure [mPa] (log scale)", ylabel="secant C1 [MPa/m]", title="stiffness against load")
-    ax[1].legend(loc="upper right", fontsize="small")
 
+    k = {n: [p["ring_mode_stiffness_N_per_m"][n - 2] * 1e12 for p in pts] for n in (2, 3)}
+    soft = [p["softest_ring_mode_stiffness_N_per_m"] * 1e12 for p in pts]
     for n in (2, 3):
-        ax[2].semilogx(P, [p["ring_mode_stiffness_N_per_m"][n - 2] * 1e12 for p in pts], "o-", label=f"mode n = {n}")
-    ax[2].semilogx(P, [p["softest_ring_mode_stiffness_N_per_m"] * 1e12 for p in pts], "ks--", label="softest mode")
+        ax[2].plot(P, k[n], "o-", label=f"mode n = {n}")
+    ax[2].plot(P, soft, "ks--", label="softest mode (n labelled)")
+    ax[2].set_xscale("log")
+    everything = k[2] + k[3] + soft
+    symlog = spans_signs_and_decades(everything)
+    if symlog:
+        # the linear range one decade wide, ending on a power of ten (ticks at 0 and +-linthresh apart)
+        lin = 10.0 ** math.floor(math.log10(min(abs(v) for v in everything if v != 0)))
+        ax[2].set_yscale("symlog", linthresh=lin)
     prev = None
-    for p in pts:  # the softest mode's n, where it changes
+    for i, p in enumerate(pts):  # the softest mode's n, where it changes, away from the curves
         if p["softest_ring_mode"] != prev:
-            ax[2].annotate(f"n = {p['softest_ring_mode']}",
-                           (p["pressure_Pa"] * 1e3, p["softest_ring_mode_stiffness_N_per_m"] * 1e12),
-                           fontsize=7, xytext=(-4, -12), textcoords="offset points", ha="right")
+            above = soft[i] >= 0
+            ax[2].annotate(f"n={p['softest_ring_mode']}", (P[i], soft[i]), fontsize=7,
+                           xytext=(0, 9 if above else -11), textcoords="offset points", ha="center",
+                           va="bottom" if above else "top")
         prev = p["softest_ring_mode"]
     ax[2].axhline(0, color="k", lw=1)
-    ax[2].set(xlabel="pressure [mPa] (log scale)", ylabel="ring-mode stiffness [pN/m]",
+    ax[2].margins(y=0.14)  # room for the n labels inside the axes, clear of the title and ticks
+    ax[2].set(xlabel="pressure [mPa] (log scale)",
+              ylabel="ring-mode stiffness [pN/m]" + (" (symlog)" if symlog else ""),
               title="ring buckling: unstable below zero")
-    ax[2].legend(loc="lower left", fontsize="small", frameon=False)
-    fig.tight_layout(rect=(0, 0.06 if lost else 0, 1, 1))
+    legends = [a.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize="small", frameon=False, ncol=2)
+               for a in ax]
+    text = "\n".join(line for _, n in notes for line in textwrap.wrap(n, 190))
+    if text:
+        fig.text(0.01, 0.01, text, fontsize=8, color="tab:red", va="bottom")
+    bottom = 0.03 + 0.02 * text.count("\n") if text else 0
+    fig.tight_layout(rect=(0, bottom, 1, 0.95 if failed else 1))
+    return fig, {"failed": failed, "title": title, "symlog": symlog, "secant_ylim": ylim, "band": band,
+                 "loglog": positive, "legends": legends, "axes": ax}
+
+
+def main(d):
+    fig, _ = figure(d)
     fig.savefig(f"{d}/calibration.png", dpi=110)
+    with open(f"{d}/calibration.json") as f:
+        c = json.load(f)
     if "tube_law" in c:
         plot_tube_law(d, c)
 

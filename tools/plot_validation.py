@@ -12,6 +12,7 @@ import re
 import struct
 import sys
 import textwrap
+import zlib
 
 import matplotlib
 
@@ -139,6 +140,30 @@ def pct(v):
     return "—" if v is None else f"{100 * v:+.1f} %"
 
 
+# the coarser 3D grids, next-finest first: each its own grey and dash, so they can be told apart
+COARSE_STYLES = (dict(color="0.35", ls="--"), dict(color="0.6", ls=":"), dict(color="0.75", ls="-."))
+
+
+def declutter(fig, labels, step=9):
+    """Moves annotations vertically (in steps of `step` points, away from the point) until
+    none overlaps one placed before it; returns how many were moved."""
+    fig.canvas.draw()
+    placed, moved = [], 0
+    for a in labels:
+        dx, dy = a.xyann
+        sign = -1 if dy < 0 else 1
+        for _ in range(12):
+            box = a.get_window_extent().expanded(1.02, 1.1)
+            if not any(box.overlaps(b) for b in placed):
+                break
+            dy += sign * step
+            a.xyann = (dx, dy)
+            moved += 1
+            fig.canvas.draw()
+        placed.append(a.get_window_extent())
+    return moved
+
+
 def velocity_figure(case, path):
     fig, ax = plt.subplots(1, 2, figsize=(12, 4.4))
     runs = [r for r in case["runs3d"] if r.get("has_cycle")]
@@ -149,8 +174,9 @@ def velocity_figure(case, path):
         T = r["cycle_time_s"]
         u = [v * 1e9 for v in s["velocity_m_per_s"]]
         ref_scale = max(ref_scale, max(abs(v) for v in u) if u else 0.0)
-        kw = dict(color="k", lw=2 if finest else 0.8, alpha=1.0 if finest else 0.4,
-                  label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm")
+        kw = dict(color="k", lw=2, label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm (finest)") if finest else \
+            dict(COARSE_STYLES[(len(runs) - 2 - k) % len(COARSE_STYLES)], lw=1.0,
+                 label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm")
         ax[0].plot(s["t_s"], u, **kw)
         ax[1].plot([t / T for t in s["t_s"]], u, **kw)
     off = []
@@ -249,6 +275,9 @@ def reference_convergence_figure(case, path):
     return True
 
 
+GRID_MARKERS = ("o", "s", "^", "D", "v", "P")
+
+
 def convergence_figure(case, path):
     if case.get("reference"):
         return reference_convergence_figure(case, path)
@@ -258,7 +287,10 @@ def convergence_figure(case, path):
     fig, ax = plt.subplots(figsize=(9.5, 4.6))
     h = [r["cell_size_m"] * 1e9 for r in runs]
     d = [r["displacement_per_cycle_m"] * 1e9 for r in runs]
-    ax.plot(h, d, "ko-", label="3D runs")
+    ax.plot(h, d, "k-", lw=1, label="3D runs")
+    for k, (hk, dk) in enumerate(zip(h, d)):  # each grid its own marker, its cell size beside it
+        ax.plot([hk], [dk], GRID_MARKERS[k % len(GRID_MARKERS)], color="k", ms=6)
+        ax.annotate(f"h = {hk:.3g} nm", (hk, dk), xytext=(6, 4), textcoords="offset points", fontsize=7)
     ref = case["reference3d"].get("displacement_per_cycle_m")
     if ref:
         rng = case["reference3d"].get("order_range")
@@ -280,8 +312,10 @@ def convergence_figure(case, path):
         ax.axhline(paper * 1e9, color="0.4", ls=":", lw=1.2, label="paper: maximum displacement over the cycle")
     ax.set(xlabel="cell size h [nm]", ylabel="displacement per cycle [nm]",
            title=f"{case['name']}: 3D grid convergence")
-    ax.set_xlim(left=-0.05 * max(h))
-    legend_right(ax)
+    ax.set_xlim(left=-0.05 * max(h), right=1.2 * max(h))
+    handles, labels = ax.get_legend_handles_labels()
+    ax.legend(handles, [textwrap.fill(t, 48) for t in labels], loc="center left", bbox_to_anchor=(1.0, 0.5),
+              fontsize="small", frameon=False)
     save(fig, path)
     return True
 
@@ -298,6 +332,7 @@ def pareto_figure(report, path):
     many = len(cases) > 3
     fig, ax = plt.subplots(figsize=(9, 5.2))
     markers = {"cells": "o-", "rtol": "^--", "h": "s-", "time step": "D--"}
+    texts = []
     colours = {("1d", "cells"): "tab:blue", ("1d", "rtol"): "tab:orange", ("3d", "h"): "black",
                ("3d", "time step"): "tab:red"}
     named = set()
@@ -324,14 +359,16 @@ def pareto_figure(report, path):
             # axes, fanned out so that points that coincide stay readable
             below = axis in ("rtol", "time step")
             for j, q in enumerate(p):
-                ax.annotate(q["resolution"], (q["wall_time_s"], 100 * q["displacement_per_cycle_error"]),
-                            fontsize=7, xytext=(4, -10 - 9 * j) if below else (-4, 4),
-                            textcoords="offset points", ha="left" if below else "right")
+                texts.append(ax.annotate(q["resolution"], (q["wall_time_s"], 100 * q["displacement_per_cycle_error"]),
+                                         fontsize=7, xytext=(4, -10) if below else (-4, 4),
+                                         textcoords="offset points", ha="left" if below else "right"))
     ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)")
     sub = f"{len(cases)} cases, one line per case and axis" if many else "error against the extrapolated 3D reference"
     fig.suptitle(f"Speed against accuracy: {report['suite']} suite\n({sub}; error against the 3D reference)"
                  if many else f"Speed against accuracy: {report['suite']} suite\n({sub})")
     legend_right(ax)
+    fig.tight_layout()  # the final axes size, so that the labels are placed where they are drawn
+    declutter(fig, texts)
     save(fig, path)
     return True
 
@@ -411,17 +448,38 @@ def multicycle_figure(report, path):
     return True
 
 
+def decode_vtk_binary(body, compressed):
+    """Bytes of one inline binary DataArray (header_type UInt32): a byte count and the
+    values, or with vtkZLibDataCompressor a block header (base64 on its own) and the
+    zlib-compressed blocks."""
+    if not compressed:
+        raw = base64.b64decode(body)
+        n = struct.unpack("<I", raw[:4])[0]
+        return raw[4:4 + n]
+    blocks = struct.unpack("<I", base64.b64decode(body[:8])[:4])[0]
+    header_bytes = 4 * (3 + blocks)
+    header_chars = 4 * ((header_bytes + 2) // 3)
+    h = struct.unpack(f"<{3 + blocks}I", base64.b64decode(body[:header_chars])[:header_bytes])
+    packed = base64.b64decode(body[header_chars:])
+    out, at = b"", 0
+    for b in range(blocks):
+        out += zlib.decompress(packed[at:at + h[3 + b]])
+        at += h[3 + b]
+    return out
+
+
 def read_vtp_points(path):
     """Node coordinates of a membrane frame written by swim (VTK XML PolyData, binary
-    Float32 inline: base64 of a UInt32 byte count followed by the values)."""
+    inline Float32 or Float64, plain or zlib-compressed)."""
     with open(path) as f:
         text = f.read()
-    m = re.search(r"<Points>\s*<DataArray[^>]*>\s*([A-Za-z0-9+/=]+)\s*</DataArray>", text)
+    m = re.search(r'<Points>\s*<DataArray[^>]*type="(Float32|Float64)"[^>]*>\s*([A-Za-z0-9+/=\s]+?)\s*</DataArray>', text)
     if not m:
         return None
-    raw = base64.b64decode(m.group(1))
-    n = struct.unpack("<I", raw[:4])[0] // 4
-    v = struct.unpack(f"<{n}f", raw[4:4 + 4 * n])
+    raw = decode_vtk_binary(re.sub(r"\s", "", m.group(2)), 'compressor="vtkZLibDataCompressor"' in text)
+    size = 4 if m.group(1) == "Float32" else 8
+    n = len(raw) // size
+    v = struct.unpack(f"<{n}{'f' if size == 4 else 'd'}", raw[:n * size])
     return [v[i:i + 3] for i in range(0, n, 3)]
 
 
@@ -449,6 +507,7 @@ def membrane_figure(case, path):
     R0 = summ["derived"]["aspect_ratio_R0_over_L"] * case["length_m"]
     fig, ax = plt.subplots(figsize=(8, 1.1 * len(pick) + 1.2))
     x0 = None
+    offsets = []
     for k, (t, fn) in enumerate(pick):
         pts = read_vtp_points(f"{folder}/{fn}")
         if not pts:
@@ -466,14 +525,17 @@ def membrane_figure(case, path):
             top.append(((hi[0] - x0) * 1e6, (hi[1] - yc) * 1e9))
             bot.append(((lo[0] - x0) * 1e6, (lo[1] - yc) * 1e9))
         off = -k * 3.0 * R0 * 1e9
+        offsets.append(off)
         for line in (top, bot):
             ax.plot([q[0] for q in line], [q[1] + off for q in line], "k-", lw=1.2)
         ax.plot([0, 0], [off - R0 * 1e9, off + R0 * 1e9], color="0.8", lw=0.6)
         ax.annotate(f"t = {si(t, 's')}", (0, off), xytext=(-8, 0), textcoords="offset points", ha="right",
                     va="center", fontsize=8)
     ax.set_xlabel("axial position from the tube's initial rear end [µm]")
-    ax.set_ylabel("transverse position [nm]\n(snapshots offset by 3 R₀)")
-    ax.set_yticks([])
+    ax.set_ylabel("transverse position about each snapshot's axis [nm]\n(snapshots offset by 3 R₀)")
+    # y ticks: -R0, 0 and +R0 about each snapshot's axis
+    ticks = [(off + d, f"{d:.0f}") for off in offsets for d in (-R0 * 1e9, 0.0, R0 * 1e9)]
+    ax.set_yticks([t for t, _ in ticks], [lab for _, lab in ticks], fontsize=7)
     ax.set_aspect("auto")
     ax.set_title(f"Membrane side view over one cycle: {case['name']}\n(3D, h = {si(run['cell_size_m'], 'm')}; "
                  f"the grey bar marks the initial rear end)")

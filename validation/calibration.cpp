@@ -122,7 +122,8 @@ std::vector<double> default_loads(const full3d::Params3d& p) {
   return out;
 }
 
-StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures) {
+StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures,
+                                   const std::function<void(std::size_t)>& on_load) {
   StaticCalibration c;
   const full3d::CylinderMesh mesh = full3d::make_mesh(p);
   c.n_theta = mesh.n_theta;
@@ -157,6 +158,7 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
     lp.softest_ring_mode_stiffness_N_per_m = *soft;
     lp.lowest_eigenvalue_N_per_m = lowest_hessian_eigenvalue(mesh, p.membrane, pr, r.X, 150);
     c.loads.push_back(lp);
+    if (on_load) on_load(c.loads.size());
   }
   // linear range: secant within 1 % of the smallest load's
   const double c_small = c.loads.front().secant_C1_Pa_per_m;

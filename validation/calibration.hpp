@@ -9,6 +9,8 @@
 // which the response stays linear (secant P / delta within 1 % of the smallest load's).
 #pragma once
 
+#include <functional>
+
 #include <string>
 #include <vector>
 
@@ -68,7 +70,9 @@ std::vector<double> default_loads(const full3d::Params3d& p);
 /// range); before that it throws NumericalError. InputError for loads <= 0.
 /// Points that are unstable to ring buckling (LoadPoint::stable) are reported and left out of
 /// the fits.
-StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures);
+/// on_load (optional): called after each load with the number of loads relaxed so far.
+StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures,
+                                   const std::function<void(std::size_t)>& on_load = {});
 
 /// Fluid-coupled confirmation of one static load: the scene's 3D tube, immersed in its fluid and
 /// container, under the same uniform inward pressure, stepped (forward Euler, the step set to

@@ -41,7 +41,7 @@ struct Cli {
 };
 
 // Runs the executable; `env` is prepended to the command line (e.g. "SWIM_TEST_FAIL_WRITE=x").
-// quiet: add --quiet (swim run; swim calibrate has no progress to silence).
+// quiet: add --quiet (no progress lines).
 Cli swim_cli(const std::string& args, const fs::path& scratch, const std::string& env = "", bool quiet = true) {
   const fs::path err = scratch / ("stderr_" + std::to_string(::getpid()) + ".txt");
   const std::string cmd = env + (env.empty() ? "" : " ") + "\"" + SWIM_BINARY_DIR + "/bin/swim\" " + args +
@@ -577,5 +577,24 @@ TEST(CalibrateCli, AFolderHoldingAnotherRunsResultsIsRefused) {
   EXPECT_NE(c.err.find("--overwrite"), std::string::npos) << c.err;
   EXPECT_EQ(slurp(run / "summary.json"), run_summary);
   EXPECT_FALSE(fs::exists(run / "calibration.json"));
+  fs::remove_all(d);
+}
+
+// swim calibrate shows its progress like swim run: with --progress a line per load on stderr
+// (percentage, loads done, time left), with --quiet none.
+TEST(CalibrateCli, ProgressLinesWithProgressNoneWithQuiet) {
+  const fs::path d = tmpdir("calibrate_progress");
+  const std::string args = "calibrate \"" SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json\" --set "
+                           "full3d.grid.cell_size='\"0.06 um\"' --set container.period='\"1.32 um\"' "
+                           "--set container.radius='\"0.27 um\"' --out \"";
+  const Cli on = swim_cli(args + (d / "on").string() + "\" --progress", d, "", false);
+  EXPECT_EQ(on.code, 3) << on.err;  // the coarse grid: C1 measured, the hydraulic radii not
+  EXPECT_NE(on.err.find("calibrate tiny_3d_cycle:   6.7%  load 1/13  ~"), std::string::npos) << on.err;
+  EXPECT_NE(on.err.find("s left\n"), std::string::npos) << on.err;
+  EXPECT_NE(on.err.find("calibrate tiny_3d_cycle: done in"), std::string::npos) << on.err;
+  const Cli off = swim_cli(args + (d / "off").string() + "\"", d);  // --quiet
+  EXPECT_EQ(off.code, 3) << off.err;
+  EXPECT_EQ(off.err.find("% "), std::string::npos) << off.err;
+  EXPECT_EQ(off.err.find("done in"), std::string::npos) << off.err;
   fs::remove_all(d);
 }

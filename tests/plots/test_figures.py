@@ -1,0 +1,292 @@
+"""The figures' choices, checked on small synthetic inputs: each plotting script exposes
+`figure(...)` returning the matplotlib figure and a dict of what it chose.
+
+Run by CTest (label unit) with /usr/bin/python3; exits 77 (skipped) without matplotlib.
+"""
+import csv
+import importlib.util
+import json
+import os
+import sys
+import tempfile
+import unittest
+
+try:
+    import matplotlib  # noqa: F401
+except ImportError:
+    print("matplotlib not importable by", sys.executable)
+    sys.exit(77)
+
+TOOLS = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "tools")
+
+
+def load(name):
+    spec = importlib.util.spec_from_file_location(name, os.path.join(TOOLS, name + ".py"))
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    return mod
+
+
+def write_csv(path, header, rows):
+    with open(path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+
+
+def legend_outside(fig, ax, legend):
+    """True when the legend's box does not overlap the axes' box (display coordinates)."""
+    fig.canvas.draw()
+    lb = legend.get_window_extent()
+    ab = ax.get_window_extent()
+    return lb.x0 >= ab.x1 or lb.x1 <= ab.x0 or lb.y0 >= ab.y1 or lb.y1 <= ab.y0
+
+
+def run_folder(d, tier="1d", status="ok"):
+    R0, L = 125e-9, 400e-9
+    ts = [i * 0.01 for i in range(20)]
+    write_csv(f"{d}/series.csv", ["t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m", "max_radius_m"],
+              [[t, t * 1e-7, 1e-7, 1e-21 * t, R0 * (1 - 0.4 * t), R0 * 1.05] for t in ts])
+    write_csv(f"{d}/radius.csv", ["t_s", "z_m", "radius_m"],
+              [[t, z * 1e-7, R0 * (1 - 0.4 * t * z / 4)] for t in ts for z in range(5)])
+    with open(f"{d}/summary.json", "w") as f:
+        json.dump({"tier": tier, "model": "force_free_confined" if tier == "1d" else "immersed_boundary",
+                   "status": status, "scene": {"name": "my_scene"}, "swimmer_length_m": L,
+                   "derived": {"contracted_ratio": 0.55, "aspect_ratio_R0_over_L": R0 / L},
+                   "segment_reached_s": [0.12, 0.05, -1], "cycle_start_times_s": [0.0, 0.15],
+                   "cycle_end_times_s": [0.15]}, f)
+
+
+class RunFigure(unittest.TestCase):
+    def setUp(self):
+        self.mod = load("plot_run")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_title_names_the_scene_and_rf_and_events_are_marked(self):
+        run_folder(self.d)
+        fig, c = self.mod.figure(self.d)
+        self.assertIn("my_scene", c["title"])
+        self.assertNotIn("FAILED", c["title"])
+        self.assertAlmostEqual(c["R_f_m"], 0.55 * 125e-9)
+        ax = c["axes"][1, 0]
+        rf = [ln for ln in ax.get_lines() if ln.get_label().startswith("R_f")]
+        self.assertEqual(len(rf), 1)
+        self.assertAlmostEqual(rf[0].get_ydata()[0], 0.55 * 125)  # nm
+        # segment 1 at 50 ms, segment 0 at 120 ms, a cycle end and start at 150 ms; -1: not reached
+        self.assertEqual([round(t, 3) for t, _ in c["events"]], [0.05, 0.12, 0.15, 0.15])
+        self.assertIn("segment reaches R_f", [ln.get_label() for ln in ax.get_lines()])
+        for leg, a in zip(c["legends"], (c["axes"][0, 0], c["axes"][0, 1], c["axes"][1, 0])):
+            self.assertTrue(legend_outside(fig, a, leg))
+
+    def test_failed_run_is_marked_failed(self):
+        run_folder(self.d, status="failed: numerical failure: CFL 0.9 exceeds 0.5")
+        fig, c = self.mod.figure(self.d)
+        self.assertTrue(c["failed"])
+        self.assertIn("FAILED: numerical failure", c["title"])
+        self.assertEqual(fig._suptitle.get_color(), "tab:red")
+
+    def test_3d_node_minimum_is_told_apart_from_the_ring_mean_map(self):
+        run_folder(self.d, tier="3d")
+        _, c = self.mod.figure(self.d)
+        self.assertIn("node minimum", c["min_label"])
+        self.assertIn("ring-mean", c["map_title"])
+
+
+class ScreenFigure(unittest.TestCase):
+    def setUp(self):
+        self.mod = load("plot_screen")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.csv = os.path.join(self.tmp.name, "designs.csv")
+        rows, i = [], 0
+        for L in (2e-7, 4e-7, 8e-7):
+            for e in (0.35, 0.6, 0.85):
+                v = 1e-8 * (1 + 10 * (L == 4e-7) * (e == 0.6)) + 1e-9 * i
+                rows.append([i, f"{L * 1e6:g} um", L, e, "ok", v * 2, v])
+                i += 1
+        write_csv(self.csv, ["design", "swimmer.length", "swimmer.length_m", "wave.contracted_ratio", "status",
+                             "displacement_m", "mean_velocity_m_per_s"], rows)
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def test_best_design_marked_and_ticks_at_swept_values(self):
+        fig, c = self.mod.figure(self.csv, "mean_velocity_m_per_s", "s", ["swimmer.length", "wave.contracted_ratio"])
+        self.assertEqual(c["best"]["design"], "4")
+        self.assertAlmostEqual(c["best_xy"][0], 400.0)  # nm
+        self.assertAlmostEqual(c["best_xy"][1], 0.6)
+        self.assertEqual([round(v) for v in c["xticks"]], [200, 400, 800])
+        self.assertEqual(c["yticks"], [0.35, 0.6, 0.85])
+        self.assertEqual(list(c["axes"][0].get_xticks()), c["xticks"])
+        stars = [ln for ln in c["axes"][-1].get_lines() if ln.get_marker() == "*"]
+        self.assertEqual(len(stars), 1)
+        self.assertIn("best design 4", fig._suptitle.get_text())
+
+    def test_goal_min_marks_the_smallest(self):
+        _, c = self.mod.figure(self.csv, "mean_velocity_m_per_s", "s", ["swimmer.length", "wave.contracted_ratio"],
+                               goal="min")
+        self.assertEqual(c["best"]["design"], "0")
+
+
+class CalibrationFigure(unittest.TestCase):
+    def setUp(self):
+        self.mod = load("plot_calibration")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def write(self, status="ok"):
+        pts = []
+        for i, P in enumerate((0.002, 0.02, 0.2)):
+            k = (5e-10, -1e-8, -3e-8)[i]
+            pts.append({"pressure_Pa": P, "displacement_m": P / 4e6 * (1 + 0.001 * i), "secant_C1_Pa_per_m": 4e6 * (1 - 0.001 * i),
+                        "in_linear_range": i < 2, "stable_to_ring_buckling": k > 0,
+                        "ring_mode_stiffness_N_per_m": [k, k * 1.1], "softest_ring_mode": 2 + i,
+                        "softest_ring_mode_stiffness_N_per_m": k})
+        with open(f"{self.d}/calibration.json", "w") as f:
+            json.dump({"load_points": pts, "C1_Pa_per_m": 4e6, "C1_spring_network_Pa_per_m": 3.98e6,
+                       "scene": {"name": "cal_scene"}, "grid": {"membrane_nodes": 100}, "status": status}, f)
+
+    def test_scales_band_and_legends(self):
+        self.write()
+        fig, c = self.mod.figure(self.d)
+        self.assertIn("cal_scene", c["title"])
+        self.assertTrue(c["symlog"])
+        self.assertEqual(c["axes"][2].get_yscale(), "symlog")
+        # room for the n labels: the axis reaches well past the softest mode's extremes
+        ax2 = c["axes"][2]
+        lo2, hi2 = ax2.get_ylim()
+        t = ax2.transScale
+        ys = [t.transform((1, v))[1] for v in (lo2, hi2, -3e4, 5e2)]  # pN/m, in the symlog's space
+        self.assertGreater(ys[2] - ys[0], 0.1 * (ys[1] - ys[0]))
+        self.assertGreater(ys[1] - ys[3], 0.1 * (ys[1] - ys[0]))
+        self.assertTrue(c["loglog"])
+        self.assertEqual(len(c["axes"][1].patches), 0)  # no filled band
+        lo, hi = c["secant_ylim"]
+        self.assertFalse(lo <= c["band"][0] and c["band"][1] <= hi)  # the axis follows the data
+        for a, leg in zip(c["axes"], c["legends"]):
+            self.assertTrue(legend_outside(fig, a, leg))
+        self.assertFalse(c["failed"])
+
+    def test_main_writes_the_png(self):
+        self.write()
+        self.mod.main(self.d)
+        self.assertTrue(os.path.exists(f"{self.d}/calibration.png"))
+
+    def test_failed_hydraulic_measurement_looks_failed(self):
+        self.write("failed: hydraulic radii: numerical failure: slipping")
+        fig, c = self.mod.figure(self.d)
+        self.assertTrue(c["failed"])
+        self.assertIn("hydraulic radii FAILED", c["title"])
+        self.assertEqual(fig._suptitle.get_color(), "tab:red")
+
+    def test_symlog_only_for_both_signs_over_decades(self):
+        self.assertTrue(self.mod.spans_signs_and_decades([1.0, -100.0]))
+        self.assertFalse(self.mod.spans_signs_and_decades([1.0, 100.0]))
+        self.assertFalse(self.mod.spans_signs_and_decades([-2.0, 3.0]))
+
+
+def vtp_compressed(path, pts):
+    """A membrane frame as swim writes it: Float32 points, zlib-compressed inline binary."""
+    import base64
+    import struct
+    import zlib
+    raw = struct.pack(f"<{3 * len(pts)}f", *[c for p in pts for c in p])
+    packed = zlib.compress(raw)
+    header = struct.pack("<4I", 1, len(raw), len(raw), len(packed))
+    body = base64.b64encode(header).decode() + base64.b64encode(packed).decode()
+    with open(path, "w") as f:
+        f.write('<?xml version="1.0"?>\n<VTKFile type="PolyData" version="1.0" byte_order="LittleEndian" '
+                'header_type="UInt32" compressor="vtkZLibDataCompressor">\n<PolyData>\n<Piece>\n<Points>\n'
+                f'<DataArray type="Float32" NumberOfComponents="3" format="binary">\n{body}\n</DataArray>\n'
+                '</Points>\n</Piece>\n</PolyData>\n</VTKFile>\n')
+
+
+class ValidationFigures(unittest.TestCase):
+    def setUp(self):
+        sys.path.insert(0, TOOLS)  # plot_validation imports plot_calibration
+        self.mod = load("plot_validation")
+        self.tmp = tempfile.TemporaryDirectory()
+        self.d = self.tmp.name
+        self.closed = []
+        self.mod.plt.close = self.closed.append  # keep the figure for inspection
+
+    def tearDown(self):
+        self.tmp.cleanup()
+
+    def membrane_case(self):
+        import math
+        R0, n_theta, rings = 125e-9, 4, 3
+        pts = [(i * 1e-7, R0 * math.cos(2 * math.pi * k / n_theta), R0 * math.sin(2 * math.pi * k / n_theta))
+               for i in range(rings) for k in range(n_theta)]
+        os.makedirs(f"{self.d}/vtk")
+        for n in range(2):
+            vtp_compressed(f"{self.d}/vtk/m{n}.vtp", pts)
+        with open(f"{self.d}/membrane.pvd", "w") as f:
+            f.write('<Collection><DataSet timestep="0" file="vtk/m0.vtp"/><DataSet timestep="0.1" file="vtk/m1.vtp"/>'
+                    '</Collection>')
+        with open(f"{self.d}/summary.json", "w") as f:
+            json.dump({"derived": {"n_theta": n_theta, "aspect_ratio_R0_over_L": R0 / 4e-7}}, f)
+        return pts, {"name": "c", "length_m": 4e-7, "runs3d": [
+            {"membrane_frames": 2, "has_cycle": True, "folder": self.d, "cycle_time_s": 0.1, "cell_size_m": 3e-8}]}
+
+    def test_compressed_membrane_frames_are_read(self):
+        pts, _ = self.membrane_case()
+        got = self.mod.read_vtp_points(f"{self.d}/vtk/m0.vtp")
+        self.assertEqual(len(got), len(pts))
+        self.assertAlmostEqual(got[5][1], pts[5][1], delta=1e-12)
+
+    def test_membrane_plot_draws_outlines_with_y_ticks(self):
+        _, case = self.membrane_case()
+        self.assertTrue(self.mod.membrane_figure(case, f"{self.d}/m.png"))
+        ax = self.closed[-1].axes[0]
+        outlines = [ln for ln in ax.get_lines() if len(ln.get_xdata()) == 3]
+        self.assertEqual(len(outlines), 4)  # top and bottom of two snapshots
+        self.assertEqual(len(ax.get_yticks()), 6)  # -R0, 0, +R0 about each snapshot
+        self.assertIn("125", [t.get_text() for t in ax.get_yticklabels()])
+
+    def test_coarse_grids_are_told_apart(self):
+        s = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-8, 0]}
+        case = {"name": "c", "models1d": [], "runs3d": [
+            {"has_cycle": True, "series": s, "cycle_time_s": 1.0, "cell_size_m": h} for h in (4e-8, 3.2e-8, 2.7e-8)]}
+        self.mod.velocity_figure(case, f"{self.d}/v.png")
+        lines = [ln for ln in self.closed[-1].axes[0].get_lines() if ln.get_label().startswith("3D")]
+        styles = {(str(ln.get_color()), ln.get_linestyle()) for ln in lines}
+        self.assertEqual(len(styles), 3)
+
+    def test_convergence_grids_apart_and_not_asymptotic_said(self):
+        runs = [{"has_cycle": True, "cell_size_m": h, "displacement_per_cycle_m": d}
+                for h, d in ((4e-8, 7e-10), (3.2e-8, 2.7e-9), (2.67e-8, 3.7e-9))]
+        case = {"name": "c", "runs3d": runs, "models1d": [], "reference3d": {
+            "order_range": [0.5, 2], "displacement_per_cycle_m": {
+                "value": 3.7e-9, "error": 3e-9, "asymptotic": False, "observed_order": 2.94, "order": None}}}
+        self.assertTrue(self.mod.convergence_figure(case, f"{self.d}/c.png"))
+        ax = self.closed[-1].axes[0]
+        markers = {ln.get_marker() for ln in ax.get_lines() if len(ln.get_xdata()) == 1 and ln.get_color() == "k"}
+        self.assertEqual(len(markers), 3)
+        self.assertIn("h = 40 nm", [t.get_text() for t in ax.texts])
+        legend = " ".join(t.get_text() for t in ax.get_legend().get_texts())
+        self.assertIn("not asymptotic", legend)
+        self.assertIn("observed order 2.94", legend.replace("\n", " "))
+
+    def test_pareto_labels_do_not_overlap(self):
+        import matplotlib.pyplot as plt
+        fig, ax = plt.subplots()
+        ax.plot([1, 1.0001, 10], [1, 1, 1])
+        texts = [ax.annotate(f"rtol = 1e-0{k}", (1 + 1e-4 * k, 1), xytext=(4, -10), textcoords="offset points",
+                             fontsize=7) for k in range(3)]
+        self.assertGreater(self.mod.declutter(fig, texts), 0)
+        fig.canvas.draw()
+        boxes = [t.get_window_extent() for t in texts]
+        for i in range(len(boxes)):
+            for j in range(i):
+                self.assertFalse(boxes[i].overlaps(boxes[j]))
+
+
+if __name__ == "__main__":
+    unittest.main()
