@@ -14,18 +14,22 @@ double reference_energy(const Params& p) {
   return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
 }
 
-double ActuationLaw::rest_radius(double R0, double C1, double extra) const {
-  // g(R) = C1 (R - R0) + q(R) + extra is continuous and strictly increasing: constant pieces
-  // are solved exactly, ramps by bisection.
-  if (n == 0) return R0 - (c + extra) / C1;
+namespace {
+/// Radius where w(R) + q(R) + extra = 0 for a continuous, strictly increasing wall load w with
+/// the inverse `static_radius` (w(static_radius(load)) = -load) and the actuation law q
+/// (continuous, non-decreasing): its constant pieces are solved by the inverse, its ramps by
+/// bisection.
+template <class W, class Inverse>
+double solve_rest_radius(const ActuationLaw& q, const W& w, const Inverse& static_radius, double extra) {
+  if (q.n == 0) return static_radius(q.c + extra);
   {  // left constant piece R <= x0
-    const double R = R0 - (y[0] + extra) / C1;
-    if (R <= x[0]) return R;
+    const double R = static_radius(q.y[0] + extra);
+    if (R <= q.x[0]) return R;
   }
-  for (int k = 1; k < n; ++k) {
-    const auto g = [&](double R) { return C1 * (R - R0) + (*this)(R) + extra; };
-    if (g(x[k - 1]) <= 0 && g(x[k]) >= 0) {
-      double a = x[k - 1], b = x[k];
+  for (int k = 1; k < q.n; ++k) {
+    const auto g = [&](double R) { return w(R) + q(R) + extra; };
+    if (g(q.x[k - 1]) <= 0 && g(q.x[k]) >= 0) {
+      double a = q.x[k - 1], b = q.x[k];
       for (int it = 0; it < 200 && b - a > 1e-15 * (std::abs(a) + std::abs(b)); ++it) {
         const double m = 0.5 * (a + b);
         (g(m) < 0 ? a : b) = m;
@@ -33,30 +37,19 @@ double ActuationLaw::rest_radius(double R0, double C1, double extra) const {
       return 0.5 * (a + b);
     }
   }
-  return R0 - (y[n - 1] + extra) / C1;  // right constant piece
+  return static_radius(q.y[q.n - 1] + extra);  // right constant piece
+}
+}  // namespace
+
+double ActuationLaw::rest_radius(double R0, double C1, double extra) const {
+  return solve_rest_radius(
+      *this, [&](double R) { return C1 * (R - R0); }, [&](double load) { return R0 - load / C1; }, extra);
 }
 
 double ActuationLaw::rest_radius(const WallLaw& wall, double extra) const {
   if (!wall.law) return rest_radius(wall.R0, wall.C1, extra);
-  // g(R) = w(R) + q(R) + extra: continuous and strictly increasing (w strictly, q
-  // non-decreasing); constant pieces by the law's own inversion, ramps by bisection
-  if (n == 0) return wall.static_radius(c + extra);
-  {
-    const double R = wall.static_radius(y[0] + extra);
-    if (R <= x[0]) return R;
-  }
-  for (int k = 1; k < n; ++k) {
-    const auto g = [&](double R) { return wall(R) + (*this)(R) + extra; };
-    if (g(x[k - 1]) <= 0 && g(x[k]) >= 0) {
-      double a = x[k - 1], b = x[k];
-      for (int it = 0; it < 200 && b - a > 1e-15 * (std::abs(a) + std::abs(b)); ++it) {
-        const double m = 0.5 * (a + b);
-        (g(m) < 0 ? a : b) = m;
-      }
-      return 0.5 * (a + b);
-    }
-  }
-  return wall.static_radius(y[n - 1] + extra);
+  return solve_rest_radius(
+      *this, [&](double R) { return wall(R); }, [&](double load) { return wall.static_radius(load); }, extra);
 }
 
 namespace {
