@@ -8,6 +8,7 @@
 #include <random>
 #include <vector>
 
+#include "tests/support/quadrature.hpp"
 #include "reduced1d/outer_flow.hpp"
 
 using namespace swim::reduced1d::outer;
@@ -206,19 +207,8 @@ TEST(OuterFlow, ReciprocalStrokesGiveNoNetDisplacement) {
     sys.kinematic(s.data());
     return sys.U;
   };
-  // 10-point Gauss-Legendre on each of many sub-intervals
-  const double xg[5] = {0.1488743389816312, 0.4333953941292472, 0.6794095682990244, 0.8650633666889845,
-                        0.9739065285171717};
-  const double wg[5] = {0.2955242247147529, 0.2692667193099963, 0.2190863625159820, 0.1494513318108240,
-                        0.0666713443086881};
-  auto integrate = [&](auto f, double t0, double t1, int pieces) {
-    double sum = 0;
-    for (int p = 0; p < pieces; ++p) {
-      const double a0 = t0 + (t1 - t0) * p / pieces, a1 = t0 + (t1 - t0) * (p + 1) / pieces;
-      const double c = 0.5 * (a0 + a1), r = 0.5 * (a1 - a0);
-      for (int k = 0; k < 5; ++k) sum += wg[k] * r * (f(c - r * xg[k]) + f(c + r * xg[k]));
-    }
-    return sum;
+  const auto integrate = [](auto f, double t0, double t1, int pieces) {
+    return ::swim::test::gauss_legendre10(f, t0, t1, pieces);
   };
   const double T1 = 0.1, T2 = 0.3;  // contract in 0.1 s, release in 0.3 s
   const double forward = integrate([&](double t) {

@@ -16,6 +16,7 @@
 
 #include <unistd.h>
 
+#include "tests/support/quadrature.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "jacobian_check.hpp"
@@ -163,7 +164,7 @@ TEST(TubeLaw, AnalyticJacobianMatchesFiniteDifferences) {
       const int n = p.protocol.segments;
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
-          const auto c = test::check_jacobian(p, phase, active, seed);
+          const auto c = reduced1d::test::check_jacobian(p, phase, active, seed);
           EXPECT_LT(c.max_rel_error, 1e-6) << "traction=" << traction << " phase=" << phase << " active=" << active;
           EXPECT_EQ(c.rank, (phase == 0 ? n - 1 - active : 0) + (outer == OuterFlow::Confined ? 2 : 0));
         }
@@ -201,18 +202,8 @@ TEST(TubeLaw, ReciprocalStrokeOnTheLawGivesNoNetDisplacement) {
     sys.kinematic(s.data());
     return sys.U;
   };
-  const double xg[5] = {0.1488743389816312, 0.4333953941292472, 0.6794095682990244, 0.8650633666889845,
-                        0.9739065285171717};
-  const double wg[5] = {0.2955242247147529, 0.2692667193099963, 0.2190863625159820, 0.1494513318108240,
-                        0.0666713443086881};
-  auto integrate = [&](auto f, double t0, double t1, int pieces) {
-    double sum = 0;
-    for (int p = 0; p < pieces; ++p) {
-      const double a0 = t0 + (t1 - t0) * p / pieces, a1 = t0 + (t1 - t0) * (p + 1) / pieces;
-      const double c = 0.5 * (a0 + a1), r = 0.5 * (a1 - a0);
-      for (int k = 0; k < 5; ++k) sum += wg[k] * r * (f(c - r * xg[k]) + f(c + r * xg[k]));
-    }
-    return sum;
+  const auto integrate = [](auto f, double t0, double t1, int pieces) {
+    return ::swim::test::gauss_legendre10(f, t0, t1, pieces);
   };
   const double T1 = 0.1, T2 = 0.3;
   const double pi = std::numbers::pi;
