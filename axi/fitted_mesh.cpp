@@ -123,6 +123,7 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     throw std::invalid_argument("FittedMesh::fit: X has " + std::to_string(X.cols()) + " columns, the mesh " +
                                 std::to_string(n_) + " membrane nodes");
   fitted_ = false;
+  walkable_ = true;
   const double Rc = p_.Rc, P = p_.period;
   for (int k = 0; k < n_; ++k) {
     const double x = X(0, k), r = X(1, k);
@@ -408,47 +409,29 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     vx[ci] = xc;
   }
 
-  // Jacobian x_xi r_eta - x_eta r_xi at the four corners of every element (bilinear map:
-  // positive at the corners implies positive everywhere); the first element where it is not
-  // positive (-1 when none).
-  auto check = [&](int& bad_c, int& bad_j) {
-    min_jac_ = INFINITY;
-    for (int c = 0; c < nc_; ++c)
-      for (int j = 0; j < ny_; ++j) {
-        double x[4], r[4];
-        corners(element(c, j), x, r);
-        double worst = INFINITY;
-        for (int i = 0; i < 4; ++i) {
-          // derivatives at corner i (times 2): along xi the edge (0,1) at eta = -1 or (3,2) at
-          // eta = +1; along eta the edge (0,3) at xi = -1 or (1,2) at xi = +1
-          const double xx = i <= 1 ? x[1] - x[0] : x[2] - x[3], rx = i <= 1 ? r[1] - r[0] : r[2] - r[3];
-          const bool left = i == 0 || i == 3;
-          const double xe = left ? x[3] - x[0] : x[2] - x[1], re = left ? r[3] - r[0] : r[2] - r[1];
-          worst = std::min(worst, 0.25 * (xx * re - xe * rx));
-        }
-        min_jac_ = std::min(min_jac_, worst);
-        if (!(worst > 0.0)) {
-          bad_c = c;
-          bad_j = j;
-          return false;
-        }
-      }
-    return true;
-  };
   int bad_c = -1, bad_j = -1;
-  if (!check(bad_c, bad_j)) {
+  if (!find_fold(bad_c, bad_j)) {
     // Where the tilted lines cross but the wall line still advances along the axis (x strictly
-    // increasing), the vertical-line mesh is valid: use it.
+    // increasing), the vertical-line mesh is valid: use it. Otherwise (or when it is not valid)
+    // smooth the tilted mesh around its folds.
     bool increasing = true;
     for (int c = 0; c < nc_; ++c) increasing = increasing && seg_dx(c) > 0.0;
-    int c2 = -1, j2 = -1;
+    bool valid = false;
     if (increasing) {
+      const std::vector<double> tilted = vx_;
+      const std::vector<char> tilted_vertical = vertical_;
       for (int c = 0; c < nc_; ++c) {
         vertical_[c] = 1;
         for (int j = 0; j <= ny_; ++j) vx_[size_t(c) * (ny_ + 1) + j] = xcol_[c];
       }
+      int c2 = -1, j2 = -1;
+      valid = find_fold(c2, j2);
+      if (!valid) {
+        vx_ = tilted;
+        vertical_ = tilted_vertical;
+      }
     }
-    if (!increasing || !check(c2, j2)) {
+    if (!valid && !smooth_where_folded(bad_c, bad_j)) {
       const int c = bad_c, j = bad_j;
       const int k = c < n_ ? c : (c - n_ < (nc_ - n_) / 2 ? n_ - 1 : 0);
       throw NumericalError("element (column " + std::to_string(c) + ", row " + std::to_string(j) +
@@ -460,6 +443,136 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
     }
   }
   fitted_ = true;
+}
+
+// Elliptic smoothing where the algebraic lines fold (see the header): Winslow's equations for the
+// interior vertices of a window of columns on one side of the wall line, the window's edge
+// columns, the axis (or container) row and the wall line held, the rows kept graded as the
+// algebraic mesh grades them by the Thomas-Middlecoff control term. ξ(x) harmonic maps the window
+// one-to-one onto the logical rectangle (Rado's theorem), so the discrete solution unfolds the
+// lines wherever the window's boundary is valid. Windows of 2 x 6 columns around the first folded
+// element, doubled while a fold stays inside the last window, up to the whole line but one column.
+bool FittedMesh::smooth_where_folded(int& bad_c, int& bad_j) {
+  if (!p_.elliptic_smoothing) return false;
+  const std::vector<double> vx0 = vx_, vr0 = vr_;
+  const std::vector<char> vertical0 = vertical_;
+  const int ci = p_.cells_inner;
+  const double P = p_.period;
+  auto wrap = [&](int c) { return ((c % nc_) + nc_) % nc_; };
+  // vertex (c, j) with c unwrapped (the periodic image's x shifted by P)
+  auto at = [&](int c, int j) { return size_t(wrap(c)) * (ny_ + 1) + j; };
+  auto shift = [&](int c) { return P * std::floor(double(c) / nc_); };
+  int half = 6, centre = bad_c, side = bad_j < ci ? 0 : 1, lo = 0, hi = -1;
+  for (int attempt = 0; attempt < 16; ++attempt) {
+    const int s = bad_j < ci ? 0 : 1;
+    // a fold inside the last window (same side): widen it; elsewhere: a new window
+    const bool inside = s == side && wrap(bad_c - lo) < hi - lo;
+    if (attempt > 0 && inside) {
+      if (2 * half + 2 >= nc_) break;
+      half = std::min(2 * half, (nc_ - 2) / 2);
+    } else if (attempt > 0) {
+      half = 6;
+      centre = bad_c;
+      side = s;
+    }
+    half = std::min(half, (nc_ - 2) / 2);
+    lo = centre - half;
+    hi = centre + 1 + half;  // vertex columns lo..hi, lo and hi held
+    const int j0 = side ? ci : 0, j1 = side ? ny_ : ci;  // rows j0, j1 held
+    const int nw = hi - lo - 1, nr = j1 - j0 - 1;
+    if (nw < 1 || nr < 1) break;
+    // unwrapped working copies of the window, rows j0..j1
+    const int W = hi - lo + 1, H = j1 - j0 + 1;
+    std::vector<double> x(size_t(W) * H), r(size_t(W) * H), q(size_t(W) * H, 0.0);
+    auto id = [&](int a, int b) { return size_t(a) * H + b; };
+    for (int a = 0; a < W; ++a)
+      for (int b = 0; b < H; ++b) {
+        x[id(a, b)] = vx_[at(lo + a, j0 + b)] + shift(lo + a);
+        r[id(a, b)] = vr_[at(lo + a, j0 + b)];
+      }
+    // the control term: each column's own algebraic row distribution, q = -s_bb / s_b
+    for (int a = 1; a < W - 1; ++a)
+      for (int b = 1; b < H - 1; ++b) {
+        const double sm = r[id(a, b - 1)], s0 = r[id(a, b)], sp = r[id(a, b + 1)];
+        q[id(a, b)] = -(sp - 2.0 * s0 + sm) / (0.5 * (sp - sm));
+      }
+    double scale = INFINITY;  // the smallest edge of the window, for the stopping rule
+    for (int a = 0; a + 1 < W; ++a)
+      for (int b = 0; b + 1 < H; ++b)
+        scale = std::min({scale, std::hypot(x[id(a + 1, b)] - x[id(a, b)], r[id(a + 1, b)] - r[id(a, b)]),
+                          std::hypot(x[id(a, b + 1)] - x[id(a, b)], r[id(a, b + 1)] - r[id(a, b)])});
+    if (!(scale > 0.0)) scale = 1e-3 * (P + p_.Rc) / (nc_ + ny_);
+    const int sweeps = 40 * (W * W + H * H) + 200;
+    for (int it = 0; it < sweeps; ++it) {
+      double moved = 0.0;
+      for (int a = 1; a < W - 1; ++a)
+        for (int b = 1; b < H - 1; ++b) {
+          const double xe = x[id(a + 1, b)], xw = x[id(a - 1, b)], xn = x[id(a, b + 1)], xs = x[id(a, b - 1)];
+          const double re = r[id(a + 1, b)], rw = r[id(a - 1, b)], rn = r[id(a, b + 1)], rs = r[id(a, b - 1)];
+          const double xxi = 0.5 * (xe - xw), rxi = 0.5 * (re - rw), xet = 0.5 * (xn - xs), ret = 0.5 * (rn - rs);
+          const double al = xet * xet + ret * ret, be = xxi * xet + rxi * ret, ga = xxi * xxi + rxi * rxi;
+          const double xc = 0.25 * (x[id(a + 1, b + 1)] - x[id(a - 1, b + 1)] - x[id(a + 1, b - 1)] + x[id(a - 1, b - 1)]);
+          const double rc = 0.25 * (r[id(a + 1, b + 1)] - r[id(a - 1, b + 1)] - r[id(a + 1, b - 1)] + r[id(a - 1, b - 1)]);
+          const double d = 2.0 * (al + ga), qq = q[id(a, b)];
+          if (!(d > 0.0)) continue;
+          const double nx = (al * (xe + xw) + ga * (xn + xs + qq * xet) - 2.0 * be * xc) / d;
+          const double nrr = (al * (re + rw) + ga * (rn + rs + qq * ret) - 2.0 * be * rc) / d;
+          moved = std::max(moved, std::hypot(nx - x[id(a, b)], nrr - r[id(a, b)]));
+          x[id(a, b)] = nx;
+          r[id(a, b)] = nrr;
+        }
+      if (moved < 1e-9 * scale) break;
+    }
+    for (int a = 1; a < W - 1; ++a) {
+      vertical_[wrap(lo + a)] = 0;
+      for (int b = 1; b < H - 1; ++b) {
+        vx_[at(lo + a, j0 + b)] = x[id(a, b)] - shift(lo + a);
+        vr_[at(lo + a, j0 + b)] = r[id(a, b)];
+      }
+    }
+    // the smoothed lines need not be graphs over r, nor ordered along the axis at every radius:
+    // the point location searches the elements instead of walking the columns
+    walkable_ = false;
+    if (find_fold(bad_c, bad_j)) return true;
+  }
+  vx_ = vx0;
+  vr_ = vr0;
+  vertical_ = vertical0;
+  walkable_ = true;
+  return false;
+}
+
+// Jacobian x_xi r_eta - x_eta r_xi at the four corners of every element (bilinear map: positive
+// at the corners implies positive everywhere); false and the first element where it is not
+// positive when there is one.
+bool FittedMesh::find_fold(int& bad_c, int& bad_j) {
+  min_jac_ = INFINITY;
+  for (int c = 0; c < nc_; ++c)
+    for (int j = 0; j < ny_; ++j) {
+      const double worst = corner_jacobian(c, j);
+      min_jac_ = std::min(min_jac_, worst);
+      if (!(worst > 0.0)) {
+        bad_c = c;
+        bad_j = j;
+        return false;
+      }
+    }
+  return true;
+}
+
+double FittedMesh::corner_jacobian(int c, int j) const {
+  double x[4], r[4];
+  corners(element(c, j), x, r);
+  double worst = INFINITY;
+  for (int i = 0; i < 4; ++i) {
+    // derivatives at corner i (times 2): along xi the edge (0,1) at eta = -1 or (3,2) at
+    // eta = +1; along eta the edge (0,3) at xi = -1 or (1,2) at xi = +1
+    const double xx = i <= 1 ? x[1] - x[0] : x[2] - x[3], rx = i <= 1 ? r[1] - r[0] : r[2] - r[3];
+    const bool left = i == 0 || i == 3;
+    const double xe = left ? x[3] - x[0] : x[2] - x[1], re = left ? r[3] - r[0] : r[2] - r[1];
+    worst = std::min(worst, 0.25 * (xx * re - xe * rx));
+  }
+  return worst;
 }
 
 void FittedMesh::corners(int e, double x[4], double r[4]) const {
@@ -503,6 +616,7 @@ int FittedMesh::locate(double& x, double r, double& xi, double& eta) const {
   const double P = p_.period, x0 = line_x(0);
   x = x0 + (x - x0) - P * std::floor((x - x0) / P);
   if (x >= x0 + P) x -= P;
+  if (!walkable_) return search(x, r, xi, eta);
   int lo = 0, hi = nc_;  // column strip: line_x(lo) <= x < line_x(hi), line_x(nc_) = x0 + P
   while (hi - lo > 1) {
     const int mid = (lo + hi) / 2;
@@ -553,6 +667,64 @@ int FittedMesh::locate(double& x, double r, double& xi, double& eta) const {
     if (std::abs(dxi) + std::abs(deta) < 1e-14) break;
   }
   return e;
+}
+
+// The reference coordinates of (x, r) in element e by Newton's method on the bilinear map,
+// unclamped; false when they do not converge.
+bool FittedMesh::invert(int e, double x, double r, double& xi, double& eta) const {
+  double cx[4], cr[4];
+  corners(e, cx, cr);
+  const double lo_x = std::min({cx[0], cx[1], cx[2], cx[3]}), hi_x = std::max({cx[0], cx[1], cx[2], cx[3]});
+  const double lo_r = std::min({cr[0], cr[1], cr[2], cr[3]}), hi_r = std::max({cr[0], cr[1], cr[2], cr[3]});
+  const double tol = 1e-9 * (hi_x - lo_x + hi_r - lo_r);
+  if (x < lo_x - tol || x > hi_x + tol || r < lo_r - tol || r > hi_r + tol) return false;
+  static constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
+  for (int start = 0; start < 5; ++start) {  // from the centre, then from each corner
+    xi = start ? 0.9 * cs[start - 1] : 0.0;
+    eta = start ? 0.9 * ct[start - 1] : 0.0;
+    if (newton(cx, cr, x, r, xi, eta)) return true;
+  }
+  return false;
+}
+
+bool FittedMesh::newton(const double cx[4], const double cr[4], double x, double r, double& xi, double& eta) {
+  static constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
+  for (int it = 0; it < 50; ++it) {
+    double fx = -x, fr = -r, xx = 0, xe = 0, rx = 0, re = 0;
+    for (int i = 0; i < 4; ++i) {
+      const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
+      const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
+      fx += m * cx[i];
+      fr += m * cr[i];
+      xx += mx * cx[i];
+      xe += me * cx[i];
+      rx += mx * cr[i];
+      re += me * cr[i];
+    }
+    const double det = xx * re - xe * rx;
+    if (!(det != 0.0)) return false;
+    const double dxi = (re * fx - xe * fr) / det, deta = (-rx * fx + xx * fr) / det;
+    xi -= dxi;
+    eta -= deta;
+    if (!(std::abs(xi) < 4.0 && std::abs(eta) < 4.0)) return false;
+    if (std::abs(dxi) + std::abs(deta) < 1e-14) return std::max(std::abs(xi), std::abs(eta)) <= 1.0 + 1e-9;
+  }
+  return false;
+}
+
+// Point location on a mesh smoothed around a fold (its lines need not be graphs over r, nor
+// ordered along the axis at every radius): every element (and its periodic image) is tried.
+int FittedMesh::search(double& x, double r, double& xi, double& eta) const {
+  for (double xs : {x, x + p_.period, x - p_.period})
+    for (int e = 0; e < elements(); ++e)
+      if (invert(e, xs, r, xi, eta)) {
+        xi = std::clamp(xi, -1.0, 1.0);
+        eta = std::clamp(eta, -1.0, 1.0);
+        x = xs;
+        return e;
+      }
+  throw std::invalid_argument("FittedMesh::locate: the point (x = " + fmt(x) + " m, r = " + fmt(r) +
+                              " m) lies in no element");
 }
 
 }  // namespace swim::axi

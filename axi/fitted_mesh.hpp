@@ -81,7 +81,23 @@
 // every element (bilinear: positive there implies positive everywhere); a non-positive one is
 // the mesh's only geometric rejection (the wall shape it cannot follow). When the tilted lines
 // fail that check and the wall line's x is strictly increasing, all lines are made vertical
-// (x = x_c; valid for any such wall) and checked again.
+// (x = x_c; valid for any such wall) and checked again. Otherwise (or if that fails too) the
+// tilted mesh is smoothed around its first folded element (FittedMeshParams::elliptic_smoothing):
+// on the fold's side of the wall line, in a window of vertex columns lo..hi (6 columns either
+// side of the element, doubled while a fold remains inside the window, up to the whole line but
+// one column), the interior vertices solve Winslow's equations
+//   alpha x_xixi - 2 beta x_xieta + gamma (x_etaeta + Q x_eta) = 0   (and the same for r),
+//   alpha = x_eta^2 + r_eta^2, beta = x_xi x_eta + r_xi r_eta, gamma = x_xi^2 + r_xi^2,
+// (central differences on the logical grid, Gauss-Seidel sweeps until no vertex moves by more
+// than 1e-9 of the window's smallest edge), with the window's edge columns, the axis (or
+// container) row and the wall line held. The logical coordinates then solve Laplace's equation
+// on the physical window, a one-to-one map onto the logical rectangle for any simply connected
+// window (Rado's theorem), so the lines unfold wherever the discrete solution follows it. The
+// control term Q = -s_etaeta / s_eta, s the radii of the column's algebraic rows, keeps the rows
+// graded towards the wall. Any other fold starts a window of its own. The smoothing changes
+// nothing on a shape the algebraic lines mesh (vertices identical to the bit), so it is a
+// discontinuous fallback: the mesh jumps where it engages, which the stepper's error control
+// sees as any other change of the shape. Point location (locate) then searches the elements.
 //
 // Q2 nodes: (2 NC) x (2 Ny + 1), index I = 0..2NC-1 along the columns (periodic; I = 2c is
 // vertex column c, I odd a column of midside/centre nodes), J = 0..2Ny along r (J = 2j the vertex
@@ -110,6 +126,9 @@ struct FittedMeshParams {
   /// width high, the rows above and below it growing geometrically (one ratio per side and
   /// column, at most 4) to fill the distance to the axis and to the container. 0: uniform rows.
   double wall_row_aspect = 0.0;
+  /// Where the algebraic lines fold (a non-positive Jacobian), smooth the interior vertices
+  /// around the fold by Winslow's elliptic equations before giving up (see the header).
+  bool elliptic_smoothing = true;
 };
 
 /// Throws swim::InputError (keys `axi.fitted.*`, `container.radius`, `container.period`) for
@@ -194,6 +213,15 @@ class FittedMesh {
   std::vector<double> vx_, vr_;  ///< NC x (Ny + 1): vertex positions
   std::vector<char> vertical_;   ///< NC: the column's line is vertical
   double min_jac_ = 0;
+
+  bool walkable_ = true;  ///< the lines are graphs over r, ordered along the axis (locate walks them)
+
+  bool find_fold(int& bad_c, int& bad_j);
+  bool invert(int e, double x, double r, double& xi, double& eta) const;
+  static bool newton(const double cx[4], const double cr[4], double x, double r, double& xi, double& eta);
+  int search(double& x, double r, double& xi, double& eta) const;
+  double corner_jacobian(int c, int j) const;
+  bool smooth_where_folded(int& bad_c, int& bad_j);
 };
 
 }  // namespace swim::axi
