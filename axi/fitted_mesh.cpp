@@ -97,6 +97,8 @@ constexpr double kCapacity = 4.0;               // or as many as have kCapacity 
 constexpr double kRowRatio = 1.1;               // where the lines tilt, the first rows grow by at most this per column
 constexpr double kLeanSlope = 1.0;              // lambda changes by at most this times length / band per segment
 constexpr double kTiltFull = 0.2;               // line slope |dx/dr| from which that limit holds fully
+constexpr int kSmoothingHalfWidth = 48;         // the widest smoothing window: this many columns either side
+constexpr int kSmoothingSweeps = 4000;          // at most this many Gauss-Seidel sweeps per window
 
 double smoothstep01(double t) {
   t = std::clamp(t, 0.0, 1.0);
@@ -451,7 +453,7 @@ void FittedMesh::fit(const Eigen::Matrix3Xd& X) {
 // algebraic mesh grades them by the Thomas-Middlecoff control term. ξ(x) harmonic maps the window
 // one-to-one onto the logical rectangle (Rado's theorem), so the discrete solution unfolds the
 // lines wherever the window's boundary is valid. Windows of 2 x 6 columns around the first folded
-// element, doubled while a fold stays inside the last window, up to the whole line but one column.
+// element, doubled while a fold stays inside the last window, up to 2 x 48.
 bool FittedMesh::smooth_where_folded(int& bad_c, int& bad_j) {
   if (!p_.elliptic_smoothing) return false;
   const std::vector<double> vx0 = vx_, vr0 = vr_;
@@ -468,8 +470,8 @@ bool FittedMesh::smooth_where_folded(int& bad_c, int& bad_j) {
     // a fold inside the last window (same side): widen it; elsewhere: a new window
     const bool inside = s == side && wrap(bad_c - lo) < hi - lo;
     if (attempt > 0 && inside) {
-      if (2 * half + 2 >= nc_) break;
-      half = std::min(2 * half, (nc_ - 2) / 2);
+      if (2 * half + 2 >= nc_ || half >= kSmoothingHalfWidth) break;
+      half = std::min(2 * half, kSmoothingHalfWidth);
     } else if (attempt > 0) {
       half = 6;
       centre = bad_c;
@@ -502,7 +504,7 @@ bool FittedMesh::smooth_where_folded(int& bad_c, int& bad_j) {
         scale = std::min({scale, std::hypot(x[id(a + 1, b)] - x[id(a, b)], r[id(a + 1, b)] - r[id(a, b)]),
                           std::hypot(x[id(a, b + 1)] - x[id(a, b)], r[id(a, b + 1)] - r[id(a, b)])});
     if (!(scale > 0.0)) scale = 1e-3 * (P + p_.Rc) / (nc_ + ny_);
-    const int sweeps = 40 * (W * W + H * H) + 200;
+    const int sweeps = std::min(40 * (W * W + H * H) + 200, kSmoothingSweeps);
     for (int it = 0; it < sweeps; ++it) {
       double moved = 0.0;
       for (int a = 1; a < W - 1; ++a)

@@ -84,12 +84,12 @@
 // (x = x_c; valid for any such wall) and checked again. Otherwise (or if that fails too) the
 // tilted mesh is smoothed around its first folded element (FittedMeshParams::elliptic_smoothing):
 // on the fold's side of the wall line, in a window of vertex columns lo..hi (6 columns either
-// side of the element, doubled while a fold remains inside the window, up to the whole line but
-// one column), the interior vertices solve Winslow's equations
+// side of the element, doubled while a fold remains inside the window, up to 48), the interior
+// vertices solve Winslow's equations
 //   alpha x_xixi - 2 beta x_xieta + gamma (x_etaeta + Q x_eta) = 0   (and the same for r),
 //   alpha = x_eta^2 + r_eta^2, beta = x_xi x_eta + r_xi r_eta, gamma = x_xi^2 + r_xi^2,
 // (central differences on the logical grid, Gauss-Seidel sweeps until no vertex moves by more
-// than 1e-9 of the window's smallest edge), with the window's edge columns, the axis (or
+// than 1e-9 of the window's smallest edge, at most 4000), with the window's edge columns, the axis (or
 // container) row and the wall line held. The logical coordinates then solve Laplace's equation
 // on the physical window, a one-to-one map onto the logical rectangle for any simply connected
 // window (Rado's theorem), so the lines unfold wherever the discrete solution follows it. The
