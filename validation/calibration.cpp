@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <memory>
 #include <cstdlib>
 #include <cmath>
 
@@ -14,7 +15,7 @@
 #include "full3d/grid.hpp"
 #include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
-#include "full3d/run3d.hpp"
+#include "full3d/world3d.hpp"
 #include "reduced1d/tube_law.hpp"
 
 #include <array>
@@ -204,12 +205,12 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
 WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,
                             bool axisymmetric_wall) {
   const auto t0 = std::chrono::steady_clock::now();
-  const full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
-  const full3d::CylinderMesh mesh = full3d::make_mesh(p);
-  full3d::IbOptions opt = full3d::ib_options(p);
-  opt.dt_key = "full3d.dt";
+  const full3d::World3d world(p);
+  const full3d::CylinderMesh& mesh = world.mesh;
+  full3d::IbOptions opt = world.options;
   opt.axisymmetric_wall = axisymmetric_wall;
-  full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), opt);
+  const std::unique_ptr<full3d::IbSolver> solver = world.solver(opt);  // a massless wall
+  full3d::IbSolver& ib = *solver;
   const Eigen::VectorXd area = mesh.node_area;
   ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) {
     Eigen::Matrix3Xd F = full3d::radial_directions(mesh, X);
