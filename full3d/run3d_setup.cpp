@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include "common/si_format.hpp"
 
 namespace swim::full3d {
 
@@ -21,10 +22,6 @@ RunSetup::RunSetup(const Params3d& params)
       fluid_every(vtk_every * std::max(1L, std::lround(params.fluid_interval / params.vtk_interval))),
       ckpt_every(steps_for(params.checkpoint_interval, params.dt)) {}
 
-std::string short_number(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string short_number(double v) { return significant(v, 4); }
 
 }  // namespace swim::full3d
