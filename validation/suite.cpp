@@ -41,11 +41,16 @@ json run_suite(const SuiteOptions& o) {
   for (std::size_t ci = 0; ci < cases.size(); ++ci) {
     const SuiteCase c = open_case(cases[ci], ci, cases.size(), suite_dir, o.data_dir);
     json cr = case_entry(c, o.data_dir);
+    // 1. the 3D resolution study
     const std::vector<Run3d> runs = resolution_study(c, cache, say, o.run_progress, cr);
+    // 2. the 3D reference, extrapolated to h -> 0; the axisymmetric reference when the case has one
     cr["reference3d"] = reference_3d(runs, orders_3d(c, suite), c.paper_max);
     axi_reference_study(c, suite, runs, cache, say, o.run_progress, cr);
+    // 3. the 1D tier calibrated from 3D
     const std::string cal_file = calibrate_case(c, cache, say, cr);
+    // 4. every 1D model against the references
     cr["models1d"] = judge_models(c, suite, cal_file, runs, cr, say);
+    // 5. speed against accuracy
     cr["speed_accuracy"] = speed_accuracy(c, suite, cal_file, runs, cr, cache, say, o.run_progress);
     wall_times(c, runs, cr);
     report["cases"].push_back(cr);
