@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <memory>
 #include <string>
 #include <thread>
 #include <utility>
@@ -29,6 +30,7 @@
 #include "full3d/reference_duct_fft.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
+#include "full3d/world3d.hpp"
 
 namespace swim::app {
 
@@ -129,13 +131,430 @@ double fft_floor_staggered(int nx, int ny, int nz, int threads, int reps) {
   return time_floor(nx, {cells, vface, wface, cells}, threads, reps);
 }
 
-/// The axisymmetric reference tier: one cycle of the round-wall amplitude scene (R_f = 0.82 R0,
-/// D fixed, the geometric recovery end) with the fitted method at `cells` across, one core,
-/// against the CPU time of one numeric factorisation of its fitted system (the unit of this
-/// method's cost: a step factors or reuses, and solves three times; both in CPU time, so that
-/// the ratio holds on a busy machine). Written to report["axi_cycle"].
-void bench_axi(scene::json& report, const std::string& out, int cells) {
-  std::printf("== axisymmetric tier (fitted) ==\n");
+// ---- 1D tier ------------------------------------------------------------------------------
+
+/// One force-driven cycle of the demo scene, best of `reps` solves.
+struct CycleTiming {
+  int cells = 0;
+  std::string set;  ///< the variant's scene change ("" for the plain scene)
+  double wall_s = 0, cycle_time_s = 0, displacement_per_cycle_m = 0;
+  long steps = 0, switches = 0;
+  bool ok = false;
+};
+
+CycleTiming time_cycle(int cells, const std::vector<std::string>& sets, const std::string& variant, int reps) {
+  const auto p = demo_params(sets);
+  reduced1d::Result r;
+  CycleTiming c;
+  c.cells = cells;
+  c.set = variant;
+  c.wall_s = best_solve_time(p, reps, r);
+  const auto m = reduced1d::metrics(p, r);
+  c.steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
+  c.switches = r.switches;
+  c.cycle_time_s = m.mean_cycle_time_s;
+  c.displacement_per_cycle_m = m.displacement_per_cycle_m;
+  c.ok = !r.failure;
+  return c;
+}
+
+void print_cycle(const CycleTiming& c) {
+  std::printf("  %6d %12.3f %10ld %10ld %10.4g%s%s%s\n", c.cells, 1e3 * c.wall_s, c.steps, c.switches, c.cycle_time_s,
+              c.set.empty() ? "" : "  ", c.set.c_str(), c.ok ? "" : "  FAILED");
+}
+
+scene::json cycle_json(const CycleTiming& c) {
+  return {{"cells", c.cells}, {"wall_time_s", c.wall_s}, {"steps", c.steps}, {"switches", c.switches},
+          {"cycle_time_s", c.cycle_time_s}, {"ok", c.ok}};
+}
+
+scene::json variant_json(const CycleTiming& c) {
+  return {{"cells", c.cells}, {"set", c.set}, {"wall_time_s", c.wall_s}, {"steps", c.steps},
+          {"displacement_per_cycle_m", c.displacement_per_cycle_m}, {"ok", c.ok}};
+}
+
+/// A screening case: the design kind, its cells, the short-wave traction.
+struct ScreeningCase {
+  std::string kind;
+  int cells;
+  bool traction = true;
+  std::string label() const { return kind + (traction ? "" : " lubrication wall") + " N=" + std::to_string(cells); }
+};
+
+/// Screening throughput of one case, on all cores and on one thread.
+struct ScreeningTiming {
+  std::string label;
+  int designs = 0, cells = 0;
+  unsigned threads = 0;
+  double wall_s[2] = {0, 0}, cpu_s[2] = {0, 0};  ///< all cores, one thread
+  long failed = 0;
+};
+
+/// A 10 x 10 grid over lambda = R_f/R0 in [0.35, 0.85] and L in [0.2, 0.8] um. Force-driven
+/// designs drive at 1.4x the static load so that every design is reachable and runs a whole
+/// cycle (failing designs would cost nothing and inflate the figure).
+ScreeningTiming time_screening(const ScreeningCase& c, bool quick, unsigned cores) {
+  const int n = c.kind == "step" ? (quick ? 100 : 1000) : (quick ? 20 : 100);
+  std::vector<reduced1d::Params> designs;
+  for (int k = 0; k < n; ++k) {
+    const double lambda = 0.35 + 0.5 * (k % 10) / 9.0;
+    const double length_um = 0.2 + 0.6 * (k / 10 % 10) / 9.0;
+    char l[64], s[64];
+    std::snprintf(l, sizeof l, "wave.contracted_ratio=%.4f", lambda);
+    std::snprintf(s, sizeof s, "swimmer.length=\"%.4f um\"", length_um);
+    std::vector<std::string> sets = {l, s, "wave.kind=\"" + c.kind + "\"", "numerics1d.cells=" + std::to_string(c.cells)};
+    if (!c.traction) sets.push_back("model1d.short_wave_traction=false");
+    if (c.kind == "step")
+      sets.push_back("protocol=null");
+    else
+      sets.insert(sets.end(), {"protocol.total_force=null", "protocol.load_factor=1.4"});
+    designs.push_back(demo_params(sets));
+  }
+  ScreeningTiming t;
+  t.label = c.label();
+  t.designs = n;
+  t.cells = c.cells;
+  t.threads = cores;
+  // On all cores, then on one thread. The process CPU time tells a CPU-starved run (other
+  // jobs on the machine: fewer cores used than threads) from poor scaling (more CPU per
+  // design on more threads).
+  for (int pass = 0; pass < 2; ++pass) {
+    const double c0 = process_cpu_seconds();
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto res = reduced1d::run_designs(designs, pass == 0 ? 0 : 1);
+    t.wall_s[pass] = seconds_since(t0);
+    t.cpu_s[pass] = process_cpu_seconds() - c0;
+    if (pass == 0) t.failed = std::count_if(res.begin(), res.end(), [](const auto& r) { return !r.ok; });
+  }
+  return t;
+}
+
+void print_screening(const ScreeningTiming& t) {
+  const int n = t.designs;
+  std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed); CPU %.3g ms/design, %.2f cores used; "
+              "1 thread: %.1f designs/s, CPU %.3g ms/design\n",
+              t.label.c_str(), n, t.wall_s[0], n / t.wall_s[0], t.failed, 1e3 * t.cpu_s[0] / n, t.cpu_s[0] / t.wall_s[0],
+              n / t.wall_s[1], 1e3 * t.cpu_s[1] / n);
+}
+
+scene::json screening_json(const ScreeningTiming& t) {
+  const int n = t.designs;
+  return {{"designs", n}, {"cells", t.cells}, {"threads", t.threads}, {"wall_time_s", t.wall_s[0]},
+          {"designs_per_s", n / t.wall_s[0]}, {"cpu_time_s", t.cpu_s[0]}, {"cores_used", t.cpu_s[0] / t.wall_s[0]},
+          {"designs_per_s_1_thread", n / t.wall_s[1]}, {"cpu_time_s_1_thread", t.cpu_s[1]}, {"failed", t.failed}};
+}
+
+/// The 1D part: one force-driven cycle at N = 50, 200, 800; at N = 200 the lubrication-only
+/// wall (no short-wave traction), the other outer flow and the paper's reproduction mode;
+/// screening throughput.
+void bench_1d(scene::json& report, bool quick, int reps, unsigned cores) {
+  std::printf("== 1D tier ==\n");
+  std::printf("one force-driven cycle (demo scene, best of %d):\n", reps);
+  std::printf("  %6s %12s %10s %10s %10s\n", "N", "wall [ms]", "steps", "switches", "cycle [s]");
+  scene::json cycles = scene::json::array();
+  for (int n : {50, 200, 800}) {
+    const CycleTiming c =
+        time_cycle(n, {"numerics1d.cells=" + std::to_string(n), "protocol.cycles=1", "time.duration=\"auto\""}, "", reps);
+    print_cycle(c);
+    cycles.push_back(cycle_json(c));
+  }
+  report["force_driven_cycle"] = cycles;
+  scene::json variants = scene::json::array();
+  for (const std::string& v : {std::string("model1d.short_wave_traction=false"), std::string("model1d.outer_flow=\"unbounded\""),
+                                std::string("model1d.model=\"paper\"")}) {
+    std::vector<std::string> sets = {"numerics1d.cells=200", "protocol.cycles=1", "time.duration=\"auto\"", v};
+    if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
+    const CycleTiming c = time_cycle(200, sets, v, reps);
+    print_cycle(c);
+    variants.push_back(variant_json(c));
+  }
+  report["force_driven_cycle_variants"] = variants;
+
+  // N = 200 (the shipped scenes' grid) and N = 50 (the default grid with the short-wave
+  // traction), and the lubrication-only wall at N = 200
+  std::printf("screening throughput (%u threads, 10 x 10 grid over lambda and L):\n", cores);
+  scene::json screening = scene::json::object();
+  for (const ScreeningCase& c : {ScreeningCase{"step", 200}, ScreeningCase{"force_driven", 200},
+                                 ScreeningCase{"force_driven", 50}, ScreeningCase{"force_driven", 200, false}}) {
+    const ScreeningTiming t = time_screening(c, quick, cores);
+    print_screening(t);
+    screening[t.label] = screening_json(t);
+  }
+  report["screening"] = screening;
+}
+
+// ---- 3D tier ------------------------------------------------------------------------------
+
+/// The time per coupled step of one scene, split into its parts, against the bare FFT Stokes
+/// solve and the FFTW floors on the same grid and threads.
+struct StepTiming {
+  std::string grid, container;
+  int nodes = 0, threads = 0;
+  double step_s = 0, best_s = 0, fluid_s = 0, spread_s = 0, interp_s = 0, forces_s = 0;
+  double bare_s = 0, floor_s = 0, mac_s = 0;
+  /// the cylinder's fluid solve against the duct's on the same grid (cylinder scenes only)
+  double cylinder_solve_s = 0, duct_solve_s = 0;
+};
+
+/// The demo swimmer in `container` at `across` cells, `thr` threads: `steps` timed steps after
+/// a warm-up, the bare solve, the floors and (cylinder) the duct's solve on the same grid.
+StepTiming time_steps(int across, const std::string& container, int thr, int steps) {
+  scene::json sc = scene::load_file(data_dir() + "/scenes/demo.json");
+  scene::apply_override(sc, "full3d.grid.cells_across=" + std::to_string(across));
+  scene::apply_override(sc, "full3d.threads=" + std::to_string(thr));
+  scene::apply_override(sc, "container.kind=\"" + container + "\"");
+  scene::json resolved;
+  const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+  const full3d::World3d world(p);
+  const full3d::MacGrid grid = world.grid();
+  const std::unique_ptr<full3d::IbSolver> solver = world.solver();  // a massless wall
+  full3d::IbSolver& ib = *solver;
+  ib.stokes().compute_pressure(false);  // the step of a run that writes no fluid frames (the default)
+  full3d::Protocol3d proto = world.protocol();
+  proto.start(0.0, world.mesh.X0);
+  ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) { return proto.force(X); });
+  full3d::IbState st = ib.initial_state();
+  ib.step(st, p.dt);  // warm-up (plans, first PCG)
+  StepTiming t;
+  t.container = container;
+  t.nodes = world.mesh.nodes();
+  t.threads = thr;
+  full3d::IbStepStats sum;
+  const auto t0 = std::chrono::steady_clock::now();
+  double best = 1e300;  // the fastest step: compared with the floor's best repetition
+  for (int k = 0; k < steps; ++k) {
+    const auto t1 = std::chrono::steady_clock::now();
+    const auto s1 = ib.step(st, p.dt);
+    best = std::min(best, seconds_since(t1));
+    sum.time_fluid += s1.time_fluid;
+    sum.time_spread += s1.time_spread;
+    sum.time_interp += s1.time_interp;
+    sum.time_forces += s1.time_forces;
+  }
+  t.step_s = seconds_since(t0) / steps;
+  t.best_s = best;
+  t.fluid_s = sum.time_fluid / steps;
+  t.spread_s = sum.time_spread / steps;
+  t.interp_s = sum.time_interp / steps;
+  t.forces_s = sum.time_forces / steps;
+  // bare FFT solve (reference::PressureCorrectionStep, full3d/reference_duct_fft.hpp) with the
+  // same forcing size
+  full3d::VectorField u(grid), f(grid);
+  for (auto& c : f.c)
+    for (size_t i = 0; i < c.size(); ++i) c[i] = std::sin(0.37 * double(i));
+  // The bare solve runs its transforms through FFTW's own threads; for some sizes
+  // (e.g. the cylinder's 34 cells across) FFTW's threaded plans are slower than its
+  // serial ones, so the reference is the faster of FFTW with `thr` threads and with one.
+  double bare_per = 1e300;
+  for (int fft_threads : {thr, 1}) {
+    if (fft_threads == 1 && thr == 1 && bare_per < 1e300) break;
+    full3d::FftOptions fo = world.options.stokes.fft;
+    fo.threads = fft_threads;
+    full3d::reference::PressureCorrectionStep bare(grid, p.fluid, fo);
+    bare.step(u, f, p.dt);
+    const auto t1 = std::chrono::steady_clock::now();
+    for (int k = 0; k < steps; ++k) bare.step(u, f, p.dt);
+    bare_per = std::min(bare_per, seconds_since(t1) / steps);
+  }
+  t.bare_s = bare_per;
+  t.floor_s = fft_floor(p.nx, p.ny, p.nz, thr, std::max(3, steps));
+  t.mac_s = fft_floor_staggered(p.nx, p.ny, p.nz, thr, std::max(3, steps));
+  char g[32];
+  std::snprintf(g, sizeof g, "%dx%dx%d%s", p.nx, p.ny, p.nz, container == "cylinder" ? " cyl" : "");
+  t.grid = g;
+  if (container == "cylinder") {
+    // the cylinder's fluid solve against the duct's on the same grid, same threads, same forcing
+    full3d::StokesOptions so = world.options.stokes;
+    so.cylinder.enabled = false;
+    full3d::StokesSolver duct(grid, p.fluid, so);
+    duct.compute_pressure(false);  // as the cylinder's solver in the step above
+    full3d::StokesSolver& cyl = ib.stokes();
+    double t_duct = 1e300, t_cyl = 1e300;
+    duct.step(u, f, p.dt);
+    for (int k = 0; k < steps; ++k) {
+      std::fill(u.c[0].begin(), u.c[0].end(), 0.0);
+      auto t1 = std::chrono::steady_clock::now();
+      duct.step(u, f, p.dt);
+      t_duct = std::min(t_duct, seconds_since(t1));
+      t1 = std::chrono::steady_clock::now();
+      cyl.step(u, f, p.dt);
+      t_cyl = std::min(t_cyl, seconds_since(t1));
+    }
+    t.cylinder_solve_s = t_cyl;
+    t.duct_solve_s = t_duct;
+  }
+  return t;
+}
+
+void print_step_header() {
+  std::printf("  (per step, ms: mean over the timed steps, best: the fastest; bare: the project's pressure-correction\n"
+              "   FFT solve; floor: 8 raw FFTW transforms of the duct's kind, sine/cosine-II across, best of the\n"
+              "   repetitions; mac: the same with the staggered grid's own kinds, sine-I of the interior faces for v\n"
+              "   and w; FFTW_MEASURE, same grid and threads; st/flr and st/mac: best step / floor)\n");
+  std::printf("  %-14s %7s %3s %9s %9s %9s %9s %9s %9s %9s %9s %7s %7s %9s %7s\n", "grid", "nodes", "thr", "step[ms]",
+              "best", "fluid", "spread", "interp", "forces", "bare[ms]", "floor[ms]", "st/bare", "st/flr", "mac[ms]",
+              "st/mac");
+}
+
+void print_steps(const StepTiming& t) {
+  std::printf("  %-14s %7d %3d %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %7.2f %7.2f %9.2f %7.2f\n",
+              t.grid.c_str(), t.nodes, t.threads, 1e3 * t.step_s, 1e3 * t.best_s, 1e3 * t.fluid_s, 1e3 * t.spread_s,
+              1e3 * t.interp_s, 1e3 * t.forces_s, 1e3 * t.bare_s, 1e3 * t.floor_s, t.step_s / t.bare_s,
+              t.best_s / t.floor_s, 1e3 * t.mac_s, t.best_s / t.mac_s);
+  if (t.container == "cylinder")
+    std::printf("  %-14s fluid solve: cylinder %.2f ms, duct %.2f ms on the same grid: ratio %.2f\n", "",
+                1e3 * t.cylinder_solve_s, 1e3 * t.duct_solve_s, t.cylinder_solve_s / t.duct_solve_s);
+}
+
+scene::json steps_json(const StepTiming& t) {
+  scene::json row = {{"grid", t.grid},
+                     {"container", t.container},
+                     {"nodes", t.nodes},
+                     {"threads", t.threads},
+                     {"step_s", t.step_s},
+                     {"step_best_s", t.best_s},
+                     {"fluid_s", t.fluid_s},
+                     {"spread_s", t.spread_s},
+                     {"interp_s", t.interp_s},
+                     {"forces_s", t.forces_s},
+                     {"bare_fft_solve_s", t.bare_s},
+                     {"step_over_bare", t.step_s / t.bare_s},
+                     {"fft_floor_s", t.floor_s},
+                     {"step_over_floor", t.best_s / t.floor_s},
+                     {"fft_floor_staggered_s", t.mac_s},
+                     {"step_over_floor_staggered", t.best_s / t.mac_s}};
+  if (t.container == "cylinder") {
+    row["cylinder_solve_s"] = t.cylinder_solve_s;
+    row["duct_solve_same_grid_s"] = t.duct_solve_s;
+    row["cylinder_over_duct"] = t.cylinder_solve_s / t.duct_solve_s;
+  }
+  return row;
+}
+
+/// The paper's single-cycle scene run end to end.
+struct PaperCycle {
+  full3d::Params3d p;
+  unsigned threads = 0;
+  full3d::RunOutcome run;
+  double wall_s = 0;
+  bool done = false;     ///< the cycle ended
+  double t_cycle = 0;    ///< its end, or the run's end
+  std::vector<std::pair<double, std::string>> split;  ///< wall time parts, largest first
+};
+
+/// The paper's single-cycle scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution and
+/// time step, run end to end on all cores as shipped (recovery included; a 3D cycle lasts
+/// several times the 1D tier's because the recovery is slow), into out/paper_cycle.
+PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
+  scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.55.json");
+  scene::apply_override(sc, "full3d.threads=" + std::to_string(cores));
+  scene::apply_override(sc, "full3d.output.vtk=false");
+  scene::json resolved;
+  PaperCycle c;
+  c.p = full3d::read_scene3d(sc, resolved);
+  c.threads = cores;
+  const std::string dir = out + "/paper_cycle";
+  output::make_dir(dir);
+  full3d::RunControl ctl;
+  ctl.progress = 1;
+  ctl.quiet_vtk = true;
+  std::printf("paper single-cycle scene (paper_amplitude_0.55, %dx%dx%d, %s, %u threads) ...\n", c.p.nx, c.p.ny, c.p.nz,
+              c.p.adaptive.enabled ? "adaptive step" : ("dt = " + std::to_string(c.p.dt) + " s").c_str(), cores);
+  std::fflush(stdout);
+  const auto t0 = std::chrono::steady_clock::now();
+  c.run = full3d::run3d(c.p, resolved, dir, ctl);
+  c.wall_s = seconds_since(t0);
+  const auto& sm = c.run.summary;
+  const auto& ends = sm.value("cycle_end_times_s", scene::json::array());
+  c.done = !c.run.failed && !ends.empty();
+  c.t_cycle = c.done ? ends[0].get<double>() : sm.value("t_end_s", 0.0);
+  // where the run's wall time went (solver_stats.json "wall_time_split_s"), largest parts first
+  const scene::json split = c.run.record.stats.value("wall_time_split_s", scene::json::object());
+  for (const auto& [k, v] : split.items()) c.split.emplace_back(v.get<double>(), k);
+  std::sort(c.split.rbegin(), c.split.rend());
+  return c;
+}
+
+void print_paper_cycle(const PaperCycle& c) {
+  const full3d::RunOutcome& r = c.run;
+  std::printf("  %s at t = %.3g s after %ld steps, displacement %.4g m, wall %.0f s (%.3g s/step; target: cycle "
+              "in <= 60 s)%s\n",
+              c.done ? "cycle ended" : "cycle NOT ended", c.t_cycle, r.steps, r.summary.value("displacement_m", 0.0),
+              c.wall_s, r.steps > 0 ? c.wall_s / double(r.steps) : 0.0, r.failed ? ("  FAILED: " + r.message).c_str() : "");
+  std::string line;
+  for (std::size_t i = 0; i < c.split.size() && i < 6; ++i) {
+    char b[96];
+    std::snprintf(b, sizeof b, "%s%s %.1f s", i ? ", " : "", c.split[i].second.c_str(), c.split[i].first);
+    line += b;
+  }
+  if (!line.empty()) std::printf("  wall time: %s\n", line.c_str());
+}
+
+scene::json paper_cycle_json(const PaperCycle& c) {
+  const full3d::Params3d& p = c.p;
+  const auto& sm = c.run.summary;
+  return {{"scene", "paper_amplitude_0.55"}, {"threads", c.threads},
+          {"grid", std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz)},
+          {"adaptive_step", p.adaptive.enabled}, {"dt_s", p.dt},
+          {"steps_per_cycle", sm.value("steps_per_cycle", scene::json::array())},
+          {"cycle_completed", c.done}, {"cycle_end_s", c.t_cycle},
+          {"steps", c.run.steps}, {"wall_time_s", c.wall_s},
+          {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", c.run.failed},
+          {"wall_time_split_s", c.run.record.stats.value("wall_time_split_s", scene::json::object())}};
+}
+
+/// The 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
+/// resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
+/// with 1 and 2 threads; then the paper's single cycle (minutes: full bench or --paper-cycle).
+void bench_3d(scene::json& report, const std::string& out, bool quick, bool paper_cycle, unsigned cores) {
+  std::printf("== 3D tier ==\n");
+  print_step_header();
+  scene::json grids = scene::json::array();
+  const int steps = quick ? 3 : 10;
+  // the demo swimmer in the square duct at three resolutions, then in the paper's
+  // cylinder at the default resolution
+  const std::vector<std::pair<int, std::string>> configs = {{12, "duct"}, {20, "duct"}, {32, "duct"}, {32, "cylinder"}};
+  for (const auto& [across, container] : configs) {
+    double per_step_thr[3] = {0, 0, 0};
+    for (int thr : {1, 2}) {
+      const StepTiming t = time_steps(across, container, thr, steps);
+      per_step_thr[thr] = t.step_s;
+      print_steps(t);
+      grids.push_back(steps_json(t));
+    }
+    std::printf("  %-14s 2-thread speedup %.2f\n", "", per_step_thr[1] / per_step_thr[2]);
+  }
+  report["full3d_step"] = grids;
+  if (paper_cycle) {
+    const PaperCycle c = run_paper_cycle(out, cores);
+    print_paper_cycle(c);
+    report["full3d_paper_cycle"] = paper_cycle_json(c);
+  } else {
+    std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
+  }
+}
+
+// ---- axisymmetric tier ------------------------------------------------------------------------
+
+/// One cycle of the axi tier's fitted method against one numeric factorisation of its system.
+struct AxiCycle {
+  int cells = 0;
+  double h = 0;
+  long unknowns = 0;
+  double factor_cpu_s = 1e300;  ///< one factorisation, best of 3, CPU time
+  axi::RunOutcomeAxi run;
+  double wall_s = 0, cpu_s = 0;
+  scene::json split;  ///< the run's wall_time_split_s
+  double fact_s = 0, solves_s = 0;
+  long factorisations = 0, gmres_iterations = 0, stokes_solves = 0;
+};
+
+/// One cycle of the round-wall amplitude scene (R_f = 0.82 R0, D fixed, the geometric recovery
+/// end) with the fitted method at `cells` across, one core, into out/axi_cycle, against the
+/// CPU time of one numeric factorisation of its fitted system (the unit of this method's cost:
+/// a step factors or reuses, and solves three times; both in CPU time, so that the ratio holds
+/// on a busy machine).
+AxiCycle run_axi_cycle(const std::string& out, int cells) {
   scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.82.json");
   for (const char* set : {"full3d.membrane.axisymmetric=true", "full3d.recovery_end=\"shape\"",
                           "full3d.membrane.bending_rigidity=\"2.1184615504e-24 J\""})
@@ -143,9 +562,10 @@ void bench_axi(scene::json& report, const std::string& out, int cells) {
   scene::apply_override(sc, "axi.grid.cells_across=" + std::to_string(cells));
   scene::json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+  AxiCycle c;
+  c.cells = cells;
+  c.h = p.h;
   // one factorisation of the system on the reference shape, best of 3
-  double factor_s = 1e300;
-  long unknowns = 0;
   {
     axi::FittedStokes fs(axi::fitted_mesh_params(p), p.base.fluid.mu, p.wall_nodes);
     const axi::AxiWall wall(axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
@@ -154,37 +574,57 @@ void bench_axi(scene::json& report, const std::string& out, int cells) {
     for (int rep = 0; rep < 3; ++rep) {  // CPU time: the ratio below is then immune to other jobs
       const double c0 = process_cpu_seconds();
       fs.factor(X, nullptr, 0.0, /*force=*/true);
-      factor_s = std::min(factor_s, process_cpu_seconds() - c0);
+      c.factor_cpu_s = std::min(c.factor_cpu_s, process_cpu_seconds() - c0);
     }
-    unknowns = fs.unknowns();
+    c.unknowns = fs.unknowns();
   }
   const std::string dir = out + "/axi_cycle";
   output::make_dir(dir);
   axi::RunControlAxi ctl;
   ctl.progress = 1;
-  std::printf("one cycle of paper_amplitude_0.82, round wall, %d cells across (h = %.3g nm, %ld unknowns) ...\n",
-              cells, 1e9 * p.h, unknowns);
+  std::printf("one cycle of paper_amplitude_0.82, round wall, %d cells across (h = %.3g nm, %ld unknowns) ...\n", cells,
+              1e9 * p.h, c.unknowns);
   std::fflush(stdout);
   const double c0 = process_cpu_seconds();
   const auto t0 = std::chrono::steady_clock::now();
-  const axi::RunOutcomeAxi r = axi::run_axi(p, resolved, dir, ctl);
-  const double wall = seconds_since(t0), cpu = process_cpu_seconds() - c0;
-  const scene::json& sm = r.summary;
-  const scene::json split = r.record.stats.value("wall_time_split_s", scene::json::object());
-  const double fact = split.value("factorisation", 0.0), solves = split.value("solves", 0.0);
-  const long nfact = split.value("factorisations", 0L), iters = split.value("gmres_iterations", 0L);
-  const long solves_n = r.record.stats.value("stokes_solves", 0L);
+  c.run = axi::run_axi(p, resolved, dir, ctl);
+  c.wall_s = seconds_since(t0);
+  c.cpu_s = process_cpu_seconds() - c0;
+  c.split = c.run.record.stats.value("wall_time_split_s", scene::json::object());
+  c.fact_s = c.split.value("factorisation", 0.0);
+  c.solves_s = c.split.value("solves", 0.0);
+  c.factorisations = c.split.value("factorisations", 0L);
+  c.gmres_iterations = c.split.value("gmres_iterations", 0L);
+  c.stokes_solves = c.run.record.stats.value("stokes_solves", 0L);
+  return c;
+}
+
+void print_axi_cycle(const AxiCycle& c) {
+  const axi::RunOutcomeAxi& r = c.run;
   std::printf("  %s: %ld steps, %ld solves, %ld factorisations, %ld GMRES iterations; wall %.0f s (CPU %.0f s), "
               "= %.0f factorisations of %.3g s (CPU); factorising %.0f %%, solving %.0f %% (target: <= 300 s per cycle)%s\n",
-              r.failed ? "FAILED" : "cycle ended", r.steps, solves_n, nfact, iters, wall, cpu, cpu / factor_s, factor_s,
-              100 * fact / wall, 100 * solves / wall, r.failed ? ("  " + r.message).c_str() : "");
-  report["axi_cycle"] = {{"scene", "paper_amplitude_0.82 (round wall, D fixed, recovery_end shape)"},
-                         {"cells_across", cells}, {"h_m", p.h}, {"unknowns", unknowns}, {"steps", r.steps},
-                         {"stokes_solves", solves_n}, {"factorisations", nfact}, {"gmres_iterations", iters},
-                         {"wall_time_s", wall}, {"cpu_time_s", cpu}, {"one_factorisation_cpu_s", factor_s},
-                         {"cpu_over_factorisation", cpu / factor_s}, {"wall_time_split_s", split},
-                         {"displacement_per_cycle_m", sm.value("displacement_per_cycle_m", scene::json())},
-                         {"cycle_times_s", sm.value("cycle_times_s", scene::json::array())}, {"failed", r.failed}};
+              r.failed ? "FAILED" : "cycle ended", r.steps, c.stokes_solves, c.factorisations, c.gmres_iterations,
+              c.wall_s, c.cpu_s, c.cpu_s / c.factor_cpu_s, c.factor_cpu_s, 100 * c.fact_s / c.wall_s,
+              100 * c.solves_s / c.wall_s, r.failed ? ("  " + r.message).c_str() : "");
+}
+
+scene::json axi_cycle_json(const AxiCycle& c) {
+  const scene::json& sm = c.run.summary;
+  return {{"scene", "paper_amplitude_0.82 (round wall, D fixed, recovery_end shape)"},
+          {"cells_across", c.cells}, {"h_m", c.h}, {"unknowns", c.unknowns}, {"steps", c.run.steps},
+          {"stokes_solves", c.stokes_solves}, {"factorisations", c.factorisations},
+          {"gmres_iterations", c.gmres_iterations}, {"wall_time_s", c.wall_s}, {"cpu_time_s", c.cpu_s},
+          {"one_factorisation_cpu_s", c.factor_cpu_s}, {"cpu_over_factorisation", c.cpu_s / c.factor_cpu_s},
+          {"wall_time_split_s", c.split},
+          {"displacement_per_cycle_m", sm.value("displacement_per_cycle_m", scene::json())},
+          {"cycle_times_s", sm.value("cycle_times_s", scene::json::array())}, {"failed", c.run.failed}};
+}
+
+void bench_axi(scene::json& report, const std::string& out, int cells) {
+  std::printf("== axisymmetric tier (fitted) ==\n");
+  const AxiCycle c = run_axi_cycle(out, cells);
+  print_axi_cycle(c);
+  report["axi_cycle"] = axi_cycle_json(c);
 }
 
 }  // namespace
@@ -199,275 +639,8 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   const int reps = quick ? 1 : 5;
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   report["hardware_threads"] = cores;
-
-  if (do1d) {
-  std::printf("== 1D tier ==\n");
-  std::printf("one force-driven cycle (demo scene, best of %d):\n", reps);
-  std::printf("  %6s %12s %10s %10s %10s\n", "N", "wall [ms]", "steps", "switches", "cycle [s]");
-  scene::json cycles = scene::json::array();
-  for (int n : {50, 200, 800}) {
-    const auto p = demo_params({"numerics1d.cells=" + std::to_string(n), "protocol.cycles=1", "time.duration=\"auto\""});
-    reduced1d::Result r;
-    const double best = best_solve_time(p, reps, r);
-    const auto m = reduced1d::metrics(p, r);
-    const long steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
-    std::printf("  %6d %12.3f %10ld %10ld %10.4g%s\n", n, 1e3 * best, steps, r.switches, m.mean_cycle_time_s,
-                r.failure ? "  FAILED" : "");
-    cycles.push_back({{"cells", n}, {"wall_time_s", best}, {"steps", steps}, {"switches", r.switches},
-                      {"cycle_time_s", m.mean_cycle_time_s}, {"ok", !r.failure}});
-  }
-  report["force_driven_cycle"] = cycles;
-  // The lubrication-only wall (no short-wave traction), the other outer flow and the paper's
-  // reproduction mode at the screening resolution.
-  scene::json variants = scene::json::array();
-  for (const std::string& v : {std::string("model1d.short_wave_traction=false"), std::string("model1d.outer_flow=\"unbounded\""),
-                                std::string("model1d.model=\"paper\"")}) {
-    std::vector<std::string> sets = {"numerics1d.cells=200", "protocol.cycles=1", "time.duration=\"auto\"", v};
-    if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
-    const auto p = demo_params(sets);
-    reduced1d::Result r;
-    const double best = best_solve_time(p, reps, r);
-    const auto m = reduced1d::metrics(p, r);
-    const long steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
-    std::printf("  %6d %12.3f %10ld %10ld %10.4g  %s%s\n", 200, 1e3 * best, steps, r.switches, m.mean_cycle_time_s,
-                v.c_str(), r.failure ? "  FAILED" : "");
-    variants.push_back({{"cells", 200}, {"set", v}, {"wall_time_s", best}, {"steps", steps},
-                        {"displacement_per_cycle_m", m.displacement_per_cycle_m}, {"ok", !r.failure}});
-  }
-  report["force_driven_cycle_variants"] = variants;
-
-  // Screening throughput: a 10 x 10 grid over lambda = R_f/R0 in [0.35, 0.85] and
-  // L in [0.2, 0.8] um. Force-driven designs drive at 1.4x the static load so that every
-  // design is reachable and runs a whole cycle (failing designs would cost nothing and
-  // inflate the figure); N = 200 (the shipped scenes' grid) and N = 50 (the default grid
-  // with the short-wave traction), and the lubrication-only wall at N = 200.
-  std::printf("screening throughput (%u threads, 10 x 10 grid over lambda and L):\n", cores);
-  scene::json screening = scene::json::object();
-  struct Case {
-    std::string kind;
-    int cells;
-    bool traction = true;
-  };
-  for (const Case& c : {Case{"step", 200}, Case{"force_driven", 200}, Case{"force_driven", 50},
-                        Case{"force_driven", 200, false}}) {
-    const int n = c.kind == "step" ? (quick ? 100 : 1000) : (quick ? 20 : 100);
-    std::vector<reduced1d::Params> designs;
-    for (int k = 0; k < n; ++k) {
-      const double lambda = 0.35 + 0.5 * (k % 10) / 9.0;
-      const double length_um = 0.2 + 0.6 * (k / 10 % 10) / 9.0;
-      char l[64], s[64];
-      std::snprintf(l, sizeof l, "wave.contracted_ratio=%.4f", lambda);
-      std::snprintf(s, sizeof s, "swimmer.length=\"%.4f um\"", length_um);
-      std::vector<std::string> sets = {l, s, "wave.kind=\"" + c.kind + "\"",
-                                       "numerics1d.cells=" + std::to_string(c.cells)};
-      if (!c.traction) sets.push_back("model1d.short_wave_traction=false");
-      if (c.kind == "step")
-        sets.push_back("protocol=null");
-      else
-        sets.insert(sets.end(), {"protocol.total_force=null", "protocol.load_factor=1.4"});
-      designs.push_back(demo_params(sets));
-    }
-    // On all cores, then on one thread. The process CPU time tells a CPU-starved run (other
-    // jobs on the machine: fewer cores used than threads) from poor scaling (more CPU per
-    // design on more threads).
-    double wall[2], cpu[2];
-    long failed = 0;
-    for (int pass = 0; pass < 2; ++pass) {
-      const double c0 = process_cpu_seconds();
-      const auto t0 = std::chrono::steady_clock::now();
-      const auto res = reduced1d::run_designs(designs, pass == 0 ? 0 : 1);
-      wall[pass] = seconds_since(t0);
-      cpu[pass] = process_cpu_seconds() - c0;
-      if (pass == 0) failed = std::count_if(res.begin(), res.end(), [](const auto& r) { return !r.ok; });
-    }
-    const std::string label = c.kind + (c.traction ? "" : " lubrication wall") + " N=" + std::to_string(c.cells);
-    std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed); CPU %.3g ms/design, %.2f cores used; "
-                "1 thread: %.1f designs/s, CPU %.3g ms/design\n",
-                label.c_str(), n, wall[0], n / wall[0], failed, 1e3 * cpu[0] / n, cpu[0] / wall[0], n / wall[1],
-                1e3 * cpu[1] / n);
-    screening[label] = {{"designs", n}, {"cells", c.cells}, {"threads", cores}, {"wall_time_s", wall[0]},
-                        {"designs_per_s", n / wall[0]}, {"cpu_time_s", cpu[0]}, {"cores_used", cpu[0] / wall[0]},
-                        {"designs_per_s_1_thread", n / wall[1]}, {"cpu_time_s_1_thread", cpu[1]},
-                        {"failed", failed}};
-  }
-  report["screening"] = screening;
-  }
-  if (do3d) {
-
-  // 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
-  // resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
-  // with 1 and 2 threads.
-  std::printf("== 3D tier ==\n");
-  std::printf("  (per step, ms: mean over the timed steps, best: the fastest; bare: the project's pressure-correction\n"
-              "   FFT solve; floor: 8 raw FFTW transforms of the duct's kind, sine/cosine-II across, best of the\n"
-              "   repetitions; mac: the same with the staggered grid's own kinds, sine-I of the interior faces for v\n"
-              "   and w; FFTW_MEASURE, same grid and threads; st/flr and st/mac: best step / floor)\n");
-  std::printf("  %-14s %7s %3s %9s %9s %9s %9s %9s %9s %9s %9s %7s %7s %9s %7s\n", "grid", "nodes", "thr", "step[ms]",
-              "best", "fluid", "spread", "interp", "forces", "bare[ms]", "floor[ms]", "st/bare", "st/flr", "mac[ms]",
-              "st/mac");
-  scene::json grids = scene::json::array();
-  const int steps = quick ? 3 : 10;
-  // the demo swimmer in the square duct at three resolutions, then in the paper's
-  // cylinder at the default resolution
-  const std::vector<std::pair<int, std::string>> configs = {{12, "duct"}, {20, "duct"}, {32, "duct"}, {32, "cylinder"}};
-  for (const auto& [across, container] : configs) {
-    double per_step_thr[3] = {0, 0, 0};
-    for (int thr : {1, 2}) {
-      scene::json sc = scene::load_file(data_dir() + "/scenes/demo.json");
-      scene::apply_override(sc, "full3d.grid.cells_across=" + std::to_string(across));
-      scene::apply_override(sc, "full3d.threads=" + std::to_string(thr));
-      scene::apply_override(sc, "container.kind=\"" + container + "\"");
-      scene::json resolved;
-      const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
-      const full3d::CylinderMesh mesh = full3d::make_mesh(p);
-      full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
-      const full3d::IbOptions o = full3d::ib_options(p);
-      full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), o);
-      ib.stokes().compute_pressure(false);  // the step of a run that writes no fluid frames (the default)
-      full3d::Protocol3d proto(p.protocol, mesh, full3d::uniform_contraction_energy(mesh, p.membrane, p.protocol.R_f));
-      proto.start(0.0, mesh.X0);
-      ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) { return proto.force(X); });
-      full3d::IbState st = ib.initial_state();
-      ib.step(st, p.dt);  // warm-up (plans, first PCG)
-      full3d::IbStepStats sum;
-      const auto t0 = std::chrono::steady_clock::now();
-      double best = 1e300;  // the fastest step: compared with the floor's best repetition
-      for (int k = 0; k < steps; ++k) {
-        const auto t1 = std::chrono::steady_clock::now();
-        const auto s1 = ib.step(st, p.dt);
-        best = std::min(best, seconds_since(t1));
-        sum.time_fluid += s1.time_fluid;
-        sum.time_spread += s1.time_spread;
-        sum.time_interp += s1.time_interp;
-        sum.time_forces += s1.time_forces;
-      }
-      const double per = seconds_since(t0) / steps;
-      // bare FFT solve (reference::PressureCorrectionStep, full3d/reference_duct_fft.hpp) with the
-      // same forcing size
-      full3d::VectorField u(grid), f(grid);
-      for (auto& c : f.c)
-        for (size_t i = 0; i < c.size(); ++i) c[i] = std::sin(0.37 * double(i));
-      // The bare solve runs its transforms through FFTW's own threads; for some sizes
-      // (e.g. the cylinder's 34 cells across) FFTW's threaded plans are slower than its
-      // serial ones, so the reference is the faster of FFTW with `thr` threads and with one.
-      double bare_per = 1e300;
-      for (int fft_threads : {thr, 1}) {
-        if (fft_threads == 1 && thr == 1 && bare_per < 1e300) break;
-        full3d::FftOptions fo = o.stokes.fft;
-        fo.threads = fft_threads;
-        full3d::reference::PressureCorrectionStep bare(grid, p.fluid, fo);
-        bare.step(u, f, p.dt);
-        const auto t1 = std::chrono::steady_clock::now();
-        for (int k = 0; k < steps; ++k) bare.step(u, f, p.dt);
-        bare_per = std::min(bare_per, seconds_since(t1) / steps);
-      }
-      per_step_thr[thr] = per;
-      const double floor_per = fft_floor(p.nx, p.ny, p.nz, thr, std::max(3, steps));
-      const double mac_per = fft_floor_staggered(p.nx, p.ny, p.nz, thr, std::max(3, steps));
-      char g[32];
-      std::snprintf(g, sizeof g, "%dx%dx%d%s", p.nx, p.ny, p.nz, container == "cylinder" ? " cyl" : "");
-      std::printf("  %-14s %7d %3d %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %9.2f %7.2f %7.2f %9.2f %7.2f\n", g,
-                  mesh.nodes(), thr, 1e3 * per, 1e3 * best, 1e3 * sum.time_fluid / steps,
-                  1e3 * sum.time_spread / steps, 1e3 * sum.time_interp / steps, 1e3 * sum.time_forces / steps,
-                  1e3 * bare_per, 1e3 * floor_per, per / bare_per, best / floor_per, 1e3 * mac_per, best / mac_per);
-      scene::json row = {{"grid", g},
-                         {"container", container},
-                         {"nodes", mesh.nodes()},
-                         {"threads", thr},
-                         {"step_s", per},
-                         {"step_best_s", best},
-                         {"fluid_s", sum.time_fluid / steps},
-                         {"spread_s", sum.time_spread / steps},
-                         {"interp_s", sum.time_interp / steps},
-                         {"forces_s", sum.time_forces / steps},
-                         {"bare_fft_solve_s", bare_per},
-                         {"step_over_bare", per / bare_per},
-                         {"fft_floor_s", floor_per},
-                         {"step_over_floor", best / floor_per},
-                         {"fft_floor_staggered_s", mac_per},
-                         {"step_over_floor_staggered", best / mac_per}};
-      if (container == "cylinder") {
-        // the cylinder's fluid solve against the duct's on the same grid, same threads, same forcing
-        full3d::StokesOptions so = o.stokes;
-        so.cylinder.enabled = false;
-        full3d::StokesSolver duct(grid, p.fluid, so);
-        duct.compute_pressure(false);  // as the cylinder's solver in the step above
-        full3d::StokesSolver& cyl = ib.stokes();
-        double t_duct = 1e300, t_cyl = 1e300;
-        duct.step(u, f, p.dt);
-        for (int k = 0; k < steps; ++k) {
-          std::fill(u.c[0].begin(), u.c[0].end(), 0.0);
-          auto t1 = std::chrono::steady_clock::now();
-          duct.step(u, f, p.dt);
-          t_duct = std::min(t_duct, seconds_since(t1));
-          t1 = std::chrono::steady_clock::now();
-          cyl.step(u, f, p.dt);
-          t_cyl = std::min(t_cyl, seconds_since(t1));
-        }
-        std::printf("  %-14s fluid solve: cylinder %.2f ms, duct %.2f ms on the same grid: ratio %.2f\n", "",
-                    1e3 * t_cyl, 1e3 * t_duct, t_cyl / t_duct);
-        row["cylinder_solve_s"] = t_cyl;
-        row["duct_solve_same_grid_s"] = t_duct;
-        row["cylinder_over_duct"] = t_cyl / t_duct;
-      }
-      grids.push_back(row);
-    }
-    std::printf("  %-14s 2-thread speedup %.2f\n", "", per_step_thr[1] / per_step_thr[2]);
-  }
-  report["full3d_step"] = grids;
-  // The paper's single-cycle scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution and
-  // time step, run end to end on all cores as shipped (recovery included; a 3D cycle lasts
-  // several times the 1D tier's because the recovery is slow). Minutes: full bench or
-  // --paper-cycle only.
-  if (paper_cycle) {
-    scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.55.json");
-    scene::apply_override(sc, "full3d.threads=" + std::to_string(cores));
-    scene::apply_override(sc, "full3d.output.vtk=false");
-    scene::json resolved;
-    const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
-    const std::string dir = out + "/paper_cycle";
-    output::make_dir(dir);
-    full3d::RunControl ctl;
-    ctl.progress = 1;
-    ctl.quiet_vtk = true;
-    std::printf("paper single-cycle scene (paper_amplitude_0.55, %dx%dx%d, %s, %u threads) ...\n", p.nx, p.ny,
-                p.nz, p.adaptive.enabled ? "adaptive step" : ("dt = " + std::to_string(p.dt) + " s").c_str(), cores);
-    std::fflush(stdout);
-    const auto t0 = std::chrono::steady_clock::now();
-    const full3d::RunOutcome r = full3d::run3d(p, resolved, dir, ctl);
-    const double wall = seconds_since(t0);
-    const auto& sm = r.summary;
-    const auto& ends = sm.value("cycle_end_times_s", scene::json::array());
-    const bool done = !r.failed && !ends.empty();
-    const double t_cycle = done ? ends[0].get<double>() : sm.value("t_end_s", 0.0);
-    std::printf("  %s at t = %.3g s after %ld steps, displacement %.4g m, wall %.0f s (%.3g s/step; target: cycle "
-                "in <= 60 s)%s\n",
-                done ? "cycle ended" : "cycle NOT ended", t_cycle, r.steps, sm.value("displacement_m", 0.0), wall,
-                r.steps > 0 ? wall / double(r.steps) : 0.0, r.failed ? ("  FAILED: " + r.message).c_str() : "");
-    report["full3d_paper_cycle"] = {{"scene", "paper_amplitude_0.55"}, {"threads", cores},
-                                    {"grid", std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz)},
-                                    {"adaptive_step", p.adaptive.enabled}, {"dt_s", p.dt},
-                                    {"steps_per_cycle", sm.value("steps_per_cycle", scene::json::array())},
-                                    {"cycle_completed", done}, {"cycle_end_s", t_cycle},
-                                    {"steps", r.steps}, {"wall_time_s", wall},
-                                    {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", r.failed}};
-    // where the run's wall time went (solver_stats.json "wall_time_split_s"), largest parts first
-    const scene::json split = r.record.stats.value("wall_time_split_s", scene::json::object());
-    report["full3d_paper_cycle"]["wall_time_split_s"] = split;
-    std::vector<std::pair<double, std::string>> parts;
-    for (const auto& [k, v] : split.items()) parts.emplace_back(v.get<double>(), k);
-    std::sort(parts.rbegin(), parts.rend());
-    std::string line;
-    for (std::size_t i = 0; i < parts.size() && i < 6; ++i) {
-      char b[96];
-      std::snprintf(b, sizeof b, "%s%s %.1f s", i ? ", " : "", parts[i].second.c_str(), parts[i].first);
-      line += b;
-    }
-    if (!line.empty()) std::printf("  wall time: %s\n", line.c_str());
-  } else {
-    std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
-  }
-  }
+  if (do1d) bench_1d(report, quick, reps, cores);
+  if (do3d) bench_3d(report, out, quick, paper_cycle, cores);
   if (do_axi) bench_axi(report, out, quick ? 16 : 32);
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());

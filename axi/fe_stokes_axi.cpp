@@ -13,6 +13,7 @@
 #include <string>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 
 namespace swim::axi {
 
@@ -88,12 +89,6 @@ const RefTables& ref() {
   return t;
 }
 
-std::string fmt(double v) {
-  char b[40];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
 // Centre and scales of an element's pressure basis {1, (x - xc)/hx, (r - rc)/hr}: the mean of
 // its corners, the mean length of its two xi-edges and its mean eta-extent. Positive for any
 // valid element, whatever the tilt of its sides; on an element with vertical sides hx is its
@@ -155,7 +150,7 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
     : mesh_(p, membrane_nodes), mu_(mu), coupling_(coupling) {
   single_threaded_blas();
   if (!(std::isfinite(mu) && mu > 0))
-    throw InputError("fluid.viscosity", fmt(mu) + " Pa s", "must be a positive finite viscosity");
+    throw InputError("fluid.viscosity", significant(mu) + " Pa s", "must be a positive finite viscosity");
   lref_ = p.Rc / (p.cells_inner + p.cells_outer);
   ps_ = mu_ / lref_;
 
@@ -573,7 +568,7 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
       fresh = true;
     }
     if (!ok)
-      throw NumericalError("the fitted Stokes solve did not converge (relative residual " + fmt(res) +
+      throw NumericalError("the fitted Stokes solve did not converge (relative residual " + significant(res) +
                                " with a fresh factorisation)",
                            "check the wall's shape and the stiffness term; change axi.fitted.cells_inner or "
                            "axi.fitted.cells_outer");
@@ -687,7 +682,7 @@ FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen:
   res.force = solve_one(ga, xa);
   res.drag = solve_one(gb, xb);
   if (!(std::isfinite(res.drag) && res.drag > 0.0) || !std::isfinite(res.force))
-    throw NumericalError("the towed tube's drag is not positive (" + fmt(res.drag) + " N s/m)",
+    throw NumericalError("the towed tube's drag is not positive (" + significant(res.drag) + " N s/m)",
                          "check the wall's shape; change axi.grid");
   res.velocity = -res.force / res.drag;
   sol_ = xa + res.velocity * xb;

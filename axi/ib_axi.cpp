@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "full3d/kernel.hpp"
 
 namespace swim::axi {
@@ -57,18 +58,12 @@ inline AxialStencil axial_stencil(const AxiGrid& g, double x, double offset) {
   return a;
 }
 
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
-
 void check_ring(const AxiGrid& g, double x, double r) {
   if (!std::isfinite(x) || !std::isfinite(r))
-    throw NumericalError("a wall ring has a non-finite position (x = " + fmt(x) + " m, r = " + fmt(r) + " m)",
+    throw NumericalError("a wall ring has a non-finite position (x = " + significant(x) + " m, r = " + significant(r) + " m)",
                          "reduce the time step tolerance (axi.time) or check the wall parameters");
   if (!(r >= (2.0 + 1e-9) * g.h))
-    throw NumericalError("a wall ring came within 2 cells of the axis (r = " + fmt(r) + " m, h = " + fmt(g.h) +
+    throw NumericalError("a wall ring came within 2 cells of the axis (r = " + significant(r) + " m, h = " + significant(g.h) +
                              " m)",
                          "refine axi.grid.cells_across or raise wave.contracted_ratio");
 }
@@ -158,8 +153,8 @@ namespace {
 
 void check_point(const AxiGrid& g, double x, double r, const char* who) {
   if (!std::isfinite(x) || !(r >= 0.0) || !(r <= g.radius()))
-    throw std::invalid_argument(std::string(who) + ": the point (x = " + fmt(x) + " m, r = " + fmt(r) +
-                                " m) must have a finite x and 0 <= r <= Rc = " + fmt(g.radius()) + " m");
+    throw std::invalid_argument(std::string(who) + ": the point (x = " + significant(x) + " m, r = " + significant(r) +
+                                " m) must have a finite x and 0 <= r <= Rc = " + significant(g.radius()) + " m");
 }
 
 // Kernel sample at (x, r) of a field whose radial rows sit at (i + offset) h (offset 0: u,
@@ -212,8 +207,8 @@ double disc_flux(const AxiGrid& g, const double* w, double x, double radius, dou
                  int n_radial) {
   if (n_radial < 1) throw std::invalid_argument("axi::disc_flux: n_radial must be >= 1");
   if (!(radius >= 0.0) || !(radius <= g.radius()))
-    throw std::invalid_argument("axi::disc_flux: the radius " + fmt(radius) + " m must lie in [0, Rc = " +
-                                fmt(g.radius()) + " m]");
+    throw std::invalid_argument("axi::disc_flux: the radius " + significant(radius) + " m must lie in [0, Rc = " +
+                                significant(g.radius()) + " m]");
   if (!std::isfinite(x)) throw std::invalid_argument("axi::disc_flux: non-finite axial position");
   const double dr = radius / n_radial;
   double q = 0.0;

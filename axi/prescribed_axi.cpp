@@ -8,17 +8,12 @@
 #include <string>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "reduced1d/discretisation.hpp"
 
 namespace swim::axi {
 
 namespace {
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
 
 constexpr int kMaxDepth = 30;  // pieces down to 2^-30 ~ 1e-9 of the output interval
 
@@ -49,8 +44,8 @@ struct Simpson {
       return {left.u + right.u + du / 15.0, left.qr + right.qr + dr / 15.0, left.qf + right.qf + df / 15.0};
     }
     if (depth >= kMaxDepth)
-      throw NumericalError("the time quadrature of the prescribed wave did not converge on a piece of " + num(b - a) +
-                               " s (velocity change " + num(du / (b - a)) + " m/s over it)",
+      throw NumericalError("the time quadrature of the prescribed wave did not converge on a piece of " + significant(b - a, 4) +
+                               " s (velocity change " + significant(du / (b - a), 4) + " m/s over it)",
                            "raise axi.tolerance, or smooth the wave (wave.width)", a);
     const Vals l = run(a, m, fa, fl, fm, left, depth + 1), r = run(m, b, fm, fr, fb, right, depth + 1);
     return {l.u + r.u, l.qr + r.qr, l.qf + r.qf};

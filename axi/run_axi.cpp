@@ -11,10 +11,12 @@
 #include "axi/fe_stokes_axi.hpp"
 #include "axi/grid_axi.hpp"
 #include "axi/ib_axi.hpp"
+#include "axi/run_folder_axi.hpp"
 #include "axi/stokes_axi.hpp"
 #include "axi/wall_axi.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
+#include "common/si_format.hpp"
 #include "full3d/protocol3d.hpp"
 
 namespace swim::axi {
@@ -36,12 +38,6 @@ namespace {
 
 double seconds_since(std::chrono::steady_clock::time_point t0) {
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-}
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
 }
 
 /// The protocol's view of the wall: a "mesh" of one node per ring (n_theta = 1), with the
@@ -93,11 +89,8 @@ class Runner {
   }
 
   RunOutcomeAxi run() {
-    RunOutcomeAxi res;
     const auto t0 = std::chrono::steady_clock::now();
-    stream_ = std::make_unique<record::RunStream>(out_, series_columns());
-    stream_->limit(ctl_.max_output_bytes);
-    rec_.attach(stream_.get());
+    stream_ = open_run_stream(rec_, out_, ctl_);
     Progress progress("axi " + p_.name() + (b_.duration > 0 ? "" : " (auto: until " + std::to_string(b_.protocol.cycles) +
                                                                   " cycle(s), progress against axi.time_limit)"),
                       t_end_, ctl_.progress);
@@ -130,15 +123,9 @@ class Runner {
       }
     }
     progress.done();
-    res.failed = failure.has_value();
-    res.message = failure ? failure->what() : "";
     events();
-    fill(failure ? "failed: " + std::string(failure->what()) : "ok", seconds_since(t0));
-    res.summary = record::write_run(out_, rec_, resolved_);
-    res.steps = steps_;
-    rec_.attach(nullptr);
-    res.record = std::move(rec_);
-    return res;
+    return finish_run(rec_, failure, seconds_since(t0), steps_, out_, resolved_,
+                      [this](const std::string& status, double wall) { fill(status, wall); });
   }
 
  private:
@@ -246,7 +233,7 @@ class Runner {
     const int n = wall_.nodes();
     for (int k = 0; k < n; ++k)
       if (!(X(1, k) > 0.0 && X(1, k) < b_.container_radius))
-        return "ring " + std::to_string(k) + " at radius " + num(X(1, k)) + " m, outside (0, Rc)";
+        return "ring " + std::to_string(k) + " at radius " + significant(X(1, k), 4) + " m, outside (0, Rc)";
     if (!fitted_) return {};
     try {
       FittedMesh probe(fitted_mesh_params(), n);
@@ -372,7 +359,7 @@ class Runner {
         accept_and_grow(err, tol);
         return;
       }
-      if (valid) last_rejection_ = "local error " + num(err) + " m above axi.tolerance x h = " + num(tol) + " m";
+      if (valid) last_rejection_ = "local error " + significant(err, 4) + " m above axi.tolerance x h = " + significant(tol, 4) + " m";
       reject(valid && err > tol ? err : -1.0, tol, 0.25);
     }
   }
@@ -381,7 +368,7 @@ class Runner {
   /// duration's end), naming the last rejection's cause when there is one.
   void check_dt_min() const {
     if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
-      throw NumericalError("the step size fell below axi.dt_min = " + num(p_.dt_min) + " s" +
+      throw NumericalError("the step size fell below axi.dt_min = " + significant(p_.dt_min, 4) + " s" +
                                (last_rejection_.empty() ? "" : " (last rejection: " + last_rejection_ + ")"),
                            fitted_ ? "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid"
                                    : "loosen axi.tolerance or lower axi.dt_min",
@@ -454,12 +441,12 @@ class Runner {
     }
     const double e = energy_[0] + energy_[1];
     if (!std::isfinite(e) || e > e_cap_)
-      throw NumericalError("the wall energy grew to " + num(e) + " J, " + num(e / e_ref_) +
+      throw NumericalError("the wall energy grew to " + significant(e, 4) + " J, " + significant(e / e_ref_, 4) +
                                " times that of the tube uniformly at R_f",
                            "reduce axi.tolerance, or raise full3d.energy_growth_limit if the load is meant", t_);
     const double sp = max_spacing(X_);
     if (!fitted_ && !(sp < 0.5 * p_.h))
-      throw NumericalError("two wall rings moved " + num(sp) + " m apart, half a cell or more (h = " + num(p_.h) +
+      throw NumericalError("two wall rings moved " + significant(sp, 4) + " m apart, half a cell or more (h = " + significant(p_.h, 4) +
                                " m): fluid would leak through the wall",
                            "lower axi.spacing_factor", t_);
     const int sw = protocol_.update(t_, X_, e);
@@ -469,7 +456,7 @@ class Runner {
       event_pending_ = true;
     }
     if (b_.duration <= 0 && t_ >= p_.time_limit && !protocol_.finished())
-      throw NumericalError("the protocol did not finish within axi.time_limit = " + num(p_.time_limit) + " s",
+      throw NumericalError("the protocol did not finish within axi.time_limit = " + significant(p_.time_limit, 4) + " s",
                            "raise axi.time_limit (the cycle may be slow to recover: see full3d.recovery_end)", t_);
   }
 

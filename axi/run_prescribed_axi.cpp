@@ -11,6 +11,7 @@
 
 #include "axi/prescribed_axi.hpp"
 #include "axi/run_axi.hpp"
+#include "axi/run_folder_axi.hpp"
 #include "axi/wall_axi.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
@@ -42,11 +43,8 @@ class PrescribedRunner {
   }
 
   RunOutcomeAxi run() {
-    RunOutcomeAxi res;
     const auto t0 = std::chrono::steady_clock::now();
-    stream_ = std::make_unique<record::RunStream>(out_, series_columns());
-    stream_->limit(ctl_.max_output_bytes);
-    rec_.attach(stream_.get());
+    stream_ = open_run_stream(rec_, out_, ctl_);
     Progress progress("axi " + p_.name() + " (" + b_.wave.kind + " wave)", t_end_, ctl_.progress);
     std::optional<NumericalError> failure;
     try {
@@ -72,14 +70,8 @@ class PrescribedRunner {
       failure = e;
     }
     progress.done();
-    res.failed = failure.has_value();
-    res.message = failure ? failure->what() : "";
-    fill(failure ? "failed: " + std::string(failure->what()) : "ok", seconds_since(t0));
-    res.summary = record::write_run(out_, rec_, resolved_);
-    res.steps = pieces_;
-    rec_.attach(nullptr);
-    res.record = std::move(rec_);
-    return res;
+    return finish_run(rec_, failure, seconds_since(t0), pieces_, out_, resolved_,
+                      [this](const std::string& status, double wall) { fill(status, wall); });
   }
 
  private:

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 
 namespace swim::axi {
 
@@ -16,12 +17,6 @@ constexpr double kPi = std::numbers::pi;
 constexpr double kSqrt3 = 1.7320508075688772935;
 // 2-point Gauss on [0, 1]
 constexpr double kXi1 = 0.5 - 0.5 / kSqrt3, kXi2 = 0.5 + 0.5 / kSqrt3;
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
 
 /// Band matrix (kl sub-, ku super-diagonals) with room for the fill of partial pivoting;
 /// row i stores columns i - kl .. i + ku + kl.
@@ -86,14 +81,14 @@ double stretching_density(double ks, double ls, double lt, double* dW_dls, doubl
 }
 
 AxiWall::AxiWall(const AxiWallParams& p) : p_(p) {
-  if (!(p.R0 > 0.0) || !std::isfinite(p.R0)) throw InputError("swimmer.R0", num(p.R0), "a positive radius in m");
-  if (!(p.L > 0.0) || !std::isfinite(p.L)) throw InputError("swimmer.L", num(p.L), "a positive length in m");
+  if (!(p.R0 > 0.0) || !std::isfinite(p.R0)) throw InputError("swimmer.R0", significant(p.R0), "a positive radius in m");
+  if (!(p.L > 0.0) || !std::isfinite(p.L)) throw InputError("swimmer.L", significant(p.L), "a positive length in m");
   if (p.nodes < 3)
     throw InputError("axi wall nodes", std::to_string(p.nodes), "an integer >= 3 (meridian nodes of the wall)");
   if (!(p.ks > 0.0) || !std::isfinite(p.ks))
-    throw InputError("axi wall spring constant ks", num(p.ks), "a positive spring constant in N/m");
+    throw InputError("axi wall spring constant ks", significant(p.ks), "a positive spring constant in N/m");
   if (!(p.D >= 0.0) || !std::isfinite(p.D))
-    throw InputError("axi wall bending rigidity D", num(p.D), "a non-negative bending rigidity in J");
+    throw InputError("axi wall bending rigidity D", significant(p.D), "a non-negative bending rigidity in J");
   n_ = p.nodes;
   if (!p.s0.empty()) {
     bool ok = int(p.s0.size()) == n_ && p.s0.front() == 0.0 && p.s0.back() == p.L;
@@ -125,11 +120,11 @@ AxiWall::AxiWall(const AxiWallParams& p) : p_(p) {
 
 std::vector<double> graded_ring_positions(double L, double spacing, double end_ratio, double growth) {
   if (!(std::isfinite(end_ratio) && end_ratio > 0.0 && end_ratio <= 1.0))
-    throw InputError("axi.rim_refinement", num(end_ratio), "a ratio in (0, 1] (1: uniform ring spacing)");
+    throw InputError("axi.rim_refinement", significant(end_ratio), "a ratio in (0, 1] (1: uniform ring spacing)");
   if (!(std::isfinite(growth) && growth > 1.0))
-    throw InputError("axi.rim_refinement", "growth " + num(growth), "a growth ratio > 1");
+    throw InputError("axi.rim_refinement", "growth " + significant(growth), "a growth ratio > 1");
   if (!(std::isfinite(L) && L > 0.0 && std::isfinite(spacing) && spacing > 0.0 && spacing <= L))
-    throw InputError("axi.spacing_factor", num(spacing) + " m", "a ring spacing in (0, L = " + num(L) + " m]");
+    throw InputError("axi.spacing_factor", significant(spacing) + " m", "a ring spacing in (0, L = " + significant(L) + " m]");
   // at each end the spacings d end_ratio growth^i (i = 0..m-1, all below d), inwards from the
   // rim; between them `mid` uniform spacings d: L = d (mid + 2 c), c = sum_i end_ratio growth^i
   std::vector<double> ratios;
@@ -149,7 +144,7 @@ std::vector<double> graded_ring_positions(double L, double spacing, double end_r
   s.back() = L;
   for (size_t k = 1; k < s.size(); ++k)
     if (!(s[k] > s[k - 1]))
-      throw InputError("axi.rim_refinement", num(end_ratio), "too fine for the swimmer's length; use a larger ratio");
+      throw InputError("axi.rim_refinement", significant(end_ratio), "too fine for the swimmer's length; use a larger ratio");
   return s;
 }
 
@@ -277,7 +272,7 @@ std::vector<double> segment_aligned_ring_positions(double L, double spacing, dou
   auto end_spacings = [&](double len) {
     const double room = len / d - 0.5;  // in cells
     if (!(room > 0.0))
-      throw InputError("protocol.segments", "", "an end segment shorter than half a ring cell (" + num(d) + " m)");
+      throw InputError("protocol.segments", "", "an end segment shorter than half a ring cell (" + significant(d) + " m)");
     std::vector<double> w;  // inwards from the rim
     // The uniform part holds what the graded spacings leave, in k equal cells; less than half a
     // cell left goes to the graded spacings instead (scaled by sigma <= 1 + 1/(2c)), so that no
@@ -308,13 +303,13 @@ std::vector<double> segment_aligned_ring_positions(double L, double spacing, dou
   s.back() = L;
   for (size_t k = 1; k < s.size(); ++k)
     if (!(s[k] > s[k - 1] + 1e-12 * L))
-      throw InputError("axi.rim_refinement", num(end_ratio), "rings that do not fit the protocol's segments; refine the grid");
+      throw InputError("axi.rim_refinement", significant(end_ratio), "rings that do not fit the protocol's segments; refine the grid");
   return s;
 }
 
 AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double tol_force, int max_iterations) {
   if (!(P != 0.0) || !std::isfinite(P))
-    throw InputError("pressure", num(P), "a non-zero finite pressure in Pa (C1 = P / (R0 - R_mid))");
+    throw InputError("pressure", significant(P), "a non-zero finite pressure in Pa (C1 = P / (R0 - R_mid))");
   if (max_iterations < 1)
     throw InputError("max_iterations", std::to_string(max_iterations), "an integer >= 1");
   const int n = wall.nodes(), nu = 2 * n - 1;
@@ -410,7 +405,7 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
   out.max_residual_force = max_node_force(g);
   if (!(out.max_residual_force <= tol_force))
     throw NumericalError("axisymmetric wall static relaxation stalled at residual force " +
-                             num(out.max_residual_force) + " N (tolerance " + num(tol_force) + " N) after " +
+                             significant(out.max_residual_force) + " N (tolerance " + significant(tol_force) + " N) after " +
                              std::to_string(it) + " Newton iterations",
                          "reduce the applied pressure (protocol.pressure sets the scale of the calibration loads)");
   out.mid_radius = 0.5 * (X(1, (n - 1) / 2) + X(1, n / 2));

@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "common/strict_json.hpp"
 #include "common/units.hpp"
 
@@ -17,12 +18,6 @@ namespace {
 const json& empty_object() {
   static const json e = json::object();
   return e;
-}
-
-std::string fmt(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
 }
 
 std::string join(const std::vector<std::string>& v) {
@@ -111,9 +106,9 @@ std::string Range::describe(const std::string& unit) const {
   const std::string u = unit.empty() ? "" : " " + unit;
   const bool has_lo = std::isfinite(lo), has_hi = std::isfinite(hi);
   if (has_lo && has_hi)
-    return std::string("must lie in ") + (lo_open ? "(" : "[") + fmt(lo) + ", " + fmt(hi) + (hi_open ? ")" : "]") + u;
-  if (has_lo) return std::string("must be ") + (lo_open ? "> " : ">= ") + fmt(lo) + u;
-  if (has_hi) return std::string("must be ") + (hi_open ? "< " : "<= ") + fmt(hi) + u;
+    return std::string("must lie in ") + (lo_open ? "(" : "[") + significant(lo) + ", " + significant(hi) + (hi_open ? ")" : "]") + u;
+  if (has_lo) return std::string("must be ") + (lo_open ? "> " : ">= ") + significant(lo) + u;
+  if (has_hi) return std::string("must be ") + (hi_open ? "< " : "<= ") + significant(hi) + u;
   return "must be finite";
 }
 
@@ -149,7 +144,7 @@ double Reader::quantity(const std::string& key, const std::string& si_unit, cons
   }
   const auto q = units::parse(path(key), text, si_unit);
   if (!range.contains(q.si))
-    throw InputError(path(key), "\"" + text + "\"", range.describe(si_unit) + " (got " + fmt(q.si) + " " + si_unit + ")");
+    throw InputError(path(key), "\"" + text + "\"", range.describe(si_unit) + " (got " + significant(q.si) + " " + si_unit + ")");
   (*resolved_)[key] = text;
   return q.si;
 }
@@ -162,7 +157,7 @@ double Reader::number(const std::string& key, double default_value, Range range)
     if (!j.is_number()) throw InputError(path(key), show(j), "must be a number (dimensionless)");
     v = j.get<double>();
   }
-  if (!range.contains(v)) throw InputError(path(key), fmt(v), range.describe(""));
+  if (!range.contains(v)) throw InputError(path(key), significant(v), range.describe(""));
   (*resolved_)[key] = v;
   return v;
 }
@@ -280,7 +275,7 @@ void check_section(const json& node, const std::string& path, const json& schema
         throw InputError(key, show(v), "must be a string \"<number> <unit>\" with a unit convertible to " + unit);
       const auto q = units::parse(key, v.get<std::string>(), unit);
       if (!range.contains(q.si))
-        throw InputError(key, show(v), range.describe(unit) + " (got " + fmt(q.si) + " " + unit + ")");
+        throw InputError(key, show(v), range.describe(unit) + " (got " + significant(q.si) + " " + unit + ")");
     } else if (k == "number") {
       if (!v.is_number()) throw InputError(key, show(v), "must be a number (dimensionless)");
       if (!range.contains(v.get<double>())) throw InputError(key, show(v), range.describe(""));

@@ -6,6 +6,12 @@
 
 namespace swim {
 
+std::string significant(double value, int digits) {
+  char buf[48];
+  std::snprintf(buf, sizeof buf, "%.*g", digits, value);
+  return buf;
+}
+
 std::string si(double value, const std::string& unit, int digits) {
   if (!std::isfinite(value)) return "n/a";
   char buf[64];

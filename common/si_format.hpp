@@ -1,10 +1,15 @@
-// Human-facing numbers with SI prefixes: "43.2 nm", "131 nm/s", "3.2 fN". Files stay in SI;
-// only printouts and figure labels use these.
+// Human-facing numbers: plain figures in messages, printouts and Markdown ("0.0123",
+// "1.5e+06"), and quantities with SI prefixes ("43.2 nm", "131 nm/s", "3.2 fN"). Files stay in
+// SI; only printouts and figure labels use these.
 #pragma once
 
 #include <string>
 
 namespace swim {
+
+/// `value` with `digits` significant digits, as printf's "%.<digits>g": "0.0123", "1.5e+06",
+/// "3", "inf", "nan".
+std::string significant(double value, int digits = 6);
 
 /// `value` in the SI `unit` ("m", "m/s", "N", "s", "m^3"), rescaled by the SI prefix
 /// (f, p, n, µ, m, -, k, M, G) that puts the mantissa in [1, 1000), with `digits`

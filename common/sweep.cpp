@@ -9,18 +9,13 @@
 #include <tuple>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "common/units.hpp"
 
 namespace swim::sweep {
 namespace {
 
 constexpr std::size_t kMaxDesigns = 1000000;
-
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.8g", v);
-  return b;
-}
 
 /// SI value of a numeric or quantity scene value, for the CSV and plots.
 std::pair<double, std::string> si_of(const std::string& key, const json& v) {
@@ -82,7 +77,7 @@ Axis read_axis(const std::string& key, const json& spec) {
       const double v = spacing == "log" ? from * std::pow(to / from, s) : from + (to - from) * s;
       // The values go into scenes and printouts as written: rounded to 8 significant digits,
       // so that 0.35 + 0.1 reads 0.45 (not 0.44999999999999996) in designs.csv and screen.json.
-      const std::string text = num(v);
+      const std::string text = significant(v, 8);
       const double rounded = std::strtod(text.c_str(), nullptr);
       if (!std::isfinite(v) || !normal(rounded))
         throw InputError(where, scene::show(spec),

@@ -278,12 +278,8 @@ std::string pct(const json& v) {
   std::snprintf(b, sizeof b, "%+.1f %%", 100.0 * v.get<double>());
   return b;
 }
-std::string num(const json& v, const char* f = "%.3g") {
-  if (!v.is_number()) return "–";
-  char b[32];
-  std::snprintf(b, sizeof b, f, v.get<double>());
-  return b;
-}
+/// A figure of the report for Markdown: `digits` significant digits, "–" when it is not a number.
+std::string num(const json& v, int digits = 3) { return v.is_number() ? significant(v.get<double>(), digits) : "–"; }
 }  // namespace
 
 std::string confirm_markdown(const json& r, const std::string& title) {
@@ -309,7 +305,7 @@ std::string confirm_markdown(const json& r, const std::string& title) {
     const json &f1 = d["figures_1d"], &f3 = d["figures_3d"], &rel = d["relative_difference_3d_vs_1d"];
     s += "| " + std::to_string(d["design"].get<int>()) + " | " + d["values"].get<std::string>() + " | " +
          d["selected_as"].get<std::string>() + " | " + std::to_string(d["rank_in_sweep_1d"].get<long>()) + " | " +
-         num(d.value("rank_1d", json(nullptr)), "%g") + " / " + num(d.value("rank_3d", json(nullptr)), "%g") + " | " +
+         num(d.value("rank_1d", json(nullptr)), 6) + " / " + num(d.value("rank_3d", json(nullptr)), 6) + " | " +
          fig(f1[m], m) + " | " + fig(f3[m], m) + " | " + pct(rel[m]) + " | " + fig(f1["displacement_per_cycle_m"], "displacement_per_cycle_m") +
          " | " + fig(f3["displacement_per_cycle_m"], "displacement_per_cycle_m") + " | " + fig(f1["cycle_time_s"], "cycle_time_s") +
          " | " + fig(f3["cycle_time_s"], "cycle_time_s") + " | " + fig(f1["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " +

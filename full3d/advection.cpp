@@ -6,17 +6,13 @@
 #include <string>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "full3d/operators.hpp"
 
 namespace swim::full3d {
 
 namespace {
 inline int wrap(int i, int n) { return i < 0 ? i + n : (i >= n ? i - n : i); }
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
 }  // namespace
 
 void advective_term(const MacGrid& g, const VectorField& u, VectorField& N) {
@@ -89,7 +85,7 @@ double advective_cfl(const MacGrid& g, const VectorField& u, double dt) {
 double advect(const MacGrid& g, VectorField& u, double dt, const AdvectionOptions& opt) {
   const double cfl = advective_cfl(g, u, dt);
   if (!(cfl <= opt.max_cfl))
-    throw NumericalError("fluid advection CFL number " + num(cfl) + " exceeds " + num(opt.max_cfl) +
+    throw NumericalError("fluid advection CFL number " + significant(cfl, 4) + " exceeds " + significant(opt.max_cfl, 4) +
                              " (sum_d max|u_d| dt/h of the Navier-Stokes advection sub-step)",
                          "reduce the time step full3d.dt (or raise StokesOptions::advection.max_cfl through the API)");
   VectorField N(g);

@@ -11,16 +11,12 @@
 #include <utility>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "full3d/ib.hpp"
 
 namespace swim::full3d {
 
 namespace {
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
 }  // namespace
 
 IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh mesh, MembraneParams membrane,
@@ -30,7 +26,7 @@ IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh m
   if (mass_.size() != mesh_.nodes())
     throw InputError("IbSolver node_mass", std::to_string(mass_.size()) + " values",
                      "one mass per membrane node (" + std::to_string(mesh_.nodes()) + ")");
-  if (!(opt_.max_cfl > 0.0)) throw InputError("full3d.max_cfl", num(opt_.max_cfl), "a positive number");
+  if (!(opt_.max_cfl > 0.0)) throw InputError("full3d.max_cfl", significant(opt_.max_cfl, 4), "a positive number");
 }
 
 IbState IbSolver::initial_state() const {
@@ -101,7 +97,7 @@ void project_axisymmetric(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, E
 }
 
 IbStepStats IbSolver::step(IbState& s, double dt) {
-  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(opt_.dt_key, num(dt), "a positive time step in s");
+  if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(opt_.dt_key, significant(dt, 4), "a positive time step in s");
   IbStepStats st;
   using clock = std::chrono::steady_clock;
   auto tic = clock::now();
@@ -168,13 +164,13 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     return st;
   }
   if (st.cfl > opt_.max_cfl)
-    throw NumericalError("advective CFL number " + num(st.cfl) + " exceeds " + num(opt_.max_cfl) +
-                             " (nodes move " + num(st.cfl) + " cells per step)",
+    throw NumericalError("advective CFL number " + significant(st.cfl, 4) + " exceeds " + significant(opt_.max_cfl, 4) +
+                             " (nodes move " + significant(st.cfl, 4) + " cells per step)",
                          dt_remedy(), s.t);
   st.max_edge = max_edge_length(mesh_, Xnew);
   if (opt_.check_no_leak && !(st.max_edge < 0.5 * grid_.h()))
-    throw NumericalError("membrane edge of " + num(st.max_edge) + " m exceeds h/2 = " + num(0.5 * grid_.h()) +
-                             " m after this step (was " + num(max_edge_length(mesh_, s.X)) +
+    throw NumericalError("membrane edge of " + significant(st.max_edge, 4) + " m exceeds h/2 = " + significant(0.5 * grid_.h(), 4) +
+                             " m after this step (was " + significant(max_edge_length(mesh_, s.X), 4) +
                              " m): the fluid would leak through the membrane",
                          "reduce the time step " + opt_.dt_key + " if the edge jumped in one step, otherwise refine the membrane",
                          s.t + dt);

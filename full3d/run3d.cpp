@@ -16,24 +16,6 @@ namespace swim::full3d {
 
 using scene::json;
 
-IbOptions ib_options(const Params3d& p) {
-  IbOptions o;
-  o.scheme = p.scheme;
-  o.max_cfl = p.max_cfl;
-  o.dt_key = "full3d.dt";
-  o.threads = p.threads;
-  o.axisymmetric_wall = p.axisymmetric_wall;
-  o.stokes.fft.threads = p.threads;
-  o.stokes.threads = p.threads;
-  if (p.container == "cylinder") {
-    o.stokes.cylinder.enabled = true;
-    o.stokes.cylinder.radius = p.container_radius;
-  }
-  o.stokes.advection.enabled = p.navier_stokes;
-  if (p.threads > 1) fftw_threads_init_once();
-  return o;
-}
-
 namespace {
 
 /// The run loop: init (fresh or from the checkpoint), then while (!finished) { step;

@@ -56,10 +56,6 @@ struct RunOutcome {
 RunOutcome run3d(const Params3d& p, const scene::json& resolved, const std::string& out_dir,
                  const RunControl& ctl = {});
 
-/// The coupled-step options a scene asks for: scheme, CFL bound, threads, container
-/// (cylinder wall kind), Navier-Stokes advection.
-IbOptions ib_options(const Params3d& p);
-
 /// One step of the paper's dry swimmer, m_i r_i'' + nu_i r_i' - F_i(r) = F^e_i (no fluid):
 /// ForwardEuler = symplectic Euler with implicit damping, Midpoint = velocity Verlet with
 /// trapezoidal damping. s.X, s.V, s.V_prev, s.t are advanced; throws NumericalError

@@ -82,7 +82,7 @@ void validate(const CheckpointReader& r, const RunSetup& run) {
   const std::size_t nodes = std::size_t(run.mesh.nodes());
   for (const char* name : {"X", "V", "V_prev"}) expect_size(r, name, 3 * nodes, "membrane mesh");
   if (!p.dry) {
-    const MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
+    const MacGrid grid = run.grid();
     const char* const u[3] = {"u0", "u1", "u2"};
     for (int c = 0; c < 3; ++c) expect_size(r, u[c], grid.size(c), "fluid grid");
     expect_size(r, "p", grid.cells(), "fluid grid");

@@ -2,7 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
+
+#include "common/si_format.hpp"
 
 namespace swim::full3d {
 
@@ -11,8 +12,7 @@ long steps_for(double interval, double dt) { return std::max(1L, std::lround(int
 }  // namespace
 
 RunSetup::RunSetup(const Params3d& params)
-    : p(params), mesh(make_mesh(params)), mass(node_masses(mesh, params.mass_per_area)),
-      e_ref(uniform_contraction_energy(mesh, params.membrane, params.protocol.R_f)),
+    : World3d(params), mass(node_masses(mesh, params.mass_per_area)),
       adaptive(params.adaptive.enabled && !params.dry), dt_key(adaptive ? "full3d.adaptive.dt_max" : "full3d.dt"),
       n_end(params.duration > 0 ? std::max(1L, std::lround(params.duration / params.dt)) : -1),
       n_limit(std::max(1L, std::lround(params.time_limit / params.dt))),
@@ -22,10 +22,6 @@ RunSetup::RunSetup(const Params3d& params)
       fluid_every(vtk_every * std::max(1L, std::lround(params.fluid_interval / params.vtk_interval))),
       ckpt_every(steps_for(params.checkpoint_interval, params.dt)) {}
 
-std::string short_number(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.4g", v);
-  return b;
-}
+std::string short_number(double v) { return significant(v, 4); }
 
 }  // namespace swim::full3d

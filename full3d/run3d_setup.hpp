@@ -12,16 +12,16 @@
 
 #include "full3d/membrane.hpp"
 #include "full3d/scene3d.hpp"
+#include "full3d/world3d.hpp"
 
 namespace swim::full3d {
 
-struct RunSetup {
+/// The scene's world (world3d.hpp: parameters, mesh, grid, solver options, protocol) and what
+/// a run adds to it.
+struct RunSetup : World3d {
   explicit RunSetup(const Params3d& p);
 
-  const Params3d& p;
-  CylinderMesh mesh;         ///< the reference mesh
   Eigen::VectorXd mass;      ///< node masses, kg
-  double e_ref;              ///< energy of the tube uniformly at R_f, J
   bool adaptive;             ///< adaptive step control (full3d.adaptive, fluid-coupled runs only)
   std::string dt_key;        ///< the step key named in messages
   long n_end;                ///< steps of a fixed duration (fixed step), -1 when the duration is auto

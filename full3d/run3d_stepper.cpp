@@ -30,16 +30,14 @@ bool crossed(double t0, double t1, double interval) {
 }  // namespace
 
 Stepper::Stepper(const RunSetup& run)
-    : run_(run), protocol_(effective_protocol(run.p, run.mesh), run.mesh, run.e_ref),
-      r_active_prev_(std::numeric_limits<double>::quiet_NaN()) {
+    : run_(run), protocol_(run.protocol()), r_active_prev_(std::numeric_limits<double>::quiet_NaN()) {
   const Params3d& p = run.p;
   if (!p.dry) {
-    grid_.emplace(p.nx, p.ny, p.nz, p.h, p.container_kind());
-    IbOptions o = ib_options(p);
+    grid_.emplace(run.grid());
+    IbOptions o = run.options;
     o.reject_on_cfl = run.adaptive;
     o.dt_key = run.dt_key;
-    const Eigen::VectorXd m = p.wall_inertia ? run.mass : Eigen::VectorXd::Zero(run.mesh.nodes());
-    ib_ = std::make_unique<IbSolver>(*grid_, p.fluid, run.mesh, p.membrane, m, o);
+    ib_ = run.solver(o, p.wall_inertia ? run.mass : Eigen::VectorXd());
     ib_->set_external_force([this](double, const Eigen::Matrix3Xd& X) { return protocol_.force(X); });
     s_ = ib_->initial_state();
   } else {

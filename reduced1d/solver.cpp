@@ -5,6 +5,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/si_format.hpp"
 #include "reduced1d/internal.hpp"
 #include "reduced1d/outer_flow.hpp"
 #include "reduced1d/protocol.hpp"
@@ -16,14 +17,8 @@ namespace swim::reduced1d {
 namespace detail {
 
 namespace {
-std::string num(double v) {
-  std::ostringstream s;
-  s.precision(6);
-  s << v;
-  return s.str();
-}
 void require(bool ok, const char* key, double value, const char* allowed) {
-  if (!ok || std::isnan(value)) throw InputError(key, num(value), allowed);
+  if (!ok || std::isnan(value)) throw InputError(key, significant(value), allowed);
 }
 }  // namespace
 

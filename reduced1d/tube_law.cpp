@@ -8,6 +8,7 @@
 #include <string>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 
 namespace swim::reduced1d {
 
@@ -19,11 +20,6 @@ struct TubeLaw::Gsl {
 };
 
 namespace {
-std::string num(double v) {
-  char b[32];
-  std::snprintf(b, sizeof b, "%.6g", v);
-  return b;
-}
 }  // namespace
 
 TubeLaw::TubeLaw(double R0, std::vector<double> R, std::vector<double> w)
@@ -35,15 +31,15 @@ TubeLaw::TubeLaw(double R0, std::vector<double> R, std::vector<double> w)
                      "a tube law needs at least three knots (R, w) of equal count");
   for (std::size_t k = 0; k < n; ++k) {
     if (!std::isfinite(R_[k]) || !std::isfinite(w_[k]) || !(R_[k] > 0))
-      throw InputError(key, "knot " + std::to_string(k) + " (" + num(R_[k]) + " m, " + num(w_[k]) + " Pa)",
+      throw InputError(key, "knot " + std::to_string(k) + " (" + significant(R_[k]) + " m, " + significant(w_[k]) + " Pa)",
                        "tube-law knots must be finite with a positive radius");
     if (k > 0 && !(R_[k] > R_[k - 1] && w_[k] > w_[k - 1]))
-      throw InputError(key, "knot " + std::to_string(k) + " (" + num(R_[k]) + " m, " + num(w_[k]) + " Pa)",
+      throw InputError(key, "knot " + std::to_string(k) + " (" + significant(R_[k]) + " m, " + significant(w_[k]) + " Pa)",
                        "tube-law knots must be strictly increasing in both radius and wall pressure (a monotone law)");
   }
   if (!(R_.back() == R0_) || !(w_.back() == 0.0))
-    throw InputError(key, "last knot (" + num(R_.back()) + " m, " + num(w_.back()) + " Pa)",
-                     "the last tube-law knot must be the undeformed tube (R0 = " + num(R0_) + " m, 0 Pa)");
+    throw InputError(key, "last knot (" + significant(R_.back()) + " m, " + significant(w_.back()) + " Pa)",
+                     "the last tube-law knot must be the undeformed tube (R0 = " + significant(R0_) + " m, 0 Pa)");
   g_->interp = gsl_interp_alloc(gsl_interp_steffen, n);
   if (!g_->interp || gsl_interp_init(g_->interp, R_.data(), w_.data(), n) != GSL_SUCCESS)
     throw InputError(key, "tube-law knots", "GSL could not build the Steffen interpolant");

@@ -7,14 +7,17 @@
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
+#include <functional>
+#include <memory>
 #include <cstdlib>
 #include <cmath>
 
 #include "common/errors.hpp"
+#include "common/si_format.hpp"
 #include "full3d/grid.hpp"
 #include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
-#include "full3d/run3d.hpp"
+#include "full3d/world3d.hpp"
 #include "reduced1d/tube_law.hpp"
 
 #include <array>
@@ -51,6 +54,44 @@ std::vector<double> ring_mode_stiffness(const full3d::CylinderMesh& mesh, const 
     k.push_back(V.cwiseProduct(grad(X + s * V) - grad(X - s * V)).sum() / (2.0 * s));
   }
   return k;
+}
+
+/// A uniform load's static state on the round branch, with the stiffness of its ring modes.
+struct RoundState {
+  double pressure_Pa = 0;
+  full3d::PressureResponse response;
+  std::vector<double> ring_mode_stiffness;  ///< N/m, of cos(n phi) for n = 2, 3, ...
+  int softest_mode = 0;                     ///< the n of the smallest
+  double softest_stiffness = 0;             ///< N/m
+};
+
+/// The uniform-load loop of the static calibration and of the tube law: the loads in the order
+/// given (increasing), each relaxed to its static state on the round branch (from the previous
+/// load's state with warm_start, else from the reference mesh) and its ring modes' stiffness
+/// measured, then handed to `take`, which returns false to end the loop. A load without a
+/// static state ends the loop: `no_state(P, error)` is called and the error rethrown when it
+/// returns true.
+void round_branch(const full3d::CylinderMesh& mesh, const full3d::MembraneParams& membrane,
+                  const std::vector<double>& loads, bool warm_start, const std::function<bool(const RoundState&)>& take,
+                  const std::function<bool(double, const NumericalError&)>& no_state) {
+  Eigen::Matrix3Xd prev;
+  for (double P : loads) {
+    RoundState st;
+    st.pressure_Pa = P;
+    try {
+      st.response = full3d::relax_under_pressure(mesh, membrane, P, 0.0, 50,
+                                                 warm_start && prev.size() ? &prev : nullptr);
+    } catch (const NumericalError& e) {
+      if (no_state(P, e)) throw;
+      return;
+    }
+    if (warm_start) prev = st.response.X;
+    st.ring_mode_stiffness = ring_mode_stiffness(mesh, membrane, P, st.response.X);
+    const auto soft = std::min_element(st.ring_mode_stiffness.begin(), st.ring_mode_stiffness.end());
+    st.softest_mode = int(soft - st.ring_mode_stiffness.begin()) + 2;
+    st.softest_stiffness = *soft;
+    if (!take(st)) return;
+  }
 }
 // Smallest eigenvalue of the Hessian of the loaded energy at X, without the two free rigid
 // motions (axial translation, rotation about the axis): Lanczos with full reorthogonalisation
@@ -132,34 +173,34 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
   c.spring_network_c1 = p.c1_estimate();
   std::vector<double> P = pressures;
   std::sort(P.begin(), P.end());
-  for (double pr : P) {
+  for (double pr : P)
     if (!(pr > 0) || !std::isfinite(pr))
       throw InputError("calibration load", std::to_string(pr), "every load must be a positive pressure");
-    full3d::PressureResponse r;
-    try {
-      r = full3d::relax_under_pressure(mesh, p.membrane, pr);
-    } catch (const NumericalError& e) {
-      // loads are tried in increasing order: the first one without a static state ends the
-      // series (the larger ones would not reach one either); three points still fit C1
-      if (c.loads.size() < 3) throw;
-      c.no_static_state_from_Pa = pr;
-      c.no_static_state_reason = e.what();
-      break;
-    }
-    LoadPoint lp;
-    lp.pressure_Pa = pr;
-    lp.displacement_m = p.R0 - r.mid_radius;
-    lp.secant_C1_Pa_per_m = r.c1;
-    lp.iterations = r.iterations;
-    lp.ring_mode_stiffness_N_per_m = ring_mode_stiffness(mesh, p.membrane, pr, r.X);
-    const auto& k = lp.ring_mode_stiffness_N_per_m;
-    const auto soft = std::min_element(k.begin(), k.end());
-    lp.softest_ring_mode = int(soft - k.begin()) + 2;
-    lp.softest_ring_mode_stiffness_N_per_m = *soft;
-    lp.lowest_eigenvalue_N_per_m = lowest_hessian_eigenvalue(mesh, p.membrane, pr, r.X, 150);
-    c.loads.push_back(lp);
-    if (on_load) on_load(c.loads.size());
-  }
+  // each load from the reference mesh
+  round_branch(
+      mesh, p.membrane, P, false,
+      [&](const RoundState& st) {
+        LoadPoint lp;
+        lp.pressure_Pa = st.pressure_Pa;
+        lp.displacement_m = p.R0 - st.response.mid_radius;
+        lp.secant_C1_Pa_per_m = st.response.c1;
+        lp.iterations = st.response.iterations;
+        lp.ring_mode_stiffness_N_per_m = st.ring_mode_stiffness;
+        lp.softest_ring_mode = st.softest_mode;
+        lp.softest_ring_mode_stiffness_N_per_m = st.softest_stiffness;
+        lp.lowest_eigenvalue_N_per_m = lowest_hessian_eigenvalue(mesh, p.membrane, st.pressure_Pa, st.response.X, 150);
+        c.loads.push_back(lp);
+        if (on_load) on_load(c.loads.size());
+        return true;
+      },
+      [&](double pr, const NumericalError& e) {
+        // loads are tried in increasing order: the first one without a static state ends the
+        // series (the larger ones would not reach one either); three points still fit C1
+        if (c.loads.size() < 3) return true;
+        c.no_static_state_from_Pa = pr;
+        c.no_static_state_reason = e.what();
+        return false;
+      });
   // linear range: secant within 1 % of the smallest load's
   const double c_small = c.loads.front().secant_C1_Pa_per_m;
   std::vector<double> x, y;
@@ -204,12 +245,12 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
 WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,
                             bool axisymmetric_wall) {
   const auto t0 = std::chrono::steady_clock::now();
-  const full3d::MacGrid grid(p.nx, p.ny, p.nz, p.h, p.container_kind());
-  const full3d::CylinderMesh mesh = full3d::make_mesh(p);
-  full3d::IbOptions opt = full3d::ib_options(p);
-  opt.dt_key = "full3d.dt";
+  const full3d::World3d world(p);
+  const full3d::CylinderMesh& mesh = world.mesh;
+  full3d::IbOptions opt = world.options;
   opt.axisymmetric_wall = axisymmetric_wall;
-  full3d::IbSolver ib(grid, p.fluid, mesh, p.membrane, Eigen::VectorXd::Zero(mesh.nodes()), opt);
+  const std::unique_ptr<full3d::IbSolver> solver = world.solver(opt);  // a massless wall
+  full3d::IbSolver& ib = *solver;
   const Eigen::VectorXd area = mesh.node_area;
   ib.set_external_force([&](double, const Eigen::Matrix3Xd& X) {
     Eigen::Matrix3Xd F = full3d::radial_directions(mesh, X);
@@ -531,31 +572,28 @@ TubeLawCalibration calibrate_tube_law(const full3d::Params3d& p, double c1, doub
   auto t0 = std::chrono::steady_clock::now();
   std::vector<Eigen::Matrix3Xd> round_X;
   {
-    Eigen::Matrix3Xd prev;
-    for (double f : load_fractions) {
-      const double P = f * Pscale;
-      full3d::PressureResponse r;
-      try {
-        r = full3d::relax_under_pressure(mesh, p.membrane, P, 0.0, 50, prev.size() ? &prev : nullptr);
-      } catch (const NumericalError& e) {
-        char b[80];
-        std::snprintf(b, sizeof b, "no static state at %.4g Pa: ", P);
-        t.round.stopped_because = b + std::string(e.what());
-        break;
-      }
-      prev = r.X;
-      LawPoint lp = make_point(mesh, P, r.X, r.max_residual_force, r.iterations);
-      const std::vector<double> k = ring_mode_stiffness(mesh, p.membrane, P, r.X);
-      const auto soft = std::min_element(k.begin(), k.end());
-      lp.softest_ring_mode = int(soft - k.begin()) + 2;
-      lp.softest_ring_mode_stiffness_N_per_m = *soft;
-      t.round.points.push_back(lp);
-      round_X.push_back(r.X);
-      if (lp.mid_radius_m <= deepest) {
-        t.round.stopped_because = "reached R_mid <= deepest_ratio R0";
-        break;
-      }
-    }
+    std::vector<double> loads;
+    for (double f : load_fractions) loads.push_back(f * Pscale);
+    // each load from the previous equilibrium
+    round_branch(
+        mesh, p.membrane, loads, true,
+        [&](const RoundState& st) {
+          const full3d::PressureResponse& r = st.response;
+          LawPoint lp = make_point(mesh, st.pressure_Pa, r.X, r.max_residual_force, r.iterations);
+          lp.softest_ring_mode = st.softest_mode;
+          lp.softest_ring_mode_stiffness_N_per_m = st.softest_stiffness;
+          t.round.points.push_back(lp);
+          round_X.push_back(r.X);
+          if (lp.mid_radius_m <= deepest) {
+            t.round.stopped_because = "reached R_mid <= deepest_ratio R0";
+            return false;
+          }
+          return true;
+        },
+        [&](double P, const NumericalError& e) {
+          t.round.stopped_because = "no static state at " + significant(P, 4) + " Pa: " + e.what();
+          return false;
+        });
     if (t.round.stopped_because.empty()) t.round.stopped_because = "end of the load list";
   }
   for (const auto& lp : t.round.points) {

@@ -16,8 +16,8 @@
 #include "full3d/grid.hpp"
 #include "full3d/ib.hpp"
 #include "full3d/membrane.hpp"
-#include "full3d/run3d.hpp"
 #include "full3d/stokes.hpp"
+#include "full3d/world3d.hpp"
 #include "reduced1d/outer_flow.hpp"
 #include "validation/richardson.hpp"
 
@@ -125,10 +125,9 @@ full3d::Params3d in_cylinder(const full3d::Params3d& scene) {
 class RigidTubeFlow {
  public:
   explicit RigidTubeFlow(const full3d::Params3d& p)
-      : p_(p),
-        grid_(p.nx, p.ny, p.nz, p.h, p.container_kind()),
-        mesh_(full3d::make_mesh(p)),
-        stokes_(grid_, p.fluid, full3d::ib_options(p).stokes) {}
+      : p_(p), world_(p_), grid_(world_.grid()), mesh_(world_.mesh), stokes_(grid_, p_.fluid, world_.options.stokes) {}
+  RigidTubeFlow(const RigidTubeFlow&) = delete;  // world_ refers to p_
+  RigidTubeFlow& operator=(const RigidTubeFlow&) = delete;
 
   const MacGrid& grid() const { return grid_; }
   const Eigen::Matrix3Xd& nodes() const { return mesh_.X0; }
@@ -265,8 +264,9 @@ class RigidTubeFlow {
   }
   static constexpr double kDt = 1e3;  // steady Stokes: rho h^2 / (mu dt) ~ 1e-13
   full3d::Params3d p_;
+  full3d::World3d world_;  ///< the scene's mesh, grid and solver options
   MacGrid grid_;
-  full3d::CylinderMesh mesh_;
+  const full3d::CylinderMesh& mesh_;
   full3d::StokesSolver stokes_;
 };
 

@@ -22,6 +22,10 @@
 // The result is report.json (every metric, threshold and verdict, with downsampled U(t)
 // series for the figures); tools/plot_validation.py turns it into report.md, report.html and
 // the PNG figures.
+//
+// The parts: the suite file (suite_file.hpp), the cache of runs and calibrations
+// (run_cache.hpp), the extrapolated references (extrapolated_reference.hpp) and the phases of a
+// case (suite_phases.hpp); run_suite calls the phases in the order above.
 #pragma once
 
 #include <functional>
@@ -29,6 +33,7 @@
 #include <vector>
 
 #include "common/scene.hpp"
+#include "validation/suite_file.hpp"
 
 namespace swim::validation {
 
@@ -62,27 +67,5 @@ scene::json run_suite(const SuiteOptions& o);
 scene::json plan_runs(const SuiteOptions& o);
 /// Runs one job of plan_runs into the cache (a finished one is reused); returns {"status", ...}.
 scene::json run_planned(const scene::json& job);
-
-/// A 1D model's scene as the suite runs it: the case's scene `s` with the model's `set` and, for
-/// a calibrated model (`"calibrated": true`), the calibration file `cal` in place of the scene's
-/// own wall stiffness (its `wall.spring_constant` or `wall.C1`).
-scene::json model_scene(scene::json s, const scene::json& model, const std::string& cal);
-
-/// Reads and checks a suite file (InputError naming the key on any problem). The scene of a
-/// case with a `reference` is looked up (as given, beside the suite, in data_dir/scenes when
-/// data_dir is not empty) and read by the axi tier on every reference grid: a scene the tier
-/// refuses is an InputError naming suite.cases[i].reference.
-scene::json load_suite(const std::string& path, const std::string& data_dir = "");
-
-/// The checks of load_suite on a suite document read from `path`: every key known and of its
-/// type at every level, thresholds and lists in range, and (with `scenes`) every case's scene
-/// read by the 3D reader with its time-step variants, every 1D model's scene by the 1D
-/// reader (also at each of cells1d and rtol1d), the extremes' scene files, the references' scenes
-/// by the axi reader. The 3D reader reads each case (and its time-step variants) at its first
-/// grid: it builds the membrane mesh, seconds on a fine grid; on the other grids the case's
-/// `full3d` section is checked against the ranges the reader accepts (a grid out of range is
-/// an InputError naming suite.cases[i].grids[g]), and rules that join several keys are checked
-/// as they run.
-void check_suite(const scene::json& suite, const std::string& path, const std::string& data_dir, bool scenes = true);
 
 }  // namespace swim::validation

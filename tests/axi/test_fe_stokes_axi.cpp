@@ -21,6 +21,7 @@
 #include "axi/fe_stokes_axi.hpp"
 #include "axi/fitted_mesh.hpp"
 #include "common/errors.hpp"
+#include "tests/support/axi_fixture.hpp"
 
 using swim::axi::FittedMesh;
 using swim::axi::FittedMeshParams;
@@ -28,25 +29,16 @@ using swim::axi::FittedStokes;
 
 namespace {
 
+using namespace swim::test::fitted_tube;
+
 constexpr double kPi = std::numbers::pi;
-constexpr double kMu = 1.0e-3;    // Pa s
-constexpr double kRc = 0.25e-6;   // m
-constexpr double kP = 2.0e-6;     // m
-constexpr double kA = 0.125e-6;   // tube radius, m
-constexpr double kL = 0.4e-6;     // tube length, m
 
 using Body = std::function<Eigen::Vector2d(double, double)>;
 
 double order(double coarse, double fine) { return std::log2(coarse / fine); }
 
 FittedMeshParams params(int ci, int co, int gap, bool closed = false, double growth = 1.0) {
-  FittedMeshParams p;
-  p.Rc = kRc;
-  p.period = kP;
-  p.cells_inner = ci;
-  p.cells_outer = co;
-  p.gap_columns = gap;
-  p.gap_growth = growth;
+  FittedMeshParams p = swim::test::fitted_mesh_params(kRc, kP, ci, co, gap, growth);
   p.closed = closed;
   return p;
 }
@@ -292,60 +284,7 @@ TEST(FittedStokes, UniformRadialBodyForceIsHeldByALinearPressureAtRest) {
 
 namespace {
 
-// Polynomial in r (coefficient n multiplies r^n).
-struct Poly {
-  std::vector<double> c;
-  double operator()(double r) const {
-    double s = 0.0;
-    for (std::size_t n = c.size(); n-- > 0;) s = s * r + c[n];
-    return s;
-  }
-  Poly d() const {
-    Poly q;
-    for (std::size_t n = 1; n < c.size(); ++n) q.c.push_back(double(n) * c[n]);
-    if (q.c.empty()) q.c.push_back(0.0);
-    return q;
-  }
-};
-
-// From the stream function psi = A r^2 (Rc^2 - r^2)^2 sin(kx x) (u_r = -(1/r) dpsi/dx,
-// u_x = (1/r) dpsi/dr: divergence-free, u_r = 0 on the axis, u = 0 at Rc, periodic):
-//   u_r = U(r) cos(kx x), U = -A kx r (Rc^2 - r^2)^2;  u_x = W(r) sin(kx x), W = 2 A (Rc^2 - r^2)(Rc^2 - 3 r^2);
-//   p = Q(r) cos(kx x), Q = P0 (1 + r^2/Rc^2)  (zero mean over x, so zero volume mean).
-// Forces from the strong equations:
-//   f_r = [Q' - mu (U'' + U'/r - U/r^2 - kx^2 U)] cos,  f_x = [-kx Q - mu (W'' + W'/r - kx^2 W)] sin.
-struct Manufactured {
-  double kx, A, P0;
-  Poly U, W, Q;
-  Manufactured() : kx(2 * kPi / kP) {
-    A = 0.01 / (2 * std::pow(kRc, 4));  // max u_x = 0.01 m/s
-    P0 = kMu * 0.01 / kRc;
-    const double R2 = kRc * kRc;
-    U.c = {0.0, -A * kx * R2 * R2, 0.0, 2 * A * kx * R2, 0.0, -A * kx};
-    W.c = {2 * A * R2 * R2, 0.0, -8 * A * R2, 0.0, 6 * A};
-    Q.c = {P0, 0.0, P0 / R2};
-  }
-  // U'/r - U/r^2 for odd U: c_n r^n -> (n - 1) c_n r^(n-2); W'/r for even W: n c_n r^(n-2).
-  double u_extra(double r) const {
-    double s = 0.0;
-    for (std::size_t n = 3; n < U.c.size(); ++n) s += double(n - 1) * U.c[n] * std::pow(r, double(n) - 2);
-    return s;
-  }
-  double w_extra(double r) const {
-    double s = 0.0;
-    for (std::size_t n = 2; n < W.c.size(); ++n) s += double(n) * W.c[n] * std::pow(r, double(n) - 2);
-    return s;
-  }
-  Eigen::Vector2d force(double x, double r) const {  // (f_x, f_r)
-    const double fr = (Q.d()(r) - kMu * (U.d().d()(r) + u_extra(r) - kx * kx * U(r))) * std::cos(kx * x);
-    const double fx = (-kx * Q(r) - kMu * (W.d().d()(r) + w_extra(r) - kx * kx * W(r))) * std::sin(kx * x);
-    return {fx, fr};
-  }
-  Eigen::Vector2d velocity(double x, double r) const {  // (u_x, u_r)
-    return {W(r) * std::sin(kx * x), U(r) * std::cos(kx * x)};
-  }
-  double p(double x, double r) const { return Q(r) * std::cos(kx * x); }
-};
+// The flow: swim::test::ManufacturedAxiFlow (tests/support/axi_fixture.hpp), in the test tube's container.
 
 struct MmsErrors {
   double u, p, div;
@@ -357,17 +296,17 @@ MmsErrors manufactured(int level) {
   const int n = 8 * (1 << level) + 1, c = 2 << level, gap = 8 << level;
   FittedStokes s(params(c, c, gap), kMu, n);
   s.factor(tube(n, 0.3, 0.3e-6, kL, 0.2));
-  const Manufactured m;
-  const Body f = [&m](double x, double r) { return m.force(x, r); };
+  const swim::test::ManufacturedAxiFlow m(kRc, kP, kMu);
+  const Body f = [&m](double x, double r) { return Eigen::Vector2d(m.f_x(r, x), m.f_r(r, x)); };
   Eigen::Matrix3Xd U;
   s.solve(Eigen::Matrix3Xd::Zero(3, n), U, &f);
-  const double eu = nodal_error(s, [&m](double x, double r) { return m.velocity(x, r); });
+  const double eu = nodal_error(s, [&m](double x, double r) { return Eigen::Vector2d(m.u_x(r, x), m.u_r(r, x)); });
   double ep = 0.0;
   for (int e = 0; e < s.mesh().elements(); ++e) {
     double cx[4], cr[4];
     s.mesh().corners(e, cx, cr);
     const double xc = 0.25 * (cx[0] + cx[1] + cx[2] + cx[3]), rc = 0.25 * (cr[0] + cr[1] + cr[2] + cr[3]);
-    ep = std::max(ep, std::abs(s.pressure(xc, rc) - m.p(xc, rc)));
+    ep = std::max(ep, std::abs(s.pressure(xc, rc) - m.p(rc, xc)));
   }
   return {eu / 0.01, ep / (2 * m.P0), s.lumen_divergence_residual()};
 }

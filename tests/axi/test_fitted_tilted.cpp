@@ -19,6 +19,7 @@
 #include "axi/fe_stokes_axi.hpp"
 #include "axi/fitted_mesh.hpp"
 #include "common/errors.hpp"
+#include "tests/support/axi_fixture.hpp"
 
 using swim::axi::FittedMesh;
 using swim::axi::FittedMeshParams;
@@ -26,22 +27,14 @@ using swim::axi::FittedStokes;
 
 namespace {
 
+using namespace swim::test::fitted_tube;
+
 constexpr double kPi = std::numbers::pi;
-constexpr double kMu = 1.0e-3;   // Pa s
-constexpr double kRc = 0.25e-6;  // m
-constexpr double kP = 2.0e-6;    // m
-constexpr double kA = 0.125e-6;  // tube radius, m
 
 using Body = std::function<Eigen::Vector2d(double, double)>;
 
 FittedMeshParams params(int ci, int co, int gap, double aspect = 0.0) {
-  FittedMeshParams p;
-  p.Rc = kRc;
-  p.period = kP;
-  p.cells_inner = ci;
-  p.cells_outer = co;
-  p.gap_columns = gap;
-  p.gap_growth = 1.2;
+  FittedMeshParams p = swim::test::fitted_mesh_params(kRc, kP, ci, co, gap, 1.2);
   p.wall_row_aspect = aspect;
   return p;
 }

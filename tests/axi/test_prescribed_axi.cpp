@@ -14,28 +14,19 @@
 #include "axi/fe_stokes_axi.hpp"
 #include "axi/fitted_mesh.hpp"
 #include "axi/prescribed_axi.hpp"
+#include "tests/support/axi_fixture.hpp"
 
 using swim::axi::FittedMeshParams;
 using swim::axi::FittedStokes;
 
 namespace {
 
+using namespace swim::test::fitted_tube;
+
 constexpr double kPi = std::numbers::pi;
-constexpr double kMu = 1.0e-3;   // Pa s
-constexpr double kRc = 0.25e-6;  // m
-constexpr double kA = 0.125e-6;  // tube radius, m
-constexpr double kL = 0.4e-6;    // tube length, m
-constexpr double kP = 2.0e-6;    // period, m
 
 FittedMeshParams params(int ci, int co, int gap, double period = kP, double growth = 1.0) {
-  FittedMeshParams p;
-  p.Rc = kRc;
-  p.period = period;
-  p.cells_inner = ci;
-  p.cells_outer = co;
-  p.gap_columns = gap;
-  p.gap_growth = growth;
-  return p;
+  return swim::test::fitted_mesh_params(kRc, period, ci, co, gap, growth);
 }
 
 // n rings uniform over [x0, x0 + L]; radius a (1 + bump sin(pi s) + asym sin(pi s)^2 sin(2 pi s)),

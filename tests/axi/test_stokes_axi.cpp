@@ -23,6 +23,7 @@
 #include "axi/ib_axi.hpp"
 #include "axi/stokes_axi.hpp"
 #include "common/errors.hpp"
+#include "tests/support/axi_fixture.hpp"
 
 using swim::axi::AxiGrid;
 using swim::axi::AxiStokes;
@@ -42,22 +43,6 @@ double max_abs(const std::vector<double>& a) {
 }
 
 double order(double coarse, double fine) { return std::log2(coarse / fine); }
-
-// Polynomial in r (coefficient n multiplies r^n).
-struct Poly {
-  std::vector<double> c;
-  double operator()(double r) const {
-    double s = 0.0;
-    for (std::size_t n = c.size(); n-- > 0;) s = s * r + c[n];
-    return s;
-  }
-  Poly d() const {
-    Poly q;
-    for (std::size_t n = 1; n < c.size(); ++n) q.c.push_back(double(n) * c[n]);
-    if (q.c.empty()) q.c.push_back(0.0);
-    return q;
-  }
-};
 
 // Discrete divergence at every cell, max |.|.
 double max_divergence(const AxiGrid& g, const std::vector<double>& u, const std::vector<double>& w) {
@@ -132,43 +117,8 @@ TEST(AxiStokes, PoiseuilleFlowConvergesAtSecondOrder) {
 
 namespace {
 
-// Manufactured flow from psi = A r^2 (Rc^2 - r^2)^2 sin(kx x):
-//   u = U(r) cos(kx x), U = -A kx r (Rc^2 - r^2)^2;  w = W(r) sin(kx x), W = 2 A (Rc^2 - r^2)(Rc^2 - 3 r^2)
-//   p = Q(r) cos(kx x), Q = P0 (1 + r^2/Rc^2)
-// (u = w = 0 at r = Rc, u odd and w, p even in r). Forces from the continuous equations:
-//   f_r = [Q' - mu (U'' + U'/r - U/r^2 - kx^2 U)] cos,  f_x = [-kx Q - mu (W'' + W'/r - kx^2 W)] sin.
-struct Manufactured {
-  double Rc, P, kx, A, P0;
-  Poly U, W, Q;
-  Manufactured(double Rc_, double P_) : Rc(Rc_), P(P_), kx(2 * kPi / P_) {
-    A = 0.01 / (2 * Rc * Rc * Rc * Rc);  // max w = 0.01 m/s
-    P0 = kMu * 0.01 / Rc;
-    const double R2 = Rc * Rc;
-    U.c = {0.0, -A * kx * R2 * R2, 0.0, 2 * A * kx * R2, 0.0, -A * kx};
-    W.c = {2 * A * R2 * R2, 0.0, -8 * A * R2, 0.0, 6 * A};
-    Q.c = {P0, 0.0, P0 / R2};
-  }
-  // U'/r - U/r^2 for odd U: term c_n r^n -> (n - 1) c_n r^(n-2); W'/r for even W: n c_n r^(n-2).
-  double u_extra(double r) const {
-    double s = 0.0;
-    for (std::size_t n = 3; n < U.c.size(); ++n) s += double(n - 1) * U.c[n] * std::pow(r, double(n) - 2);
-    return s;
-  }
-  double w_extra(double r) const {
-    double s = 0.0;
-    for (std::size_t n = 2; n < W.c.size(); ++n) s += double(n) * W.c[n] * std::pow(r, double(n) - 2);
-    return s;
-  }
-  double fr(double r, double x) const {
-    return (Q.d()(r) - kMu * (U.d().d()(r) + u_extra(r) - kx * kx * U(r))) * std::cos(kx * x);
-  }
-  double fx(double r, double x) const {
-    return (-kx * Q(r) - kMu * (W.d().d()(r) + w_extra(r) - kx * kx * W(r))) * std::sin(kx * x);
-  }
-  double u(double r, double x) const { return U(r) * std::cos(kx * x); }
-  double w(double r, double x) const { return W(r) * std::sin(kx * x); }
-  double p(double r, double x) const { return Q(r) * std::cos(kx * x); }
-};
+// The manufactured flow (tests/support/axi_fixture.hpp): u = u_r, w = u_x.
+using Manufactured = swim::test::ManufacturedAxiFlow;
 
 struct MmsErrors {
   double u, w, p;
@@ -177,12 +127,12 @@ struct MmsErrors {
 MmsErrors manufactured_errors(int nr) {
   const double P = 2 * kRc;
   const AxiGrid g = grid(nr, 2 * nr);
-  const Manufactured m(kRc, P);
+  const Manufactured m(kRc, P, kMu);
   std::vector<double> fr(g.u_size(), 0.0), fx(g.w_size(), 0.0), u, w, p;
   for (int i = 1; i < g.nr; ++i)
-    for (int j = 0; j < g.nx; ++j) fr[g.at(i, j)] = m.fr(g.r_face(i), g.x_cell(j));
+    for (int j = 0; j < g.nx; ++j) fr[g.at(i, j)] = m.f_r(g.r_face(i), g.x_cell(j));
   for (int i = 0; i < g.nr; ++i)
-    for (int j = 0; j < g.nx; ++j) fx[g.at(i, j)] = m.fx(g.r_cell(i), g.x_face(j));
+    for (int j = 0; j < g.nx; ++j) fx[g.at(i, j)] = m.f_x(g.r_cell(i), g.x_face(j));
   AxiStokes s(g, kMu);
   s.solve(fr, fx, u, w, &p);
   double eu = 0, ew = 0, ep = 0, umax = 0, wmax = 0, pmax = 0, pmean = 0;
@@ -191,13 +141,13 @@ MmsErrors manufactured_errors(int nr) {
   pmean /= double(g.p_size());  // the solver's gauge: zero plain mean over the cells
   for (int i = 0; i <= g.nr; ++i)
     for (int j = 0; j < g.nx; ++j) {
-      const double ue = m.u(g.r_face(i), g.x_cell(j));
+      const double ue = m.u_r(g.r_face(i), g.x_cell(j));
       eu = std::max(eu, std::abs(u[g.at(i, j)] - ue));
       umax = std::max(umax, std::abs(ue));
     }
   for (int i = 0; i < g.nr; ++i)
     for (int j = 0; j < g.nx; ++j) {
-      const double we = m.w(g.r_cell(i), g.x_face(j));
+      const double we = m.u_x(g.r_cell(i), g.x_face(j));
       ew = std::max(ew, std::abs(w[g.at(i, j)] - we));
       wmax = std::max(wmax, std::abs(we));
       const double pe = m.p(g.r_cell(i), g.x_cell(j)) - pmean;

@@ -1,0 +1,243 @@
+#include "validation/extrapolated_reference.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <string>
+
+#include "validation/verdicts.hpp"
+
+namespace swim::validation {
+
+namespace {
+
+/// A number for the report: null when it is not finite (never NaN in a file).
+json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
+
+json extrapolation_json(const Extrapolation& e) {
+  return json{{"value", num(e.value)},         {"error", num(e.error)},
+              {"order", num(e.order)},         {"observed_order", num(e.observed_order)},
+              {"asymptotic", e.asymptotic},    {"note", e.note}};
+}
+
+std::string percent_text(double x) {
+  char b[48];
+  std::snprintf(b, sizeof b, "%.2g %%", 100.0 * x);
+  return b;
+}
+
+/// A figure of the reference converged: asymptotic, with an observed order (three grids),
+/// its relative error at most `target`.
+bool figure_converged(const Extrapolation& e, double rel, double target) {
+  return e.asymptotic && std::isfinite(e.observed_order) && std::isfinite(rel) && rel <= target;
+}
+
+/// The cycle time as the sum of the protocol's phases (CycleFigures::phase_times_s), each
+/// extrapolated on its own (richardson_sum). Null when the runs' phases differ in number.
+json phase_sum_cycle_time(const std::vector<double>& h, const std::vector<std::vector<double>>& phases, double assumed,
+                          const OrderRange& orders, double target) {
+  const std::size_t np = phases.front().size();
+  for (const auto& p : phases)
+    if (p.size() != np || np < 2) return nullptr;
+  const SumExtrapolation s = richardson_sum(h, phases, assumed, orders, target);
+  json list = json::array();
+  for (std::size_t k = 0; k < np; ++k) {
+    json j = extrapolation_json(s.parts[k]);
+    j["phase"] = k == 0 ? std::string("first contraction")
+                 : k + 1 == np ? std::string("recovery")
+                               : "contraction " + std::to_string(k + 1);
+    list.push_back(j);
+  }
+  return {{"value", num(s.value)},
+          {"error", num(s.error)},
+          {"order", nullptr},
+          {"observed_order", nullptr},
+          {"asymptotic", s.asymptotic},
+          {"note", "sum of the protocol's " + std::to_string(np) +
+                       " phases, each extrapolated on its own (error: the sum of theirs)"},
+          {"phases", list},
+          {"relative_error", num(s.relative_error)},
+          {"converged", s.converged}};
+}
+
+}  // namespace
+
+json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool with_max) {
+  std::vector<double> hs, fd, fT, hm, fm;
+  for (const auto& r : runs)
+    if (r.cyc.has_cycle) {
+      hs.push_back(r.h);
+      fd.push_back(r.cyc.displacement_per_cycle_m);
+      fT.push_back(r.cyc.cycle_time_s);
+      if (std::isfinite(r.max_displacement)) {
+        hm.push_back(r.h);
+        fm.push_back(r.max_displacement);
+      }
+    }
+  if (hs.size() < 2)
+    return {{"grids_used", hs.size()}, {"note", "fewer than two grids completed a cycle: no extrapolated reference"}};
+  // two grids: first order, or the range's nearest end when first order lies outside it
+  const double assumed = std::clamp(1.0, orders.lo, orders.hi);
+  const Extrapolation ed = richardson(hs, fd, assumed, orders);
+  const Extrapolation eT = richardson(hs, fT, assumed, orders);
+  // the mean velocity of the reference is its displacement over its cycle time; the
+  // relative errors add (bounds, as everywhere in the verdicts: verdicts.hpp)
+  Extrapolation ev;
+  ev.value = ed.value / eT.value;
+  ev.error = std::abs(ev.value) * (std::abs(ed.error / ed.value) + std::abs(eT.error / eT.value));
+  ev.asymptotic = ed.asymptotic && eT.asymptotic;
+  ev.note = "extrapolated displacement per cycle / extrapolated cycle time (relative errors added)";
+  json ref = {{"grids_used", hs.size()},
+              {"order_range", {orders.lo, orders.hi}},
+              {"displacement_per_cycle_m", extrapolation_json(ed)},
+              {"cycle_time_s", extrapolation_json(eT)},
+              {"mean_velocity_per_cycle_m_per_s", extrapolation_json(ev)}};
+  // the largest centre displacement over the run, where the paper gives it
+  if (with_max && hm.size() >= 2) ref["max_displacement_m"] = extrapolation_json(richardson(hm, fm, assumed, orders));
+  return ref;
+}
+
+json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target) {
+  std::vector<double> h, d, T, v, hm, m;
+  std::vector<std::vector<double>> phases;
+  for (const auto& r : runs)
+    if (r.cyc.has_cycle) {
+      h.push_back(r.h);
+      d.push_back(r.cyc.displacement_per_cycle_m);
+      T.push_back(r.cyc.cycle_time_s);
+      v.push_back(r.cyc.mean_velocity_per_cycle_m_per_s);
+      phases.push_back(r.cyc.phase_times_s);
+      if (std::isfinite(r.max_displacement)) {
+        hm.push_back(r.h);
+        m.push_back(r.max_displacement);
+      }
+    }
+  json ref = {{"grids_used", h.size()}, {"order_range", {orders.lo, orders.hi}}, {"target_relative", target}};
+  const std::string target_text = percent_text(target);
+  if (h.size() < 2) {
+    ref["converged"] = false;
+    ref["statement"] = "not converged to " + target_text + ": fewer than two of the reference's grids completed a cycle, "
+                       "so it has no extrapolated value";
+    ref["note"] = "fewer than two grids completed a cycle: no extrapolated reference";
+    return ref;
+  }
+  const double assumed = std::clamp(1.0, orders.lo, orders.hi);
+  struct Fig {
+    const char* key;
+    const char* words;
+    const std::vector<double>* hh;
+    const std::vector<double>* f;
+  };
+  std::vector<Fig> figs = {{"displacement_per_cycle_m", "displacement per cycle", &h, &d},
+                           {"cycle_time_s", "cycle time", &h, &T},
+                           {"mean_velocity_per_cycle_m_per_s", "mean velocity per cycle", &h, &v}};
+  if (with_max && hm.size() >= 2) figs.push_back({"max_displacement_m", "maximum displacement", &hm, &m});
+  for (const Fig& f : figs) {
+    const Extrapolation e = richardson(*f.hh, *f.f, assumed, orders);
+    json j = extrapolation_json(e);
+    const double rel = std::abs(e.value) > 0 ? std::abs(e.error / e.value) : std::numeric_limits<double>::quiet_NaN();
+    j["relative_error"] = num(rel);
+    j["converged"] = figure_converged(e, rel, target);
+    ref[f.key] = j;
+  }
+  // three grids or more: the cycle time phase by phase when the whole cycle's series does not converge
+  if (h.size() >= 3 && !ref["cycle_time_s"]["converged"].get<bool>()) {
+    json ps = phase_sum_cycle_time(h, phases, assumed, orders, target);
+    if (!ps.is_null()) {
+      ps["whole_cycle"] = ref["cycle_time_s"];
+      ref["cycle_time_s"] = ps;
+      const json& jd = ref["displacement_per_cycle_m"];
+      const double dv = jd["value"].is_number() ? jd["value"].get<double>() : std::numeric_limits<double>::quiet_NaN();
+      const double rd = jd["relative_error"].is_number() ? jd["relative_error"].get<double>()
+                                                         : std::numeric_limits<double>::quiet_NaN();
+      const double tv = ps["value"].get<double>(), rt = ps["relative_error"].is_number()
+                                                            ? ps["relative_error"].get<double>()
+                                                            : std::numeric_limits<double>::quiet_NaN();
+      const double vv = dv / tv, rv = rd + rt;
+      json jv = {{"value", num(vv)},
+                 {"error", num(std::abs(vv) * rv)},
+                 {"order", nullptr},
+                 {"observed_order", nullptr},
+                 {"asymptotic", jd["asymptotic"].get<bool>() && ps["asymptotic"].get<bool>()},
+                 {"note", "extrapolated displacement per cycle / cycle time from its phases (relative errors added)"},
+                 {"relative_error", num(rv)},
+                 {"converged", jd["converged"].get<bool>() && ps["converged"].get<bool>() && std::isfinite(rv) &&
+                                   rv <= target},
+                 {"direct", ref["mean_velocity_per_cycle_m_per_s"]}};
+      ref["mean_velocity_per_cycle_m_per_s"] = jv;
+    }
+  }
+  bool all = true;
+  std::string parts;
+  for (const Fig& f : figs) {
+    const json& j = ref[f.key];
+    const bool ok = j["converged"].get<bool>();
+    all = all && ok;
+    std::string why;
+    if (j.contains("phases")) why = " (the sum of its phases)";
+    else if (j.contains("direct")) why = " (displacement over the phases' cycle time)";
+    else if (!j["asymptotic"].get<bool>()) why = " (not in the asymptotic range)";
+    else if (j["observed_order"].is_null()) why = " (two grids: no observed order)";
+    const bool has_rel = j["relative_error"].is_number();
+    parts += std::string(parts.empty() ? "" : ", ") + f.words + " ± " +
+             (has_rel ? percent_text(j["relative_error"].get<double>()) : std::string("—")) + why;
+  }
+  ref["converged"] = all;
+  ref["statement"] = std::string(all ? "converged to " : "not converged to ") + target_text + ": " + parts;
+  return ref;
+}
+
+/// The 3D extrapolation against the axisymmetric reference, figure by figure: both values
+/// with their errors, the difference, e_3d + e_ref, agree / disagree (verdicts.hpp), the 3D
+/// series' observed order, and the finest 3D grid's relative error against the reference.
+json compare_3d_with_reference(const json& ref3d, const json& ref, const std::vector<const Run3d*>& runs) {
+  json out = json::object();
+  const Run3d* finest = nullptr;
+  for (const Run3d* r : runs)
+    if (!finest || r->h < finest->h) finest = r;
+  for (const char* key : {"displacement_per_cycle_m", "cycle_time_s", "mean_velocity_per_cycle_m_per_s", "max_displacement_m"}) {
+    const bool in3d = ref3d.contains(key) && ref3d[key].is_object(), inref = ref.contains(key) && ref[key].is_object();
+    if (!inref) continue;
+    auto get = [](const json& j, const char* k) {
+      return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::numeric_limits<double>::quiet_NaN();
+    };
+    const double a = in3d ? get(ref3d[key], "value") : std::numeric_limits<double>::quiet_NaN();
+    const double ea = in3d ? std::abs(get(ref3d[key], "error")) : std::numeric_limits<double>::quiet_NaN();
+    const double b = get(ref[key], "value"), eb = std::abs(get(ref[key], "error"));
+    json c = {{"value_3d", num(a)},
+              {"error_3d", num(ea)},
+              {"order_3d", in3d ? ref3d[key]["order"] : json(nullptr)},
+              {"observed_order_3d", in3d ? ref3d[key]["observed_order"] : json(nullptr)},
+              {"asymptotic_3d", in3d ? ref3d[key]["asymptotic"] : json(nullptr)},
+              {"value_reference", num(b)},
+              {"error_reference", num(eb)},
+              {"difference", num(a - b)},
+              {"combined_uncertainty", num(ea + eb)},
+              {"verdict", agreement_verdict(a, ea, b, eb)}};
+    if (!in3d) c["note"] = "fewer than two 3D grids completed a cycle: no 3D extrapolation";
+    double f = std::numeric_limits<double>::quiet_NaN();
+    if (finest) {
+      const std::string k = key;
+      f = k == "displacement_per_cycle_m" ? finest->cyc.displacement_per_cycle_m
+          : k == "cycle_time_s"           ? finest->cyc.cycle_time_s
+          : k == "mean_velocity_per_cycle_m_per_s" ? finest->cyc.mean_velocity_per_cycle_m_per_s
+                                                   : finest->max_displacement;
+      c["finest_3d_cell_size_m"] = finest->h;
+    }
+    c["finest_3d_value"] = num(f);
+    c["finest_3d_relative_error"] = std::abs(b) > 0 ? num((f - b) / std::abs(b)) : json(nullptr);
+    out[key] = c;
+  }
+  return out;
+}
+
+/// The reference's order range: its `order_range`, else the axi method's own (the fitted
+/// method is a sharp-interface one, the immersed boundary first order at best).
+OrderRange reference_orders(const json& ref, const axi::ParamsAxi& p) {
+  if (ref.contains("order_range")) return parse_order_range(ref["order_range"], "reference.order_range");
+  return p.method == axi::AxiMethod::Fitted ? kSharpInterfaceOrders : kImmersedBoundaryOrders;
+}
+
+
+}  // namespace swim::validation

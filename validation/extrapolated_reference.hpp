@@ -1,0 +1,45 @@
+// The references a case's 1D models are judged against, from the case's runs on a grid series:
+//   - the 3D reference: displacement per cycle, cycle time and (where the paper gives it) the
+//     largest centre displacement, each extrapolated to h -> 0 over the 3D grids that completed
+//     a cycle (richardson.hpp); the mean velocity per cycle as displacement over cycle time;
+//   - the axisymmetric reference: the same figures over the axi tier's grids, with the
+//     reference's order range, each stated converged or not against a target relative error;
+//   - the 3D extrapolation against the axisymmetric reference, figure by figure.
+// Each is the report entry itself (report.json: "reference3d", "reference",
+// "comparison_3d_vs_reference"); numbers that are not finite are null.
+#pragma once
+
+#include <vector>
+
+#include "axi/scene_axi.hpp"
+#include "validation/richardson.hpp"
+#include "validation/run_cache.hpp"
+
+namespace swim::validation {
+
+/// The 3D reference of a case's resolution study over the runs that completed a cycle, with
+/// the observed orders the 3D scheme can show (`orders`); the largest displacement with
+/// `with_max`. Fewer than two such runs: a note and no values.
+json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool with_max);
+
+/// The axisymmetric reference from its runs: each headline figure (and the largest centre
+/// displacement with `with_max`) extrapolated to h -> 0 with the reference's order range over
+/// the grids that completed a cycle; each figure converged when it is asymptotic, has an
+/// observed order (three grids) and its relative error is at most `target`; the reference
+/// converged when every figure is. When the whole cycle's time is not converged, it is taken
+/// as the sum of its phases, each extrapolated on its own, and the mean velocity per cycle as
+/// the displacement over that time (relative errors added); the whole cycle's extrapolation is
+/// kept beside it. `statement` says so with the figures reached.
+json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target);
+
+/// The 3D extrapolation (reference_3d's entry) against the axisymmetric reference, figure by
+/// figure: both values with their errors, the difference, e_3d + e_ref, agree / disagree
+/// (verdicts.hpp), the 3D series' observed order, and the finest 3D grid's relative error
+/// against the reference. `runs`: the 3D runs that completed a cycle.
+json compare_3d_with_reference(const json& ref3d, const json& ref, const std::vector<const Run3d*>& runs);
+
+/// The reference's order range: its `order_range`, else the axi method's own (the fitted
+/// method is a sharp-interface one, the immersed boundary first order at best).
+OrderRange reference_orders(const json& ref, const axi::ParamsAxi& p);
+
+}  // namespace swim::validation
