@@ -177,12 +177,25 @@ json same_swimmer(json resolved) {
 /// A run folder's scene.resolved.json resolved again by the current scene reader (the 3D
 /// tier's, or with axi_tier the axisymmetric tier's): keys the reader gained since the run was
 /// written appear with their defaults, so a run stays found as long as its physics is what
-/// the scene would resolve to today. null when the reader no longer accepts it.
+/// the scene would resolve to today (a wall written before full3d.membrane.bending_model
+/// existed resolves as the fixed k_b it had). null when the reader no longer accepts it.
 json current_resolution(const json& written, bool axi_tier = false) {
   try {
+    json w = written;
+    // written before the wall model (no full3d.membrane.bending_model): k_b was
+    // bending_constant on every mesh, bending_model "fixed_kb" today; a k_b set from
+    // bending_rigidity, and the axi tier's D, came from the earlier radial-lobe measure of D
+    // and are no run of today's reader (docs/full3d.md, "The wall model")
+    const json* mem = w.is_object() && w.contains("full3d") && w["full3d"].is_object() && w["full3d"].contains("membrane")
+                          ? &w["full3d"]["membrane"]
+                          : nullptr;
+    if (mem && mem->is_object() && !mem->contains("bending_model")) {
+      if (axi_tier || mem->contains("bending_rigidity")) return nullptr;
+      w["full3d"]["membrane"]["bending_model"] = "fixed_kb";
+    }
     json again;
-    if (axi_tier) axi::read_scene_axi(written, again);
-    else full3d::read_scene3d(written, again);
+    if (axi_tier) axi::read_scene_axi(w, again);
+    else full3d::read_scene3d(w, again);
     return again;
   } catch (const std::exception&) {
     return nullptr;
