@@ -164,9 +164,10 @@ int run3d(const RunOptions& o, const scene::json& sc) {
   std::fflush(stdout);  // the note follows the result line, also when both go to one file
   if (s.contains("max_wrinkle_over_h") && s["max_wrinkle_over_h"].get<double>() > 0.5)
     std::fprintf(stderr,
-                 "swim: note: the tube wall wrinkled (azimuthal lobes up to %s RMS, %.2g cells): the lobes follow the "
-                 "grid, so the displacement depends on full3d.grid.cells_across; a wall stiff enough in bending "
-                 "(full3d.membrane.bending_rigidity, docs/full3d.md \"Wall wrinkling\") keeps it round\n",
+                 "swim: note: the tube wall wrinkled (azimuthal lobes up to %s RMS, %.2g cells): without a seed the "
+                 "lobes follow the grid, so the displacement depends on full3d.grid.cells_across; a seed "
+                 "(full3d.membrane.seed_mode, seed_amplitude) chooses them, a wall stiff enough in bending "
+                 "(full3d.membrane.bending_rigidity) keeps it round (docs/full3d.md \"Wall wrinkling\")\n",
                  si(s["max_wrinkle_m"].get<double>(), "m").c_str(), s["max_wrinkle_over_h"].get<double>());
   plot_and_list(out, o.plot, had_plot);
   if (r.failed) {

@@ -78,17 +78,15 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
     throw InputError("full3d.membrane.bending_form", "\"printed\"",
                      "the axisymmetric wall measures bending from the reference shape (\"reference_angle\")");
 
-  // 2. The wall's moduli: the network's spring constant and the bending rigidity D the 3D
-  // tier's wall has on the scene's 3D mesh (equal to full3d.membrane.bending_rigidity when given).
+  // 2. The wall's moduli: the network's spring constant and the bending rigidity D of the 3D
+  // reader (the scene's D; with full3d.membrane.bending_model = "fixed_kb", what the fixed k_b
+  // gives the scene's 3D mesh).
   p.ks = b.membrane.ks;
-  {
-    const full3d::CylinderMesh mesh = full3d::make_mesh(b);
-    p.D = b.membrane.kb * full3d::bending_rigidity_per_kb(mesh, b.membrane.bending);
-    p.bending_source = b.bending_rigidity > 0 ? "full3d.membrane.bending_rigidity"
-                                              : "full3d.membrane.bending_constant " + fmt(b.membrane.kb, "N") +
-                                                    " on the 3D mesh of full3d.grid (n_theta " +
-                                                    std::to_string(mesh.n_theta) + ")";
-  }
+  if (b.seed_amplitude > 0.0)
+    throw InputError("full3d.membrane.seed_amplitude", fmt(b.seed_amplitude, ""),
+                     "the axisymmetric tier's wall is round (no lobes): set it to 0 or run --tier 3d");
+  p.D = b.bending_rigidity;
+  p.bending_source = b.bending_source;
 
   // 3. The axi section.
   json& res_axi = resolved["axi"];

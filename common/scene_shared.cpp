@@ -69,11 +69,13 @@ ContainerSpec read_container(Reader& top, double R0, double L) {
 WallSpec read_wall(Reader& top, double R0) {
   WallSpec w;
   Reader r = top.child("wall");
-  w.stiffness = one_of(r, {"C1", "spring_constant", "calibration"}, "spring_constant");
+  w.stiffness = one_of(r, {"C1", "spring_constant", "stretching_modulus", "calibration"}, "spring_constant");
   if (w.stiffness == "C1")
     w.value = r.quantity("C1", "Pa/m", "", Range::positive());
   else if (w.stiffness == "spring_constant")
     w.value = r.quantity("spring_constant", "N/m", "5.5e-8 N/m", Range::positive());
+  else if (w.stiffness == "stretching_modulus")  // the network's 2D Young's modulus Y = 2 k_s / sqrt(3)
+    w.value = std::sqrt(3.0) / 2.0 * r.quantity("stretching_modulus", "N/m", "", Range::positive());
   else
     w.calibration = r.text("calibration", "");
   if (r.has("law")) w.law = r.choice("law", "linear", {"linear", "calibrated_round", "calibrated_buckled"});

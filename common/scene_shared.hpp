@@ -39,8 +39,12 @@ struct ContainerSpec {
 ContainerSpec read_container(Reader& top, double R0, double L);
 
 struct WallSpec {
-  std::string stiffness;    ///< "C1", "spring_constant" or "calibration"
-  double value = 0;         ///< C1 [Pa/m] or k_s [N/m]; 0 for a calibration file
+  std::string stiffness;    ///< the key given: "C1", "spring_constant", "stretching_modulus" or "calibration"
+  /// C1 [Pa/m], or the spring constant k_s [N/m] of the network (wall.spring_constant, or
+  /// wall.stretching_modulus Y converted with k_s = sqrt(3) Y / 2); 0 for a calibration file
+  double value = 0;
+  /// The wall is given as a spring network (k_s in value): spring_constant or stretching_modulus.
+  bool network() const { return stiffness == "spring_constant" || stiffness == "stretching_modulus"; }
   std::string calibration;  ///< path, for "calibration"
   double mass_per_area = 0; ///< [kg/m^2] (mass_per_length converted with 2 pi R0, source-equations.md §1)
   /// wall.law: "linear" (the default, and when the key is absent: not echoed, so scenes without

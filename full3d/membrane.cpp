@@ -4,6 +4,7 @@
 #include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <string>
@@ -78,9 +79,6 @@ CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector
         m.edges.push_back({key.first, key.second});
       }
     }
-  m.rest_length.resize(Eigen::Index(m.edges.size()));
-  for (std::size_t e = 0; e < m.edges.size(); ++e)
-    m.rest_length[Eigen::Index(e)] = (m.X0.col(m.edges[e][1]) - m.X0.col(m.edges[e][0])).norm();
   for (const auto& [ab, c] : directed_opposite) {
     const auto [a, b] = ab;
     if (a > b) continue;  // visit each interior edge once
@@ -89,6 +87,14 @@ CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector
     m.hinges.push_back({a, b, c, it->second});
     m.hinge_edge.push_back(edge_id.at({a, b}));
   }
+  set_reference_geometry(m);
+  return m;
+}
+
+void set_reference_geometry(CylinderMesh& m) {
+  m.rest_length.resize(Eigen::Index(m.edges.size()));
+  for (std::size_t e = 0; e < m.edges.size(); ++e)
+    m.rest_length[Eigen::Index(e)] = (m.X0.col(m.edges[e][1]) - m.X0.col(m.edges[e][0])).norm();
   m.rest_angle.resize(Eigen::Index(m.hinges.size()));
   for (std::size_t k = 0; k < m.hinges.size(); ++k) {
     const auto& h = m.hinges[k];
@@ -97,13 +103,58 @@ CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector
   }
   m.rest_cos = m.rest_angle.array().cos();
   m.rest_sin = m.rest_angle.array().sin();
-  m.node_area = Eigen::VectorXd::Zero(nn);
+  m.node_area = Eigen::VectorXd::Zero(m.nodes());
   for (const auto& t : m.triangles) {
     const double area =
         0.5 * (m.X0.col(t[1]) - m.X0.col(t[0])).cross(m.X0.col(t[2]) - m.X0.col(t[0])).norm();
     for (int v : t) m.node_area[v] += area / 3.0;
   }
-  return m;
+}
+
+void seed_ring_mode(CylinderMesh& mesh, int m, double eps) {
+  if (!(m == 0 || m >= 2)) throw InputError("full3d.membrane.seed_mode", std::to_string(m), "0 (no seed) or >= 2");
+  if (!(eps >= 0.0 && eps < 0.5))
+    throw InputError("full3d.membrane.seed_amplitude", num(eps), "a fraction of R0 in [0, 0.5)");
+  if (m == 0 || eps == 0.0) return;
+  if (!(2 * m < mesh.n_theta))
+    throw InputError("full3d.membrane.seed_mode", std::to_string(m),
+                     "fewer than half the nodes per ring (" + std::to_string(mesh.n_theta) +
+                         " on this mesh), so that the ring resolves the lobes");
+  for (int i = 0; i < mesh.nodes(); ++i) {
+    const double dy = mesh.X0(1, i) - mesh.axis_start[1], dz = mesh.X0(2, i) - mesh.axis_start[2];
+    const double f = 1.0 + eps * std::cos(m * std::atan2(dz, dy));
+    mesh.X0(1, i) = mesh.axis_start[1] + f * dy;
+    mesh.X0(2, i) = mesh.axis_start[2] + f * dz;
+  }
+  set_reference_geometry(mesh);
+}
+
+double ring_buckling_pressure(int m, double D, double R, RingLoad load) {
+  if (m < 2) return std::numeric_limits<double>::infinity();  // m = 1 is a rigid shift of the ring
+  const double m2 = double(m) * m;
+  const double b = D / (R * R * R);
+  return load == RingLoad::Hydrostatic ? (m2 - 1.0) * b : (m2 - 1.0) * (m2 - 1.0) / (m2 - 2.0) * b;
+}
+
+double ring_mode_growth_rate(int m, double P, double D, double R, double drag, RingLoad load) {
+  if (m < 2) return -std::numeric_limits<double>::infinity();
+  const double m2 = double(m) * m;
+  // modal stiffness per unit length K_m (energy pi a^2 K_m / 2 of the lobe w = a cos(m theta),
+  // v = -(a / m) sin(m theta)) and modal drag c R (1 + 1/m^2) (dissipation pi c R (1 + 1/m^2) adot^2 / 2)
+  const double K = load == RingLoad::Hydrostatic
+                       ? (m2 - 1.0) * ((m2 - 1.0) * D / (R * R * R) - P)
+                       : (m2 - 1.0) * (m2 - 1.0) * D / (R * R * R) - P * ((m2 - 1.0) * (m2 - 1.0) - 1.0) / m2;
+  return -K / (drag * R * (1.0 + 1.0 / m2));
+}
+
+int fastest_ring_mode(double P, double D, double R, RingLoad load, int m_max) {
+  int best = 0;
+  double rate = 0.0;
+  for (int m = 2; m <= m_max; ++m) {
+    const double s = ring_mode_growth_rate(m, P, D, R, 1.0, load);
+    if (s > rate) rate = s, best = m;
+  }
+  return best;
 }
 
 int n_theta_for_spacing(double R0, double spacing) {
@@ -213,21 +264,24 @@ void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, 
   add_stretching_range(mesh, X, ks, 0, mesh.edges.size(), F);
 }
 
-double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form) {
+Eigen::Matrix3Xd inextensional_lobes(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, int m, double amp) {
+  Eigen::Matrix3Xd Y = X;
+  for (int i = 0; i < mesh.nodes(); ++i) {
+    const double dy = X(1, i) - mesh.axis_start[1], dz = X(2, i) - mesh.axis_start[2];
+    const double r = std::hypot(dy, dz), phi = std::atan2(dz, dy);
+    const double ur = amp * std::cos(m * phi), ut = -amp / m * std::sin(m * phi);
+    Y(1, i) += (ur * dy - ut * dz) / r;
+    Y(2, i) += (ur * dz + ut * dy) / r;
+  }
+  return Y;
+}
+
+double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form, int m) {
   const double R0 = mesh.radius, w = 1e-4 * R0;
-  auto lobed = [&](double amp) {
-    Eigen::Matrix3Xd X = mesh.X0;
-    for (int i = 0; i < mesh.nodes(); ++i) {
-      const double dy = X(1, i) - mesh.axis_start[1], dz = X(2, i) - mesh.axis_start[2];
-      const double f = 1.0 + amp / R0 * std::cos(2.0 * std::atan2(dz, dy));
-      X(1, i) = mesh.axis_start[1] + f * dy;
-      X(2, i) = mesh.axis_start[2] + f * dz;
-    }
-    return bending_energy(mesh, X, 1.0, form);
-  };
+  auto lobed = [&](double amp) { return bending_energy(mesh, inextensional_lobes(mesh, mesh.X0, m, amp), 1.0, form); };
   const double e2 = 0.5 * (lobed(w) + lobed(-w)) - bending_energy(mesh, mesh.X0, 1.0, form);
   const double length = mesh.ring_spacing * (mesh.n_rings - 1);
-  const double dk = 3.0 * w / (R0 * R0);
+  const double dk = (double(m) * m - 1.0) * w / (R0 * R0);
   return 2.0 * e2 / (0.5 * 2.0 * M_PI * R0 * length * dk * dk);
 }
 

@@ -54,6 +54,35 @@ struct CylinderMesh {
 
 /// Builds the cylinder mesh. Throws swim::InputError for R0 <= 0, L <= 0, n_theta < 3.
 CylinderMesh make_cylinder(double R0, double L, int n_theta, const Eigen::Vector3d& axis_start);
+/// The reference quantities (rest lengths, rest angles with their cosines and sines, node
+/// areas) from mesh.X0: the stress-free state is the reference shape X0.
+void set_reference_geometry(CylinderMesh& mesh);
+/// Seed imperfection of the stress-free shape (full3d.membrane.seed_mode, seed_amplitude):
+/// every node of X0 moves radially to r = R0 (1 + eps cos(m phi)), phi its angle about the
+/// axis, the same on every ring, and the reference quantities are recomputed, so the seeded
+/// tube is an unstressed tube with lobes of amplitude eps R0. m = 0 or eps = 0: no change.
+/// Throws swim::InputError for m = 1 or m < 0, eps outside [0, 0.5) and 2 m >= n_theta.
+void seed_ring_mode(CylinderMesh& mesh, int m, double eps);
+
+/// How a uniform radial load acts on the wall: Hydrostatic, a pressure normal to the deformed
+/// wall (a fluid); CentrallyDirected, a force of fixed magnitude per reference area directed at
+/// the axis (the tier's actuation load, potential P sum A_i r_i).
+enum class RingLoad { Hydrostatic, CentrallyDirected };
+/// Linear buckling load (Pa) of a ring of radius R (m) and bending rigidity D (J) in mode m
+/// (lobes w = a cos(m theta), inextensional: hoop stretching is much stiffer than bending):
+///   hydrostatic          p_m = (m^2 - 1) D / R^3,
+///   centrally directed   p_m = (m^2 - 1)^2 D / ((m^2 - 2) R^3)   (4.5 D / R^3 for m = 2).
+/// A tube with free ends under a load uniform along its axis buckles in these modes, uniform
+/// along the axis (no axial strain; docs/full3d.md, "Ring buckling"). m < 2: infinity.
+double ring_buckling_pressure(int m, double D, double R, RingLoad load);
+/// Linear growth rate (1/s, negative: decay) of ring mode m under the uniform load P (Pa)
+/// with an overdamped wall c dX/dt = F per area (drag c, kg/(m^2 s)):
+///   sigma_m = -K_m / (c R (1 + 1/m^2)),  K_m = (m^2-1)^2 D / R^3 - P ((m^2-1)^2 - 1) / m^2
+/// (centrally directed; hydrostatic: K_m = (m^2 - 1) ((m^2 - 1) D / R^3 - P)); K_m = 0 at p_m.
+double ring_mode_growth_rate(int m, double P, double D, double R, double drag, RingLoad load);
+/// The mode m in [2, m_max] that grows fastest under P (largest positive ring_mode_growth_rate);
+/// 0 when every mode is stable (P below every p_m).
+int fastest_ring_mode(double P, double D, double R, RingLoad load, int m_max = 64);
 /// n_theta whose ring chord is closest to (not above) the target node spacing.
 int n_theta_for_spacing(double R0, double spacing);
 /// Cylinder with target node spacing (m).
@@ -85,13 +114,20 @@ double dihedral_angle(const Eigen::Vector3d& a, const Eigen::Vector3d& b, const 
 double stretching_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, int threads = 1);
 double bending_energy(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                       int threads = 1);
+/// X with inextensional ring lobes of mode m added: radial w = amp cos(m phi) and
+/// tangential v = -(amp / m) sin(m phi) about the reference axis (v' = -w: the hoop does not
+/// stretch to first order), the same on every ring.
+Eigen::Matrix3Xd inextensional_lobes(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, int m, double amp);
 /// The bending rigidity D (J) that eq. (8) gives this mesh's wall per unit k_b (N): the
-/// energy of small ovalisation lobes r = R0 + w cos(2 theta) (second difference in w)
-/// against the continuum (D / 2) int dkappa^2 dA, dkappa = 3 w cos(2 theta) / R0^2. Every
-/// hinge angle scales with the edge length times the curvature, so D / k_b is about a
-/// quarter of the mean edge length (docs/full3d.md, "Wall wrinkling"): eq. (8) with a fixed
-/// k_b softens as the mesh is refined.
-double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form);
+/// energy of small inextensional lobes of mode m (inextensional_lobes; second difference in
+/// the amplitude w) against the continuum (D / 2) int dkappa^2 dA, dkappa = (m^2 - 1) w
+/// cos(m theta) / R0^2. The lobes must not stretch the hoop: a hinge measures the turning
+/// between neighbouring edges, which purely radial lobes change by m^2 w / R0 per radian
+/// instead of (m^2 - 1) w / R0 (D too high by m^4 / (m^2 - 1)^2, 1.78 for m = 2). Every hinge
+/// angle scales with the edge length a times the curvature, so D / k_b = (sqrt(3) / 8) a for
+/// an equilateral lattice (docs/full3d.md, "The wall model"): eq. (8) with a fixed k_b softens
+/// as the mesh is refined.
+double bending_rigidity_per_kb(const CylinderMesh& mesh, BendingForm form, int m = 2);
 void add_stretching_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double ks, Eigen::Matrix3Xd& F);
 void add_bending_forces(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, double kb, BendingForm form,
                         Eigen::Matrix3Xd& F);

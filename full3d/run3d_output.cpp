@@ -144,7 +144,11 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                   {"ring_spacing_m", mesh.ring_spacing},
                   {"max_edge_m", max_edge_length(mesh, mesh.X0)},
                   {"bending_constant_N", p.membrane.kb},
-                  {"bending_rigidity_J", p.membrane.kb * bending_rigidity_per_kb(mesh, p.membrane.bending)},
+                  {"bending_rigidity_J", p.bending_rigidity},
+                  {"bending_rigidity_from", p.bending_source},
+                  {"bending_model", p.bending_model == Params3d::BendingModel::FixedKb ? "fixed_kb" : "rigidity"},
+                  {"seed_mode", p.seed_mode},
+                  {"seed_amplitude", p.seed_amplitude},
                   {"segment_boundaries_m", protocol.boundaries()}};
   // the largest edge at the output steps; the no-leak guard needs < 0.5 h
   const double emax = rec_.series.count() ? rec_.series.max("max_edge_m") : 0.0;

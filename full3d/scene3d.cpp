@@ -2,6 +2,9 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
+#include <mutex>
+#include <tuple>
 
 #include "common/errors.hpp"
 #include "common/scene_shared.hpp"
@@ -39,7 +42,27 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh) {
   return q;
 }
 
-CylinderMesh make_mesh(const Params3d& p) { return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor); }
+CylinderMesh make_mesh(const Params3d& p) {
+  CylinderMesh mesh = make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor);
+  seed_ring_mode(mesh, p.seed_mode, p.seed_amplitude);
+  return mesh;
+}
+
+double reference_rigidity_per_kb(double R0, double L, double a_ref, BendingForm form) {
+  static std::mutex lock;
+  static std::map<std::tuple<double, double, double, int>, double> cache;
+  const auto key = std::make_tuple(R0, L, a_ref, int(form));
+  {
+    const std::lock_guard<std::mutex> g(lock);
+    const auto it = cache.find(key);
+    if (it != cache.end()) return it->second;
+  }
+  const double v =
+      bending_rigidity_per_kb(make_cylinder_for_grid(R0, L, 2.0 * a_ref, Eigen::Vector3d::Zero(), 1.0), form);
+  const std::lock_guard<std::mutex> g(lock);
+  cache[key] = v;
+  return v;
+}
 
 Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) {
   Params3d p;
@@ -63,10 +86,11 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   }
   {
     const scene::WallSpec w = scene::read_wall(top, R0);
-    if (w.stiffness != "spring_constant")
+    if (!w.network())
       throw InputError("wall." + w.stiffness, scene::show(scene.at("wall").at(w.stiffness)),
                        "the 3D tier models the wall as a spring network and needs its spring constant: give "
-                       "wall.spring_constant (N/m) instead; C1 and calibration are 1D lumped stiffnesses");
+                       "wall.spring_constant (N/m) or wall.stretching_modulus (N/m) instead; C1 and calibration "
+                       "are 1D lumped stiffnesses");
     p.membrane.ks = w.value;
     p.mass_per_area = w.mass_per_area;
   }
@@ -160,15 +184,49 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
                                                                                                : IbScheme::ForwardEuler;
     {
       Reader m = f.child("membrane");
+      p.bending_model = m.choice("bending_model", "rigidity", {"rigidity", "fixed_kb"}) == "fixed_kb"
+                            ? Params3d::BendingModel::FixedKb
+                            : Params3d::BendingModel::Rigidity;
+      const bool fixed_kb = p.bending_model == Params3d::BendingModel::FixedKb;
       if (m.has("bending_rigidity")) {
         p.bending_rigidity = m.quantity("bending_rigidity", "J", "", Range::positive());
         if (m.has("bending_constant"))
           throw InputError(m.path("bending_rigidity"), fmt(p.bending_rigidity, "J"),
                            "give either full3d.membrane.bending_constant (eq. 8's k_b, N) or "
                            "full3d.membrane.bending_rigidity (the wall's rigidity D, J), not both");
+        if (fixed_kb)
+          throw InputError(m.path("bending_rigidity"), fmt(p.bending_rigidity, "J"),
+                           "a wall given by its bending rigidity cannot also have the fixed k_b of "
+                           "full3d.membrane.bending_model = \"fixed_kb\" (the paper's literal eq. 8): "
+                           "remove one of full3d.membrane.bending_rigidity and full3d.membrane.bending_model");
+        if (m.has("reference_edge"))
+          throw InputError(m.path("reference_edge"), fmt(m.quantity("reference_edge", "m", "", Range::positive()), "m"),
+                           "maps full3d.membrane.bending_constant to the rigidity D; not used with "
+                           "full3d.membrane.bending_rigidity (remove one of the two)");
+        p.bending_source = "full3d.membrane.bending_rigidity";
       } else {
         p.membrane.kb = m.quantity("bending_constant", "N", "1e-15 N", Range::non_negative());
+        if (fixed_kb) {
+          if (m.has("reference_edge"))
+            throw InputError(m.path("reference_edge"), fmt(m.quantity("reference_edge", "m", "", Range::positive()), "m"),
+                             "maps full3d.membrane.bending_constant to the rigidity D; not used with "
+                             "full3d.membrane.bending_model = \"fixed_kb\" (remove one of the two)");
+        } else {
+          p.reference_edge = m.quantity("reference_edge", "m", fmt(kDefaultReferenceEdge, "m"), Range::positive());
+          if (!(p.reference_edge >= 0.01 * R0 && p.reference_edge <= R0))
+            throw InputError(m.path("reference_edge"), fmt(p.reference_edge, "m"),
+                             "between 0.01 swimmer.radius and swimmer.radius (" + fmt(0.01 * R0, "m") + " to " +
+                                 fmt(R0, "m") + ")");
+        }
       }
+      p.seed_mode = int(m.integer("seed_mode", 0, 0, 64));
+      if (p.seed_mode == 1)
+        throw InputError(m.path("seed_mode"), "1",
+                         "0 (no seed) or a lobe number >= 2 (m = 1 is a sideways shift of the ring, not a lobe)");
+      p.seed_amplitude = m.number("seed_amplitude", 0.0, Range::closed(0.0, 0.1));
+      if (p.seed_amplitude > 0.0 && p.seed_mode == 0)
+        throw InputError(m.path("seed_amplitude"), fmt(p.seed_amplitude, ""),
+                         "a seed needs its lobe number: give full3d.membrane.seed_mode >= 2 as well");
       p.membrane.bending = m.choice("bending_form", "reference_angle", {"reference_angle", "printed"}) == "printed"
                                ? BendingForm::Printed
                                : BendingForm::ReferenceAngle;
@@ -245,8 +303,23 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   if (mesh.nodes() > 2000000)
     throw InputError("full3d.grid", "", "the membrane would have more than 2e6 nodes; use a coarser grid");
   Protocol3d check(p.protocol, mesh, 1.0);  // every segment must hold a ring
-  // a given rigidity sets eq. (8)'s k_b for this mesh (D / k_b scales with the edge length)
-  if (p.bending_rigidity > 0.0) p.membrane.kb = p.bending_rigidity / bending_rigidity_per_kb(mesh, p.membrane.bending);
+  // The wall's bending rigidity D and eq. (8)'s k_b on this mesh (D / k_b scales with the edge
+  // length; measured on the unseeded mesh, the seed being an imperfection of the same wall)
+  const double per_kb_run = bending_rigidity_per_kb(
+      p.seed_amplitude > 0.0 ? make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor) : mesh,
+      p.membrane.bending);
+  if (p.bending_model == Params3d::BendingModel::FixedKb) {
+    p.bending_rigidity = p.membrane.kb * per_kb_run;
+    p.bending_source = "full3d.membrane.bending_constant " + fmt(p.membrane.kb, "N") +
+                       " fixed on every mesh (bending_model fixed_kb; n_theta " + std::to_string(mesh.n_theta) + ")";
+  } else {
+    if (!(p.bending_rigidity > 0.0)) {
+      p.bending_rigidity = p.membrane.kb * reference_rigidity_per_kb(p.R0, p.L, p.reference_edge, p.membrane.bending);
+      p.bending_source = "full3d.membrane.bending_constant " + fmt(p.membrane.kb, "N") + " at reference_edge " +
+                         fmt(p.reference_edge, "m");
+    }
+    p.membrane.kb = p.bending_rigidity / per_kb_run;
+  }
   return p;
 }
 

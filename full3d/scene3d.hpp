@@ -58,9 +58,22 @@ struct Params3d {
   double period = 2.0e-6;          ///< container length along x, m
   int nx = 128, ny = 32, nz = 32;  ///< grid cells
   double h = 0.5e-6 / 32;          ///< cell size, m
-  /// full3d.membrane.bending_rigidity, J (0: not given). When given, membrane.kb is set so
-  /// that eq. (8) gives the wall this rigidity on the run's mesh (bending_rigidity_per_kb).
+  /// The wall's bending rigidity D, J, as read (docs/full3d.md, "The wall model"):
+  ///  - BendingModel::Rigidity (default): D is full3d.membrane.bending_rigidity, or the paper's
+  ///    k_b (full3d.membrane.bending_constant) mapped to D on the scene's tube meshed at the
+  ///    reference edge (full3d.membrane.reference_edge); membrane.kb is then set per mesh so
+  ///    that eq. (8) gives the wall this D on the run's mesh (bending_rigidity_per_kb);
+  ///  - BendingModel::FixedKb (the paper's literal eq. 8, a reproduction setting): membrane.kb
+  ///    is bending_constant on every mesh and D is what it gives the run's mesh.
+  enum class BendingModel { Rigidity, FixedKb };
+  BendingModel bending_model = BendingModel::Rigidity;
   double bending_rigidity = 0.0;
+  double reference_edge = 0.0;     ///< m; the edge length bending_constant is mapped at (0: not used)
+  std::string bending_source;      ///< where D comes from (summary.json derived.bending_rigidity_from)
+  /// full3d.membrane.seed_mode, seed_amplitude: lobes m of amplitude eps R0 in the stress-free
+  /// shape (seed_ring_mode); 0: none
+  int seed_mode = 0;
+  double seed_amplitude = 0.0;
   /// full3d.membrane.axisymmetric: the wall moves in axisymmetric ring motions only
   /// (IbOptions::axisymmetric_wall); false (default): every node follows the fluid.
   bool axisymmetric_wall = false;
@@ -100,7 +113,16 @@ Params3d read_scene3d(const scene::json& scene, scene::json& resolved, bool pres
 /// The protocol parameters with the recovery-end energy of full3d.recovery_end filled in.
 ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh);
 
-/// The reference mesh of the scene (no-leak rule with the scene's spacing factor).
+/// The reference mesh of the scene (no-leak rule with the scene's spacing factor), with the
+/// scene's seed imperfection (full3d.membrane.seed_mode, seed_amplitude) in its stress-free shape.
 CylinderMesh make_mesh(const Params3d& p);
+
+/// The default of full3d.membrane.reference_edge, m: the longest-edge bound of the default
+/// grid of the paper's container, 0.6 * (0.5 um / 32) / 2 = 4.6875 nm.
+inline constexpr double kDefaultReferenceEdge = 4.6875e-9;
+/// D / k_b (m) of eq. (8) on the tube of radius R0 and length L meshed at the reference edge
+/// a_ref (the coarsest mesh whose longest edge is below a_ref): the map from the paper's k_b
+/// to the wall's D. Cached per (R0, L, a_ref, form).
+double reference_rigidity_per_kb(double R0, double L, double a_ref, BendingForm form);
 
 }  // namespace swim::full3d

@@ -146,7 +146,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     calibration = w.calibration;
     if (w.stiffness == "C1")
       p.wall.C1 = w.value;
-    else if (w.stiffness == "spring_constant")
+    else if (w.network())
       p.wall.C1 = scene::c1_from_spring_constant(w.value, R0);
     else
       p.wall.C1 = c1_from_calibration("wall.calibration", w.calibration, scene_dir);

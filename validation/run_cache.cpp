@@ -86,11 +86,29 @@ json same_swimmer(json resolved) {
 /// tier's, or with axi_tier the axisymmetric tier's): keys the reader gained since the run was
 /// written appear with their defaults, so a run stays found as long as its physics is what
 /// the scene would resolve to today. null when the reader no longer accepts it.
+///
+/// A wall written before full3d.membrane.bending_model existed: on the 3D tier, a fixed k_b
+/// (no bending_rigidity) resolves as the "fixed_kb" it was; a k_b set from a stated
+/// bending_rigidity came from the earlier radial-lobe measure of D (about twice the wall's D),
+/// so that run is not today's. On the axisymmetric tier a stated bending_rigidity was used as
+/// it is today (D itself); without one, D came from that measure, and the run is not today's
+/// (docs/full3d.md, "The wall model").
 json current_resolution(const json& written, bool axi_tier) {
   try {
+    json w = written;
+    json* mem = w.is_object() && w.contains("full3d") && w["full3d"].is_object() &&
+                        w["full3d"].contains("membrane") && w["full3d"]["membrane"].is_object()
+                    ? &w["full3d"]["membrane"]
+                    : nullptr;
+    const bool stated = mem && mem->contains("bending_rigidity");
+    if (!mem || !mem->contains("bending_model")) {
+      if (axi_tier && !stated) return nullptr;
+      if (!axi_tier && stated) return nullptr;
+      if (!axi_tier) w["full3d"]["membrane"]["bending_model"] = "fixed_kb";
+    }
     json again;
-    if (axi_tier) axi::read_scene_axi(written, again);
-    else full3d::read_scene3d(written, again);
+    if (axi_tier) axi::read_scene_axi(w, again);
+    else full3d::read_scene3d(w, again);
     return again;
   } catch (const std::exception&) {
     return nullptr;

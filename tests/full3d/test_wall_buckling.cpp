@@ -1,0 +1,346 @@
+// The wall model (docs/full3d.md, "The wall model"): a bending rigidity that does not depend
+// on the mesh, the ring-buckling estimate, the mode a uniform load grows on meshes of different
+// symmetry, and the seed imperfection.
+//
+// The buckled modes are measured on the discrete wall by an overdamped relaxation of the
+// membrane alone (c A_i dX_i/dt = F_i, no fluid): from the symmetric equilibrium under a
+// uniform load, a small perturbation grows in the unstable modes at their linear rates, and
+// the ring's Fourier spectrum of the radial displacement says which one.
+#include <gtest/gtest.h>
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <complex>
+#include <cstdio>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "common/scene.hpp"
+#include "full3d/membrane.hpp"
+#include "full3d/run3d_measure.hpp"
+#include "full3d/scene3d.hpp"
+
+using namespace swim;
+using namespace swim::full3d;
+
+namespace {
+constexpr double kR0 = 0.125e-6;
+
+// The test's own measure of the wall's bending rigidity on a mesh: the hinge energy of axially
+// uniform inextensional lobes (radial w cos(m phi), tangential -(w/m) sin(m phi), set here
+// on each node's polar coordinates) against the continuum (D / 2) int dkappa^2 dA,
+// dkappa = (m^2 - 1) w cos(m phi) / R0^2 (m = 4 here: not the m = 2 lobes the scene's
+// mapping uses).
+double measured_rigidity(const CylinderMesh& mesh, double kb, BendingForm form, int lobes) {
+  const double R0 = mesh.radius, w = 1e-4 * R0;
+  auto lobed = [&](double amp) {
+    Eigen::Matrix3Xd X = mesh.X0;
+    for (int i = 0; i < mesh.nodes(); ++i) {
+      const double dy = X(1, i) - mesh.axis_start[1], dz = X(2, i) - mesh.axis_start[2];
+      const double phi = std::atan2(dz, dy) - amp / (lobes * R0) * std::sin(lobes * std::atan2(dz, dy));
+      const double r = std::hypot(dy, dz) + amp * std::cos(lobes * std::atan2(dz, dy));
+      X(1, i) = mesh.axis_start[1] + r * std::cos(phi);
+      X(2, i) = mesh.axis_start[2] + r * std::sin(phi);
+    }
+    return bending_energy(mesh, X, kb, form);
+  };
+  const double e2 = 0.5 * (lobed(w) + lobed(-w)) - bending_energy(mesh, mesh.X0, kb, form);
+  const double dk = (lobes * lobes - 1) * w / (R0 * R0);
+  return 2.0 * e2 / (0.5 * 2.0 * M_PI * R0 * mesh.length * dk * dk);
+}
+
+Params3d paper_scene(int cells, const std::vector<std::string>& sets) {
+  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json");
+  sc["full3d"]["grid"]["cells_across"] = cells;
+  for (const auto& s : sets) scene::apply_override(sc, s);
+  scene::json resolved;
+  return read_scene3d(sc, resolved);
+}
+
+// Amplitudes |c_m| (m = 0 .. n_theta/2) of the radial displacement r_i - R_ref of one ring,
+// c_m = (2 / n) sum_i (r_i - R_ref) exp(-i m phi_i), phi_i the node's reference angle.
+std::vector<double> ring_spectrum(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, int ring) {
+  const Eigen::VectorXd r = node_radii(mesh, X);
+  double mean = 0.0;
+  for (int i = 0; i < mesh.n_theta; ++i) mean += r[mesh.node(ring, i)] / mesh.n_theta;
+  std::vector<double> out(std::size_t(mesh.n_theta / 2 + 1), 0.0);
+  for (int m = 0; m <= mesh.n_theta / 2; ++m) {
+    std::complex<double> c = 0.0;
+    for (int i = 0; i < mesh.n_theta; ++i) {
+      const int k = mesh.node(ring, i);
+      const double phi = 2.0 * M_PI * (i + 0.5 * (ring % 2)) / mesh.n_theta;
+      c += (r[k] - mean) * std::polar(1.0, -m * phi);
+    }
+    out[std::size_t(m)] = 2.0 / mesh.n_theta * std::abs(c);
+  }
+  return out;
+}
+
+int dominant_lobes(const std::vector<double>& spectrum) {
+  return int(std::max_element(spectrum.begin() + 2, spectrum.end()) - spectrum.begin());
+}
+
+// Overdamped relaxation of the membrane under the uniform load P (potential P sum A_i r_i):
+// X += dt / (c A_i) (F_el - P A_i e_r), c = 1 kg/(m^2 s), for the time T. The step is 0.9 / lambda_max of
+// the relaxation operator (power iteration on differences of the exact forces), inside the
+// explicit bound 2 / lambda_max.
+struct Relaxation {
+  const CylinderMesh& mesh;
+  MembraneParams p;
+  double pressure;
+  Eigen::Matrix3Xd force(const Eigen::Matrix3Xd& X) const {
+    Eigen::Matrix3Xd F = elastic_forces(mesh, X, p);
+    const Eigen::Matrix3Xd e = radial_directions(mesh, X);
+    for (int i = 0; i < mesh.nodes(); ++i) F.col(i) -= pressure * mesh.node_area[i] * e.col(i);
+    return F;
+  }
+  Eigen::Matrix3Xd rate(const Eigen::Matrix3Xd& X) const {
+    Eigen::Matrix3Xd V = force(X);
+    for (int i = 0; i < mesh.nodes(); ++i) V.col(i) /= mesh.node_area[i];
+    return V;
+  }
+  double largest_rate(const Eigen::Matrix3Xd& X) const {
+    std::mt19937 rng(5);
+    std::normal_distribution<double> N(0.0, 1.0);
+    Eigen::Matrix3Xd v(3, X.cols());
+    for (Eigen::Index i = 0; i < v.size(); ++i) v.data()[i] = N(rng);
+    const double s = 1e-6 * mesh.rest_length.minCoeff();
+    double lambda = 0.0;
+    for (int it = 0; it < 60; ++it) {
+      v /= v.norm();
+      const Eigen::Matrix3Xd w = (rate(X - s * v) - rate(X + s * v)) / (2.0 * s);
+      lambda = w.norm();
+      v = w;
+    }
+    return lambda;
+  }
+  Eigen::Matrix3Xd run(Eigen::Matrix3Xd X, double T) const {
+    const double dt = 0.9 / (1.2 * largest_rate(X));
+    const long steps = long(std::ceil(T / dt));
+    for (long n = 0; n < steps; ++n) X += (T / steps) * rate(X);
+    return X;
+  }
+};
+
+// A short tube on n_theta nodes per ring with the rigidity D (the scene's mapping of k_b on this mesh).
+CylinderMesh tube(int n_theta) { return make_cylinder(kR0, 2.0 * kR0, n_theta, Eigen::Vector3d::Zero()); }
+MembraneParams wall_with_rigidity(const CylinderMesh& mesh, double D) {
+  MembraneParams p;
+  p.kb = D / bending_rigidity_per_kb(mesh, p.bending);
+  return p;
+}
+constexpr double kD = 4.0e-24;  // J; Y R^2 / D = 250: the load 12 D / R^3 contracts the tube by 2 %
+}  // namespace
+
+// ---- the wall's rigidity by mesh ----
+
+// With the default wall model (bending_model "rigidity") the bending rigidity measured on the
+// discrete wall (m = 4 lobes, the test's own measure) equals the scene's D on the meshes of 24,
+// 32, 40 and 48 cells across (126, 168, 210 and 252 nodes per ring) within 6 %; the paper's
+// literal fixed k_b gives the same meshes rigidities that differ by more than that (it halves
+// with the edge length), so it fails the same assertion.
+TEST(WallRigidity, MeasuredRigidityIsTheScenesOnEveryMeshAndAFixedKbIsNot) {
+  constexpr double kTol = 0.06;
+  std::vector<double> fixed;
+  for (int cells : {24, 32, 40, 48}) {
+    const Params3d p = paper_scene(cells, {});
+    const CylinderMesh mesh = make_mesh(p);
+    const double D = measured_rigidity(mesh, p.membrane.kb, p.membrane.bending, 4);
+    std::printf("%d cells, n_theta %d, edge %.3g m: rigidity wall D = %.4g J (scene %.4g J, %+.2f %%)", cells,
+                mesh.n_theta, mesh.rest_length.mean(), D, p.bending_rigidity, 100.0 * (D / p.bending_rigidity - 1.0));
+    EXPECT_NEAR(D / p.bending_rigidity, 1.0, kTol) << cells << " cells";
+    const Params3d q = paper_scene(cells, {"full3d.membrane.bending_model=\"fixed_kb\""});
+    EXPECT_DOUBLE_EQ(q.membrane.kb, 1e-15);
+    fixed.push_back(measured_rigidity(make_mesh(q), q.membrane.kb, q.membrane.bending, 4));
+    std::printf("; fixed k_b: D = %.4g J; D / (k_b a) for m = 2, 3, 4, 8: %.4f %.4f %.4f %.4f\n", fixed.back(),
+                bending_rigidity_per_kb(mesh, p.membrane.bending, 2) / mesh.rest_length.mean(),
+                bending_rigidity_per_kb(mesh, p.membrane.bending, 3) / mesh.rest_length.mean(),
+                bending_rigidity_per_kb(mesh, p.membrane.bending, 4) / mesh.rest_length.mean(),
+                bending_rigidity_per_kb(mesh, p.membrane.bending, 8) / mesh.rest_length.mean());
+  }
+  // the fixed k_b's rigidity against the same assertion: a constant D would be within kTol of
+  // every mesh's value; the spread is far larger
+  const double lo = *std::min_element(fixed.begin(), fixed.end()), hi = *std::max_element(fixed.begin(), fixed.end());
+  EXPECT_GT(hi / lo - 1.0, 4.0 * kTol);
+  EXPECT_NEAR(hi / lo, 2.0, 0.2);  // 24 vs 48 cells: half the edge length, half the rigidity
+}
+
+// The default maps the paper's k_b = 1e-15 N at the reference edge 4.6875 nm, the default grid's:
+// at 32 cells (the default) the rigidity wall is the literal one, k_b = 1e-15 N exactly.
+TEST(WallRigidity, TheDefaultGridKeepsThePapersKb) {
+  const Params3d p = paper_scene(32, {});
+  EXPECT_EQ(p.bending_model, Params3d::BendingModel::Rigidity);
+  EXPECT_NEAR(p.membrane.kb, 1e-15, 1e-9 * 1e-15);
+  EXPECT_NEAR(p.reference_edge, 4.6875e-9, 1e-20);
+  const Params3d q = paper_scene(32, {"full3d.membrane.bending_model=\"fixed_kb\""});
+  EXPECT_NEAR(q.bending_rigidity, p.bending_rigidity, 1e-9 * p.bending_rigidity);
+  // a stated D is the same wall as the k_b it maps from
+  char d[64];
+  std::snprintf(d, sizeof d, "full3d.membrane.bending_rigidity=\"%.17g J\"", p.bending_rigidity);
+  const Params3d r = paper_scene(48, {d});
+  EXPECT_NEAR(r.membrane.kb, paper_scene(48, {}).membrane.kb, 1e-5 * r.membrane.kb);
+}
+
+// The stretching modulus is the network's 2D Young's modulus Y = 2 k_s / sqrt(3).
+TEST(WallRigidity, StretchingModulusIsTheNetworksYoungsModulus) {
+  const Params3d p = paper_scene(24, {"wall={\"stretching_modulus\": \"6.350852961e-8 N/m\"}"});
+  EXPECT_NEAR(p.membrane.ks, 5.5e-8, 1e-9 * 5.5e-8);
+}
+
+// A wall given both ways is refused before anything is written, naming both keys.
+TEST(WallRigidity, AWallGivenBothWaysIsRefusedNamingBothKeys) {
+  auto refused = [](const std::vector<std::string>& sets, const std::string& a, const std::string& b) {
+    try {
+      paper_scene(24, sets);
+      ADD_FAILURE() << "accepted: " << sets.front();
+    } catch (const InputError& err) {
+      const std::string m = err.what();
+      EXPECT_NE(m.find(a), std::string::npos) << m;
+      EXPECT_NE(m.find(b), std::string::npos) << m;
+    }
+  };
+  refused({"full3d.membrane.bending_rigidity=\"2e-24 J\"", "full3d.membrane.bending_model=\"fixed_kb\""},
+          "full3d.membrane.bending_rigidity", "full3d.membrane.bending_model");
+  refused({"full3d.membrane.bending_rigidity=\"2e-24 J\"", "full3d.membrane.bending_constant=\"1e-15 N\""},
+          "full3d.membrane.bending_rigidity", "full3d.membrane.bending_constant");
+  refused({"full3d.membrane.bending_rigidity=\"2e-24 J\"", "full3d.membrane.reference_edge=\"5 nm\""},
+          "full3d.membrane.reference_edge", "full3d.membrane.bending_rigidity");
+  refused({"full3d.membrane.bending_model=\"fixed_kb\"", "full3d.membrane.reference_edge=\"5 nm\""},
+          "full3d.membrane.reference_edge", "full3d.membrane.bending_model");
+  refused({"wall.stretching_modulus=\"6e-8 N/m\""}, "wall.stretching_modulus", "spring_constant");
+}
+
+// ---- the ring-buckling estimate ----
+
+// The free ring's loads (Timoshenko & Gere, Theory of Elastic Stability, 1961, sec. 7.4):
+// 3 D / R^3 (hydrostatic) and 4.5 D / R^3 (centrally directed) for m = 2; both tend to
+// m^2 D / R^3 for many lobes. The growth rate changes sign at p_m; the fastest mode moves from
+// m = 2 to m = 3 as the load passes the rates' crossing (centrally directed: 4.5 D/R^3 < P,
+// m = 3 faster from P = (m2 rate = m3 rate) ~ 8.9 D/R^3).
+TEST(RingBuckling, LoadsAndGrowthRatesOfTheFreeRing) {
+  const double D = 2e-24, R = 0.1e-6, b = D / (R * R * R);
+  EXPECT_NEAR(ring_buckling_pressure(2, D, R, RingLoad::Hydrostatic), 3.0 * b, 1e-12 * b);
+  EXPECT_NEAR(ring_buckling_pressure(2, D, R, RingLoad::CentrallyDirected), 4.5 * b, 1e-12 * b);
+  EXPECT_NEAR(ring_buckling_pressure(3, D, R, RingLoad::CentrallyDirected), 64.0 / 7.0 * b, 1e-12 * b);
+  EXPECT_NEAR(ring_buckling_pressure(40, D, R, RingLoad::CentrallyDirected) / (1600.0 * b), 1.0, 1e-3);
+  EXPECT_NEAR(ring_buckling_pressure(40, D, R, RingLoad::Hydrostatic) / (1600.0 * b), 1.0, 1e-3);
+  EXPECT_TRUE(std::isinf(ring_buckling_pressure(1, D, R, RingLoad::Hydrostatic)));
+  for (auto load : {RingLoad::Hydrostatic, RingLoad::CentrallyDirected})
+    for (int m = 2; m <= 8; ++m) {
+      const double pm = ring_buckling_pressure(m, D, R, load);
+      EXPECT_LT(ring_mode_growth_rate(m, 0.99 * pm, D, R, 1.0, load), 0.0);
+      EXPECT_GT(ring_mode_growth_rate(m, 1.01 * pm, D, R, 1.0, load), 0.0);
+    }
+  EXPECT_EQ(fastest_ring_mode(4.4 * b, D, R, RingLoad::CentrallyDirected), 0);
+  EXPECT_EQ(fastest_ring_mode(7.0 * b, D, R, RingLoad::CentrallyDirected), 2);
+  EXPECT_EQ(fastest_ring_mode(12.0 * b, D, R, RingLoad::CentrallyDirected), 3);
+  EXPECT_EQ(fastest_ring_mode(3.5 * b, D, R, RingLoad::Hydrostatic), 2);
+}
+
+// ---- the mode a uniform load grows ----
+
+// A uniform load on the free tube grows the mode the estimate predicts at that load, on meshes
+// of 20 (four-fold, no three-fold), 23 (prime) and 24 (four- and three-fold) nodes per ring: m = 2 at
+// 7 D/R^3 (only m = 2 unstable) and m = 3 at 12 D/R^3 (m = 2 and 3 unstable, m = 3 fastest).
+// The perturbation is random (all modes alike); it grows 10^4 times at the predicted rate.
+TEST(RingBuckling, UniformLoadGrowsThePredictedModeOnEveryMesh) {
+  for (int n : {20, 23, 24}) {
+    const CylinderMesh mesh = tube(n);
+    const MembraneParams p = wall_with_rigidity(mesh, kD);
+    for (double load : {7.0, 12.0}) {
+      // the load is load D / R^3 at the loaded radius R (two passes of the static relaxation)
+      double R = kR0, P = 0.0;
+      PressureResponse eq;
+      for (int pass = 0; pass < 3; ++pass) {
+        P = load * kD / std::pow(R, 3);
+        eq = relax_under_pressure(mesh, p, P);
+        R = eq.mid_radius;
+      }
+      const int predicted = fastest_ring_mode(P, kD, R, RingLoad::CentrallyDirected);
+      ASSERT_EQ(predicted, load < 10 ? 2 : 3);
+      const double rate = ring_mode_growth_rate(predicted, P, kD, R, 1.0, RingLoad::CentrallyDirected);
+      std::mt19937 rng(17 + n);
+      std::normal_distribution<double> N(0.0, 1e-9 * kR0);
+      Eigen::Matrix3Xd X = eq.X;
+      for (Eigen::Index i = 0; i < X.size(); ++i) X.data()[i] += N(rng);
+      const Relaxation relax{mesh, p, P};
+      const Eigen::Matrix3Xd Y = relax.run(X, std::log(1e4) / rate);
+      const int ring = mesh.n_rings / 2;
+      const std::vector<double> s = ring_spectrum(mesh, Y, ring);
+      std::printf("n_theta %d, P = %.0f D/R0^3: predicted m = %d; grown amplitudes m = 2, 3, 4: %.3g %.3g %.3g R0\n", n,
+                  load, predicted, s[2] / kR0, s[3] / kR0, s[4] / kR0);
+      EXPECT_EQ(dominant_lobes(s), predicted) << "n_theta " << n << ", load " << load;
+      EXPECT_GT(s[std::size_t(predicted)], 1e-7 * kR0);  // grown from ~1e-9 R0
+    }
+  }
+}
+
+// ---- the seed ----
+
+// A seed of mode m and amplitude eps R0 in the stress-free shape grows mode m under a load
+// above its buckling load: m = 2 and m = 3 at 12 D/R^3 on 20 nodes per ring (where m = 3
+// would grow faster from noise), each from eps = 1e-8 to more than 100 eps. With a zero seed the
+// symmetric mesh stays round to round-off under the same load for the same time.
+TEST(WallSeed, SeedGrowsItsModeAndNoSeedStaysRound) {
+  double R = kR0, P = 0.0;
+  {
+    const CylinderMesh mesh = tube(20);
+    for (int pass = 0; pass < 3; ++pass) {
+      P = 12.0 * kD / std::pow(R, 3);
+      R = relax_under_pressure(mesh, wall_with_rigidity(mesh, kD), P).mid_radius;
+    }
+  }
+  const double T = std::log(1e4) / ring_mode_growth_rate(3, P, kD, R, 1.0, RingLoad::CentrallyDirected);
+  const int ring = 5;
+  for (int m : {2, 3}) {
+    CylinderMesh mesh = tube(20);
+    const MembraneParams p = wall_with_rigidity(mesh, kD);
+    seed_ring_mode(mesh, m, 1e-8);
+    EXPECT_NEAR(ring_spectrum(mesh, mesh.X0, ring)[std::size_t(m)], 1e-8 * kR0, 1e-3 * 1e-8 * kR0);
+    const Relaxation relax{mesh, p, P};
+    const Eigen::Matrix3Xd Y = relax.run(mesh.X0, T);
+    const std::vector<double> s = ring_spectrum(mesh, Y, ring);
+    std::printf("seed m = %d, eps = 1e-8: grown amplitudes m = 2, 3, 4: %.3g %.3g %.3g R0\n", m, s[2] / kR0,
+                s[3] / kR0, s[4] / kR0);
+    EXPECT_EQ(dominant_lobes(s), m);
+    EXPECT_GT(s[std::size_t(m)], 100 * 1e-8 * kR0);
+  }
+  const CylinderMesh mesh = tube(20);
+  const MembraneParams p = wall_with_rigidity(mesh, kD);
+  const Relaxation relax{mesh, p, P};
+  const Eigen::Matrix3Xd Y = relax.run(mesh.X0, T);
+  const double wrinkle = wall_wrinkle(mesh, node_radii(mesh, Y), ring_radii(mesh, Y));
+  std::printf("no seed: wall wrinkle %.3g R0 after the same time\n", wrinkle / kR0);
+  EXPECT_LT(wrinkle, 1e-11 * kR0);
+}
+
+// The scene keys: the seed is in the run's stress-free mesh with the stated mode and amplitude;
+// bad seeds are refused naming the key.
+TEST(WallSeed, SceneKeysSeedTheRunsMesh) {
+  const Params3d p = paper_scene(24, {"full3d.membrane.seed_mode=4", "full3d.membrane.seed_amplitude=0.01"});
+  const CylinderMesh mesh = make_mesh(p);
+  const std::vector<double> s = ring_spectrum(mesh, mesh.X0, mesh.n_rings / 2);
+  EXPECT_NEAR(s[4], 0.01 * kR0, 1e-6 * kR0);
+  EXPECT_EQ(dominant_lobes(s), 4);
+  // the seeded wall has the unseeded wall's rigidity
+  EXPECT_NEAR(p.bending_rigidity, paper_scene(24, {}).bending_rigidity, 1e-12 * p.bending_rigidity);
+  EXPECT_NEAR(p.membrane.kb, paper_scene(24, {}).membrane.kb, 1e-12 * p.membrane.kb);
+  auto refused_key = [](const std::vector<std::string>& sets) {
+    try {
+      paper_scene(24, sets);
+    } catch (const InputError& err) {
+      return err.key();
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused_key({"full3d.membrane.seed_mode=1", "full3d.membrane.seed_amplitude=0.01"}),
+            "full3d.membrane.seed_mode");
+  EXPECT_EQ(refused_key({"full3d.membrane.seed_amplitude=0.01"}), "full3d.membrane.seed_amplitude");
+  EXPECT_EQ(refused_key({"full3d.membrane.seed_amplitude=0.2", "full3d.membrane.seed_mode=2"}),
+            "full3d.membrane.seed_amplitude");
+  EXPECT_EQ(refused_key({"full3d.membrane.seed_mode=64", "full3d.membrane.seed_amplitude=0.01", "full3d.grid.cells_across=12"}),
+            "full3d.membrane.seed_mode");
+}
