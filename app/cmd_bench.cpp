@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <string>
 #include <thread>
 #include <utility>
@@ -203,18 +204,33 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   if (do1d) {
   std::printf("== 1D tier ==\n");
   std::printf("one force-driven cycle (demo scene, best of %d):\n", reps);
-  std::printf("  %6s %12s %10s %10s %10s\n", "N", "wall [ms]", "steps", "switches", "cycle [s]");
+  std::printf("  %6s %12s %10s %10s %10s %10s %10s\n", "N", "wall [ms]", "steps", "set-ups", "residuals", "switches",
+              "cycle [s]");
   scene::json cycles = scene::json::array();
-  for (int n : {50, 200, 800}) {
-    const auto p = demo_params({"numerics1d.cells=" + std::to_string(n), "protocol.cycles=1", "time.duration=\"auto\""});
+  // the default model at N = 50, 200, 800, and at N = 50 with the calibrated round-wall law
+  // (docs/tube-law.md) in place of the linear one
+  const std::string law_file = SWIM_SOURCE_DIR "/docs/tube-law/calibration.json";
+  const bool have_law = std::filesystem::exists(law_file);
+  const std::vector<std::string> calibrated = {"wall.spring_constant=null", "wall.calibration=\"" + law_file + "\"",
+                                               "wall.law=\"calibrated_round\""};
+  for (int n : {50, 200, 800, -50}) {
+    if (n < 0 && !have_law) continue;
+    std::vector<std::string> sets = {"numerics1d.cells=" + std::to_string(std::abs(n)), "protocol.cycles=1",
+                                     "time.duration=\"auto\""};
+    if (n < 0) sets.insert(sets.end(), calibrated.begin(), calibrated.end());
+    const auto p = demo_params(sets);
     reduced1d::Result r;
     const double best = best_solve_time(p, reps, r);
     const auto m = reduced1d::metrics(p, r);
-    const long steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
-    std::printf("  %6d %12.3f %10ld %10ld %10.4g%s\n", n, 1e3 * best, steps, r.switches, m.mean_cycle_time_s,
+    auto stat = [&](const char* k) { return r.stats.count(k) ? r.stats.at(k) : 0L; };
+    std::printf("  %6d %12.3f %10ld %10ld %10ld %10ld %10.4g%s%s\n", std::abs(n), 1e3 * best, stat("steps"),
+                stat("lin_setups"), stat("rhs_evals"), r.switches, m.mean_cycle_time_s, n < 0 ? "  calibrated_round wall" : "",
                 r.failure ? "  FAILED" : "");
-    cycles.push_back({{"cells", n}, {"wall_time_s", best}, {"steps", steps}, {"switches", r.switches},
-                      {"cycle_time_s", m.mean_cycle_time_s}, {"ok", !r.failure}});
+    cycles.push_back({{"cells", std::abs(n)}, {"wall_law", n < 0 ? "calibrated_round" : "linear"}, {"wall_time_s", best},
+                      {"steps", stat("steps")}, {"newton_setups", stat("lin_setups")},
+                      {"newton_iterations", stat("nonlin_iters")}, {"residual_evals", stat("rhs_evals")},
+                      {"switches", r.switches}, {"cycle_time_s", m.mean_cycle_time_s},
+                      {"displacement_per_cycle_m", m.displacement_per_cycle_m}, {"ok", !r.failure}});
   }
   report["force_driven_cycle"] = cycles;
   // The lubrication-only wall (no short-wave traction), the other outer flow and the paper's
@@ -247,9 +263,11 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
     std::string kind;
     int cells;
     bool traction = true;
+    bool calibrated_law = false;
   };
   for (const Case& c : {Case{"step", 200}, Case{"force_driven", 200}, Case{"force_driven", 50},
-                        Case{"force_driven", 200, false}}) {
+                        Case{"force_driven", 50, true, true}, Case{"force_driven", 200, false}}) {
+    if (c.calibrated_law && !have_law) continue;
     const int n = c.kind == "step" ? (quick ? 100 : 1000) : (quick ? 20 : 100);
     std::vector<reduced1d::Params> designs;
     for (int k = 0; k < n; ++k) {
@@ -261,6 +279,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       std::vector<std::string> sets = {l, s, "wave.kind=\"" + c.kind + "\"",
                                        "numerics1d.cells=" + std::to_string(c.cells)};
       if (!c.traction) sets.push_back("model1d.short_wave_traction=false");
+      if (c.calibrated_law) sets.insert(sets.end(), calibrated.begin(), calibrated.end());
       if (c.kind == "step")
         sets.push_back("protocol=null");
       else
@@ -280,7 +299,8 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
       cpu[pass] = process_cpu_seconds() - c0;
       if (pass == 0) failed = std::count_if(res.begin(), res.end(), [](const auto& r) { return !r.ok; });
     }
-    const std::string label = c.kind + (c.traction ? "" : " lubrication wall") + " N=" + std::to_string(c.cells);
+    const std::string label = c.kind + (c.traction ? "" : " lubrication wall") +
+                              (c.calibrated_law ? " calibrated_round wall" : "") + " N=" + std::to_string(c.cells);
     std::printf("  %-20s %6d designs in %8.3f s: %9.1f designs/s (%ld failed); CPU %.3g ms/design, %.2f cores used; "
                 "1 thread: %.1f designs/s, CPU %.3g ms/design\n",
                 label.c_str(), n, wall[0], n / wall[0], failed, 1e3 * cpu[0] / n, cpu[0] / wall[0], n / wall[1],

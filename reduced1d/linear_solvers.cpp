@@ -359,7 +359,7 @@ struct BlockTri {
           for (int r = 0; r < s; ++r) {
             const double u = Uk[c * ld + r];
             if (u == 0.0) continue;
-            for (int q = 0; q < ld; ++q) P[c * ld + q] += Di[r * ld + q] * u;
+            for (int q = 0; q < ld; q += 4) store4(P + c * ld + q, load4(P + c * ld + q) + load4(Di + r * ld + q) * u);
           }
       }
     }
