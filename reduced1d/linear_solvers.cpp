@@ -20,8 +20,9 @@ namespace {
 // Four doubles as one AVX register (GCC/Clang vector extension). The block kernels below
 // update whole padded rows and columns with it: left to itself the compiler fully unrolls
 // those 4- to 16-element loops into scalar operations. Loads and stores go through memcpy
-// (no alignment or aliasing assumptions); a - f * b contracts to the same fused
-// multiply-add as the scalar code, so the results are the same bit for bit.
+// (no alignment or aliasing assumptions); a - f * b contracts to a fused multiply-add as the
+// scalar code did (blocks of 8, the default model at N = 50: the same results bit for bit;
+// other block sizes differ in the last bits, docs/performance-1d.md).
 using V4 = double __attribute__((vector_size(32)));
 inline V4 load4(const double* p) {
   V4 v;
