@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cstdio>
 #include <ctime>
+#include <filesystem>
 #include <memory>
 #include <string>
 #include <thread>
@@ -137,10 +138,20 @@ double fft_floor_staggered(int nx, int ny, int nz, int threads, int reps) {
 struct CycleTiming {
   int cells = 0;
   std::string set;  ///< the variant's scene change ("" for the plain scene)
+  std::string wall_law = "linear";
   double wall_s = 0, cycle_time_s = 0, displacement_per_cycle_m = 0;
-  long steps = 0, switches = 0;
+  long steps = 0, switches = 0, newton_setups = 0, newton_iterations = 0, residual_evals = 0;
   bool ok = false;
 };
+
+/// The calibrated round-wall law shipped in docs/tube-law/ (absent in an installed tree).
+const std::string kLawFile = SWIM_SOURCE_DIR "/docs/tube-law/calibration.json";
+
+/// The scene changes that put the calibrated round-wall law (docs/tube-law.md) in place of the
+/// linear one.
+std::vector<std::string> calibrated_wall_sets() {
+  return {"wall.spring_constant=null", "wall.calibration=\"" + kLawFile + "\"", "wall.law=\"calibrated_round\""};
+}
 
 CycleTiming time_cycle(int cells, const std::vector<std::string>& sets, const std::string& variant, int reps) {
   const auto p = demo_params(sets);
@@ -150,7 +161,11 @@ CycleTiming time_cycle(int cells, const std::vector<std::string>& sets, const st
   c.set = variant;
   c.wall_s = best_solve_time(p, reps, r);
   const auto m = reduced1d::metrics(p, r);
-  c.steps = r.stats.count("steps") ? r.stats.at("steps") : 0;
+  auto stat = [&](const char* k) { return r.stats.count(k) ? r.stats.at(k) : 0L; };
+  c.steps = stat("steps");
+  c.newton_setups = stat("lin_setups");
+  c.newton_iterations = stat("nonlin_iters");
+  c.residual_evals = stat("rhs_evals");
   c.switches = r.switches;
   c.cycle_time_s = m.mean_cycle_time_s;
   c.displacement_per_cycle_m = m.displacement_per_cycle_m;
@@ -159,13 +174,23 @@ CycleTiming time_cycle(int cells, const std::vector<std::string>& sets, const st
 }
 
 void print_cycle(const CycleTiming& c) {
-  std::printf("  %6d %12.3f %10ld %10ld %10.4g%s%s%s\n", c.cells, 1e3 * c.wall_s, c.steps, c.switches, c.cycle_time_s,
-              c.set.empty() ? "" : "  ", c.set.c_str(), c.ok ? "" : "  FAILED");
+  std::printf("  %6d %12.3f %10ld %10ld %10ld %10ld %10.4g%s%s%s%s\n", c.cells, 1e3 * c.wall_s, c.steps, c.newton_setups,
+              c.residual_evals, c.switches, c.cycle_time_s, c.set.empty() ? "" : "  ", c.set.c_str(),
+              c.wall_law == "linear" ? "" : ("  " + c.wall_law + " wall").c_str(), c.ok ? "" : "  FAILED");
 }
 
 scene::json cycle_json(const CycleTiming& c) {
-  return {{"cells", c.cells}, {"wall_time_s", c.wall_s}, {"steps", c.steps}, {"switches", c.switches},
-          {"cycle_time_s", c.cycle_time_s}, {"ok", c.ok}};
+  return {{"cells", c.cells},
+          {"wall_law", c.wall_law},
+          {"wall_time_s", c.wall_s},
+          {"steps", c.steps},
+          {"newton_setups", c.newton_setups},
+          {"newton_iterations", c.newton_iterations},
+          {"residual_evals", c.residual_evals},
+          {"switches", c.switches},
+          {"cycle_time_s", c.cycle_time_s},
+          {"displacement_per_cycle_m", c.displacement_per_cycle_m},
+          {"ok", c.ok}};
 }
 
 scene::json variant_json(const CycleTiming& c) {
@@ -178,7 +203,11 @@ struct ScreeningCase {
   std::string kind;
   int cells;
   bool traction = true;
-  std::string label() const { return kind + (traction ? "" : " lubrication wall") + " N=" + std::to_string(cells); }
+  bool calibrated_law = false;
+  std::string label() const {
+    return kind + (traction ? "" : " lubrication wall") + (calibrated_law ? " calibrated_round wall" : "") +
+           " N=" + std::to_string(cells);
+  }
 };
 
 /// Screening throughput of one case, on all cores and on one thread.
@@ -204,6 +233,10 @@ ScreeningTiming time_screening(const ScreeningCase& c, bool quick, unsigned core
     std::snprintf(s, sizeof s, "swimmer.length=\"%.4f um\"", length_um);
     std::vector<std::string> sets = {l, s, "wave.kind=\"" + c.kind + "\"", "numerics1d.cells=" + std::to_string(c.cells)};
     if (!c.traction) sets.push_back("model1d.short_wave_traction=false");
+    if (c.calibrated_law) {
+      const auto law = calibrated_wall_sets();
+      sets.insert(sets.end(), law.begin(), law.end());
+    }
     if (c.kind == "step")
       sets.push_back("protocol=null");
     else
@@ -250,11 +283,21 @@ scene::json screening_json(const ScreeningTiming& t) {
 void bench_1d(scene::json& report, bool quick, int reps, unsigned cores) {
   std::printf("== 1D tier ==\n");
   std::printf("one force-driven cycle (demo scene, best of %d):\n", reps);
-  std::printf("  %6s %12s %10s %10s %10s\n", "N", "wall [ms]", "steps", "switches", "cycle [s]");
+  std::printf("  %6s %12s %10s %10s %10s %10s %10s\n", "N", "wall [ms]", "steps", "set-ups", "residuals", "switches",
+              "cycle [s]");
   scene::json cycles = scene::json::array();
-  for (int n : {50, 200, 800}) {
-    const CycleTiming c =
-        time_cycle(n, {"numerics1d.cells=" + std::to_string(n), "protocol.cycles=1", "time.duration=\"auto\""}, "", reps);
+  // the default model at N = 50, 200, 800, and at N = 50 with the calibrated round-wall law
+  const bool have_law = std::filesystem::exists(kLawFile);
+  for (int n : {50, 200, 800, -50}) {
+    if (n < 0 && !have_law) continue;
+    std::vector<std::string> sets = {"numerics1d.cells=" + std::to_string(std::abs(n)), "protocol.cycles=1",
+                                     "time.duration=\"auto\""};
+    if (n < 0) {
+      const auto law = calibrated_wall_sets();
+      sets.insert(sets.end(), law.begin(), law.end());
+    }
+    CycleTiming c = time_cycle(std::abs(n), sets, "", reps);
+    if (n < 0) c.wall_law = "calibrated_round";
     print_cycle(c);
     cycles.push_back(cycle_json(c));
   }
@@ -275,7 +318,9 @@ void bench_1d(scene::json& report, bool quick, int reps, unsigned cores) {
   std::printf("screening throughput (%u threads, 10 x 10 grid over lambda and L):\n", cores);
   scene::json screening = scene::json::object();
   for (const ScreeningCase& c : {ScreeningCase{"step", 200}, ScreeningCase{"force_driven", 200},
-                                 ScreeningCase{"force_driven", 50}, ScreeningCase{"force_driven", 200, false}}) {
+                                 ScreeningCase{"force_driven", 50}, ScreeningCase{"force_driven", 50, true, true},
+                                 ScreeningCase{"force_driven", 200, false}}) {
+    if (c.calibrated_law && !have_law) continue;
     const ScreeningTiming t = time_screening(c, quick, cores);
     print_screening(t);
     screening[t.label] = screening_json(t);

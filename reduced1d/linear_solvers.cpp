@@ -16,6 +16,21 @@
 namespace swim::reduced1d::sun {
 
 namespace {
+
+// Four doubles as one AVX register (GCC/Clang vector extension). The block kernels below
+// update whole padded rows and columns with it: left to itself the compiler fully unrolls
+// those 4- to 16-element loops into scalar operations. Loads and stores go through memcpy
+// (no alignment or aliasing assumptions); a - f * b contracts to a fused multiply-add as the
+// scalar code did (blocks of 8, the default model at N = 50: the same results bit for bit;
+// other block sizes differ in the last bits, docs/performance-1d.md).
+using V4 = double __attribute__((vector_size(32)));
+inline V4 load4(const double* p) {
+  V4 v;
+  std::memcpy(&v, p, sizeof v);
+  return v;
+}
+inline void store4(double* p, V4 v) { std::memcpy(p, &v, sizeof v); }
+
 // Band LU with partial pivoting (LAPACK dgbtf2 layout: A(i, j) at ab[j * ldab + kv + i - j],
 // kv = ku + kl, ldab = 2 kl + ku + 1), compiled with the project's flags (the distribution's
 // SUNDIALS band kernels are unoptimised, see serial_kernels.hpp).
@@ -137,6 +152,9 @@ struct BlockTri {
   // from lbeg[k] to lbeg[k + 1]
   std::vector<int> lpos, lbeg;
   std::vector<double> lval;
+  // the same L_k dense (S x S column-major, stride lead(S)), for the solves: a dense product
+  // of whole vectors costs less than the scattered updates over the nonzeros
+  std::vector<double> Ld;
   struct Entry {
     int row;
     long col;
@@ -179,7 +197,7 @@ struct BlockTri {
       if (i < o || i >= o + S * N) bpos[i] = int(border.size()), border.push_back(i);
     nb = int(border.size());
     const std::size_t blk = std::size_t(S) * lead(S) * N;
-    Dinv.assign(blk, 0.0), Up.assign(blk, 0.0);
+    Dinv.assign(blk, 0.0), Up.assign(blk, 0.0), Ld.assign(blk, 0.0);
     lpos.clear(), lval.clear(), lbeg.assign(N + 1, 0);
     G.assign(std::size_t(nb) * nb, 0.0);
     gpiv.assign(nb, 0);
@@ -283,7 +301,7 @@ struct BlockTri {
         if (r == k) continue;
         const double f = Dm[r * ld + k];
         Dm[r * ld + k] = 0.0;
-        for (int c = 0; c < ld; ++c) Dm[r * ld + c] -= f * pk[c];
+        for (int c = 0; c < ld; c += 4) store4(Dm + r * ld + c, load4(Dm + r * ld + c) - f * load4(pk + c));
       }
       for (int c = 0; c < ld; ++c) Dm[k * ld + c] = pk[c];
     }
@@ -321,6 +339,7 @@ struct BlockTri {
       for (int e = 0; e < int(SS); ++e)
         if (L[e] != 0.0) lpos.push_back(e), lval.push_back(L[e]);
       lbeg[k + 1] = int(lpos.size());
+      std::copy(L, L + SS, Ld.data() + k * SS);
       if (k > 0) {  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
         const double* Pp = Up.data() + (k - 1) * SS;
         for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) {
@@ -341,7 +360,7 @@ struct BlockTri {
           for (int r = 0; r < s; ++r) {
             const double u = Uk[c * ld + r];
             if (u == 0.0) continue;
-            for (int q = 0; q < ld; ++q) P[c * ld + q] += Di[r * ld + q] * u;
+            for (int q = 0; q < ld; q += 4) store4(P + c * ld + q, load4(P + c * ld + q) + load4(Di + r * ld + q) * u);
           }
       }
     }
@@ -374,26 +393,30 @@ struct BlockTri {
   template <int s>
   static void matvec(const double* A, const double* x, double* y) {
     constexpr int ld = lead(s);
-    alignas(32) double y0[ld] = {}, y1[ld] = {};
+    constexpr int nv = ld / 4;
+    V4 y0[nv] = {}, y1[nv] = {};
     int c = 0;
     for (; c + 1 < s; c += 2)
-      for (int i = 0; i < ld; ++i) y0[i] += A[c * ld + i] * x[c], y1[i] += A[(c + 1) * ld + i] * x[c + 1];
+      for (int i = 0; i < nv; ++i)
+        y0[i] += load4(A + c * ld + 4 * i) * x[c], y1[i] += load4(A + (c + 1) * ld + 4 * i) * x[c + 1];
     if constexpr (s % 2 == 1)
-      for (int i = 0; i < ld; ++i) y0[i] += A[(s - 1) * ld + i] * x[s - 1];
-    for (int i = 0; i < ld; ++i) y[i] = y0[i] + y1[i];
+      for (int i = 0; i < nv; ++i) y0[i] += load4(A + (s - 1) * ld + 4 * i) * x[s - 1];
+    for (int i = 0; i < nv; ++i) store4(y + 4 * i, y0[i] + y1[i]);
   }
 
   template <int s>
   void solve_cells(double* b) {
     constexpr int ld = lead(s);
     constexpr std::size_t SS = std::size_t(s) * ld;
-    alignas(32) double T[ld] = {}, y[ld] = {}, x[ld] = {};
-    const int* lp = lpos.data();
-    const double* lv = lval.data();
+    alignas(32) double T[ld] = {}, y[ld] = {}, x[ld] = {}, Ly[ld] = {};
     for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} (b_k - L_k y_{k-1})
       double* bk = b + o + k * s;
-      for (int i = 0; i < s; ++i) T[i] = bk[i];
-      for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) T[lp[e] % ld] -= lv[e] * y[lp[e] / ld];
+      if (k > 0) {
+        matvec<s>(Ld.data() + k * SS, y, Ly);
+        for (int i = 0; i < s; ++i) T[i] = bk[i] - Ly[i];
+      } else {
+        for (int i = 0; i < s; ++i) T[i] = bk[i];
+      }
       matvec<s>(Dinv.data() + k * SS, T, y);
       for (int i = 0; i < s; ++i) bk[i] = y[i];
     }

@@ -3,6 +3,7 @@
 #include <gsl/gsl_errno.h>
 #include <gsl/gsl_interp.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <string>
@@ -45,6 +46,32 @@ TubeLaw::TubeLaw(double R0, std::vector<double> R, std::vector<double> w)
     throw InputError(key, "tube-law knots", "GSL could not build the Steffen interpolant");
   s_lo_ = gsl_interp_eval_deriv(g_->interp, R_.data(), w_.data(), R_.front(), nullptr);
   s_hi_ = gsl_interp_eval_deriv(g_->interp, R_.data(), w_.data(), R_.back(), nullptr);
+  // The Steffen coefficients (M. Steffen, Astron. Astrophys. 239, 443 (1990), as GSL's
+  // gsl_interp_steffen computes them): y'_k from the neighbouring secants with the limiter,
+  // the end knots' y' their secants.
+  std::vector<double> yp(n);
+  yp[0] = (w_[1] - w_[0]) / (R_[1] - R_[0]);
+  for (std::size_t k = 1; k + 1 < n; ++k) {
+    const double hk = R_[k + 1] - R_[k], hm = R_[k] - R_[k - 1];
+    const double sk = (w_[k + 1] - w_[k]) / hk, sm = (w_[k] - w_[k - 1]) / hm;
+    const double pk = (sm * hk + sk * hm) / (hm + hk);
+    // both secants are positive (strictly increasing knots): sign factor 2
+    yp[k] = 2.0 * std::min(std::abs(sm), std::min(std::abs(sk), 0.5 * std::abs(pk)));
+  }
+  yp[n - 1] = (w_[n - 1] - w_[n - 2]) / (R_[n - 1] - R_[n - 2]);
+  a_.resize(n - 1), b_.resize(n - 1), c_.resize(n - 1), d_.resize(n - 1);
+  for (std::size_t k = 0; k + 1 < n; ++k) {
+    const double hk = R_[k + 1] - R_[k], sk = (w_[k + 1] - w_[k]) / hk;
+    a_[k] = (yp[k] + yp[k + 1] - 2.0 * sk) / hk / hk;
+    b_[k] = (3.0 * sk - 2.0 * yp[k] - yp[k + 1]) / hk;
+    c_[k] = yp[k];
+    d_[k] = w_[k];
+  }
+  int_to_R0_.assign(n, 0.0);
+  for (std::size_t k = n - 1; k-- > 0;) {
+    const double x = R_[k + 1] - R_[k];
+    int_to_R0_[k] = int_to_R0_[k + 1] + x * (d_[k] + x * (0.5 * c_[k] + x * (b_[k] / 3.0 + x * 0.25 * a_[k])));
+  }
   // Steffen's end slope may be zero (the secants' limiter); the law must keep a positive slope
   // so that the static radius is unique: fall back to the end secant
   if (!(s_lo_ > 0)) s_lo_ = (w_[1] - w_[0]) / (R_[1] - R_[0]);
@@ -52,6 +79,11 @@ TubeLaw::TubeLaw(double R0, std::vector<double> R, std::vector<double> w)
 }
 
 TubeLaw::~TubeLaw() = default;
+
+std::size_t TubeLaw::interval(double R) const {
+  // the largest k with R_k <= R (R_front < R < R_back: 0 <= k <= n - 2)
+  return std::size_t(std::upper_bound(R_.begin(), R_.end(), R) - R_.begin()) - 1;
+}
 
 double TubeLaw::eval(double R, double& dw) const {
   if (R <= R_.front()) {
@@ -62,15 +94,19 @@ double TubeLaw::eval(double R, double& dw) const {
     dw = s_hi_;
     return s_hi_ * (R - R0_);
   }
-  dw = gsl_interp_eval_deriv(g_->interp, R_.data(), w_.data(), R, nullptr);
-  return gsl_interp_eval(g_->interp, R_.data(), w_.data(), R, nullptr);
+  const std::size_t k = interval(R);
+  const double x = R - R_[k];
+  dw = c_[k] + x * (2.0 * b_[k] + x * 3.0 * a_[k]);
+  return d_[k] + x * (c_[k] + x * (b_[k] + x * a_[k]));
 }
 
 double TubeLaw::energy(double R) const {
   if (R >= R0_) return 0.5 * s_hi_ * (R - R0_) * (R - R0_);
   const double a = std::max(R, R_.front());
-  // int_{R0}^{R} w = -int_{a}^{R0} w - int_{R}^{a} w
-  double e = -gsl_interp_eval_integ(g_->interp, R_.data(), w_.data(), a, R0_, nullptr);
+  // int_{R0}^{R} w = -int_{a}^{R0} w - int_{R}^{a} w; int_{a}^{R0} w = int_{R_k}^{R0} w - int_{R_k}^{a} w
+  const std::size_t k = a <= R_.front() ? 0 : interval(a);
+  const double x = a - R_[k];
+  double e = -(int_to_R0_[k] - x * (d_[k] + x * (0.5 * c_[k] + x * (b_[k] / 3.0 + x * 0.25 * a_[k]))));
   if (R < a) {
     const double d = a - R;  // linear piece below the deepest knot: w = w0 + s_lo (r - a)
     e += -w_.front() * d + 0.5 * s_lo_ * d * d;  // -int_{R}^{a} w

@@ -43,9 +43,17 @@ class TubeLaw {
   double static_radius(double P) const;
 
  private:
+  /// Index k of the knot interval [R_k, R_{k+1}) holding R (R_front < R < R_back).
+  std::size_t interval(double R) const;
+
   double R0_;
   std::vector<double> R_, w_;
   double s_lo_ = 0, s_hi_ = 0;  // end slopes
+  // The interpolant's cubic on interval k, w = d_k + x (c_k + x (b_k + x a_k)) with
+  // x = R - R_k (GSL's Steffen coefficients, computed here so that an evaluation is one
+  // search and one Horner pass instead of two library calls), and the integral of w from
+  // R_k to R0 (the energy's whole intervals).
+  std::vector<double> a_, b_, c_, d_, int_to_R0_;
   struct Gsl;
   std::unique_ptr<Gsl> g_;
 };

@@ -14,6 +14,8 @@
 #include <utility>
 #include <vector>
 
+#include <gsl/gsl_errno.h>
+#include <gsl/gsl_interp.h>
 #include <unistd.h>
 
 #include "tests/support/quadrature.hpp"
@@ -71,6 +73,31 @@ Params cycle(int N) {
 
 // Knots sampled from a straight line give back the line (Steffen's interpolant is exact on
 // collinear data), its slope C1 at R0, and the elastic energy C1 (R - R0)^2 / 2.
+// The law evaluates its own copy of the Steffen coefficients (one search and one Horner pass)
+// and the energy from the integrals of whole intervals: the same function as GSL's
+// gsl_interp_steffen (value, slope, integral) to round-off, on and between the knots.
+TEST(TubeLaw, EvaluationMatchesGslSteffen) {
+  for (auto f : {collapsible, nearly_linear}) {
+    const auto law = law_from(f);
+    const auto& R = law->knots_R();
+    const auto& w = law->knots_w();
+    gsl_interp* g = gsl_interp_alloc(gsl_interp_steffen, R.size());
+    ASSERT_EQ(gsl_interp_init(g, R.data(), w.data(), R.size()), GSL_SUCCESS);
+    const double wmax = std::abs(w.front()), smax = kC1 * 3.0, emax = std::abs(law->energy(R.front()));
+    std::vector<double> at(R.begin(), R.end() - 1);
+    for (int k = 1; k < 4000; ++k) at.push_back(R.front() + (R.back() - R.front()) * k / 4000.0);
+    for (double r : at) {
+      double dw = 0;
+      const double v = law->eval(r, dw);
+      EXPECT_NEAR(v, gsl_interp_eval(g, R.data(), w.data(), r, nullptr), 1e-14 * wmax) << r / kR0;
+      EXPECT_NEAR(dw, gsl_interp_eval_deriv(g, R.data(), w.data(), r, nullptr), 1e-12 * smax) << r / kR0;
+      EXPECT_NEAR(law->energy(r), -gsl_interp_eval_integ(g, R.data(), w.data(), r, kR0, nullptr), 1e-14 * emax)
+          << r / kR0;
+    }
+    gsl_interp_free(g);
+  }
+}
+
 TEST(TubeLaw, CollinearKnotsGiveTheLinearLaw) {
   const auto law = law_from(linear);
   EXPECT_NEAR(law->slope_at_R0() / kC1, 1.0, 1e-12);
