@@ -421,7 +421,7 @@ TEST(Run3d, ResumeWithLargerTimeLimitFinishesTheCycle) {
   ctl.progress = 0;
   ctl.quiet_vtk = true;
   const Scene full = cycle_scene("1.5 s");
-  const std::string a = fresh_dir("limit_a"), b = fresh_dir("limit_b");
+  const std::string a = fresh_dir("longer_limit_a"), b = fresh_dir("longer_limit_b");
   const RunOutcome ra = run3d(full.p, full.resolved, a, ctl);
   ASSERT_FALSE(ra.failed) << ra.message;
   const Scene capped = cycle_scene("0.3 s");
