@@ -709,7 +709,8 @@ bool FittedMesh::newton(const double cx[4], const double cr[4], double x, double
     xi -= dxi;
     eta -= deta;
     if (!(std::abs(xi) < 4.0 && std::abs(eta) < 4.0)) return false;
-    if (std::abs(dxi) + std::abs(deta) < 1e-14) return std::max(std::abs(xi), std::abs(eta)) <= 1.0 + 1e-9;
+    // converged far below the inside tolerance (1e-14 can lie below the round-off of a thin element)
+    if (std::abs(dxi) + std::abs(deta) < 1e-11) return std::max(std::abs(xi), std::abs(eta)) <= 1.0 + 1e-9;
   }
   return false;
 }
