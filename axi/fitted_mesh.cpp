@@ -647,23 +647,11 @@ int FittedMesh::locate(double& x, double r, double& xi, double& eta) const {
     return e;
   }
   // Newton on the bilinear map
-  static constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
   xi = 0.0;
   eta = 0.0;
   for (int it = 0; it < 50; ++it) {
-    double fx = -x, fr = -r, xx = 0, xe = 0, rx = 0, re = 0;
-    for (int i = 0; i < 4; ++i) {
-      const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
-      const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
-      fx += m * cx[i];
-      fr += m * cr[i];
-      xx += mx * cx[i];
-      xe += me * cx[i];
-      rx += mx * cr[i];
-      re += me * cr[i];
-    }
-    const double det = xx * re - xe * rx;
-    const double dxi = (re * fx - xe * fr) / det, deta = (-rx * fx + xx * fr) / det;
+    double dxi, deta;
+    newton_step(cx, cr, x, r, xi, eta, dxi, deta);
     xi = std::clamp(xi - dxi, -1.0, 1.0);
     eta = std::clamp(eta - deta, -1.0, 1.0);
     if (std::abs(dxi) + std::abs(deta) < 1e-14) break;
@@ -689,23 +677,32 @@ bool FittedMesh::invert(int e, double x, double r, double& xi, double& eta) cons
   return false;
 }
 
-bool FittedMesh::newton(const double cx[4], const double cr[4], double x, double r, double& xi, double& eta) {
+// One Newton step on the bilinear map of the corners (cx, cr) towards (x, r) from (xi, eta):
+// the update (dxi, deta); false where the map's Jacobian vanishes (the update is then not finite).
+bool FittedMesh::newton_step(const double cx[4], const double cr[4], double x, double r, double xi, double eta,
+                             double& dxi, double& deta) {
   static constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
+  double fx = -x, fr = -r, xx = 0, xe = 0, rx = 0, re = 0;
+  for (int i = 0; i < 4; ++i) {
+    const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
+    const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
+    fx += m * cx[i];
+    fr += m * cr[i];
+    xx += mx * cx[i];
+    xe += me * cx[i];
+    rx += mx * cr[i];
+    re += me * cr[i];
+  }
+  const double det = xx * re - xe * rx;
+  dxi = (re * fx - xe * fr) / det;
+  deta = (-rx * fx + xx * fr) / det;
+  return det != 0.0;
+}
+
+bool FittedMesh::newton(const double cx[4], const double cr[4], double x, double r, double& xi, double& eta) {
   for (int it = 0; it < 50; ++it) {
-    double fx = -x, fr = -r, xx = 0, xe = 0, rx = 0, re = 0;
-    for (int i = 0; i < 4; ++i) {
-      const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
-      const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
-      fx += m * cx[i];
-      fr += m * cr[i];
-      xx += mx * cx[i];
-      xe += me * cx[i];
-      rx += mx * cr[i];
-      re += me * cr[i];
-    }
-    const double det = xx * re - xe * rx;
-    if (!(det != 0.0)) return false;
-    const double dxi = (re * fx - xe * fr) / det, deta = (-rx * fx + xx * fr) / det;
+    double dxi, deta;
+    if (!newton_step(cx, cr, x, r, xi, eta, dxi, deta)) return false;
     xi -= dxi;
     eta -= deta;
     if (!(std::abs(xi) < 4.0 && std::abs(eta) < 4.0)) return false;

@@ -219,6 +219,8 @@ class FittedMesh {
   bool find_fold(int& bad_c, int& bad_j);
   bool invert(int e, double x, double r, double& xi, double& eta) const;
   static bool newton(const double cx[4], const double cr[4], double x, double r, double& xi, double& eta);
+  static bool newton_step(const double cx[4], const double cr[4], double x, double r, double xi, double eta,
+                          double& dxi, double& deta);
   int search(double& x, double r, double& xi, double& eta) const;
   double corner_jacobian(int c, int j) const;
   bool smooth_where_folded(int& bad_c, int& bad_j);
