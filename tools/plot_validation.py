@@ -226,6 +226,8 @@ def order_text(e):
     obs = e.get("observed_order")
     if e.get("asymptotic") and e.get("order"):
         return f"order {e['order']:.2f}" + ("" if obs is not None else " (assumed)")
+    if e.get("method") == "expansion_fit":
+        return "not asymptotic: f0 + a h + b h² fitted" + (f" (three finest: order {obs:.2f})" if obs is not None else "")
     return "not asymptotic" + (f", observed order {obs:.2f}" if obs is not None else "")
 
 
@@ -298,6 +300,8 @@ def convergence_figure(case, path):
         obs = ref.get("observed_order")
         if ref["asymptotic"]:
             what = f" (order {ref['order']:.2f}, accepted in {rng_text})" if ref["order"] else ""
+        elif ref.get("method") == "expansion_fit":
+            what = " (not asymptotic: f0 + a h + b h² fitted to the grids, error = leave-one-out change)"
         else:
             what = (" (not asymptotic: finest ± spread" +
                     (f"; observed order {obs:.2f} outside {rng_text}" if obs is not None and
@@ -746,7 +750,8 @@ def reference_markdown(c):
                 out.append(f"  - {words_alt}: {si(w['value'], unit)} ± {si(w['error'], unit)}; {order_text(w)}")
     cmp = c.get("comparison_3d_vs_reference") or {}
     if cmp:
-        out += ["", "3D extrapolation against the axisymmetric reference (agree when |Δ| ≤ e_3d + e_ref):", "",
+        out += ["", "3D extrapolation against the axisymmetric reference (disagree when |Δ| > e_3d + e_ref; otherwise "
+                "agree, or inconclusive when e_3d + e_ref exceeds a quarter of the reference):", "",
                 "| figure | 3D (h → 0) | 3D order | axisymmetric reference | Δ = 3D − ref | e_3d + e_ref | verdict | finest 3D grid vs ref |",
                 "|---|---|---|---|---|---|---|---|"]
         for key, words, unit in FIGURE_WORDS:
@@ -756,7 +761,8 @@ def reference_markdown(c):
             obs = e.get("observed_order_3d")
             fr = e.get("finest_3d_relative_error")
             out.append(f"| {words} | {si(e['value_3d'], unit)} ± {si(e['error_3d'], unit)} | "
-                       f"{'—' if obs is None else f'{obs:.2f}'}{'' if e.get('asymptotic_3d') else ' (not asymptotic)'} | "
+                       f"{'—' if obs is None else f'{obs:.2f}'}{'' if e.get('asymptotic_3d') else ' (not asymptotic)'}"
+                       f"{'; fit f0 + a h + b h²' if e.get('method_3d') == 'expansion_fit' else ''} | "
                        f"{si(e['value_reference'], unit)} ± {si(e['error_reference'], unit)} | "
                        f"{si(e['difference'], unit)} | {si(e['combined_uncertainty'], unit)} | **{e['verdict']}** | "
                        f"{pct(fr)} (h = {si(e.get('finest_3d_cell_size_m'), 'm')}) |")

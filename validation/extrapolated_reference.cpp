@@ -18,7 +18,8 @@ json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 json extrapolation_json(const Extrapolation& e) {
   return json{{"value", num(e.value)},         {"error", num(e.error)},
               {"order", num(e.order)},         {"observed_order", num(e.observed_order)},
-              {"asymptotic", e.asymptotic},    {"note", e.note}};
+              {"asymptotic", e.asymptotic},    {"method", e.method},
+              {"note", e.note}};
 }
 
 std::string percent_text(double x) {
@@ -79,14 +80,15 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
     return {{"grids_used", hs.size()}, {"note", "fewer than two grids completed a cycle: no extrapolated reference"}};
   // two grids: first order, or the range's nearest end when first order lies outside it
   const double assumed = std::clamp(1.0, orders.lo, orders.hi);
-  const Extrapolation ed = richardson(hs, fd, assumed, orders);
-  const Extrapolation eT = richardson(hs, fT, assumed, orders);
+  const Extrapolation ed = extrapolate_series(hs, fd, assumed, orders);
+  const Extrapolation eT = extrapolate_series(hs, fT, assumed, orders);
   // the mean velocity of the reference is its displacement over its cycle time; the
   // relative errors add (bounds, as everywhere in the verdicts: verdicts.hpp)
   Extrapolation ev;
   ev.value = ed.value / eT.value;
   ev.error = std::abs(ev.value) * (std::abs(ed.error / ed.value) + std::abs(eT.error / eT.value));
   ev.asymptotic = ed.asymptotic && eT.asymptotic;
+  ev.method = ed.method == eT.method ? ed.method : ed.method + " / " + eT.method;
   ev.note = "extrapolated displacement per cycle / extrapolated cycle time (relative errors added)";
   json ref = {{"grids_used", hs.size()},
               {"order_range", {orders.lo, orders.hi}},
@@ -94,7 +96,7 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
               {"cycle_time_s", extrapolation_json(eT)},
               {"mean_velocity_per_cycle_m_per_s", extrapolation_json(ev)}};
   // the largest centre displacement over the run, where the paper gives it
-  if (with_max && hm.size() >= 2) ref["max_displacement_m"] = extrapolation_json(richardson(hm, fm, assumed, orders));
+  if (with_max && hm.size() >= 2) ref["max_displacement_m"] = extrapolation_json(extrapolate_series(hm, fm, assumed, orders));
   return ref;
 }
 
@@ -210,6 +212,7 @@ json compare_3d_with_reference(const json& ref3d, const json& ref, const std::ve
               {"order_3d", in3d ? ref3d[key]["order"] : json(nullptr)},
               {"observed_order_3d", in3d ? ref3d[key]["observed_order"] : json(nullptr)},
               {"asymptotic_3d", in3d ? ref3d[key]["asymptotic"] : json(nullptr)},
+              {"method_3d", in3d && ref3d[key].contains("method") ? ref3d[key]["method"] : json(nullptr)},
               {"value_reference", num(b)},
               {"error_reference", num(eb)},
               {"difference", num(a - b)},

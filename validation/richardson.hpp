@@ -50,6 +50,8 @@ struct Extrapolation {
   /// differences of opposite sign, or an order beyond the search bracket)
   double observed_order = std::numeric_limits<double>::quiet_NaN();
   bool asymptotic = false;
+  /// "richardson" (or two grids with the assumed order), "expansion_fit", "finest_grid"
+  std::string method = "finest_grid";
   std::string note;      ///< how the value was obtained
 };
 
@@ -63,6 +65,29 @@ double bracketed_root(const std::function<double(double)>& f, double lo, double 
 /// outside the range.
 Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order = 1.0,
                          OrderRange range = kImmersedBoundaryOrders);
+
+/// The error expansion of a first-order method before its asymptotic range,
+///   f(h) = f0 + a h + b h^2,
+/// fitted by least squares to four or more grids (an immersed boundary whose first-order
+/// smearing of the wall is large enough for the second-order term to matter on every affordable
+/// grid: the three-grid Richardson then shows no order). The error of f0 is the larger of
+///   - the largest change of f0 when one grid is left out of the fit (each refit has three
+///     grids or more), which the fit's own residual cannot hide, and
+///   - its distance to the finest pair's Richardson value at order 1 and at the lowest order
+///     the scheme can show (range.lo): before the asymptotic range an immersed boundary shows
+///     orders below 1 (the free rims' square-root singularities), which integer powers miss. The fit is refused (the finest value with the spread of the
+/// finest three as its error, `asymptotic` false, `order` 0) when it has fewer than four grids,
+/// when the scheme is not first order at best (its order range must hold 1 and end at 2 or
+/// below: a second-order method's expansion has no h term), or when f0 moves the finest value by more than
+/// half of it (kMaxCorrection). A fitted value is not asymptotic either: `asymptotic` stays
+/// false, `order` is 1 (the leading term) and the note says how it was obtained.
+Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderRange range = kImmersedBoundaryOrders);
+
+/// richardson() over the grids; where the finest three are not in the asymptotic range and the
+/// series has four or more grids of a first-order method, expansion_fit() instead (when it is
+/// not refused; its note then also gives Richardson's).
+Extrapolation extrapolate_series(const std::vector<double>& h, const std::vector<double>& f, double assumed_order,
+                                 OrderRange range);
 
 /// A figure that is the sum of parts that converge differently (the cycle time as the sum of
 /// the protocol's phases), each part extrapolated on its own with richardson(). Where the

@@ -177,7 +177,9 @@ std::string tolerance_verdict(double rel, double rel_error, double tolerance) {
 
 std::string agreement_verdict(double a, double ea, double b, double eb) {
   if (!std::isfinite(a) || !std::isfinite(ea) || !std::isfinite(b) || !std::isfinite(eb)) return "not assessed";
-  return std::abs(a - b) <= std::abs(ea) + std::abs(eb) ? "agree" : "disagree";
+  const double e = std::abs(ea) + std::abs(eb);
+  if (std::abs(a - b) > e) return "disagree";
+  return e <= kAgreementResolution * std::abs(b) ? "agree" : "inconclusive";
 }
 
 const json& judged_reference(const json& c) {

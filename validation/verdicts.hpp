@@ -18,8 +18,9 @@
 //     inconclusive otherwise; a difference within the reference's error bar cannot fail.
 //   A claim over several cases is refuted when one case refutes it, not assessed when a case
 //   lacks its data, reproduced when every case reproduces it, inconclusive otherwise.
-//   3D against a converged reference (each figure): agree when |3D - ref| <= e_3d + e_ref,
-//     disagree otherwise (the same linear combination of error bars).
+//   3D against a converged reference (each figure): disagree when |3D - ref| > e_3d + e_ref
+//     (the same linear combination of error bars); otherwise agree, or inconclusive when
+//     e_3d + e_ref exceeds kAgreementResolution of the reference (bars that wide overlap anyway).
 //
 // A case's reference is its axisymmetric reference ("reference", the extrapolation of an axi
 // grid series) when the suite gives it one, else its 3D extrapolation ("reference3d"): every
@@ -43,8 +44,13 @@ OrderRange parse_order_range(const scene::json& value, const std::string& key);
 /// rel_error is not finite.
 std::string tolerance_verdict(double rel, double rel_error, double tolerance);
 
-/// Two values with their error bars: "agree" when |a - b| <= ea + eb (the bars overlap),
-/// "disagree" otherwise; "not assessed" when a number is not finite.
+/// Widest combined error bar, relative to the reference value, under which overlapping bars
+/// say "agree": wider bars overlap whatever the two values are, and say nothing.
+constexpr double kAgreementResolution = 0.25;
+
+/// Two values with their error bars (b the reference): "disagree" when |a - b| > ea + eb;
+/// otherwise "agree" when ea + eb <= kAgreementResolution |b|, "inconclusive" when the bars
+/// are wider than that; "not assessed" when a number is not finite.
 std::string agreement_verdict(double a, double ea, double b, double eb);
 
 /// The reference a case of a report is judged against: its "reference" (the axisymmetric

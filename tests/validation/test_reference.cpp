@@ -135,7 +135,8 @@ TEST(SuiteReference, ASceneTheAxiTierRefusesIsRefusedAtLoad) {
 
 // 3D against the reference: agree when |a - b| <= e_a + e_b (the error bars touch or
 // overlap), disagree beyond; the bound is linear, not quadrature (1.5 apart with bars 1 and
-// 0.5 agree, where quadrature, 1.12, would not).
+// 0.5 agree, where quadrature, 1.12, would not). Overlapping bars wider than a quarter of the
+// reference value say nothing: inconclusive.
 TEST(SuiteReference, AgreementIsTheLinearSumOfTheErrorBars) {
   EXPECT_EQ(agreement_verdict(10.0, 1.0, 11.5, 0.5), "agree");
   EXPECT_EQ(agreement_verdict(11.5, 0.5, 10.0, 1.0), "agree");
@@ -145,6 +146,9 @@ TEST(SuiteReference, AgreementIsTheLinearSumOfTheErrorBars) {
   EXPECT_EQ(agreement_verdict(10.0, -1.0, 11.5, 0.5), "agree");  // an error is a magnitude
   EXPECT_EQ(agreement_verdict(std::nan(""), 1.0, 10.0, 1.0), "not assessed");
   EXPECT_EQ(agreement_verdict(10.0, 1.0, 10.0, INFINITY), "not assessed");
+  EXPECT_EQ(agreement_verdict(10.0, 1.5, 10.0, 1.0), "agree");         // 2.5 = 25 % of 10
+  EXPECT_EQ(agreement_verdict(10.0, 1.6, 10.0, 1.0), "inconclusive");  // 2.6 > 25 % of 10
+  EXPECT_EQ(agreement_verdict(40.0, 20.0, 10.0, 1.0), "disagree");     // wide bars, yet apart
 }
 
 // A case with an axisymmetric reference judges its 1D model against it: a 1D displacement of

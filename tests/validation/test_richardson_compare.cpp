@@ -45,6 +45,55 @@ TEST(Richardson, NonMonotoneSequenceIsReportedNotExtrapolated) {
   EXPECT_DOUBLE_EQ(e.error, 2.0);
 }
 
+// A first-order method before its asymptotic range, f = f0 + a h + b h^2 with b h comparable
+// to a (the immersed boundary's smeared wall on the affordable grids): the three finest grids
+// show an order outside [0.5, 2], so Richardson gives the finest value; the error-expansion fit
+// over five grids recovers f0 exactly, with zero leave-one-out change; its error bar is the
+// distance to the finest pair's extrapolation at order 1 and 0.5, which covers f0.
+TEST(ExpansionFit, RecoversTheLimitOfAFirstOrderSeriesBeforeItsAsymptoticRange) {
+  const std::vector<double> h = {15.625, 12.5, 10.4167, 8.92857, 7.8125};
+  std::vector<double> f;
+  for (double x : h) f.push_back(40.0 - 1.8 * x + 0.05 * x * x);
+  const Extrapolation r = richardson(h, f);
+  EXPECT_FALSE(r.asymptotic);
+  const Extrapolation e = extrapolate_series(h, f, 1.0, kImmersedBoundaryOrders);
+  EXPECT_EQ(e.method, "expansion_fit");
+  EXPECT_FALSE(e.asymptotic);
+  EXPECT_NEAR(e.value, 40.0, 1e-9);
+  const double r1 = f[4] + (f[4] - f[3]) / (h[3] / h[4] - 1.0);
+  const double rh = f[4] + (f[4] - f[3]) / (std::sqrt(h[3] / h[4]) - 1.0);
+  EXPECT_NEAR(e.error, std::max(std::abs(r1 - 40.0), std::abs(rh - 40.0)), 1e-9);
+  EXPECT_DOUBLE_EQ(e.order, 1.0);
+  // noise on one grid: the fit moves, and the leave-one-out error covers the move
+  f[2] += 0.3;
+  const Extrapolation n = expansion_fit(h, f);
+  EXPECT_GT(std::abs(n.value - 40.0), 0.05);
+  EXPECT_GE(n.error, std::abs(n.value - 40.0));
+}
+
+// The fit is refused, with the finest value and the spread of the finest three, where it has
+// no footing: three grids, a second-order scheme (no h term), or a correction larger than half
+// of the finest value.
+TEST(ExpansionFit, IsRefusedWhereItHasNoFooting) {
+  const std::vector<double> h4 = {4, 3, 2, 1};
+  const std::vector<double> f4 = {6.0, 7.0, 9.0, 8.5};
+  const Extrapolation three = expansion_fit({3, 2, 1}, {7.0, 9.0, 8.5});
+  EXPECT_EQ(three.method, "finest_grid");
+  EXPECT_DOUBLE_EQ(three.value, 8.5);
+  EXPECT_DOUBLE_EQ(three.error, 2.0);
+  EXPECT_EQ(expansion_fit(h4, f4, kSharpInterfaceOrders).method, "finest_grid");
+  // f0 = 100 from a finest value of 10: refused
+  std::vector<double> f;
+  for (double x : h4) f.push_back(100.0 - 90.0 * x + 0.5 * x * x);
+  const Extrapolation big = expansion_fit(h4, f);
+  EXPECT_EQ(big.method, "finest_grid");
+  EXPECT_DOUBLE_EQ(big.value, f.back());
+  // an asymptotic series keeps Richardson
+  std::vector<double> g;
+  for (double x : h4) g.push_back(29.0 - 0.3 * x);
+  EXPECT_EQ(extrapolate_series(h4, g, 1.0, kImmersedBoundaryOrders).method, "richardson");
+}
+
 // A sum of two parts with errors of opposite sign and different orders (order 1.5 from below,
 // 3 from above, as a first contraction and the rest of a cycle): the sum's own series shows no
 // order, the parts extrapolated apart recover the limit and both orders.
