@@ -18,6 +18,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402  (a dependency of matplotlib)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_calibration  # noqa: E402
@@ -251,6 +252,12 @@ def reference_convergence_figure(case, path):
         ea = ref.get(key)
         if p3:
             ax.plot(*zip(*p3), "ko-", ms=5, label=f"3D runs: {order_text(e3)}")
+            if e3 and e3.get("method") == "expansion_fit" and len(p3) >= 4:
+                # the fitted error expansion, from h = 0 to the coarsest grid
+                hh, ff = zip(*p3)
+                c = np.polyfit(hh, ff, 2)
+                hs = np.linspace(0.0, max(hh), 60)
+                ax.plot(hs, np.polyval(c, hs), "k--", lw=0.8, label="3D: fitted f0 + a h + b h²")
         if pa:
             ax.plot(*zip(*pa), "s-", color="tab:blue", ms=5,
                     label=f"axisymmetric runs ({ref.get('method', 'axi')}): {order_text(ea)}")
