@@ -229,6 +229,8 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   const std::size_t run_done = text.find("3d tiny_3d_cycle");
   ASSERT_NE(run_done, std::string::npos) << text;
   EXPECT_NE(text.find(": done in ", run_done), std::string::npos) << text;
+  EXPECT_NE(text.find("3d tiny_3d_cycle (auto: until 1 cycle, progress against full3d.time_limit)"), std::string::npos)
+      << text;
   const std::size_t grid2 = text.find(": 3D grid 2/3 (");
   ASSERT_NE(grid2, std::string::npos) << text;
   EXPECT_GT(grid2, run_done) << text;
