@@ -151,7 +151,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
     double T = 0;
     for (const auto& v : s["cycle_times_s"]) T += v.get<double>();
     T /= double(s["cycle_times_s"].size());
-    per_cycle = std::to_string(cycles) + " cycle(s) of " + si(T, "s");
+    per_cycle = std::to_string(cycles) + (cycles == 1 ? " cycle of " : " cycles of ") + si(T, "s");
   }
   std::printf("%s (3d): displacement %s, mean velocity %s (%.3g body lengths/s); %s; pumped %s; %ld steps; "
               "wall time %s\n  -> %s/summary.json\n",

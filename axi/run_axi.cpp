@@ -92,7 +92,7 @@ class Runner {
     const auto t0 = std::chrono::steady_clock::now();
     stream_ = open_run_stream(rec_, out_, ctl_);
     Progress progress("axi " + p_.name() + (b_.duration > 0 ? "" : " (auto: until " + std::to_string(b_.protocol.cycles) +
-                                                                  " cycle(s), progress against axi.time_limit)"),
+                                                                  (b_.protocol.cycles == 1 ? " cycle" : " cycles") + ", progress against axi.time_limit)"),
                       t_end_, ctl_.progress);
     std::optional<NumericalError> failure;
     try {

@@ -43,7 +43,7 @@ class Runner {
       measured_.events(stepper_.protocol().state());
     }
     Progress progress("3d " + p_.name + (run_.n_end > 0 ? "" : " (auto: until " + std::to_string(p_.protocol.cycles) +
-                                                                   " cycle(s), progress against full3d.time_limit)"),
+                                                                   (p_.protocol.cycles == 1 ? " cycle" : " cycles") + ", progress against full3d.time_limit)"),
                       run_.t_end(), ctl_.progress);
     long this_process = 0;
     std::optional<NumericalError> failure;

@@ -13,6 +13,7 @@
 #include <sstream>
 #include <string>
 
+#include "common/si_format.hpp"
 #include "reduced1d/force_model.hpp"
 #include "reduced1d/integrator.hpp"
 #include "reduced1d/internal.hpp"
@@ -31,6 +32,9 @@ std::string fmt(double v) {
   s << v;
   return s.str();
 }
+
+// A length in a message, with its SI prefix ("200 nm", "68.75 nm").
+std::string metres(double v) { return si(v, "m", 4); }
 
 // ---------------------------------------------------------------------------------------
 // Unbounded outer flow: U(t) = slender-body average of the flow induced by the wall motion,
@@ -239,8 +243,8 @@ void EventLoop::start() {
   if (!fixed_ && M_.wall.law && P_.protocol.q <= -M_.wall(P_.protocol.R_f)) {
     throw NumericalError(
         "the actuation cannot contract the tube to R_f: under the actuation pressure q = " + fmt(P_.protocol.q) +
-            " Pa the static radius of the calibrated tube law, " + fmt(M_.wall.static_radius(P_.protocol.q)) +
-            " m, is not below R_f = " + fmt(P_.protocol.R_f) + " m",
+            " Pa the static radius of the calibrated tube law, " + metres(M_.wall.static_radius(P_.protocol.q)) +
+            ", is not below R_f = " + metres(P_.protocol.R_f),
         "raise the actuation (protocol.pressure) above the law's static load at R_f, " +
             fmt(-M_.wall(P_.protocol.R_f)) + " Pa, or raise wave.contracted_ratio",
         0.0);
@@ -248,8 +252,8 @@ void EventLoop::start() {
   if (!fixed_ && !M_.wall.law && P_.protocol.q <= M_.C1 * (M_.R0 - P_.protocol.R_f)) {
     throw NumericalError(
         "the actuation cannot contract the tube to R_f: under the actuation pressure q = " + fmt(P_.protocol.q) +
-            " Pa the static radius R0 - q/C1 = " + fmt(M_.R0 - P_.protocol.q / M_.C1) +
-            " m is not below R_f = " + fmt(P_.protocol.R_f) + " m",
+            " Pa the static radius R0 - q/C1 = " + metres(M_.R0 - P_.protocol.q / M_.C1) +
+            " is not below R_f = " + metres(P_.protocol.R_f),
         "raise the actuation (protocol.pressure) above C1 (R0 - R_f) = " + fmt(M_.C1 * (M_.R0 - P_.protocol.R_f)) +
             " Pa or raise wave.contracted_ratio",
         0.0);
@@ -283,7 +287,7 @@ bool EventLoop::switch_protocol() {
   if (machine_.collapsed()) {
     const int imin = int(std::min_element(Rcells_.begin(), Rcells_.end()) - Rcells_.begin());
     record(t, be_->y());
-    throw NumericalError("tube radius collapsed to zero at z = " + fmt(res_.z[imin]) + " m",
+    throw NumericalError("tube radius collapsed to zero at z = " + metres(res_.z[imin]),
                          "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) or raise wave.contracted_ratio", t);
   }
   if (machine_.cycle_completed()) {
@@ -322,9 +326,9 @@ void EventLoop::check_end_radii(double t) const {
   if ((lo0 < collapse_ || loL < collapse_) && M_.wall.law) {
     const bool left = lo0 < collapse_;
     throw NumericalError(
-        "tube radius collapsed to zero at z = " + fmt(left ? 0.0 : M_.L) +
-            " m: under its actuation the open end's static radius on the calibrated tube law, " +
-            fmt(left ? lo0 : loL) + " m, is below the collapse radius " + fmt(collapse_) + " m",
+        "tube radius collapsed to zero at z = " + metres(left ? 0.0 : M_.L) +
+            ": under its actuation the open end's static radius on the calibrated tube law, " +
+            metres(left ? lo0 : loL) + ", is below the collapse radius " + metres(collapse_),
         "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) below the law's "
         "static load at the collapse radius, " + fmt(-M_.wall(collapse_)) + " Pa",
         t);
@@ -332,8 +336,8 @@ void EventLoop::check_end_radii(double t) const {
   if (lo0 < collapse_ || loL < collapse_) {
     const bool left = lo0 < collapse_;
     throw NumericalError(
-        "tube radius collapsed to zero at z = " + fmt(left ? 0.0 : M_.L) +
-            " m: under its actuation the open end has no positive rest radius (R0 - q/C1 <= 0)",
+        "tube radius collapsed to zero at z = " + metres(left ? 0.0 : M_.L) +
+            ": under its actuation the open end has no positive rest radius (R0 - q/C1 <= 0)",
         "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) below C1 R0 = " +
             fmt(M_.C1 * M_.R0) + " Pa or raise wall.C1",
         t);

@@ -36,9 +36,12 @@ def si_scale(values, unit):
 
 
 def read_csv(path):
+    """Columns by name; a file with its header and no rows gives empty columns."""
     with open(path) as f:
-        rows = list(csv.DictReader(f))
-    return {k: [float(r[k]) for r in rows] for k in rows[0]} if rows else {}
+        reader = csv.DictReader(f)
+        rows = list(reader)
+        names = reader.fieldnames or []
+    return {k: [float(r[k]) for r in rows] for k in names}
 
 
 def read_summary(run_dir):
@@ -86,11 +89,26 @@ EVENT_STYLE = {"segment": dict(color="tab:green", ls="--", lw=0.7, alpha=0.7),
                "cycle": dict(color="tab:purple", ls="-.", lw=0.9, alpha=0.8)}
 
 
+def empty_figure(title, failed):
+    """A run that stopped before its first output time (series.csv holds its header only): the
+    title and status, and a sentence in place of the panels."""
+    fig, a = plt.subplots(figsize=(12.5, 3.2))
+    fig.suptitle(title, color="tab:red" if failed else "black")
+    a.set_axis_off()
+    a.text(0.5, 0.35, "no output time was reached: series.csv and radius.csv hold no rows to plot",
+           transform=a.transAxes, ha="center", va="center", color="tab:red" if failed else "black")
+    fig.tight_layout(rect=(0, 0, 1, 0.97 if not failed else 0.80))
+    return fig, {"title": title, "failed": failed, "R_f_m": None, "events": [], "min_label": None,
+                 "map_title": None, "legends": [], "axes": [a], "empty": True}
+
+
 def figure(run_dir):
     s = read_csv(f"{run_dir}/series.csv")
     summary = read_summary(run_dir)
     title, failed = title_of(summary, run_dir)
     is3d = summary.get("tier") == "3d"
+    if not s.get("t_s"):
+        return empty_figure(title, failed)
     fig, ax = plt.subplots(2, 2, figsize=(12.5, 7.8))
     fig.suptitle(title, color="tab:red" if failed else "black")
     tf, tu = si_scale(s["t_s"], "s")
@@ -137,6 +155,8 @@ def figure(run_dir):
     has_map = False
     try:
         r = read_csv(f"{run_dir}/radius.csv")
+        if not r.get("t_s"):
+            raise ValueError("no radius profile was written")
         times = sorted(set(r["t_s"]))
         zs = sorted(set(r["z_m"]))
         grid = [[float("nan")] * len(zs) for _ in times]
@@ -163,7 +183,7 @@ def figure(run_dir):
     fig.tight_layout(rect=(0, 0, 1, 0.97 if not failed else 0.92))
     choices = {"title": title, "failed": failed, "R_f_m": rf_m, "events": ev,
                "min_label": lo, "map_title": map_title if has_map else None,
-               "legends": legends, "axes": ax}
+               "legends": legends, "axes": ax, "empty": False}
     return fig, choices
 
 

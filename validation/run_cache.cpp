@@ -8,6 +8,7 @@
 #include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/progress.hpp"
 #include "common/run_folder.hpp"
 #include "common/strict_json.hpp"
 #include "full3d/run3d.hpp"
@@ -410,7 +411,8 @@ RunAxi RunCache::run_axi(const json& sc, int progress) {
 }
 
 std::string RunCache::calibration(const json& base, const std::string& grid_key, const json& grid,
-                                  const std::string& name, json& cal_j, const std::function<void()>& starting) {
+                                  const std::string& name, json& cal_j, const std::function<void()>& starting,
+                                  int progress) {
   json s = base;
   set_key(s, grid_key, grid);
   set_key(s, "full3d.threads", threads_);  // as the 3D runs; not part of the key
@@ -439,14 +441,22 @@ std::string RunCache::calibration(const json& base, const std::string& grid_key,
   if (starting) starting();
   try {
     const auto t0 = std::chrono::steady_clock::now();
-    const StaticCalibration c = calibrate_static(p, default_loads(p));
+    const std::vector<double> loads = default_loads(p);
+    const std::size_t steps = loads.size() + 2;  // the loads, the hydraulic radii, the towed tube
+    Progress bar("calibration " + p.name, double(steps), progress);
+    const StaticCalibration c = calibrate_static(p, loads, [&](std::size_t done) {
+      bar.step(done, steps, "load " + std::to_string(done) + "/" + std::to_string(loads.size()));
+    });
     const HydraulicRadii hr = measure_hydraulic_radii(p);
+    bar.step(loads.size() + 1, steps, "hydraulic radii");
     cal_j = to_json(c, p, resolved);
     json hj = to_json(hr);
     hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
     hj.erase("wall_time_s");
     cal_j.update(hj);
     cal_j.update(calibrate_towed(p, hr).json);
+    bar.step(steps, steps, "towed tube");
+    bar.done();
     cal_j["wall_time_s"] = seconds_since(t0);
     cal_j["status"] = "ok";
     fs::create_directories(dir);

@@ -104,9 +104,10 @@ class RunCache {
   /// The calibration of `base` at `grid` (set at grid_key): read from the calibrations folder
   /// when a valid one of this physics and format is there, else computed and written
   /// (`starting` called first). Returns the calibration file ("" when it failed) and its
-  /// content in cal_j.
+  /// content in cal_j. `progress` as SuiteOptions::run_progress: a line per load, then the
+  /// hydraulic radii and the towed tube, with the time left (as swim calibrate).
   std::string calibration(const json& base, const std::string& grid_key, const json& grid, const std::string& name,
-                          json& cal_j, const std::function<void()>& starting = {});
+                          json& cal_j, const std::function<void()>& starting = {}, int progress = 0);
 
   /// The report's "cache": what was reused and rejected (and why), and whether every folder and
   /// calibration read is still what was read (verified again now).

@@ -47,7 +47,7 @@ json run_suite(const SuiteOptions& o) {
     cr["reference3d"] = reference_3d(runs, orders_3d(c, suite), c.paper_max);
     axi_reference_study(c, suite, runs, cache, say, o.run_progress, cr);
     // 3. the 1D tier calibrated from 3D
-    const std::string cal_file = calibrate_case(c, cache, say, cr);
+    const std::string cal_file = calibrate_case(c, cache, say, cr, o.run_progress);
     // 4. every 1D model against the references
     cr["models1d"] = judge_models(c, suite, cal_file, runs, cr, say);
     // 5. speed against accuracy

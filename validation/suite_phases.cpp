@@ -9,6 +9,7 @@
 
 #include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
+#include "full3d/scene3d.hpp"
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
@@ -155,15 +156,34 @@ json case_entry(const SuiteCase& c, const std::string& data_dir) {
 std::vector<Run3d> resolution_study(const SuiteCase& c, RunCache& cache, const Say& say, int progress, json& cr) {
   std::vector<Run3d> runs;
   json runs_j = json::array();
+  // the relative cost of each grid's run: its cells per time step (the simulated span is the
+  // same physics on every grid); a fixed step costs 1/dt steps, an adaptive one follows h
+  std::vector<double> cost;
+  for (const json& grid : c.grids) {
+    json s = c.base, resolved;
+    set_key(s, c.grid_key, grid);
+    const full3d::Params3d p = full3d::read_scene3d(s, resolved);
+    cost.push_back(double(p.nx) * p.ny * p.nz / (p.adaptive.enabled ? p.h : p.dt));
+  }
+  double done_wall = 0;
   for (std::size_t g = 0; g < c.grids.size(); ++g) {
     json s = c.base;
     set_key(s, c.grid_key, c.grids[g]);
+    // the time left in the stage, estimated from the last run that ran here
+    std::string left;
+    if (g > 0 && !runs.back().cached && runs.back().wall > 0) {
+      double est = 0;
+      for (std::size_t k = g; k < c.grids.size(); ++k) est += runs.back().wall * cost[k] / cost[g - 1];
+      left = ", about " + std::to_string(long(std::ceil(est))) + " s left in this stage (so far " +
+             std::to_string(long(std::ceil(done_wall))) + " s)";
+    }
     say(c.tag + ": 3D grid " + std::to_string(g + 1) + "/" + std::to_string(c.grids.size()) + " (" + c.grid_key +
-        " = " + c.grids[g].dump() + ")");
+        " = " + c.grids[g].dump() + left + ")");
     // the finest grid writes membrane frames, about 12 per cycle of the grid before it
     double frames = 0;
     if (g + 1 == c.grids.size() && g > 0 && runs.back().cyc.has_cycle) frames = runs.back().cyc.cycle_time_s / 12.0;
     Run3d r = cache.run_3d(s, frames, progress);
+    done_wall += r.cached ? 0.0 : r.wall;
     cr["length_m"] = r.length;
     r.record["grid_value"] = c.grids[g];
     runs_j.push_back(r.record);
@@ -234,11 +254,11 @@ void axi_reference_study(const SuiteCase& c, const json& suite, const std::vecto
   cr["comparison_3d_vs_reference"] = compare_3d_with_reference(cr["reference3d"], cr["reference"], done3d);
 }
 
-std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, json& cr) {
+std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, json& cr, int progress) {
   const std::size_t cg = c.calibration_grid;
   json cal_j;
   const std::string cal_file = cache.calibration(c.base, c.grid_key, c.grids[cg], c.name, cal_j,
-                                                 [&] { say(c.tag + ": calibration at grid " + std::to_string(cg + 1)); });
+                                                 [&] { say(c.tag + ": calibration at grid " + std::to_string(cg + 1)); }, progress);
   cr["calibration"] = {{"grid_index", cg}, {"grid_value", c.grids[cg]}, {"file", cal_file}};
   for (const char* k : {"C1_Pa_per_m", "C1_stderr_Pa_per_m", "C1_spring_network_Pa_per_m", "hydraulic_offset_inner_m",
                         "hydraulic_offset_inner_uncertainty_m", "hydraulic_offset_outer_m",

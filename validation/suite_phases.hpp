@@ -55,7 +55,7 @@ void axi_reference_study(const SuiteCase& c, const json& suite, const std::vecto
 
 /// 3. The calibration at the case's calibration grid. Adds "calibration"; returns the
 /// calibration file, "" when it failed.
-std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, json& cr);
+std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, json& cr, int progress = 0);
 
 /// 4. Every 1D model of the suite, compared with the case's judged reference, with the 3D run
 /// at the calibration grid, and (U(t)) with the finest 3D run; verdicts against the

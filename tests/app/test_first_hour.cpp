@@ -109,7 +109,11 @@ TEST(ShippedScenesRun, EachSucceedsOnThe3dTier) {
     ASSERT_TRUE(s.is_object());
     EXPECT_EQ(s["status"], "ok");
     EXPECT_GE(s["steps"].get<long>(), 4);
-    if (scene.stem() == "tiny_3d_cycle") { EXPECT_EQ(s["cycles_completed"].get<int>(), 1); }
+    if (scene.stem() == "tiny_3d_cycle") {
+      EXPECT_EQ(s["cycles_completed"].get<int>(), 1);
+      EXPECT_NE(c.out.find("; 1 cycle of "), std::string::npos) << c.out;  // not "1 cycle(s)"
+    }
+    EXPECT_EQ(c.out.find("cycle(s)"), std::string::npos) << c.out;
     EXPECT_EQ(swim::output::verify_folder(out.string()), "");
   }
   fs::remove_all(d);
@@ -304,6 +308,30 @@ TEST(Printouts, VolumesInOneUnitAndAPrescribedWavePrintsItsTransit) {
   EXPECT_EQ(p.out.find("0 cycle"), std::string::npos) << p.out;
   EXPECT_NE(p.out.find("per wave transit"), std::string::npos) << p.out;
   EXPECT_NE(p.out.find("\u00b5m\u00b3"), std::string::npos) << p.out;
+  fs::remove_all(d);
+}
+
+// The README's warning, tried: the demo's total force on half the tube closes it at its open
+// end (exit 3). The message gives lengths with their SI prefix and the parameter to change; with
+// --plot the failed run still gets its run.png, marked failed, and listed in summary.json.
+TEST(Printouts, AFailedRunNamesLengthsWithPrefixesAndItsPlotIsDrawn) {
+  const fs::path d = swim::test::scratch_dir("swim_first_hour_failed");
+  const fs::path out = d / "run";
+  const Cli c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --out \"" + out.string() +
+                             "\" --set swimmer.length='\"0.2 um\"'" + (have_matplotlib() ? " --plot" : ""),
+                         d);
+  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_NE(c.err.find("collapsed to zero at z = 200 nm"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("e-0"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("protocol.total_force"), std::string::npos) << c.err;
+  const json s = summary_of(out);
+  ASSERT_TRUE(s.is_object());
+  EXPECT_EQ(s["status"].get<std::string>().rfind("failed: ", 0), 0u) << s["status"];
+  if (have_matplotlib()) {
+    EXPECT_EQ(c.err.find("plotting with plot_run.py failed"), std::string::npos) << c.err;
+    EXPECT_TRUE(fs::exists(out / "run.png"));
+    EXPECT_EQ(swim::output::verify_folder(out.string(), {"run.png"}), "");
+  }
   fs::remove_all(d);
 }
 

@@ -182,8 +182,11 @@ TEST(ShippedScenes3d, DescriptionsStateTrueFigures) {
     if (number(d, R"(h = ([\d.]+) nm)", v)) { EXPECT_NEAR(v, p.h * 1e9, 0.05); }
     if (number(d, R"((\d+) (membrane )?nodes)", v)) { EXPECT_EQ(static_cast<int>(v), make_mesh(p).nodes()); }
     EXPECT_EQ(d.find('~' + std::string("1000 nodes")), std::string::npos);
-    if (number(d, R"(R0 = ([\d.]+) um)", v)) { EXPECT_NEAR(v * 1e-6, p.R0, 0.005 * p.R0); }
-    if (number(d, R"(\bL = ([\d.]+) um)", v)) { EXPECT_NEAR(v * 1e-6, p.L, 0.005 * p.L); }
+    // lengths in µm, as in every human-facing text (not "um", the unit syntax of the scene values)
+    EXPECT_FALSE(std::regex_search(d, std::regex(R"(\d um\b)"))) << d;
+    if (number(d, "R0 = ([\\d.]+) \u00b5m", v)) { EXPECT_NEAR(v * 1e-6, p.R0, 0.005 * p.R0); }
+    if (number(d, "\\bL = ([\\d.]+) \u00b5m", v)) { EXPECT_NEAR(v * 1e-6, p.L, 0.005 * p.L); }
+    EXPECT_TRUE(std::regex_search(d, std::regex("(R0|L) = [\\d.]+ \u00b5m"))) << "states R0 or L: " << d;
     if (number(d, R"(R_f = ([\d.]+) R0)", v)) { EXPECT_NEAR(v, resolved["wave"]["contracted_ratio"].get<double>(), 1e-9); }
     const int cycles = resolved["protocol"]["cycles"].get<int>();
     if (d.find("one cycle") != std::string::npos || d.find("one complete") != std::string::npos) { EXPECT_EQ(cycles, 1); }

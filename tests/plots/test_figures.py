@@ -89,6 +89,22 @@ class RunFigure(unittest.TestCase):
         self.assertIn("FAILED: numerical failure", c["title"])
         self.assertEqual(fig._suptitle.get_color(), "tab:red")
 
+    def test_run_failed_before_its_first_output_is_drawn_failed_without_data(self):
+        # the run stopped at t = 0 (series.csv and radius.csv hold their headers only)
+        run_folder(self.d, status="failed: numerical failure: tube radius collapsed to zero")
+        write_csv(f"{self.d}/series.csv", ["t_s", "x_center_m", "velocity_m_per_s", "energy_J", "min_radius_m",
+                                           "max_radius_m"], [])
+        write_csv(f"{self.d}/radius.csv", ["t_s", "z_m", "radius_m"], [])
+        fig, c = self.mod.figure(self.d)
+        self.assertTrue(c["failed"])
+        self.assertTrue(c["empty"])
+        self.assertIn("FAILED: numerical failure: tube radius collapsed", c["title"])
+        self.assertEqual(fig._suptitle.get_color(), "tab:red")
+        texts = [t.get_text() for a in fig.axes for t in a.texts]
+        self.assertTrue(any("no output time was reached" in t for t in texts), texts)
+        self.mod.main(self.d)  # the script itself writes run.png for such a folder
+        self.assertTrue(os.path.getsize(f"{self.d}/run.png") > 0)
+
     def test_3d_node_minimum_is_told_apart_from_the_ring_mean_map(self):
         run_folder(self.d, tier="3d")
         _, c = self.mod.figure(self.d)

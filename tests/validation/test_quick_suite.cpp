@@ -203,22 +203,49 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   EXPECT_EQ(c5["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
   EXPECT_EQ(c5["models1d"][0]["displacement_per_cycle_m"], c["models1d"][0]["displacement_per_cycle_m"]);
 
-  // through the command line: a damaged cached run is rejected, named, recomputed, and the
-  // command exits 0 with a report whose figures are those of the first suite
+  // through the command line: a damaged cached run and calibration are rejected, named,
+  // recomputed, and the command exits 0 with a report whose figures are those of the first
+  // suite; with --progress it says which stage and run it is in, each recomputed run's and the
+  // calibration's own progress, and the time left in the stage
   change_digit(fs::path(stopped) / "series.csv", "\n");
+  change_digit(c5["calibration"]["file"].get<std::string>(), "\"C1_Pa_per_m\"");
   const std::string log = out + "/validate.txt";
   const std::string cmd = std::string("\"") + SWIM_BINARY_DIR + "/bin/swim\" validate \"" + o.suite + "\" --out \"" + out +
-                          "\" --threads 1 --quiet > \"" + log + "\" 2>&1";
+                          "\" --threads 1 --progress > \"" + log + "\" 2>&1";
   const int status = std::system(cmd.c_str());
   std::ifstream in(log);
   std::stringstream printed;
   printed << in.rdbuf();
+  const std::string text = printed.str();
   ASSERT_TRUE(WIFEXITED(status));
-  EXPECT_EQ(WEXITSTATUS(status), 0) << printed.str();
-  EXPECT_NE(printed.str().find("1 rejected and recomputed"), std::string::npos) << printed.str();
-  EXPECT_NE(printed.str().find("series.csv: changed"), std::string::npos) << printed.str();
+  EXPECT_EQ(WEXITSTATUS(status), 0) << text;
+  EXPECT_NE(text.find("2 rejected and recomputed"), std::string::npos) << text;
+  EXPECT_NE(text.find("series.csv: changed"), std::string::npos) << text;
+  // the stage and the run: case, grid and its value
+  EXPECT_NE(text.find("validate: case 1/1"), std::string::npos) << text;
+  EXPECT_NE(text.find(": 3D grid 1/3 (full3d.grid = {\"cells_across\":12})"), std::string::npos) << text;
+  // the recomputed run's own progress (its label names the scene), then the stage's time left
+  // estimated from it before the next grid
+  const std::size_t run_done = text.find("3d tiny_3d_cycle");
+  ASSERT_NE(run_done, std::string::npos) << text;
+  EXPECT_NE(text.find(": done in ", run_done), std::string::npos) << text;
+  EXPECT_NE(text.find("3d tiny_3d_cycle (auto: until 1 cycle, progress against full3d.time_limit)"), std::string::npos)
+      << text;
+  const std::size_t grid2 = text.find(": 3D grid 2/3 (");
+  ASSERT_NE(grid2, std::string::npos) << text;
+  EXPECT_GT(grid2, run_done) << text;
+  EXPECT_NE(text.substr(grid2, text.find('\n', grid2) - grid2).find(" s left in this stage (so far "), std::string::npos)
+      << text;
+  // the calibration's own progress: its loads, the hydraulic radii, the towed tube, time left
+  const std::size_t cal_at = text.find("calibration at grid 3");
+  ASSERT_NE(cal_at, std::string::npos) << text;
+  EXPECT_NE(text.find("calibration tiny_3d_cycle: ", cal_at), std::string::npos) << text;
+  EXPECT_NE(text.find("load 1/", cal_at), std::string::npos) << text;
+  EXPECT_NE(text.find("hydraulic radii  ~", cal_at), std::string::npos) << text;
+  EXPECT_NE(text.find("s left", cal_at), std::string::npos) << text;
   std::ifstream rin(out + "/report.json");
   const scene::json r6 = scene::json::parse(rin);
-  EXPECT_EQ(r6["cache"]["rejected"], 1) << r6["cache"].dump();
+  EXPECT_EQ(r6["cache"]["rejected"], 2) << r6["cache"].dump();
   EXPECT_EQ(r6["cases"][0]["runs3d"][0]["displacement_per_cycle_m"], c["runs3d"][0]["displacement_per_cycle_m"]);
+  EXPECT_EQ(r6["cases"][0]["calibration"]["C1_Pa_per_m"], cal["C1_Pa_per_m"]);
 }
