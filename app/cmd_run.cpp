@@ -159,8 +159,7 @@ scene::json run_coarse(const RunOptions& o, const CoarseRun& c, const std::strin
   auto failed = [&](const std::string& why) {
     output::reset_ledger(dir);  // the coarse run's files and failure are not the run's
     std::fflush(stdout);
-    std::fprintf(stderr, "swim: error estimate: the coarse run failed (%s); the run goes on without an estimate
-",
+    std::fprintf(stderr, "swim: error estimate: the coarse run failed (%s); the run goes on without an estimate\n",
                  why.c_str());
     return scene::json{{"status", "failed: the coarse run (" + std::to_string(c.cells) + " cells across): " + why}};
   };

@@ -28,17 +28,26 @@ TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, dou
   e.interval_low = *std::min_element(e.extrapolated, e.extrapolated + 3);
   e.interval_high = *std::max_element(e.extrapolated, e.extrapolated + 3);
   for (double v : e.extrapolated) e.error = std::max(e.error, std::abs(v - e.extrapolated_order1));
-  if (positive && e.interval_low < 0 && e.extrapolated_order1 >= 0) {
-    char b[200];
-    std::snprintf(b, sizeof b, "the lower bound %.4g (an extrapolation at order %g) is below 0; the figure is positive, "
+  auto add_note = [&](const std::string& n) { e.note += (e.note.empty() ? "" : "; ") + n; };
+  char b[240];
+  if ((fine > 0 && coarse < 0) || (fine < 0 && coarse > 0))
+    add_note("the two grids give opposite signs: the coarse grid is far from the asymptotic range, so the "
+             "interval means little");
+  if (positive && e.interval_low < 0) {
+    const double raw1 = e.extrapolated_order1;
+    std::snprintf(b, sizeof b, "the lower bound %.4g (the extrapolation at order %g) is below 0; the figure is positive, "
                   "so interval_low is 0", e.interval_low,
                   kEstimateOrders[std::min_element(e.extrapolated, e.extrapolated + 3) - e.extrapolated]);
-    e.note = b;
+    add_note(b);
     e.interval_low = 0;
     e.clipped = true;
-  } else if (positive && e.extrapolated_order1 < 0) {
-    e.note = "the order-1 extrapolation of this positive figure is negative: the two grids are too coarse for the "
-             "estimate to mean much";
+    if (raw1 < 0) {
+      std::snprintf(b, sizeof b, "the order-1 extrapolation %.4g is below 0 too, so extrapolated_order1 is 0: the two "
+                    "grids are too coarse for this figure's estimate", raw1);
+      add_note(b);
+      e.extrapolated_order1 = 0;
+    }
+    e.interval_high = std::max(e.interval_high, 0.0);
   }
   return e;
 }

@@ -13,7 +13,8 @@
 // E_p is monotone in p, so the interval holds E_p for every p of the range: a figure that
 // follows f0 + C h^p exactly with p in [0.5, 2] has its f0 inside the interval.
 // A figure that is positive by its nature (the cycle time) whose lower bound falls below 0
-// has that bound clipped to 0 (with a note giving the unclipped value); the error keeps it.
+// has that bound clipped to 0 (with a note giving the unclipped value; E_1 too when it is
+// negative); the error and extrapolated_order0_5, extrapolated_order2 keep the unclipped values.
 #pragma once
 
 #include <string>
@@ -29,18 +30,19 @@ constexpr double kEstimateOrders[3] = {kImmersedBoundaryOrders.lo, 1.0, kImmerse
 struct TwoGridEstimate {
   double fine = 0, coarse = 0;
   double extrapolated[3] = {0, 0, 0};  ///< E_p for p = kEstimateOrders
-  double extrapolated_order1 = 0;      ///< E_1
+  double extrapolated_order1 = 0;      ///< E_1 (a positive figure's: at least 0)
   double interval_low = 0, interval_high = 0;
   double error = 0;                    ///< max |E_p - E_1|
   bool clipped = false;                ///< interval_low raised to 0 (a positive figure)
-  std::string note;                    ///< why it was clipped; empty otherwise
+  /// why a bound was clipped, or that the grids give opposite signs; empty otherwise
+  std::string note;
 };
 
 /// E_p = fine + (fine - coarse) / (r^p - 1), r = h_coarse / h_fine.
 double extrapolate_two_grids(double fine, double coarse, double h_fine, double h_coarse, double order);
 
-/// The estimate of one figure. positive: the figure cannot be negative (its lower bound is
-/// clipped at 0 when that keeps it at or below E_1). Throws InputError for non-finite values
+/// The estimate of one figure. positive: the figure cannot be negative (a bound or E_1 below 0
+/// is reported as 0, with a note). Throws InputError for non-finite values
 /// or h_coarse <= h_fine.
 TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive);
 

@@ -27,7 +27,9 @@ TEST(ErrorEstimate, ExactPowerLawsRecoverTheLimitAndTheIntervalHoldsIt) {
       EXPECT_GE(e.interval_high, e.extrapolated_order1);
       // the error reaches f0 from E_1
       EXPECT_GE(e.error, std::abs(e.extrapolated_order1 - f0) - 1e-9);
-      if (p == 1.0) EXPECT_NEAR(e.extrapolated_order1, f0, 1e-9 * f0);
+      if (p == 1.0) {
+        EXPECT_NEAR(e.extrapolated_order1, f0, 1e-9 * f0);
+      }
       EXPECT_FALSE(e.clipped);
     }
   }
@@ -77,6 +79,22 @@ TEST(ErrorEstimate, TheMeasuredCycleTimesBracketTheReferenceAndANegativeBoundIsC
   EXPECT_TRUE(j.contains("note"));
   // not a positive figure: the negative bound stays
   EXPECT_LT(two_grid_estimate(0.616, 0.752, h, H, false).interval_low, 0.0);
+  // grids too coarse: the cycle time falls so fast (0.695 s on 12 cells, 1.162 s on 9, the
+  // tiny cycle scene) that E_1 = -0.706 s too; it is reported as 0 with a note, the interval
+  // [0, E_2 = 0.0946 s], the unclipped values in the note, the error and E_0.5
+  const TwoGridEstimate c = two_grid_estimate(0.695, 1.162, 0.48e-6 / 12, 0.48e-6 / 9, true);
+  EXPECT_EQ(c.extrapolated_order1, 0.0);
+  EXPECT_EQ(c.interval_low, 0.0);
+  EXPECT_NEAR(c.interval_high, 0.0946, 0.0001);
+  EXPECT_NEAR(c.extrapolated[1], -0.706, 0.001);
+  EXPECT_NEAR(c.error, 1.618, 0.001);  // |E_0.5 - E_1| = |-2.324 + 0.706| s
+  EXPECT_NE(c.note.find("-0.706"), std::string::npos) << c.note;
+  EXPECT_NE(c.note.find("too coarse"), std::string::npos) << c.note;
+  // opposite signs on the two grids are named
+  const TwoGridEstimate s = two_grid_estimate(0.53e-9, -5.76e-9, 0.48e-6 / 12, 0.48e-6 / 9, false);
+  EXPECT_NE(s.note.find("opposite signs"), std::string::npos) << s.note;
+  EXPECT_LE(s.interval_low, s.extrapolated_order1);
+  EXPECT_LE(s.extrapolated_order1, s.interval_high);
 }
 
 // The summary object: the method, both grids, the order range [0.5, 2], an object per headline
