@@ -147,8 +147,14 @@ CoarseRun coarse_run(const scene::json& sc, const full3d::Params3d& p) {
   c.scene = sc;
   scene::apply_override(c.scene, "full3d.grid.cell_size=null");
   scene::apply_override(c.scene, "full3d.grid.cells_across=" + std::to_string(best));
-  c.p = full3d::read_scene3d(c.scene, c.resolved);
-  check_output_size(estimate_output(c.p), c.scene);
+  try {
+    c.p = full3d::read_scene3d(c.scene, c.resolved);
+    check_output_size(estimate_output(c.p), c.scene);
+  } catch (const InputError& e) {
+    throw InputError("--error-estimate", "the coarse grid full3d.grid.cells_across = " + std::to_string(best),
+                     std::string("the coarse run's scene is refused (") + e.what() +
+                         "); refine the grid or leave --error-estimate out");
+  }
   return c;
 }
 
