@@ -117,7 +117,9 @@ TEST(ErrorEstimateCli, ACoarseRunGivesTheErrorOfEachHeadlineFigureOrSaysWhyItFai
 }
 
 // Expected: exit 2 before anything is written, the message naming --error-estimate, the tier
-// and what is allowed (--tier 3d); with --resume, naming both options.
+// and what is allowed (--tier 3d); with --resume, naming both options; a scene whose coarse grid
+// the reader refuses (a swimmer of radius 0.135 um fits the 0.24 um duct with the kernel's 2 h
+// on 12 cells across, not on 9), naming --error-estimate, the coarse grid and the reader's key.
 TEST(ErrorEstimateCli, OnlyA3dRunWithoutResumeTakesTheOption) {
   const fs::path d = swim::test::scratch_dir("swim_error_estimate_bad");
   for (const std::string tier : {"1d", "axi"}) {
@@ -136,5 +138,13 @@ TEST(ErrorEstimateCli, OnlyA3dRunWithoutResumeTakesTheOption) {
   EXPECT_NE(c.err.find("--error-estimate"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("--resume"), std::string::npos) << c.err;
   EXPECT_TRUE(fs::is_empty(out));
+  const fs::path wide = d / "wide";
+  const Cli w = swim_cli("run \"" + kTinyCycle + "\" --tier 3d --error-estimate --set swimmer.radius='\"0.135 um\"' --out \"" +
+                             wide.string() + "\"",
+                         d);
+  EXPECT_EQ(w.code, 2) << w.err;
+  EXPECT_NE(w.err.find("'--error-estimate' = the coarse grid full3d.grid.cells_across = 9"), std::string::npos) << w.err;
+  EXPECT_NE(w.err.find("container.radius"), std::string::npos) << w.err;
+  EXPECT_FALSE(fs::exists(wide));
   fs::remove_all(d);
 }
