@@ -21,6 +21,9 @@ struct RunOptions {
   std::string resume;  ///< 3D: continue the run whose output folder (with checkpoint.bin) is given
   bool overwrite = false;  ///< replace another run's results in the output folder
   int threads = 0;  ///< 3D: threads of the run (full3d.threads); 0: the scene's
+  /// 3D: also run the scene on a coarser grid (RUN/error_estimate/coarse) and report the run's
+  /// discretisation error in summary.json's error_estimate (validation/error_estimate.hpp)
+  bool error_estimate = false;
 };
 
 int run(const RunOptions& o);

@@ -1,10 +1,12 @@
 #include <algorithm>
+#include <cmath>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <optional>
 
 #include "app/app.hpp"
 #include "app/scene_checks.hpp"
@@ -23,6 +25,7 @@
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
+#include "validation/error_estimate.hpp"
 
 namespace swim::app {
 
@@ -113,6 +116,98 @@ void print_summary_1d(const std::string& name, const scene::json& s, double wall
   throw;
 }
 
+// --error-estimate: the same scene on a coarser grid, a run folder of its own in
+// RUN/error_estimate/coarse (docs/full3d.md, "A run's own error estimate").
+struct CoarseRun {
+  int cells = 0;
+  scene::json scene;
+  scene::json resolved;
+  full3d::Params3d p;
+};
+
+// The grid the 3D reader accepts (the container period a multiple of the cell size) nearest to
+// 3/4 of the run's cells across, coarser than it; an even count on a tie. Read and checked as
+// the run's own scene (InputError, exit 2, before anything is written).
+CoarseRun coarse_run(const scene::json& sc, const full3d::Params3d& p) {
+  const double width = 2.0 * p.container_radius;
+  const int n = int(std::lround(width / p.h));
+  const double target = 0.75 * n;
+  int best = 0;
+  for (int c = 4; c < n; ++c) {
+    if (!scene::multiple_of(p.period, width / c)) continue;
+    const double dc = std::abs(c - target), db = std::abs(best - target);
+    if (best == 0 || dc < db - 1e-9 || (std::abs(dc - db) <= 1e-9 && c % 2 == 0 && best % 2 != 0)) best = c;
+  }
+  if (best == 0)
+    throw InputError("--error-estimate", "full3d.grid.cells_across = " + std::to_string(n),
+                     "needs a coarser grid of at least 4 cells across whose cell size divides container.period; "
+                     "refine the grid or leave --error-estimate out");
+  CoarseRun c;
+  c.cells = best;
+  c.scene = sc;
+  scene::apply_override(c.scene, "full3d.grid.cell_size=null");
+  scene::apply_override(c.scene, "full3d.grid.cells_across=" + std::to_string(best));
+  try {
+    c.p = full3d::read_scene3d(c.scene, c.resolved);
+    check_output_size(estimate_output(c.p), c.scene);
+  } catch (const InputError& e) {
+    throw InputError("--error-estimate", "the coarse grid full3d.grid.cells_across = " + std::to_string(best),
+                     std::string("the coarse run's scene is refused (") + e.what() +
+                         "); refine the grid or leave --error-estimate out");
+  }
+  return c;
+}
+
+// Runs the coarse grid into its folder inside the run's. Its summary, or {"status": "failed: ..."}
+// when it cannot give the per-cycle figures; a failure of the coarse run never fails the run.
+scene::json run_coarse(const RunOptions& o, const CoarseRun& c, const std::string& out) {
+  const std::string dir = (fs::path(out) / "error_estimate" / "coarse").string();
+  auto failed = [&](const std::string& why) {
+    output::reset_ledger(dir);  // the coarse run's files and failure are not the run's
+    std::fflush(stdout);
+    std::fprintf(stderr, "swim: error estimate: the coarse run failed (%s); the run goes on without an estimate\n",
+                 why.c_str());
+    return scene::json{{"status", "failed: the coarse run (" + std::to_string(c.cells) + " cells across): " + why}};
+  };
+  try {
+    output::RunFolder folder(dir, {"3d", c.resolved, false, false, "--error-estimate"});
+    full3d::RunControl ctl;
+    ctl.progress = o.progress;
+    ctl.max_output_bytes = static_cast<std::uintmax_t>(scene::output_limits(c.scene).max_bytes);
+    full3d::RunOutcome r;
+    try {
+      r = full3d::run3d(c.p, c.resolved, dir, ctl);
+    } catch (const std::exception& e) {
+      folder.mark_failed(e.what());
+      return failed(e.what());
+    }
+    if (r.failed) return failed(r.message);
+    const auto& s = r.summary;
+    if (!s["displacement_per_cycle_m"].is_number())
+      return failed("no cycle completed (" + s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")");
+    std::printf("%s (3d, error estimate, coarse grid %d cells across, h = %s): %s per cycle, cycle %s; %ld steps; "
+                "wall time %s\n  -> %s/summary.json\n",
+                c.p.name.c_str(), c.cells, si(c.p.h, "m").c_str(), si(s["displacement_per_cycle_m"].get<double>(), "m").c_str(),
+                si(s["cycle_time_s"].get<double>(), "s").c_str(), r.steps, si(s["wall_time_s"].get<double>(), "s").c_str(),
+                dir.c_str());
+    std::fflush(stdout);
+    return s;
+  } catch (const std::exception& e) {
+    return failed(e.what());
+  }
+}
+
+// summary.json (committed again, still last) with `key` set.
+void add_to_summary(const std::string& out, const std::string& key, const scene::json& value) {
+  const std::string path = (fs::path(out) / "summary.json").string();
+  std::ifstream in(path);
+  scene::json j = scene::json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return;
+  for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
+  j[key] = value;
+  output::write_json(path, j);
+}
+
 // The 3D tier: read and validate, run (full3d/run3d.hpp), report.
 int run3d(const RunOptions& o, const scene::json& sc) {
   scene::json resolved;
@@ -123,6 +218,12 @@ int run3d(const RunOptions& o, const scene::json& sc) {
     throw InputError("--out", o.out, "with --resume the run continues in the resumed folder; omit --out");
   if (!o.resume.empty() && o.overwrite)
     throw InputError("--overwrite", "", "cannot be combined with --resume (it would remove the run to continue)");
+  if (!o.resume.empty() && o.error_estimate)
+    throw InputError("--error-estimate", "--resume " + o.resume,
+                     "cannot be combined with --resume (the estimate's coarse run is not continued); resume without "
+                     "--error-estimate, or run the scene again with --error-estimate and --overwrite");
+  std::optional<CoarseRun> coarse;
+  if (o.error_estimate) coarse = coarse_run(sc, p);
   const std::string out = !o.resume.empty() ? o.resume : o.out.empty() ? "out/" + p.name + "-3d" : o.out;
   if (!o.resume.empty() && !fs::exists(full3d::checkpoint_path(out)))
     throw InputError("--resume", o.resume, "no checkpoint.bin in this folder");
@@ -138,9 +239,27 @@ int run3d(const RunOptions& o, const scene::json& sc) {
   ctl.progress = o.progress;
   ctl.max_output_bytes = static_cast<std::uintmax_t>(scene::output_limits(sc).max_bytes);
   ctl.resume = !o.resume.empty();
+  scene::json coarse_summary;
+  if (coarse) {
+    if (o.progress != 0)
+      std::fprintf(stderr, "swim: error estimate: 1 of 2, the coarse run (%d cells across, h = %s) into %s/error_estimate/coarse\n",
+                   coarse->cells, si(coarse->p.h, "m").c_str(), out.c_str());
+    coarse_summary = run_coarse(o, *coarse, out);
+    if (o.progress != 0)
+      std::fprintf(stderr, "swim: error estimate: 2 of 2, the run itself (%d cells across, h = %s)\n",
+                   int(std::lround(2.0 * p.container_radius / p.h)), si(p.h, "m").c_str());
+  }
   full3d::RunOutcome r;
   try {
     r = full3d::run3d(p, resolved, out, ctl);
+    // the estimate joins the summary (committed again, still last) when the run itself finished
+    if (coarse && !r.failed) {
+      scene::json e = coarse_summary.contains("status") && coarse_summary["status"] != "ok"
+                          ? coarse_summary
+                          : validation::error_estimate_json(r.summary, coarse_summary, coarse->cells, p.h, coarse->p.h);
+      add_to_summary(out, "error_estimate", e);
+      r.summary["error_estimate"] = e;
+    }
   } catch (const std::exception& e) {
     fail_run(folder, e);
   }
@@ -159,6 +278,22 @@ int run3d(const RunOptions& o, const scene::json& sc) {
               si(s["mean_velocity_m_per_s"].get<double>(), "m/s").c_str(), s["body_lengths_per_s"].get<double>(),
               per_cycle.c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps,
               si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
+  if (s.contains("error_estimate")) {
+    const auto& e = s["error_estimate"];
+    if (e["status"] != "ok") {
+      std::printf("  error estimate: %s\n", e["status"].get<std::string>().c_str());
+    } else {
+      for (const char* k : {"displacement_per_cycle_m", "cycle_time_s"}) {
+        const auto& f = e[k];
+        const char* unit = std::string(k) == "cycle_time_s" ? "s" : "m";
+        std::printf("  error estimate, %s: %s on this grid, %s on %d cells across; extrapolated %s, interval [%s, %s]\n",
+                    std::string(k) == "cycle_time_s" ? "cycle time" : "displacement per cycle",
+                    si(f["fine"].get<double>(), unit).c_str(), si(f["coarse"].get<double>(), unit).c_str(),
+                    e["coarse_cells_across"].get<int>(), si(f["extrapolated_order1"].get<double>(), unit).c_str(),
+                    si(f["interval_low"].get<double>(), unit).c_str(), si(f["interval_high"].get<double>(), unit).c_str());
+      }
+    }
+  }
   // a wall that buckled into lobes beyond half a cell: its pattern, and the displacement
   // that depends on it, follow the grid (docs/full3d.md, "Wall wrinkling")
   std::fflush(stdout);  // the note follows the result line, also when both go to one file
@@ -222,6 +357,10 @@ int run_axi(const RunOptions& o, const scene::json& sc) {
 
 int run(const RunOptions& o) {
   // 1. Everything is read and validated before anything is written.
+  if (o.error_estimate && o.tier != "3d")
+    throw InputError("--error-estimate", "--tier " + o.tier,
+                     "only a 3D run (--tier 3d) estimates its own discretisation error, by a second run on a coarser "
+                     "grid; add --tier 3d or leave --error-estimate out");
   scene::json sc = scene::load_file(o.scene);
   for (const auto& s : o.sets) scene::apply_override(sc, s);
   if (o.threads > 0) {

@@ -1,6 +1,7 @@
 // swim: command line of the peristaltic micro-swimmer suite (product contract in README.md).
 //
 //   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--plot] [--resume DIR] [--overwrite] [--threads N]
+//                       [--error-estimate]
 //   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
 //   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|axi|all]
@@ -57,6 +58,9 @@ int main(int argc, char** argv) {
                 "Replace the results of another run in the output folder (its files are removed first)");
   run->add_option("--threads", ro.threads, "3D: threads of the run (sets full3d.threads; default: the scene's, 1)")
       ->check(CLI::Range(1, 256));
+  run->add_flag("--error-estimate", ro.error_estimate,
+                "3D: also run the scene on a coarser grid (3/4 of the cells across, in OUT/error_estimate/coarse) and "
+                "report the run's discretisation error in summary.json (error_estimate)");
   add_progress(run);
 
   std::string out;

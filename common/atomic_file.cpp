@@ -139,8 +139,10 @@ class FdBuf : public std::streambuf {
   char buf_[1 << 16];
 };
 
-// SWIM_TEST_FAIL_WRITE=<name>[:<bytes>]: the byte budget for a file of that name, else -1.
-long long injected_budget(const std::string& name) {
+// SWIM_TEST_FAIL_WRITE=<name>[:<bytes>]: the byte budget for a file of that name (a name with a
+// '/' is matched against the end of the file's path: "coarse/radius.csv"), else -1.
+long long injected_budget(const std::string& path) {
+  const std::string name = fs::path(path).filename().string();
   const char* e = std::getenv("SWIM_TEST_FAIL_WRITE");
   if (!e || !*e) return -1;
   std::string spec(e);
@@ -149,7 +151,10 @@ long long injected_budget(const std::string& name) {
     budget = std::atoll(spec.c_str() + c + 1);
     spec = spec.substr(0, c);
   }
-  return spec == name ? budget : -1;
+  if (spec.find('/') == std::string::npos) return spec == name ? budget : -1;
+  const bool tail = path.size() > spec.size() && path.compare(path.size() - spec.size(), spec.size(), spec) == 0 &&
+                    path[path.size() - spec.size() - 1] == '/';
+  return path == spec || tail ? budget : -1;
 }
 
 /// Flush and check the stream, close the file and rename `from` to `to`. Any failure is
@@ -192,7 +197,7 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)), impl_(std::ma
     note_failure(path_, reason_of(err));
     throw OutputError(name, reason_of(err));
   }
-  impl_->buf = std::make_unique<FdBuf>(impl_->fd, injected_budget(name));
+  impl_->buf = std::make_unique<FdBuf>(impl_->fd, injected_budget(path_));
   impl_->stream = std::make_unique<std::ostream>(impl_->buf.get());
 }
 
@@ -273,7 +278,7 @@ void PartFile::open(int flags, Mark from) {
     note_failure(path_, reason_of(err));
     throw OutputError(name, reason_of(err));
   }
-  long long budget = injected_budget(fs::path(path_).filename().string());
+  long long budget = injected_budget(path_);
   if (budget >= 0) budget += static_cast<long long>(from.bytes);
   impl_->buf = std::make_unique<FdBuf>(impl_->fd, budget, from.bytes, from.checksum);
   impl_->stream = std::make_unique<std::ostream>(impl_->buf.get());

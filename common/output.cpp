@@ -47,7 +47,7 @@ void write_json(const std::string& path, const json& value) {
     with_files = value;
     json files = json::array();
     for (const auto& r : committed_files(dir))
-      if (r.name != "summary.json" && r.name[0] != '.') files.push_back({{"name", r.name}, {"bytes", r.bytes}, {"fnv1a64", r.fnv1a64}});
+      if (r.name != "summary.json" && fs::path(r.name).filename().string()[0] != '.') files.push_back({{"name", r.name}, {"bytes", r.bytes}, {"fnv1a64", r.fnv1a64}});
     with_files["files"] = files;
     with_files["swim_version"] = version();
     out = &with_files;

@@ -138,6 +138,13 @@ bool RunFolder::is_result_name(const std::string& rel) {
                                               "confirm.json", "confirm.md", "confirm.png", "trajectory.csv",
                                               "optimum.json", "optimum.scene.json", "optimize.png"};
   if (fixed.count(rel)) return true;
+  // the coarse-grid run of --error-estimate: a run folder of its own inside the run's
+  static const std::string coarse = "error_estimate/coarse/";
+  if (rel == "error_estimate" || rel == "error_estimate/coarse") return true;
+  if (rel.rfind(coarse, 0) == 0) {
+    const std::string in = rel.substr(coarse.size());
+    return in == kLock || is_result_name(in);
+  }
   static const std::regex frames(R"(vtk/(membrane_\d+\.vtp|fluid_\d+\.vti))");
   static const std::regex temps(R"((vtk/)?\.[^/]+\.tmp(-\d+)?)");
   return std::regex_match(rel, frames) || std::regex_match(rel, temps);

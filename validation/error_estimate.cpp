@@ -1,0 +1,96 @@
+#include "validation/error_estimate.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "common/errors.hpp"
+#include <cstdio>
+
+namespace swim::validation {
+
+double extrapolate_two_grids(double fine, double coarse, double h_fine, double h_coarse, double order) {
+  const double r = h_coarse / h_fine;
+  return fine + (fine - coarse) / (std::pow(r, order) - 1.0);
+}
+
+TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive) {
+  if (!std::isfinite(fine) || !std::isfinite(coarse))
+    throw InputError("error_estimate", std::to_string(fine) + ", " + std::to_string(coarse),
+                     "the figures of both grids must be finite");
+  if (!(std::isfinite(h_fine) && std::isfinite(h_coarse) && h_fine > 0 && h_coarse > h_fine))
+    throw InputError("error_estimate", std::to_string(h_fine) + ", " + std::to_string(h_coarse),
+                     "the coarse grid's cell size must exceed the fine grid's (both positive)");
+  TwoGridEstimate e;
+  e.fine = fine;
+  e.coarse = coarse;
+  for (int i = 0; i < 3; ++i) e.extrapolated[i] = extrapolate_two_grids(fine, coarse, h_fine, h_coarse, kEstimateOrders[i]);
+  e.extrapolated_order1 = e.extrapolated[1];
+  e.interval_low = *std::min_element(e.extrapolated, e.extrapolated + 3);
+  e.interval_high = *std::max_element(e.extrapolated, e.extrapolated + 3);
+  for (double v : e.extrapolated) e.error = std::max(e.error, std::abs(v - e.extrapolated_order1));
+  auto add_note = [&](const std::string& n) { e.note += (e.note.empty() ? "" : "; ") + n; };
+  char b[240];
+  if ((fine > 0 && coarse < 0) || (fine < 0 && coarse > 0))
+    add_note("the two grids give opposite signs: the coarse grid is far from the asymptotic range, so the "
+             "interval means little");
+  if (positive && e.interval_low < 0) {
+    const double raw1 = e.extrapolated_order1;
+    std::snprintf(b, sizeof b, "the lower bound %.4g (the extrapolation at order %g) is below 0; the figure is positive, "
+                  "so interval_low is 0", e.interval_low,
+                  kEstimateOrders[std::min_element(e.extrapolated, e.extrapolated + 3) - e.extrapolated]);
+    add_note(b);
+    e.interval_low = 0;
+    e.clipped = true;
+    if (raw1 < 0) {
+      std::snprintf(b, sizeof b, "the order-1 extrapolation %.4g is below 0 too, so extrapolated_order1 is 0: the two "
+                    "grids are too coarse for this figure's estimate", raw1);
+      add_note(b);
+      e.extrapolated_order1 = 0;
+    }
+    e.interval_high = std::max(e.interval_high, 0.0);
+  }
+  return e;
+}
+
+scene::json to_json(const TwoGridEstimate& e) {
+  scene::json j = {{"fine", e.fine},
+                   {"coarse", e.coarse},
+                   {"extrapolated_order1", e.extrapolated_order1},
+                   {"interval_low", e.interval_low},
+                   {"interval_high", e.interval_high},
+                   {"error", e.error},
+                   {"extrapolated_order0_5", e.extrapolated[0]},
+                   {"extrapolated_order2", e.extrapolated[2]}};
+  if (!e.note.empty()) j["note"] = e.note;
+  return j;
+}
+
+scene::json error_estimate_json(const scene::json& fine, const scene::json& coarse, int coarse_cells_across,
+                                double h_fine, double h_coarse) {
+  for (const auto* s : {&fine, &coarse}) {
+    const char* which = s == &fine ? "the run" : "the coarse run";
+    for (const char* k : kEstimatedFigures)
+      if (!s->contains(k) || !(*s)[k].is_number()) {
+        std::string why = s->contains("per_cycle_absent_because") && (*s)["per_cycle_absent_because"].is_string()
+                              ? (*s)["per_cycle_absent_because"].get<std::string>()
+                              : std::string("no ") + k;
+        return {{"status", std::string("failed: ") + which + " has no per-cycle figures (" + why + ")"}};
+      }
+  }
+  scene::json j = {{"status", "ok"},
+                   {"method", "two grids: this run and a second run on a coarser grid (error_estimate/coarse); "
+                              "E_p = f + (f - F) / (r^p - 1), r = coarse_cell_size_m / fine_cell_size_m, at the "
+                              "orders p of order_range and 1; extrapolated_order1 = E_1, interval = [min, max] of E_p, "
+                              "error = max |E_p - E_1|"},
+                   {"coarse_cells_across", coarse_cells_across},
+                   {"coarse_cell_size_m", h_coarse},
+                   {"fine_cell_size_m", h_fine},
+                   {"order_range", {kImmersedBoundaryOrders.lo, kImmersedBoundaryOrders.hi}}};
+  for (const char* k : kEstimatedFigures) {
+    const bool positive = std::string(k) == "cycle_time_s";
+    j[k] = to_json(two_grid_estimate(fine[k].get<double>(), coarse[k].get<double>(), h_fine, h_coarse, positive));
+  }
+  return j;
+}
+
+}  // namespace swim::validation

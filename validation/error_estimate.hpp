@@ -1,0 +1,63 @@
+// A single 3D run's own discretisation error, from a second run on a coarser grid
+// (`swim run SCENE --tier 3d --error-estimate`, docs/full3d.md "A run's own error estimate").
+//
+// With the figure f on the run's grid (cell size h) and F on the coarser grid (H = r h, r > 1),
+// the extrapolation to h -> 0 at an assumed order p is
+//     E_p = f + (f - F) / (r^p - 1).
+// The order the immersed boundary shows on affordable grids is not known for a single pair of
+// grids (it is pre-asymptotic: observed orders between about 0.25 and 2), so the estimate takes
+// the orders of the scheme's range (validation::kImmersedBoundaryOrders, [0.5, 2]) and 1:
+//     extrapolated value   E_1,
+//     interval             [min, max] of {E_0.5, E_1, E_2},
+//     error                max |E_p - E_1| over those p.
+// E_p is monotone in p, so the interval holds E_p for every p of the range: a figure that
+// follows f0 + C h^p exactly with p in [0.5, 2] has its f0 inside the interval.
+// A figure that is positive by its nature (the cycle time) whose lower bound falls below 0
+// has that bound clipped to 0 (with a note giving the unclipped value; E_1 too when it is
+// negative); the error and extrapolated_order0_5, extrapolated_order2 keep the unclipped values.
+#pragma once
+
+#include <string>
+
+#include "common/scene.hpp"
+#include "validation/richardson.hpp"
+
+namespace swim::validation {
+
+/// The assumed orders of the estimate: the immersed boundary's range and 1.
+constexpr double kEstimateOrders[3] = {kImmersedBoundaryOrders.lo, 1.0, kImmersedBoundaryOrders.hi};
+
+struct TwoGridEstimate {
+  double fine = 0, coarse = 0;
+  double extrapolated[3] = {0, 0, 0};  ///< E_p for p = kEstimateOrders
+  double extrapolated_order1 = 0;      ///< E_1 (a positive figure's: at least 0)
+  double interval_low = 0, interval_high = 0;
+  double error = 0;                    ///< max |E_p - E_1|
+  bool clipped = false;                ///< interval_low raised to 0 (a positive figure)
+  /// why a bound was clipped, or that the grids give opposite signs; empty otherwise
+  std::string note;
+};
+
+/// E_p = fine + (fine - coarse) / (r^p - 1), r = h_coarse / h_fine.
+double extrapolate_two_grids(double fine, double coarse, double h_fine, double h_coarse, double order);
+
+/// The estimate of one figure. positive: the figure cannot be negative (a bound or E_1 below 0
+/// is reported as 0, with a note). Throws InputError for non-finite values
+/// or h_coarse <= h_fine.
+TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive);
+
+/// summary.json's object of one figure: fine, coarse, extrapolated_order1, interval_low,
+/// interval_high, error, extrapolated_order0_5, extrapolated_order2 (and note when clipped).
+scene::json to_json(const TwoGridEstimate& e);
+
+/// The headline figures of a run (summary.json keys) the estimate covers.
+constexpr const char* kEstimatedFigures[3] = {"displacement_per_cycle_m", "cycle_time_s",
+                                              "mean_velocity_per_cycle_m_per_s"};
+
+/// summary.json's `error_estimate` object from the two runs' summaries: method, the grids,
+/// order_range and an object per figure of kEstimatedFigures; {"status": "failed: ..."} (no
+/// numbers) when either summary has no per-cycle figures.
+scene::json error_estimate_json(const scene::json& fine_summary, const scene::json& coarse_summary, int coarse_cells_across,
+                                double h_fine, double h_coarse);
+
+}  // namespace swim::validation
