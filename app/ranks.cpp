@@ -300,14 +300,10 @@ void stop_workers() {
   if (!g_mpi || g_rank != 0 || g_stopped) return;
   g_stopped = true;
   for (int r = 1; r < g_size; ++r) {
-    // a lost rank may be dead: never wait on it
-    MPI_Request q;
-    MPI_Isend(nullptr, 0, MPI_CHAR, r, kStop, MPI_COMM_WORLD, &q);
-    if (std::any_of(g_lost.begin(), g_lost.end(), [&](const LostRank& l) { return l.rank == r; })) {
-      MPI_Request_free(&q);
-    } else {
-      MPI_Wait(&q, MPI_STATUS_IGNORE);
-    }
+    // a lost rank may be dead: send it nothing (a send to a dead peer leaves a connection
+    // attempt pending, and MPI_Finalize then waits on it for ever)
+    if (std::any_of(g_lost.begin(), g_lost.end(), [&](const LostRank& l) { return l.rank == r; })) continue;
+    MPI_Send(nullptr, 0, MPI_CHAR, r, kStop, MPI_COMM_WORLD);
   }
 }
 
