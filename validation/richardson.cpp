@@ -40,6 +40,26 @@ std::string OrderRange::text() const {
   return b;
 }
 
+namespace {
+
+/// The series ordered from the coarsest grid to the finest; InputError for repeated spacings.
+void coarse_to_fine(const std::vector<double>& h, const std::vector<double>& f, std::vector<double>& hs,
+                    std::vector<double>& fs) {
+  std::vector<std::size_t> idx(h.size());
+  std::iota(idx.begin(), idx.end(), 0);
+  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return h[a] > h[b]; });
+  hs.clear();
+  fs.clear();
+  for (std::size_t i : idx) {
+    hs.push_back(h[i]);
+    fs.push_back(f[i]);
+  }
+  for (std::size_t i = 1; i < hs.size(); ++i)
+    if (!(hs[i] < hs[i - 1])) throw InputError("validation grids", std::to_string(hs[i]), "distinct grid spacings");
+}
+
+}  // namespace
+
 Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order, OrderRange range) {
   if (h.size() != f.size() || h.size() < 2)
     throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
@@ -48,16 +68,8 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
                      "0 < lo < hi <= " + std::to_string(int(kOrderSearchMax)) + " (the orders the scheme can show)");
   if (!(assumed_order >= range.lo && assumed_order <= range.hi))
     throw InputError("assumed order", std::to_string(assumed_order), "inside the order range " + range.text());
-  std::vector<std::size_t> idx(h.size());
-  std::iota(idx.begin(), idx.end(), 0);
-  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return h[a] > h[b]; });
   std::vector<double> hs, fs;
-  for (std::size_t i : idx) {
-    hs.push_back(h[i]);
-    fs.push_back(f[i]);
-  }
-  for (std::size_t i = 1; i < hs.size(); ++i)
-    if (!(hs[i] < hs[i - 1])) throw InputError("validation grids", std::to_string(hs[i]), "distinct grid spacings");
+  coarse_to_fine(h, f, hs, fs);
   const std::size_t n = hs.size();
   const double f3 = fs[n - 1], f2 = fs[n - 2], h3 = hs[n - 1], h2 = hs[n - 2];
   Extrapolation e;
@@ -171,16 +183,8 @@ double expansion_f0(const std::vector<double>& h, const std::vector<double>& f, 
 Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderRange range) {
   if (h.size() != f.size() || h.size() < 2)
     throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
-  std::vector<std::size_t> idx(h.size());
-  std::iota(idx.begin(), idx.end(), 0);
-  std::sort(idx.begin(), idx.end(), [&](std::size_t a, std::size_t b) { return h[a] > h[b]; });
   std::vector<double> hs, fs;
-  for (std::size_t i : idx) {
-    hs.push_back(h[i]);
-    fs.push_back(f[i]);
-  }
-  for (std::size_t i = 1; i < hs.size(); ++i)
-    if (!(hs[i] < hs[i - 1])) throw InputError("validation grids", std::to_string(hs[i]), "distinct grid spacings");
+  coarse_to_fine(h, f, hs, fs);
   const std::size_t n = hs.size();
   const double finest = fs.back();
   const std::size_t k3 = n >= 3 ? n - 3 : 0;
