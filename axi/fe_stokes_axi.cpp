@@ -60,8 +60,6 @@ inline double dlag(int i, double t) {
 constexpr double kG = 0.7745966692414834;  // sqrt(3/5)
 constexpr double kGp[3] = {-kG, 0.0, kG};
 constexpr double kGw[3] = {5.0 / 9.0, 8.0 / 9.0, 5.0 / 9.0};
-// Corner signs of the bilinear map, in the order (-1,-1), (1,-1), (1,1), (-1,1).
-constexpr double kCs[4] = {-1, 1, 1, -1}, kCt[4] = {-1, -1, 1, 1};
 
 // Reference tables at the 9 quadrature points q = 3 qb + qa (qa along xi): Q2 shape functions
 // (local node a = 3 b + i, i along xi) and their reference derivatives.
@@ -123,17 +121,8 @@ void FittedStokes::element_geometry(int e, Geometry& g) const {
   pressure_scales(cx, cr, g.xc, g.rc, g.hx, g.hr);
   for (int q = 0; q < 9; ++q) {
     const double xi = T.xi[q], eta = T.eta[q];
-    double x = 0, r = 0, xx = 0, xe = 0, rx = 0, re = 0;
-    for (int i = 0; i < 4; ++i) {
-      const double m = 0.25 * (1 + kCs[i] * xi) * (1 + kCt[i] * eta);
-      const double mx = 0.25 * kCs[i] * (1 + kCt[i] * eta), me = 0.25 * kCt[i] * (1 + kCs[i] * xi);
-      x += m * cx[i];
-      r += m * cr[i];
-      xx += mx * cx[i];
-      xe += me * cx[i];
-      rx += mx * cr[i];
-      re += me * cr[i];
-    }
+    const BilinearPoint b = bilinear_map(cx, cr, xi, eta);
+    const double x = b.x, r = b.r, xx = b.xx, xe = b.xe, rx = b.rx, re = b.re;
     const double det = xx * re - xe * rx, inv = 1.0 / det;
     g.x[q] = x;
     g.r[q] = r;

@@ -681,18 +681,8 @@ bool FittedMesh::invert(int e, double x, double r, double& xi, double& eta) cons
 // the update (dxi, deta); false where the map's Jacobian vanishes (the update is then not finite).
 bool FittedMesh::newton_step(const double cx[4], const double cr[4], double x, double r, double xi, double eta,
                              double& dxi, double& deta) {
-  static constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
-  double fx = -x, fr = -r, xx = 0, xe = 0, rx = 0, re = 0;
-  for (int i = 0; i < 4; ++i) {
-    const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
-    const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
-    fx += m * cx[i];
-    fr += m * cr[i];
-    xx += mx * cx[i];
-    xe += me * cx[i];
-    rx += mx * cr[i];
-    re += me * cr[i];
-  }
+  const BilinearPoint b = bilinear_map(cx, cr, xi, eta);
+  const double fx = b.x - x, fr = b.r - r, xx = b.xx, xe = b.xe, rx = b.rx, re = b.re;
   const double det = xx * re - xe * rx;
   dxi = (re * fx - xe * fr) / det;
   deta = (-rx * fx + xx * fr) / det;

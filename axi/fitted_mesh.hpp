@@ -114,6 +114,30 @@
 
 namespace swim::axi {
 
+/// The bilinear map of a quadrilateral's corners (cx, cr) (in the order (xi, eta) = (-1,-1),
+/// (1,-1), (1,1), (-1,1)) at (xi, eta): the point and the four derivatives of the map.
+struct BilinearPoint {
+  double x = 0, r = 0;    ///< the mapped point
+  double xx = 0, xe = 0;  ///< dx/dxi, dx/deta
+  double rx = 0, re = 0;  ///< dr/dxi, dr/deta
+  double det() const { return xx * re - xe * rx; }
+};
+inline BilinearPoint bilinear_map(const double cx[4], const double cr[4], double xi, double eta) {
+  constexpr double cs[4] = {-1, 1, 1, -1}, ct[4] = {-1, -1, 1, 1};
+  BilinearPoint b;
+  for (int i = 0; i < 4; ++i) {
+    const double m = 0.25 * (1 + cs[i] * xi) * (1 + ct[i] * eta);
+    const double mx = 0.25 * cs[i] * (1 + ct[i] * eta), me = 0.25 * ct[i] * (1 + cs[i] * xi);
+    b.x += m * cx[i];
+    b.r += m * cr[i];
+    b.xx += mx * cx[i];
+    b.xe += me * cx[i];
+    b.rx += mx * cr[i];
+    b.re += me * cr[i];
+  }
+  return b;
+}
+
 struct FittedMeshParams {
   double Rc = 0, period = 0;   ///< container radius and period, m
   int cells_inner = 8;         ///< element rows between the axis and the membrane line

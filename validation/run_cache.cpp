@@ -141,6 +141,26 @@ bool interrupted_run(const std::string& dir) {
   return !s.is_discarded() && is_running(s) && fs::exists(full3d::checkpoint_path(dir));
 }
 
+/// The report entry both tiers' runs share: the cell size, the outcome, where the run is, its
+/// cost, and its per-cycle figures when it completed a cycle.
+json run_entry(double h, const std::string& status, bool cached, const std::string& dir, double wall,
+               const json& summary, const record::CycleFigures& cyc) {
+  json j = {{"cell_size_m", h},
+            {"status", status},
+            {"cached", cached},
+            {"folder", dir},
+            {"wall_time_s", wall},
+            {"steps", summary.value("steps", 0L)},
+            {"cycles_completed", summary.value("cycles_completed", 0)},
+            {"has_cycle", cyc.has_cycle}};
+  if (cyc.has_cycle) {
+    j["displacement_per_cycle_m"] = cyc.displacement_per_cycle_m;
+    j["cycle_time_s"] = cyc.cycle_time_s;
+    j["mean_velocity_per_cycle_m_per_s"] = cyc.mean_velocity_per_cycle_m_per_s;
+  }
+  return j;
+}
+
 }  // namespace
 
 // ---- series ----------------------------------------------------------------------------
@@ -330,17 +350,10 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   r.wall = summary.value("wall_time_s", 0.0);
   r.series = series_of(rec);
   r.cyc = cycle_figures_of(rec, summary);
-  r.record = {{"cell_size_m", p.h},
-              {"grid", {p.nx, p.ny, p.nz}},
-              {"status", status},
-              {"cached", r.cached},
-              {"folder", dir},
-              {"wall_time_s", r.wall},
-              {"steps", summary.value("steps", 0L)},
-              {"cycles_completed", summary.value("cycles_completed", 0)},
-              {"membrane_frames", fs::exists(fs::path(dir) / "membrane.pvd")},
-              {"pumped_volume_m3", summary.value("pumped_volume_m3", 0.0)},
-              {"has_cycle", r.cyc.has_cycle}};
+  r.record = run_entry(p.h, status, r.cached, dir, r.wall, summary, r.cyc);
+  r.record["grid"] = {p.nx, p.ny, p.nz};
+  r.record["membrane_frames"] = fs::exists(fs::path(dir) / "membrane.pvd");
+  r.record["pumped_volume_m3"] = summary.value("pumped_volume_m3", 0.0);
   // the wall's largest departure from axisymmetry (runs written before the wrinkle measure
   // existed have none)
   for (const char* k : {"max_wrinkle_m", "max_wrinkle_over_h"})
@@ -348,11 +361,6 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number()) {
     r.max_displacement = summary["max_displacement_m"].get<double>();
     r.record["max_displacement_m"] = r.max_displacement;
-  }
-  if (r.cyc.has_cycle) {
-    r.record["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
-    r.record["cycle_time_s"] = r.cyc.cycle_time_s;
-    r.record["mean_velocity_per_cycle_m_per_s"] = r.cyc.mean_velocity_per_cycle_m_per_s;
   }
   // the first cycle of a one-cycle scene; the whole run of a multi-cycle one (Figure 14)
   const double t_end = r.series.t.empty() ? 0.0 : r.series.t.back();
@@ -388,21 +396,11 @@ RunAxi RunCache::run_axi(const json& sc, int progress) {
   r.cyc = cycle_figures_of(rec, summary);
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number())
     r.max_displacement = summary["max_displacement_m"].get<double>();
-  r.record = {{"cell_size_m", p.h},
-              {"grid", {p.nr, p.nx}},
-              {"method", p.method_name()},
-              {"status", status},
-              {"cached", r.cached},
-              {"folder", dir},
-              {"wall_time_s", r.wall},
-              {"steps", summary.value("steps", 0L)},
-              {"cycles_completed", summary.value("cycles_completed", 0)},
-              {"has_cycle", r.cyc.has_cycle}};
+  r.record = run_entry(p.h, status, r.cached, dir, r.wall, summary, r.cyc);
+  r.record["grid"] = {p.nr, p.nx};
+  r.record["method"] = p.method_name();
   if (std::isfinite(r.max_displacement)) r.record["max_displacement_m"] = r.max_displacement;
   if (r.cyc.has_cycle) {
-    r.record["displacement_per_cycle_m"] = r.cyc.displacement_per_cycle_m;
-    r.record["cycle_time_s"] = r.cyc.cycle_time_s;
-    r.record["mean_velocity_per_cycle_m_per_s"] = r.cyc.mean_velocity_per_cycle_m_per_s;
     r.record["cycle_phase_times_s"] = r.cyc.phase_times_s;
   } else {
     r.record["no_cycle_reason"] = r.cyc.absent_because;
