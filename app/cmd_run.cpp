@@ -315,16 +315,27 @@ int run3d(const RunOptions& o, const scene::json& sc) {
 
 // The axisymmetric reference tier: read and validate, run (axi/run_axi.hpp), report.
 int run_axi(const RunOptions& o, const scene::json& sc) {
-  if (!o.resume.empty()) throw InputError("--resume", o.resume, "only the 3D tier writes checkpoints; add --tier 3d");
   scene::json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
   check_other_tier(sc, "axi");
-  const std::string out = o.out.empty() ? "out/" + p.name() + "-axi" : o.out;
+  if (!o.resume.empty() && !o.out.empty() && fs::path(o.out) != fs::path(o.resume))
+    throw InputError("--out", o.out, "with --resume the run continues in the resumed folder; omit --out");
+  if (!o.resume.empty() && o.overwrite)
+    throw InputError("--overwrite", "", "cannot be combined with --resume (it would remove the run to continue)");
+  const std::string out = !o.resume.empty() ? o.resume : o.out.empty() ? "out/" + p.name() + "-axi" : o.out;
+  if (!o.resume.empty() && !fs::exists(full3d::checkpoint_path(out)))
+    throw InputError("--resume", o.resume, "no checkpoint.bin in this folder");
+  // a damaged or foreign checkpoint is refused before the folder is touched
+  if (!o.resume.empty()) {
+    const std::string tier = output::RunFolder::tier_of(out);
+    if (tier.empty() || tier == "axi") axi::check_resumable_axi(p, resolved, out);
+  }
   const bool had_plot = fs::exists(fs::path(out) / "run.png");
-  output::RunFolder folder(out, {"axi", resolved, o.overwrite, false, "--out"});
+  output::RunFolder folder(out, {"axi", resolved, o.overwrite, !o.resume.empty(), o.resume.empty() ? "--out" : "--resume"});
   axi::RunControlAxi ctl;
   ctl.progress = o.progress;
   ctl.max_output_bytes = static_cast<std::uintmax_t>(scene::output_limits(sc).max_bytes);
+  ctl.resume = !o.resume.empty();
   axi::RunOutcomeAxi r;
   try {
     r = axi::run_axi(p, resolved, out, ctl);
@@ -347,7 +358,7 @@ int run_axi(const RunOptions& o, const scene::json& sc) {
     std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
   plot_and_list(out, o.plot, had_plot);
   if (r.failed) {
-    std::fprintf(stderr, "swim: %s\n  partial results kept in %s\n", r.message.c_str(), out.c_str());
+    std::fprintf(stderr, "swim: %s\n  partial results and the last checkpoint kept in %s\n", r.message.c_str(), out.c_str());
     return 3;
   }
   return 0;
@@ -371,7 +382,8 @@ int run(const RunOptions& o) {
   }
   if (o.tier == "3d") return run3d(o, sc);
   if (o.tier == "axi") return run_axi(o, sc);
-  if (!o.resume.empty()) throw InputError("--resume", o.resume, "only the 3D tier writes checkpoints; add --tier 3d");
+  if (!o.resume.empty())
+    throw InputError("--resume", o.resume, "only the 3D and axisymmetric tiers write checkpoints; add --tier 3d or --tier axi");
   scene::json resolved;
   const std::string scene_dir = fs::path(o.scene).parent_path().string();
   const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir.empty() ? "." : scene_dir);

@@ -53,7 +53,7 @@ int main(int argc, char** argv) {
   run->add_option("--out", ro.out, "Output directory (default out/<scene name>-<tier>)");
   run->add_option("--set", ro.sets, "Override a scene value: key.path=value (same unit syntax as the file)");
   run->add_flag("--plot", ro.plot, "Also write plots (PNG) of the run");
-  run->add_option("--resume", ro.resume, "3D: continue an interrupted run from the checkpoint in this output folder");
+  run->add_option("--resume", ro.resume, "3D and axi: continue an interrupted run from the checkpoint in this output folder");
   run->add_flag("--overwrite", ro.overwrite,
                 "Replace the results of another run in the output folder (its files are removed first)");
   run->add_option("--threads", ro.threads, "3D: threads of the run (sets full3d.threads; default: the scene's, 1)")

@@ -241,11 +241,7 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
         if (L[i] >= 0 && L[j] >= 0 && (i < 18 || j < 18)) P[i * kLoc + j] = find_position(L[i], L[j]);
   }
 
-  lu_ = std::make_unique<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>>();
-  // One step of iterative refinement (UMFPACK's default allows two): without it the
-  // threshold-pivoted LU of the saddle-point system leaves relative errors near 1e-9; one step
-  // brings them to round-off at the cost of one more solve and residual.
-  lu_->umfpackControl()(UMFPACK_IRSTEP) = 1;
+  lu_ = new_lu();
   rhs_.setZero(n_);
   sol_.setZero(n_);
 }
@@ -378,6 +374,21 @@ void FittedStokes::set_reuse(bool on, int refactor_after, double tolerance) {
   reuse_ = on;
   refactor_after_ = refactor_after;
   tol_ = tolerance;
+}
+
+std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> FittedStokes::new_lu() {
+  auto lu = std::make_unique<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>>();
+  // One step of iterative refinement (UMFPACK's default allows two): without it the
+  // threshold-pivoted LU of the saddle-point system leaves relative errors near 1e-9; one step
+  // brings them to round-off at the cost of one more solve and residual.
+  lu->umfpackControl()(UMFPACK_IRSTEP) = 1;
+  return lu;
+}
+
+void FittedStokes::forget_factorisation() {
+  analysed_ = lu_valid_ = lu_current_ = false;
+  last_iters_ = 0;
+  lu_ = new_lu();
 }
 
 void FittedStokes::numeric_factor() {

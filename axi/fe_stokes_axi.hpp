@@ -138,6 +138,10 @@ class FittedStokes {
   /// Throws std::invalid_argument for refactor_after < 0 or a tolerance not in (0, 1).
   void set_reuse(bool on, int refactor_after = kRefactorAfter, double tolerance = kReuseTolerance);
   bool reuse() const { return reuse_; }
+  /// Drops the factorisation and the symbolic analysis: the next factor() starts as a new
+  /// solver's first does. A run checkpoints after calling it, so that a run resumed from the
+  /// checkpoint (new solvers) repeats the uninterrupted one bit for bit.
+  void forget_factorisation();
   static constexpr int kRefactorAfter = 8;
   static constexpr double kReuseTolerance = 1e-12;
   /// GMRES iterations (preconditioner applications) and relative true residual ||b - A x|| / ||b||
@@ -200,6 +204,8 @@ class FittedStokes {
     long reused = 0;             ///< solves done with the factorisation of an earlier system
   };
   const Timing& timing() const { return timing_; }
+  /// The counts and times of a run so far (a resumed run's statistics continue them).
+  void set_timing(const Timing& t) { timing_ = t; }
 
   // ---- additions (diagnostics and tests)
   /// The viscous dissipation a(u, u) of the last solution, W (element-wise quadrature; the
@@ -240,6 +246,7 @@ class FittedStokes {
   std::vector<std::array<double, 5>> gw_;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> A_;
   std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> lu_;
+  static std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> new_lu();
   bool analysed_ = false, factored_ = false, solved_ = false;
   bool reuse_ = true;
   int refactor_after_ = kRefactorAfter;

@@ -17,7 +17,11 @@
 #include "common/errors.hpp"
 #include "common/progress.hpp"
 #include "common/si_format.hpp"
+#include "full3d/checkpoint.hpp"
 #include "full3d/protocol3d.hpp"
+#include "full3d/run3d_checkpoint.hpp"
+#include "full3d/run3d_output.hpp"
+#include "common/output.hpp"
 
 namespace swim::axi {
 
@@ -90,27 +94,46 @@ class Runner {
 
   RunOutcomeAxi run() {
     const auto t0 = std::chrono::steady_clock::now();
-    stream_ = open_run_stream(rec_, out_, ctl_);
+    if (ctl_.resume)
+      restore();
+    else
+      stream_ = open_run_stream(rec_, out_, ctl_);
     Progress progress("axi " + p_.name() + (b_.duration > 0 ? "" : " (auto: until " + std::to_string(b_.protocol.cycles) +
                                                                   (b_.protocol.cycles == 1 ? " cycle" : " cycles") + ", progress against axi.time_limit)"),
                       t_end_, ctl_.progress);
     std::optional<NumericalError> failure;
+    long this_process = 0;
     try {
-      x_center0_ = center(X_);
-      protocol_.start(0.0, X_);
-      events();
-      evaluate(X_, U_, &energy_);
-      fluxes(0.0);
-      record();
-      next_out_ = b_.output_interval;
-      dt_ = p_.event_dt;
+      if (!ctl_.resume) {
+        x_center0_ = center(X_);
+        protocol_.start(0.0, X_);
+        events();
+        evaluate(X_, U_, &energy_);
+        fluxes(0.0);
+        record();
+        next_out_ = b_.output_interval;
+        next_checkpoint_ = p_.checkpoint_interval;
+        dt_ = p_.event_dt;
+        save_checkpoint(seconds_since(t0));
+      }
       while (!finished()) {
         step();
+        ++this_process;
         progress.update(t_);
         const bool event = events();
         if (event || t_ >= next_out_ - 1e-12 * b_.output_interval || finished()) {
           record();
           while (next_out_ <= t_ + 1e-12 * b_.output_interval) next_out_ += b_.output_interval;
+        }
+        if (!finished() && t_ >= next_checkpoint_ - 1e-12 * p_.checkpoint_interval) {
+          while (next_checkpoint_ <= t_ + 1e-12 * p_.checkpoint_interval) next_checkpoint_ += p_.checkpoint_interval;
+          save_checkpoint(wall_before_ + seconds_since(t0));
+        }
+        if (ctl_.stop_after_steps > 0 && this_process >= ctl_.stop_after_steps && !finished()) {
+          RunOutcomeAxi stopped;
+          stopped.interrupted = true;
+          stopped.steps = steps_;
+          return stopped;
         }
       }
     } catch (const NumericalError& e) {
@@ -124,9 +147,108 @@ class Runner {
     }
     progress.done();
     events();
-    return finish_run(rec_, failure, seconds_since(t0), steps_, out_, resolved_,
+    return finish_run(rec_, failure, wall_before_ + seconds_since(t0), steps_, out_, resolved_,
                       [this](const std::string& status, double wall) { fill(status, wall); });
   }
+
+ private:
+  // ---- checkpoints ----------------------------------------------------------------------
+  /// The run's state between steps, listed once for writing and reading (full3d/checkpoint.hpp).
+  template <class Self, class F>
+  static void records(Self& self, F&& f) {
+    f("t", self.t_);
+    f("step", self.steps_);
+    f("X", self.X_.data(), std::size_t(self.X_.size()));
+    f("U", self.U_.data(), std::size_t(self.U_.size()));
+    f("energy", self.energy_.data(), self.energy_.size());
+    auto& st = self.protocol_.state();
+    f("phase", st.phase);
+    f("active", st.active);
+    f("cycles_completed", st.cycles_completed);
+    f("switches", st.switches);
+    f("cycle_start", st.cycle_start);
+    f("cycle_end", st.cycle_end);
+    f("segment_reached", st.segment_reached);
+    f("dt_next", self.dt_);
+    f("dt_last", self.dt_last_);
+    f("dt_min_taken", self.dt_min_taken_);
+    f("dt_max_taken", self.dt_max_taken_);
+    f("next_output", self.next_out_);
+    f("next_checkpoint", self.next_checkpoint_);
+    f("x_center0", self.x_center0_);
+    f("flux_rear", self.q_rear_);
+    f("flux_front", self.q_front_);
+    f("volume_rear", self.vol_rear_);
+    f("volume_front", self.vol_front_);
+    f("step_flux_rear", self.step_q_rear_);
+    f("step_flux_front", self.step_q_front_);
+    f("split_forces", self.split_forces_);
+    f("split_spread", self.split_spread_);
+    f("split_fluid", self.split_fluid_);
+    f("split_interp", self.split_interp_);
+    f("split_stiffness", self.split_stiffness_);
+    f("rejected", self.rejected_);
+    f("solves", self.solves_);
+    f("last_recorded", self.last_recorded_);
+    f("event_retakes", self.event_retakes_);
+    f("event_tries", self.event_tries_);
+    f("event_pending", self.event_pending_);
+  }
+
+  /// The fitted solvers' statistics so far, as numbers (they continue in a resumed run).
+  static std::vector<double> timing_record(const FittedStokes::Timing& t) {
+    return {t.assemble, t.factor, t.solve, double(t.factorisations), double(t.solves), double(t.krylov_iterations),
+            double(t.reused)};
+  }
+  static FittedStokes::Timing timing_of(const std::vector<double>& v) {
+    FittedStokes::Timing t;
+    t.assemble = v.at(0), t.factor = v.at(1), t.solve = v.at(2);
+    t.factorisations = long(v.at(3)), t.solves = long(v.at(4)), t.krylov_iterations = long(v.at(5)),
+    t.reused = long(v.at(6));
+    return t;
+  }
+
+  /// The partial results (streams flushed, summary.json "running: ..."), then checkpoint.bin,
+  /// then summary.json again listing it; the fitted solvers then forget their factorisations.
+  void save_checkpoint(double wall) {
+    fill("running: last checkpoint at t = " + significant(t_, 4) + " s (resume with --resume " + out_ + ")", wall);
+    const std::vector<double> marks = record::write_snapshot(out_, rec_, resolved_);
+    full3d::CheckpointWriter w(full3d::RunCheckpoint::scene_hash(resolved_));
+    records(*this, full3d::CheckpointOut(w));
+    rec_.save([&](const std::string& name, const std::vector<double>& v) { w.put(name, v); });
+    if (fitted_) {
+      w.put("stage_timing", timing_record(stage_->timing()));
+      w.put("flow_timing", timing_record(flow_->timing()));
+    }
+    w.put(full3d::kOutputMarks, marks);
+    w.put("wall_time_s", wall);
+    w.save(out_ + "/checkpoint.bin");
+    output::write_json(out_ + "/summary.json", record::summary(rec_, resolved_));
+    if (fitted_) {
+      stage_->forget_factorisation();
+      flow_->forget_factorisation();
+    }
+  }
+
+  /// The state of checkpoint.bin (checked first, check_resumable_axi), the streams continued
+  /// from its marks.
+  void restore() {
+    const full3d::CheckpointReader r = open_checkpoint(p_, resolved_, out_);
+    records(*this, full3d::CheckpointIn(r));
+    rec_.load([&](const std::string& name) { return r.get_vector(name); });
+    if (fitted_) {
+      stage_->set_timing(timing_of(r.get_vector("stage_timing")));
+      flow_->set_timing(timing_of(r.get_vector("flow_timing")));
+    }
+    wall_before_ = r.get_double("wall_time_s");
+    stream_ = std::make_unique<record::RunStream>(out_, r.get_vector(full3d::kOutputMarks));
+    stream_->limit(ctl_.max_output_bytes);
+    rec_.attach(stream_.get());
+  }
+
+ public:
+  /// checkpoint.bin of a run of this scene in `dir`, read and checked (see run_axi.hpp).
+  static full3d::CheckpointReader open_checkpoint(const ParamsAxi& p, const json& resolved, const std::string& dir);
 
  private:
   full3d::ProtocolParams effective() const {
@@ -612,7 +734,7 @@ class Runner {
   std::vector<double> fr_, fx_, u_, w_;
   std::array<double, 2> energy_{};
   double t_ = 0, dt_ = 0, dt_last_ = 0, dt_min_taken_ = 0, dt_max_taken_ = 0, t_end_ = 0, next_out_ = 0;
-  double e_cap_ = 0, x_center0_ = 0;
+  double e_cap_ = 0, x_center0_ = 0, next_checkpoint_ = 0, wall_before_ = 0;
   double q_rear_ = 0, q_front_ = 0, vol_rear_ = 0, vol_front_ = 0, step_q_rear_ = 0, step_q_front_ = 0;
   long steps_ = 0, rejected_ = 0, solves_ = 0, last_recorded_ = -1, event_retakes_ = 0;
   int event_tries_ = 0;
@@ -622,10 +744,73 @@ class Runner {
   double split_forces_ = 0, split_spread_ = 0, split_fluid_ = 0, split_interp_ = 0, split_stiffness_ = 0;
 };
 
+full3d::CheckpointReader Runner::open_checkpoint(const ParamsAxi& p, const json& resolved, const std::string& dir) {
+  if (p.base.wave.prescribed())
+    throw InputError("--resume", dir, "a prescribed wave's run (wave.kind = " + p.base.wave.kind +
+                                          ") writes no checkpoint; run it again");
+  full3d::CheckpointReader r(dir + "/checkpoint.bin", full3d::RunCheckpoint::scene_hash(resolved));
+  const auto count = [](std::int64_t v) { return std::to_string(v); };
+  const auto int_in = [&](const char* name, std::int64_t lo, std::int64_t hi, const std::string& what) {
+    const std::int64_t v = r.get_int(name);
+    if (v < lo || v > hi)
+      r.damaged("the checkpoint's " + what + " ('" + name + "') is " + count(v) + ", outside [" + count(lo) + ", " +
+                count(hi) + "]");
+    return v;
+  };
+  const auto expect_size = [&](const char* name, std::size_t n, const std::string& what) {
+    if (r.size_of(name) != n)
+      r.damaged("the checkpoint's '" + std::string(name) + "' has " + std::to_string(r.size_of(name)) +
+                " values, this scene's " + what + " needs " + std::to_string(n) + " (a different grid or wall)");
+  };
+  if (const std::string bad = r.first_non_finite(); !bad.empty())
+    r.damaged("the checkpoint's record '" + bad + "' holds a NaN or infinite value");
+  const double t = r.get_double("t");
+  const double t_end = p.base.duration > 0 ? p.base.duration : p.time_limit;
+  if (t < 0.0 || t > t_end)
+    r.damaged("the checkpoint's simulated time t = " + significant(t, 4) + " s lies outside this run's [0, " +
+              significant(t_end, 4) + "] s (time.duration, or axi.time_limit when the duration is auto)");
+  const std::int64_t big = std::int64_t(1) << 53;
+  const std::int64_t n = int_in("step", 0, big, "step count");
+  int_in("last_recorded", -1, n, "last output step");
+  int_in("phase", 0, 1, "protocol phase (a finished run has no checkpoint to continue)");
+  int_in("active", 0, p.base.protocol.segments - 1, "active segment");
+  int_in("cycles_completed", 0, n, "completed cycles");
+  for (const char* name : {"switches", "rejected", "solves", "event_retakes"}) int_in(name, 0, big, "counter");
+  int_in("event_tries", 0, 1000, "event retries");
+  int_in("event_pending", 0, 1, "event flag");
+  const std::size_t rings = std::size_t(p.wall_nodes);
+  expect_size("X", 3 * rings, "wall rings");
+  expect_size("U", 3 * rings, "wall rings");
+  expect_size("energy", 2, "wall energies");
+  if (p.method == AxiMethod::Fitted) {
+    expect_size("stage_timing", 7, "solver statistics");
+    expect_size("flow_timing", 7, "solver statistics");
+  }
+  expect_size(full3d::kOutputMarks, 6, "output streams (size and checksum of series.csv.part and radius.csv.part)");
+  const std::vector<double> X = r.get_vector("X");
+  const double Rc = p.base.container_radius;
+  for (std::size_t k = 0; k < rings; ++k)
+    if (!(X[3 * k + 1] > 0.0 && X[3 * k + 1] < Rc))
+      r.damaged("the checkpoint's ring " + std::to_string(k) + " lies at radius " + significant(X[3 * k + 1], 4) +
+                " m, outside the container (0, " + significant(Rc, 4) + " m)");
+  if (r.get_double("wall_time_s") < 0.0) r.damaged("the checkpoint's wall time is negative");
+  if (!record::RunStream::matches(dir, r.get_vector(full3d::kOutputMarks)))
+    r.damaged("the partial results series.csv.part and radius.csv.part next to it are missing or do not match it "
+              "(changed, or shorter than at the checkpoint)");
+  return r;
+}
+
 }  // namespace
 
+void check_resumable_axi(const ParamsAxi& p, const json& resolved, const std::string& out_dir) {
+  Runner::open_checkpoint(p, resolved, out_dir);
+}
+
 RunOutcomeAxi run_axi(const ParamsAxi& p, const json& resolved, const std::string& out_dir, const RunControlAxi& ctl) {
-  if (p.base.wave.prescribed()) return run_prescribed_axi(p, resolved, out_dir, ctl);
+  if (p.base.wave.prescribed()) {
+    if (ctl.resume) Runner::open_checkpoint(p, resolved, out_dir);  // refused, naming why
+    return run_prescribed_axi(p, resolved, out_dir, ctl);
+  }
   Runner r(p, resolved, out_dir, ctl);
   return r.run();
 }

@@ -36,7 +36,8 @@ const json& section_keys() {
                               {"dt_max", "quantity:s@positive"},
                               {"dt_min", "quantity:s@positive"},
                               {"event_dt", "quantity:s@positive"},
-                              {"time_limit", "quantity:s@positive"}}}};
+                              {"time_limit", "quantity:s@positive"},
+                              {"checkpoint_interval", "quantity:s@positive"}}}};
   return keys;
 }
 
@@ -147,6 +148,9 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
     throw InputError(a.path("event_dt"), fmt(p.event_dt, "s"),
                      "must lie between axi.dt_min = " + fmt(p.dt_min, "s") + " and axi.dt_max = " + fmt(p.dt_max, "s"));
   p.time_limit = a.quantity("time_limit", "s", fmt(b.time_limit, "s"), Range::positive());
+  // simulated time between checkpoints (a schedule in simulated time keeps a resumed run
+  // identical to an uninterrupted one); the 3D tier's default
+  p.checkpoint_interval = a.quantity("checkpoint_interval", "s", fmt(10.0 * b.output_interval, "s"), Range::positive());
   a.finish();
 
   // 4. Consistency.

@@ -58,6 +58,7 @@ struct ParamsAxi {
   double tolerance = 2e-4;     ///< local position error per step, in cells (h)
   double dt_max = 8e-3, dt_min = 1e-8, event_dt = 1e-4;  ///< s
   double time_limit = 2.0;     ///< s; run cap when the duration is auto
+  double checkpoint_interval = 0.0;  ///< s of simulated time between checkpoints (protocol-driven runs)
 
   const std::string& name() const { return base.name; }
   const char* method_name() const { return method == AxiMethod::Fitted ? "fitted" : "immersed_boundary"; }

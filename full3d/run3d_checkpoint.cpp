@@ -19,13 +19,18 @@ constexpr const char* kWallTime = "wall_time_s";
 
 /// The scene as it must match on resume: everything except the keys that only steer
 /// output cadence and parallelism, and the cap of an auto-duration run (a run stopped by
-/// the cap can be continued with a larger one).
+/// the cap can be continued with a larger one). The same for both tiers that checkpoint
+/// (3D and the axisymmetric tier's own keys).
 std::string resume_key(const scene::json& resolved) {
   scene::json r = resolved;
   if (r.contains("full3d") && r["full3d"].is_object()) {
     r["full3d"].erase("checkpoint_interval");
     r["full3d"].erase("threads");
     r["full3d"].erase("time_limit");
+  }
+  if (r.contains("axi") && r["axi"].is_object()) {
+    r["axi"].erase("checkpoint_interval");
+    r["axi"].erase("time_limit");
   }
   return r.dump();
 }

@@ -57,14 +57,15 @@ record::CycleFigures cycle_figures_of(const record::RunRecord& rec, const json& 
   return c;
 }
 
-/// The part of a resolved 3D scene that determines its results: without the output settings
-/// (frames, intervals), the checkpoint interval and the thread count.
+/// The part of a resolved scene that determines its results: without the output settings
+/// (frames, intervals), the checkpoint intervals and the thread count.
 json physics_of(json resolved) {
   if (resolved.contains("full3d") && resolved["full3d"].is_object()) {
     resolved["full3d"].erase("output");
     resolved["full3d"].erase("checkpoint_interval");
     resolved["full3d"].erase("threads");
   }
+  if (resolved.contains("axi") && resolved["axi"].is_object()) resolved["axi"].erase("checkpoint_interval");
   return resolved;
 }
 
@@ -376,13 +377,26 @@ RunAxi RunCache::run_axi(const json& sc, int progress) {
   json summary = find_finished(dir, key, true);
   RunAxi r;
   r.cached = !summary.is_null();
+  // an interrupted run of this physics continues from its checkpoint (as run_3d's)
+  bool resume = false;
+  if (!r.cached && interrupted_run(dir)) {
+    try {
+      axi::check_resumable_axi(p, resolved, dir);
+      resume = true;
+    } catch (const InputError& e) {
+      reject(dir, std::string("interrupted run not resumed: ") + e.what());
+    }
+  }
   if (!r.cached) {
-    fs::remove_all(dir);
-    output::reset_ledger(dir);
-    fs::create_directories(dir);
+    if (!resume) {
+      fs::remove_all(dir);
+      output::reset_ledger(dir);
+      fs::create_directories(dir);
+    }
     axi::RunControlAxi ctl;
     ctl.progress = progress;
     ctl.keep_rows = true;
+    ctl.resume = resume;
     summary = axi::run_axi(p, resolved, dir, ctl).summary;
   } else {
     ++reused_;

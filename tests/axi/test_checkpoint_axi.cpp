@@ -1,0 +1,95 @@
+// Checkpoints of the axisymmetric tier: a run stopped part way and resumed from its last
+// checkpoint repeats the uninterrupted run bit for bit (the fitted solvers drop their
+// factorisations at every checkpoint, as a resumed run's new solvers start without one), and
+// a damaged or foreign checkpoint is refused before anything is restored.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <string>
+
+#include "axi/run_axi.hpp"
+#include "axi/scene_axi.hpp"
+#include "axi_test_support.hpp"
+#include "common/errors.hpp"
+#include "common/scene.hpp"
+
+namespace {
+
+using swim::scene::json;
+using swim::axi::testing::TempDir;
+
+/// The round-wall amplitude scene on the coarsest fitted grid, for part of its cycle.
+json short_round_wall(const std::string& duration) {
+  json sc = swim::scene::load_file(std::string(SWIM_SOURCE_DIR) + "/data/scenes/paper_amplitude_0.82.json");
+  sc["full3d"]["membrane"]["axisymmetric"] = true;
+  sc["full3d"]["recovery_end"] = "shape";
+  sc["axi"]["method"] = "fitted";
+  sc["axi"]["grid"]["cells_across"] = 8;
+  sc["axi"]["checkpoint_interval"] = "10 ms";
+  sc["time"]["duration"] = duration;
+  return sc;
+}
+
+swim::axi::RunControlAxi quiet() {
+  swim::axi::RunControlAxi c;
+  c.progress = 0;
+  c.keep_rows = true;
+  return c;
+}
+
+std::string read_all(const std::filesystem::path& f) {
+  std::ifstream in(f, std::ios::binary);
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+}  // namespace
+
+TEST(AxiCheckpoint, AResumedRunRepeatsTheUninterruptedOneBitForBit) {
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(short_round_wall("60 ms"), resolved);
+  TempDir a("swim-axi-ckpt-a"), b("swim-axi-ckpt-b");
+  const swim::axi::RunOutcomeAxi ra = swim::axi::run_axi(p, resolved, a.path.string(), quiet());
+  ASSERT_FALSE(ra.failed) << ra.message;
+  ASSERT_GT(ra.steps, 20);
+  swim::axi::RunControlAxi stop = quiet();
+  stop.stop_after_steps = ra.steps / 2;  // "killed" between two checkpoints
+  ASSERT_TRUE(swim::axi::run_axi(p, resolved, b.path.string(), stop).interrupted);
+  swim::axi::RunControlAxi res = quiet();
+  res.resume = true;
+  const swim::axi::RunOutcomeAxi rb = swim::axi::run_axi(p, resolved, b.path.string(), res);
+  ASSERT_FALSE(rb.failed) << rb.message;
+  EXPECT_EQ(rb.steps, ra.steps);
+  EXPECT_EQ(rb.summary["t_end_s"].get<double>(), ra.summary["t_end_s"].get<double>());
+  EXPECT_EQ(rb.summary["displacement_m"].get<double>(), ra.summary["displacement_m"].get<double>());
+  EXPECT_NE(ra.summary["displacement_m"].get<double>(), 0.0);
+  EXPECT_EQ(rb.summary["segment_reached_s"], ra.summary["segment_reached_s"]);
+  // the streamed results continue where the checkpoint left them: the same files
+  EXPECT_EQ(read_all(b.path / "series.csv"), read_all(a.path / "series.csv"));
+  EXPECT_EQ(read_all(b.path / "radius.csv"), read_all(a.path / "radius.csv"));
+}
+
+TEST(AxiCheckpoint, ADamagedOrForeignCheckpointIsRefusedNamingResume) {
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(short_round_wall("30 ms"), resolved);
+  TempDir a("swim-axi-ckpt-bad");
+  swim::axi::RunControlAxi stop = quiet();
+  stop.stop_after_steps = 15;
+  ASSERT_TRUE(swim::axi::run_axi(p, resolved, a.path.string(), stop).interrupted);
+  EXPECT_NO_THROW(swim::axi::check_resumable_axi(p, resolved, a.path.string()));
+  // another scene (another load): refused by the scene hash
+  json other = short_round_wall("30 ms"), other_resolved;
+  other["protocol"]["pressure"] = "0.4 Pa";
+  const swim::axi::ParamsAxi q = swim::axi::read_scene_axi(other, other_resolved);
+  try {
+    swim::axi::check_resumable_axi(q, other_resolved, a.path.string());
+    ADD_FAILURE() << "a checkpoint of another scene was accepted";
+  } catch (const swim::InputError& e) {
+    EXPECT_EQ(e.key(), "--resume");
+  }
+  // one changed byte in the payload: refused by the checksum
+  const auto ck = a.path / "checkpoint.bin";
+  std::string bytes = read_all(ck);
+  bytes[bytes.size() / 2] ^= 0x20;
+  std::ofstream(ck, std::ios::binary | std::ios::trunc) << bytes;
+  EXPECT_THROW(swim::axi::check_resumable_axi(p, resolved, a.path.string()), swim::InputError);
+}
