@@ -90,7 +90,9 @@ std::vector<design::Confirmed> confirm_over_ranks(const std::vector<design::Cand
                      {{"kind", "confirm3d"},
                       {"scene", sc},
                       {"runs_dir", fs::absolute(o.runs_dir).string()},
-                      {"label", design::confirm_label(c)}},
+                      {"label", design::confirm_label(c)},
+                      {"error_estimate", design::wants_error_estimate(o.section)},
+                      {"metric", o.metric}},
                      cost_3d(sc),
                      {}});
   }
@@ -198,7 +200,9 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     for (size_t k = 0; k < sw.count(); ++k) {
       scene::json resolved;
       try {
-        full3d::read_scene3d(design::confirm_scene(sw.design(k), confirm_section, threads), resolved);
+        const scene::json sc = design::confirm_scene(sw.design(k), confirm_section, threads);
+        full3d::read_scene3d(sc, resolved);
+        design::check_error_estimate(sc, confirm_section, "confirm");
       } catch (const InputError& e) {
         throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) +
                                           ") on the 3D tier: " + e.what());
@@ -224,7 +228,13 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   // the same sweep's finished results replaced); the sweep is identified by what it runs.
   scene::json identity = {{"base", sw.base}, {"metric", sw.metric}, {"goal", sw.maximize ? "max" : "min"}};
   for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
+  // confirm.error_estimate adds coarse runs beside the 3D runs and changes none of them: a sweep
+  // confirmed with and without it is the same sweep (its finished runs reused)
   if (!sw.confirm.is_null()) identity["confirm"] = sw.confirm;
+  if (identity.contains("confirm") && identity["confirm"].is_object()) {
+    identity["confirm"].erase("error_estimate");
+    if (identity["confirm"].empty()) identity.erase("confirm");
+  }
   // the 3D runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
   output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json", "confirm-runs"});
 
