@@ -166,12 +166,16 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", sw.name});
   if (report["agreement"].is_object()) {
     const auto& a = report["agreement"];
-    std::printf("rank agreement over %d designs: Kendall tau %.3g [%.3g, %.3g], Spearman rho %.3g [%.3g, %.3g] (95 %%); "
-                "%zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
-                a["designs"].get<int>(), a["kendall_tau"].get<double>(), a["kendall_tau_ci_95"][0].get<double>(),
-                a["kendall_tau_ci_95"][1].get<double>(), a["spearman_rho"].get<double>(),
+    char tau[96] = "undefined (every pair tied)";
+    if (a["kendall_tau"].is_number())
+      std::snprintf(tau, sizeof tau, "%.3g [%.3g, %.3g]", a["kendall_tau"].get<double>(),
+                    a["kendall_tau_ci_95"][0].get<double>(), a["kendall_tau_ci_95"][1].get<double>());
+    std::printf("rank agreement over %d designs: Kendall tau %s, Spearman rho %.3g [%.3g, %.3g] (95 %%); "
+                "%zu pair(s) tied by the 3D error bars, %zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
+                a["designs"].get<int>(), tau, a["spearman_rho"].get<double>(),
                 a["spearman_rho_ci_95"][0].get<double>(), a["spearman_rho_ci_95"][1].get<double>(),
-                report["misranked_designs"].size(), out.c_str(), out.c_str());
+                a["pairs_tied_by_3d_error_bars"].get<std::size_t>(), report["misranked_designs"].size(), out.c_str(),
+                out.c_str());
   }
   scene::json s = {{"status", report["status"]}, {"designs", report["designs_confirmed"]}, {"file", "confirm.json"}};
   if (report["agreement"].is_object()) {

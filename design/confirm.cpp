@@ -187,6 +187,11 @@ Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::
   const std::string figure = estimated_figure(metric);
   const json* have = c.summary.contains("error_estimate") ? &c.summary["error_estimate"] : nullptr;
   const bool complete = have && (have->value("status", std::string()) != "ok" || have->contains(figure));
+  if (error_estimate && complete) {  // an earlier invocation's estimate: its coarse run, reused
+    const json cs = finished_summary(validation::coarse_folder(c.folder));
+    c.coarse_run = c.coarse_reused = !cs.is_null();
+    c.coarse_wall_time_s = cs.is_null() ? 0.0 : cs.value("wall_time_s", 0.0);
+  }
   if (error_estimate && c.ok && c.summary["displacement_per_cycle_m"].is_number() && !complete) {
     const json e = estimate_error(c, sc, p, figure, progress);
     if (!output::amend_summary(c.folder, [&](json& j) { j["error_estimate"] = e; }))
@@ -245,8 +250,12 @@ json agreement_json(const RankAgreement& a, const std::vector<std::string>& labe
   json mis = json::array();
   for (const auto& [i, j] : a.misranked) mis.push_back({labels[i], labels[j]});
   return {{"designs", a.n},
-          {"kendall_tau", a.kendall_tau},
-          {"kendall_tau_ci_95", {a.kendall_ci.lo, a.kendall_ci.hi}},
+          {"kendall_tau", a.kendall_defined ? json(a.kendall_tau) : json(nullptr)},
+          {"kendall_tau_ci_95", a.kendall_defined ? json({a.kendall_ci.lo, a.kendall_ci.hi}) : json(nullptr)},
+          {"kendall_tau_absent_because",
+           a.kendall_defined ? json(nullptr)
+                             : json("every pair is tied in 1D or in 3D (3D ties counting those within the error bars): "
+                                    "tau-b is 0/0, the 3D tier does not order these designs beyond its own error")},
           {"spearman_rho", a.spearman_rho},
           {"spearman_rho_ci_95", {a.spearman_ci.lo, a.spearman_ci.hi}},
           {"method",
@@ -405,7 +414,10 @@ std::string confirm_markdown(const json& r, const std::string& title) {
   if (r["agreement"].is_object()) {
     const json& a = r["agreement"];
     s += "| rank agreement over " + std::to_string(a["designs"].get<int>()) + " designs | value | 95 % interval |\n|---|---|---|\n";
-    s += "| Kendall τ-b | " + num(a["kendall_tau"]) + " | [" + num(a["kendall_tau_ci_95"][0]) + ", " + num(a["kendall_tau_ci_95"][1]) + "] |\n";
+    if (a["kendall_tau"].is_number())
+      s += "| Kendall τ-b | " + num(a["kendall_tau"]) + " | [" + num(a["kendall_tau_ci_95"][0]) + ", " + num(a["kendall_tau_ci_95"][1]) + "] |\n";
+    else
+      s += "| Kendall τ-b | – (" + a["kendall_tau_absent_because"].get<std::string>() + ") | – |\n";
     s += "| Spearman ρ | " + num(a["spearman_rho"]) + " | [" + num(a["spearman_rho_ci_95"][0]) + ", " + num(a["spearman_rho_ci_95"][1]) + "] |\n\n";
     s += "Method: " + a["method"].get<std::string>() + ".\n\n";
     std::string mis;

@@ -40,8 +40,10 @@ def main(path, png, name):
     agreement = rep.get("agreement")
     sub = ""
     if agreement:
-        sub = (f"\nKendall \u03c4 = {agreement['kendall_tau']:.2f} "
-               f"[{agreement['kendall_tau_ci_95'][0]:.2f}, {agreement['kendall_tau_ci_95'][1]:.2f}], "
+        tau = agreement.get("kendall_tau")
+        tau_text = (f"{tau:.2f} [{agreement['kendall_tau_ci_95'][0]:.2f}, {agreement['kendall_tau_ci_95'][1]:.2f}]"
+                    if tau is not None else "undefined (every pair tied within the 3D error bars)")
+        sub = (f"\nKendall \u03c4 = {tau_text}, "
                f"Spearman \u03c1 = {agreement['spearman_rho']:.2f} "
                f"[{agreement['spearman_rho_ci_95'][0]:.2f}, {agreement['spearman_rho_ci_95'][1]:.2f}] (95 %)")
     fig.suptitle(f"3D confirmation of {name}: {len(pts)} design(s), {LABELS.get(metric, (metric,))[0]}{sub}")

@@ -116,6 +116,14 @@ TEST(ConfirmErrorBars, DesignsWithinTheirThreeDErrorBarsAreTiedNotMisranked) {
   EXPECT_EQ(off["agreement"]["misranked_pairs"][0], json({"design 0", "design 1"}));
   EXPECT_NEAR(off["agreement"]["kendall_tau"].get<double>(), 1.0 / 3.0, 1e-12);
 
+  // bars that reach across every pair: no order in 3D, so no Kendall tau (null, and why)
+  const json all = report({estimated(10e-9, 9e-9), estimated(10.5e-9, 9.5e-9), estimated(1e-9, 0.5e-9)}, true);
+  EXPECT_EQ(all["agreement"]["pairs_tied_by_3d_error_bars"], 3);
+  EXPECT_TRUE(all["agreement"]["kendall_tau"].is_null());
+  EXPECT_TRUE(all["agreement"]["kendall_tau_ci_95"].is_null());
+  EXPECT_TRUE(all["agreement"]["kendall_tau_absent_because"].is_string());
+  EXPECT_NE(confirm_markdown(all, "t").find("tau-b is 0/0"), std::string::npos);
+
   // bars that do not reach (a coarse grid close to the run's) leave the pair misranked
   const json tight = report({estimated(10e-9, 9.99e-9), estimated(10.5e-9, 10.49e-9), estimated(1e-9, 1e-9)}, true);
   EXPECT_EQ(tight["agreement"]["pairs_tied_by_3d_error_bars"], 0);

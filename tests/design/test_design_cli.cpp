@@ -195,7 +195,10 @@ TEST(ScreenConfirm, TheErrorEstimateGivesEachRunItsErrorBarAndTiesThePairsWithin
   ASSERT_EQ(c.code, 0) << c.err;
   const json again = read(out / "confirm.json");
   EXPECT_DOUBLE_EQ(again["wall_time_3d_s"].get<double>(), 0.0);
-  for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(again["designs"][i]["error_bar_3d"], r["designs"][i]["error_bar_3d"]);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(again["designs"][i]["error_bar_3d"], r["designs"][i]["error_bar_3d"]);
+    EXPECT_EQ(again["designs"][i]["coarse_wall_time_3d_s"], r["designs"][i]["coarse_wall_time_3d_s"]);
+  }
   EXPECT_EQ(again["agreement"], r["agreement"]);
   fs::remove_all(d);
 }
