@@ -219,27 +219,21 @@ TEST(ScreenConfirm, BadInputIsExitTwoNamingTheKeyAndWritesNothing) {
   EXPECT_EQ(c.code, 2);
   EXPECT_NE(c.err.find("metric"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("directed_to_diffusive_ratio"), std::string::npos) << c.err;
-  sw = tiny_sweep();
-  sw["confirm"] = {{"grid", {{"cells", 16}}}};
-  write(d / "grid.json", sw);
-  c = run_swim("screen \"" + (d / "grid.json").string() + "\" --confirm 2" + tail, d);
-  EXPECT_EQ(c.code, 2);
-  EXPECT_NE(c.err.find("confirm.grid"), std::string::npos) << c.err;
-  sw = tiny_sweep();
-  sw["confirm"] = {{"error_estimate", 1}};
-  write(d / "estimate.json", sw);
-  c = run_swim("screen \"" + (d / "estimate.json").string() + "\" --confirm 2" + tail, d);
-  EXPECT_EQ(c.code, 2);
-  EXPECT_NE(c.err.find("confirm.error_estimate"), std::string::npos) << c.err;
-  EXPECT_NE(c.err.find("true or false"), std::string::npos) << c.err;
+  // a confirm section refused: exit 2 naming `key` (and saying `allowed`)
+  auto refused = [&](const json& section, const std::string& key, const std::string& allowed) {
+    json bad = tiny_sweep();
+    bad["confirm"] = section;
+    write(d / "section.json", bad);
+    const Cli r = run_swim("screen \"" + (d / "section.json").string() + "\" --confirm 2" + tail, d);
+    EXPECT_EQ(r.code, 2) << section.dump();
+    EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(allowed), std::string::npos) << r.err;
+  };
+  refused({{"grid", {{"cells", 16}}}}, "confirm.grid", "cells_across");
+  refused({{"error_estimate", 1}}, "confirm.error_estimate", "true or false");
   // a grid whose coarse grid the 3D reader refuses (9 cells across the 0.48 um duct: its coarse
   // grid, 6 cells, leaves the swimmer no room for the kernel's support)
-  sw = tiny_sweep();
-  sw["confirm"] = {{"grid", {{"cells_across", 9}}}};
-  write(d / "coarse.json", sw);
-  c = run_swim("screen \"" + (d / "coarse.json").string() + "\" --confirm 2" + tail, d);
-  EXPECT_EQ(c.code, 2);
-  EXPECT_NE(c.err.find("confirm.error_estimate"), std::string::npos) << c.err;
+  refused({{"grid", {{"cells_across", 9}}}}, "confirm.error_estimate", "coarse");
   EXPECT_FALSE(fs::exists(out));
   fs::remove_all(d);
 }
