@@ -53,6 +53,11 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   scene::json identity = scene::load_file(spec_path);
   identity.erase("description");
   identity["base"] = spec.base;
+  if (identity.contains("confirm")) {
+    const scene::json c = design::confirm_identity(identity["confirm"]);
+    if (c.is_null()) identity.erase("confirm");
+    else identity["confirm"] = c;
+  }
   output::RunFolder folder(out, {"optimize", identity, overwrite, false, "--out", "optimum.json", "confirm-runs"});
 
   design::SearchOptions so;

@@ -232,13 +232,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   // the same sweep's finished results replaced); the sweep is identified by what it runs.
   scene::json identity = {{"base", sw.base}, {"metric", sw.metric}, {"goal", sw.maximize ? "max" : "min"}};
   for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
-  // confirm.error_estimate adds coarse runs beside the 3D runs and changes none of them: a sweep
-  // confirmed with and without it is the same sweep (its finished runs reused)
-  if (!sw.confirm.is_null()) identity["confirm"] = sw.confirm;
-  if (identity.contains("confirm") && identity["confirm"].is_object()) {
-    identity["confirm"].erase("error_estimate");
-    if (identity["confirm"].empty()) identity.erase("confirm");
-  }
+  if (const scene::json c = design::confirm_identity(sw.confirm); !c.is_null()) identity["confirm"] = c;
   // the 3D runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
   output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json", "confirm-runs"});
 

@@ -58,6 +58,13 @@ bool wants_error_estimate(const json& section) {
                                                                    : kErrorEstimateDefault;
 }
 
+json confirm_identity(const json& section) {
+  if (!section.is_object()) return section;
+  json j = section;
+  j.erase("error_estimate");
+  return j.empty() ? json(nullptr) : j;
+}
+
 void check_error_estimate(const json& scene3d, const json& section, const std::string& where) {
   if (!wants_error_estimate(section)) return;
   json resolved;

@@ -39,6 +39,11 @@ json read_confirm_section(const json& section, const std::string& where);
 constexpr bool kErrorEstimateDefault = true;
 bool wants_error_estimate(const json& section);
 
+/// A confirm section as part of a folder's identity: without error_estimate, which adds coarse
+/// runs beside the 3D runs and changes none of them (so a sweep or spec confirmed with and
+/// without it is the same, its finished runs reused); null when nothing else is left.
+json confirm_identity(const json& section);
+
 /// With the error estimate on: throws InputError naming `where`.error_estimate when the 3D
 /// scene (confirm_scene) has no coarse grid (validation::coarse_grid).
 void check_error_estimate(const json& scene3d, const json& section, const std::string& where);
