@@ -42,7 +42,9 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   if (confirm) {  // the designs must run in 3D too: the start's 3D scene is checked before anything runs
     scene::json resolved;
     try {
-      full3d::read_scene3d(design::confirm_scene(spec.design(start), spec.confirm, threads), resolved);
+      const scene::json sc = design::confirm_scene(spec.design(start), spec.confirm, threads);
+      full3d::read_scene3d(sc, resolved);
+      design::check_error_estimate(sc, spec.confirm, "confirm");
     } catch (const InputError& e) {
       throw InputError(e.key(), "", std::string("the start design on the 3D tier (add --no-confirm to skip the 3D run): ") + e.what());
     }
@@ -51,6 +53,11 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   scene::json identity = scene::load_file(spec_path);
   identity.erase("description");
   identity["base"] = spec.base;
+  if (identity.contains("confirm")) {
+    const scene::json c = design::confirm_identity(identity["confirm"]);
+    if (c.is_null()) identity.erase("confirm");
+    else identity["confirm"] = c;
+  }
   output::RunFolder folder(out, {"optimize", identity, overwrite, false, "--out", "optimum.json", "confirm-runs"});
 
   design::SearchOptions so;

@@ -58,16 +58,8 @@ void plot_and_list(const std::string& out, bool plot_asked, bool had_plot) {
                    out.c_str());
     return;
   }
-  const std::string path = (fs::path(out) / "summary.json").string();
   // the summary committed again (still last), after `change`
-  auto rewrite_summary = [&](const std::function<void(scene::json&)>& change) {
-    std::ifstream in(path);
-    scene::json j = scene::json::parse(in, nullptr, false);
-    if (j.is_discarded() || !j.is_object()) return;
-    for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
-    change(j);
-    output::write_json(path, j);
-  };
+  auto rewrite_summary = [&](const std::function<void(scene::json&)>& change) { output::amend_summary(out, change); };
   try {
     if (!plot("plot_run.py", {out}) || !output::adopt(png.string())) return;
   } catch (const Interrupted& e) {
@@ -116,42 +108,15 @@ void print_summary_1d(const std::string& name, const scene::json& s, double wall
   throw;
 }
 
-// --error-estimate: the same scene on a coarser grid, a run folder of its own in
-// RUN/error_estimate/coarse (docs/full3d.md, "A run's own error estimate").
-struct CoarseRun {
-  int cells = 0;
-  scene::json scene;
-  scene::json resolved;
-  full3d::Params3d p;
-};
-
-// The grid the 3D reader accepts (the container period a multiple of the cell size) nearest to
-// 3/4 of the run's cells across, coarser than it; an even count on a tie. Read and checked as
-// the run's own scene (InputError, exit 2, before anything is written).
-CoarseRun coarse_run(const scene::json& sc, const full3d::Params3d& p) {
-  const double width = 2.0 * p.container_radius;
-  const int n = int(std::lround(width / p.h));
-  const double target = 0.75 * n;
-  int best = 0;
-  for (int c = 4; c < n; ++c) {
-    if (!scene::multiple_of(p.period, width / c)) continue;
-    const double dc = std::abs(c - target), db = std::abs(best - target);
-    if (best == 0 || dc < db - 1e-9 || (std::abs(dc - db) <= 1e-9 && c % 2 == 0 && best % 2 != 0)) best = c;
-  }
-  if (best == 0)
-    throw InputError("--error-estimate", "full3d.grid.cells_across = " + std::to_string(n),
-                     "needs a coarser grid of at least 4 cells across whose cell size divides container.period; "
-                     "refine the grid or leave --error-estimate out");
-  CoarseRun c;
-  c.cells = best;
-  c.scene = sc;
-  scene::apply_override(c.scene, "full3d.grid.cell_size=null");
-  scene::apply_override(c.scene, "full3d.grid.cells_across=" + std::to_string(best));
+// --error-estimate: the same scene on a coarser grid (validation::coarse_grid), a run folder of
+// its own in RUN/error_estimate/coarse (docs/full3d.md, "A run's own error estimate"). Read and
+// checked as the run's own scene (InputError, exit 2, before anything is written).
+validation::CoarseGrid coarse_run(const scene::json& sc, const full3d::Params3d& p) {
+  validation::CoarseGrid c = validation::coarse_grid(sc, p, "--error-estimate");
   try {
-    c.p = full3d::read_scene3d(c.scene, c.resolved);
     check_output_size(estimate_output(c.p), c.scene);
   } catch (const InputError& e) {
-    throw InputError("--error-estimate", "the coarse grid full3d.grid.cells_across = " + std::to_string(best),
+    throw InputError("--error-estimate", "the coarse grid full3d.grid.cells_across = " + std::to_string(c.cells),
                      std::string("the coarse run's scene is refused (") + e.what() +
                          "); refine the grid or leave --error-estimate out");
   }
@@ -160,8 +125,8 @@ CoarseRun coarse_run(const scene::json& sc, const full3d::Params3d& p) {
 
 // Runs the coarse grid into its folder inside the run's. Its summary, or {"status": "failed: ..."}
 // when it cannot give the per-cycle figures; a failure of the coarse run never fails the run.
-scene::json run_coarse(const RunOptions& o, const CoarseRun& c, const std::string& out) {
-  const std::string dir = (fs::path(out) / "error_estimate" / "coarse").string();
+scene::json run_coarse(const RunOptions& o, const validation::CoarseGrid& c, const std::string& out) {
+  const std::string dir = validation::coarse_folder(out);
   auto failed = [&](const std::string& why) {
     output::reset_ledger(dir);  // the coarse run's files and failure are not the run's
     std::fflush(stdout);
@@ -197,17 +162,6 @@ scene::json run_coarse(const RunOptions& o, const CoarseRun& c, const std::strin
   }
 }
 
-// summary.json (committed again, still last) with `key` set.
-void add_to_summary(const std::string& out, const std::string& key, const scene::json& value) {
-  const std::string path = (fs::path(out) / "summary.json").string();
-  std::ifstream in(path);
-  scene::json j = scene::json::parse(in, nullptr, false);
-  if (j.is_discarded() || !j.is_object()) return;
-  for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
-  j[key] = value;
-  output::write_json(path, j);
-}
-
 // The 3D tier: read and validate, run (full3d/run3d.hpp), report.
 int run3d(const RunOptions& o, const scene::json& sc) {
   scene::json resolved;
@@ -222,7 +176,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
     throw InputError("--error-estimate", "--resume " + o.resume,
                      "cannot be combined with --resume (the estimate's coarse run is not continued); resume without "
                      "--error-estimate, or run the scene again with --error-estimate and --overwrite");
-  std::optional<CoarseRun> coarse;
+  std::optional<validation::CoarseGrid> coarse;
   if (o.error_estimate) coarse = coarse_run(sc, p);
   const std::string out = !o.resume.empty() ? o.resume : o.out.empty() ? "out/" + p.name + "-3d" : o.out;
   if (!o.resume.empty() && !fs::exists(full3d::checkpoint_path(out)))
@@ -257,7 +211,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
       scene::json e = coarse_summary.contains("status") && coarse_summary["status"] != "ok"
                           ? coarse_summary
                           : validation::error_estimate_json(r.summary, coarse_summary, coarse->cells, p.h, coarse->p.h);
-      add_to_summary(out, "error_estimate", e);
+      output::amend_summary(out, [&](scene::json& j) { j["error_estimate"] = e; });
       r.summary["error_estimate"] = e;
     }
   } catch (const std::exception& e) {

@@ -90,7 +90,9 @@ std::vector<design::Confirmed> confirm_over_ranks(const std::vector<design::Cand
                      {{"kind", "confirm3d"},
                       {"scene", sc},
                       {"runs_dir", fs::absolute(o.runs_dir).string()},
-                      {"label", design::confirm_label(c)}},
+                      {"label", design::confirm_label(c)},
+                      {"error_estimate", design::wants_error_estimate(o.section)},
+                      {"metric", o.metric}},
                      cost_3d(sc),
                      {}});
   }
@@ -164,12 +166,16 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", sw.name});
   if (report["agreement"].is_object()) {
     const auto& a = report["agreement"];
-    std::printf("rank agreement over %d designs: Kendall tau %.3g [%.3g, %.3g], Spearman rho %.3g [%.3g, %.3g] (95 %%); "
-                "%zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
-                a["designs"].get<int>(), a["kendall_tau"].get<double>(), a["kendall_tau_ci_95"][0].get<double>(),
-                a["kendall_tau_ci_95"][1].get<double>(), a["spearman_rho"].get<double>(),
+    char tau[96] = "undefined (every pair tied)";
+    if (a["kendall_tau"].is_number())
+      std::snprintf(tau, sizeof tau, "%.3g [%.3g, %.3g]", a["kendall_tau"].get<double>(),
+                    a["kendall_tau_ci_95"][0].get<double>(), a["kendall_tau_ci_95"][1].get<double>());
+    std::printf("rank agreement over %d designs: Kendall tau %s, Spearman rho %.3g [%.3g, %.3g] (95 %%); "
+                "%zu pair(s) tied by the 3D error bars, %zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
+                a["designs"].get<int>(), tau, a["spearman_rho"].get<double>(),
                 a["spearman_rho_ci_95"][0].get<double>(), a["spearman_rho_ci_95"][1].get<double>(),
-                report["misranked_designs"].size(), out.c_str(), out.c_str());
+                a["pairs_tied_by_3d_error_bars"].get<std::size_t>(), report["misranked_designs"].size(), out.c_str(),
+                out.c_str());
   }
   scene::json s = {{"status", report["status"]}, {"designs", report["designs_confirmed"]}, {"file", "confirm.json"}};
   if (report["agreement"].is_object()) {
@@ -198,7 +204,9 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     for (size_t k = 0; k < sw.count(); ++k) {
       scene::json resolved;
       try {
-        full3d::read_scene3d(design::confirm_scene(sw.design(k), confirm_section, threads), resolved);
+        const scene::json sc = design::confirm_scene(sw.design(k), confirm_section, threads);
+        full3d::read_scene3d(sc, resolved);
+        design::check_error_estimate(sc, confirm_section, "confirm");
       } catch (const InputError& e) {
         throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) +
                                           ") on the 3D tier: " + e.what());
@@ -224,7 +232,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   // the same sweep's finished results replaced); the sweep is identified by what it runs.
   scene::json identity = {{"base", sw.base}, {"metric", sw.metric}, {"goal", sw.maximize ? "max" : "min"}};
   for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
-  if (!sw.confirm.is_null()) identity["confirm"] = sw.confirm;
+  if (const scene::json c = design::confirm_identity(sw.confirm); !c.is_null()) identity["confirm"] = c;
   // the 3D runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
   output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json", "confirm-runs"});
 

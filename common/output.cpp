@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <exception>
 #include <filesystem>
+#include <fstream>
+#include <set>
 
 #include "common/errors.hpp"
 #include "common/version.hpp"
@@ -56,6 +58,32 @@ void write_json(const std::string& path, const json& value) {
   if (carries_own_checksum(path)) f.stream() << json_text_with_checksum(*out);
   else f.stream() << out->dump(2, ' ', false, json::error_handler_t::replace) << "\n";
   f.commit();
+}
+
+void adopt_listed(const std::string& dir) {
+  const fs::path d(dir);
+  std::ifstream in(d / "summary.json");
+  const json s = json::parse(in, nullptr, false);
+  if (s.is_discarded() || !s.is_object()) return;
+  std::set<std::string> have;
+  for (const auto& r : committed_files(dir)) have.insert(r.name);
+  if (!have.count("summary.json")) adopt((d / "summary.json").string());
+  if (!s.contains("files") || !s["files"].is_array()) return;
+  for (const auto& f : s["files"])
+    if (f.contains("name") && f["name"].is_string() && !have.count(f["name"].get<std::string>()))
+      adopt((d / f["name"].get<std::string>()).string());
+}
+
+bool amend_summary(const std::string& dir, const std::function<void(json&)>& change) {
+  const std::string path = (fs::path(dir) / "summary.json").string();
+  std::ifstream in(path);
+  json j = json::parse(in, nullptr, false);
+  if (j.is_discarded() || !j.is_object()) return false;
+  adopt_listed(dir);
+  for (const char* k : {"files", "swim_version", "checksum_algorithm", "self_fnv1a64"}) j.erase(k);
+  change(j);
+  write_json(path, j);
+  return true;
 }
 
 bool carries_own_checksum(const std::string& path) {

@@ -9,6 +9,7 @@
 #pragma once
 
 #include <charconv>
+#include <functional>
 #include <initializer_list>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -37,6 +38,17 @@ void make_dir(const std::string& dir);
 /// written into its folder is added, and a folder with a failed file is an OutputError.
 /// summary.json and calibration.json also carry a checksum of themselves (json_text_with_checksum).
 void write_json(const std::string& path, const json& value);
+
+/// Record in the ledger the files of a finished run folder that an earlier process committed:
+/// its summary.json and every file the summary's "files" names, except those this process has
+/// committed itself; a file no longer readable is left out. So a summary written into a
+/// folder holding `dir` (or into `dir` itself) lists them.
+void adopt_listed(const std::string& dir);
+
+/// `dir`/summary.json committed again (still last, its "files" and checksums renewed) after
+/// `change` edited it; the files it listed that an earlier process committed stay listed
+/// (adopt_listed). False, nothing written, when there is no readable summary.json.
+bool amend_summary(const std::string& dir, const std::function<void(json&)>& change);
 
 /// True for the files that carry a checksum of themselves: summary.json and calibration.json,
 /// the commit points of run and calibration folders.

@@ -6,12 +6,14 @@
 #include <fstream>
 
 #include "common/errors.hpp"
+#include "common/output.hpp"
 #include "common/si_format.hpp"
 #include "common/run_folder.hpp"
 #include "common/strict_json.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/screen.hpp"
+#include "validation/error_estimate.hpp"
 
 namespace swim::design {
 namespace fs = std::filesystem;
@@ -36,7 +38,12 @@ json read_confirm_section(const json& section, const std::string& where) {
   if (section.is_null()) return json::object();
   if (!section.is_object()) throw InputError(where, scene::show(section), "must be an object {\"grid\": {...}}");
   for (auto it = section.begin(); it != section.end(); ++it)
-    if (it.key() != "grid") throw InputError(where + "." + it.key(), scene::show(it.value()), "unknown key; allowed: grid");
+    if (it.key() != "grid" && it.key() != "error_estimate")
+      throw InputError(where + "." + it.key(), scene::show(it.value()), "unknown key; allowed: grid, error_estimate");
+  if (section.contains("error_estimate") && !section["error_estimate"].is_boolean())
+    throw InputError(where + ".error_estimate", scene::show(section["error_estimate"]),
+                     std::string("must be true or false (default ") + (kErrorEstimateDefault ? "true" : "false") +
+                         ": each finished 3D run also runs on a coarser grid for its own error bar)");
   if (section.contains("grid")) {
     const json& g = section["grid"];
     if (!g.is_object() || g.size() != 1 || !(g.contains("cells_across") || g.contains("cell_size")))
@@ -44,6 +51,28 @@ json read_confirm_section(const json& section, const std::string& where) {
                        "must be {\"cells_across\": <even integer>} or {\"cell_size\": \"<length>\"} (full3d.grid)");
   }
   return section;
+}
+
+bool wants_error_estimate(const json& section) {
+  return section.is_object() && section.contains("error_estimate") ? section["error_estimate"].get<bool>()
+                                                                   : kErrorEstimateDefault;
+}
+
+json confirm_identity(const json& section) {
+  if (!section.is_object()) return section;
+  json j = section;
+  j.erase("error_estimate");
+  return j.empty() ? json(nullptr) : j;
+}
+
+void check_error_estimate(const json& scene3d, const json& section, const std::string& where) {
+  if (!wants_error_estimate(section)) return;
+  json resolved;
+  validation::coarse_grid(scene3d, full3d::read_scene3d(scene3d, resolved), where + ".error_estimate");
+}
+
+std::string estimated_figure(const std::string& metric) {
+  return metric == "mean_cycle_time_s" ? "cycle_time_s" : metric;
 }
 
 json confirm_scene(json sc, const json& section, int threads) {
@@ -67,7 +96,10 @@ json number_or_null(double v, bool present) { return present && std::isfinite(v)
 }  // namespace
 
 json confirmed_to_json(const Confirmed& c) {
-  return {{"summary", c.summary}, {"folder", c.folder}, {"reused", c.reused}, {"ok", c.ok}, {"cell_size_m", c.cell_size_m}};
+  return {{"summary", c.summary},       {"folder", c.folder},
+          {"reused", c.reused},         {"ok", c.ok},
+          {"cell_size_m", c.cell_size_m}, {"coarse_run", c.coarse_run},
+          {"coarse_reused", c.coarse_reused}, {"coarse_wall_time_s", c.coarse_wall_time_s}};
 }
 
 Confirmed confirmed_from_json(const json& j) {
@@ -77,12 +109,76 @@ Confirmed confirmed_from_json(const json& j) {
   c.reused = j.at("reused").get<bool>();
   c.ok = j.at("ok").get<bool>();
   c.cell_size_m = j.at("cell_size_m").get<double>();
+  c.coarse_run = j.at("coarse_run").get<bool>();
+  c.coarse_reused = j.at("coarse_reused").get<bool>();
+  c.coarse_wall_time_s = j.at("coarse_wall_time_s").get<double>();
   return c;
 }
 
 std::string confirm_label(const Candidate& c) { return "design-" + std::to_string(c.design); }
 
-Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::string& label, int progress) {
+namespace {
+// The 3D run of (p, resolved) in `dir`: the finished one reused, an interrupted one continued
+// from a checkpoint that matches the scene, else run afresh into the cleared folder.
+json run_or_reuse(const full3d::Params3d& p, const json& resolved, const fs::path& dir, int progress, bool& reused) {
+  json s = finished_summary(dir);
+  reused = !s.is_null() && !running(s);
+  if (reused) return s;
+  bool resume = false;
+  if (running(s) && fs::exists(full3d::checkpoint_path(dir.string()))) {
+    try {
+      full3d::check_resumable(p, resolved, dir.string());
+      resume = true;
+    } catch (const InputError&) {
+    }
+  }
+  if (!resume) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  full3d::RunControl ctl;
+  ctl.progress = progress;
+  ctl.quiet_vtk = true;
+  ctl.resume = resume;
+  return full3d::run3d(p, resolved, dir.string(), ctl).summary;
+}
+
+// The error estimate of the finished run c (validation/error_estimate.hpp): its coarse run in
+// c.folder/error_estimate/coarse, then the estimate of the headline figures and `figure`.
+json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, const std::string& figure, int progress) {
+  validation::CoarseGrid g;
+  try {
+    g = validation::coarse_grid(sc, p, "confirm.error_estimate");
+  } catch (const InputError& e) {
+    return {{"status", std::string("failed: no coarse grid: ") + e.what()}};
+  }
+  const std::string dir = validation::coarse_folder(c.folder);
+  json s;
+  try {
+    s = run_or_reuse(g.p, g.resolved, dir, progress, c.coarse_reused);
+  } catch (const std::exception& e) {
+    s = {{"status", std::string("failed: ") + e.what()}};
+  }
+  c.coarse_run = true;
+  c.coarse_wall_time_s = s.value("wall_time_s", 0.0);
+  const std::string status = s.value("status", std::string("unknown"));
+  const std::string what = "the coarse run (" + std::to_string(g.cells) + " cells across)";
+  if (status != "ok") {
+    output::reset_ledger(dir);  // the coarse run's files are not the run's (as with swim run)
+    return {{"status", "failed: " + what + ": " + status}};
+  }
+  if (!s["displacement_per_cycle_m"].is_number()) {
+    output::reset_ledger(dir);
+    return {{"status", "failed: " + what + ": no cycle completed (" +
+                           s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
+  }
+  if (c.coarse_reused) output::adopt_listed(dir);  // an earlier invocation's coarse run, listed by the run
+  return validation::error_estimate_json(c.summary, s, g.cells, p.h, g.p.h, {figure});
+}
+}  // namespace
+
+Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::string& label, int progress,
+                        bool error_estimate, const std::string& metric) {
   json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
   json physics = resolved;
@@ -91,30 +187,24 @@ Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::
   Confirmed c;
   c.folder = dir.string();
   c.cell_size_m = p.h;
-  json s = finished_summary(dir);
-  if (!s.is_null() && !running(s)) {
-    c.summary = s;
-    c.reused = true;
-  } else {
-    bool resume = false;
-    if (running(s) && fs::exists(full3d::checkpoint_path(dir.string()))) {
-      try {
-        full3d::check_resumable(p, resolved, dir.string());
-        resume = true;
-      } catch (const InputError&) {
-      }
-    }
-    if (!resume) {
-      fs::remove_all(dir);
-      fs::create_directories(dir);
-    }
-    full3d::RunControl ctl;
-    ctl.progress = progress;
-    ctl.quiet_vtk = true;
-    ctl.resume = resume;
-    c.summary = full3d::run3d(p, resolved, dir.string(), ctl).summary;
-  }
+  c.summary = run_or_reuse(p, resolved, dir, progress, c.reused);
   c.ok = c.summary.value("status", std::string()) == "ok";
+  // the estimate of a finished run with its per-cycle figures (as swim run --error-estimate
+  // gives one); an estimate the summary holds already is kept
+  const std::string figure = estimated_figure(metric);
+  const json* have = c.summary.contains("error_estimate") ? &c.summary["error_estimate"] : nullptr;
+  const bool complete = have && (have->value("status", std::string()) != "ok" || have->contains(figure));
+  if (error_estimate && complete) {  // an earlier invocation's estimate: its coarse run, reused
+    const json cs = finished_summary(validation::coarse_folder(c.folder));
+    c.coarse_run = c.coarse_reused = !cs.is_null();
+    c.coarse_wall_time_s = cs.is_null() ? 0.0 : cs.value("wall_time_s", 0.0);
+  }
+  if (error_estimate && c.ok && c.summary["displacement_per_cycle_m"].is_number() && !complete) {
+    const json e = estimate_error(c, sc, p, figure, progress);
+    if (!output::amend_summary(c.folder, [&](json& j) { j["error_estimate"] = e; }))
+      throw OutputError((dir / "summary.json").string(), "could not be read back to add the error estimate");
+    c.summary["error_estimate"] = e;
+  }
   return c;
 }
 
@@ -141,11 +231,16 @@ json figures_3d(const json& s, const std::string& metric) {
   return f;
 }
 
-double error_bar_3d(const json& s, const std::string& figure) {
-  if (s.contains("error_bars") && s["error_bars"].is_object() && s["error_bars"].contains(figure) &&
-      s["error_bars"][figure].is_number())
-    return std::abs(s["error_bars"][figure].get<double>());
-  return 0.0;
+json error_bar_3d(const json& s, const std::string& figure) {
+  const std::string k = estimated_figure(figure);
+  if (!s.contains("error_estimate") || !s["error_estimate"].is_object()) return nullptr;
+  const json& e = s["error_estimate"];
+  if (e.value("status", std::string()) != "ok" || !e.contains(k) || !e[k].is_object()) return nullptr;
+  const json& f = e[k];
+  for (const char* b : {"fine", "interval_low", "interval_high"})
+    if (!f.contains(b) || !f[b].is_number()) return nullptr;
+  const double v = f["fine"].get<double>();
+  return std::max(std::abs(v - f["interval_low"].get<double>()), std::abs(v - f["interval_high"].get<double>()));
 }
 
 json relative_differences(const json& fig1d, const json& fig3d) {
@@ -162,8 +257,12 @@ json agreement_json(const RankAgreement& a, const std::vector<std::string>& labe
   json mis = json::array();
   for (const auto& [i, j] : a.misranked) mis.push_back({labels[i], labels[j]});
   return {{"designs", a.n},
-          {"kendall_tau", a.kendall_tau},
-          {"kendall_tau_ci_95", {a.kendall_ci.lo, a.kendall_ci.hi}},
+          {"kendall_tau", a.kendall_defined ? json(a.kendall_tau) : json(nullptr)},
+          {"kendall_tau_ci_95", a.kendall_defined ? json({a.kendall_ci.lo, a.kendall_ci.hi}) : json(nullptr)},
+          {"kendall_tau_absent_because",
+           a.kendall_defined ? json(nullptr)
+                             : json("every pair is tied in 1D or in 3D (3D ties counting those within the error bars): "
+                                    "tau-b is 0/0, the 3D tier does not order these designs beyond its own error")},
           {"spearman_rho", a.spearman_rho},
           {"spearman_rho_ci_95", {a.spearman_ci.lo, a.spearman_ci.hi}},
           {"method",
@@ -190,15 +289,29 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
   std::vector<std::size_t> used;  // candidates in the agreement
   std::vector<std::string> labels, failures;
   double wall = 0;
+  const bool estimate = wants_error_estimate(o.section);
   for (std::size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const std::string label = "design " + std::to_string(c.design);
     const json sc = confirm_scene(c.scene, o.section, o.threads);
-    Confirmed r = o.run ? o.run(i, sc, confirm_label(c)) : run_confirmed(sc, o.runs_dir, confirm_label(c), o.progress);
+    Confirmed r = o.run ? o.run(i, sc, confirm_label(c))
+                        : run_confirmed(sc, o.runs_dir, confirm_label(c), o.progress, estimate, o.metric);
     if (on_done) on_done(i, r);
     const json f1 = figures_1d(c.metrics, o.metric), f3 = figures_3d(r.summary, o.metric);
     const std::string status = r.summary.value("status", std::string("unknown"));
     if (!r.reused) wall += r.summary.value("wall_time_s", 0.0);
+    if (r.coarse_run && !r.coarse_reused) wall += r.coarse_wall_time_s;
+    // the error bar of the metric, and why there is none
+    const json bar = estimate ? error_bar_3d(r.summary, o.metric) : json(nullptr);
+    json bar_absent = nullptr;
+    if (!estimate) {
+      bar_absent = "confirm.error_estimate is false";
+    } else if (bar.is_null()) {
+      const json& e = r.summary.contains("error_estimate") ? r.summary["error_estimate"] : json(nullptr);
+      bar_absent = e.is_object() && e.contains("status") && e["status"] != "ok"
+                       ? json(e["status"])
+                       : json("no error estimate: the 3D run did not finish with its per-cycle figures");
+    }
     json d = {{"design", c.design},
               {"values", c.values},
               {"selected_as", c.selected_as},
@@ -210,8 +323,21 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
               {"cell_size_3d_m", r.cell_size_m},
               {"figures_1d", f1},
               {"figures_3d", f3},
-              {"error_bar_3d", error_bar_3d(r.summary, o.metric)},
+              {"error_bar_3d", bar},
+              {"error_bar_3d_absent_because", bar_absent},
+              {"coarse_wall_time_3d_s", r.coarse_run ? json(r.coarse_wall_time_s) : json(nullptr)},
               {"relative_difference_3d_vs_1d", relative_differences(f1, f3)}};
+    if (estimate && r.summary.contains("error_estimate") && r.summary["error_estimate"].is_object()) {
+      const json& e = r.summary["error_estimate"];
+      const std::string k = estimated_figure(o.metric);
+      d["error_estimate_3d"] = e.contains(k) ? json{{"figure", k},
+                                                    {"coarse_cells_across", e["coarse_cells_across"]},
+                                                    {"coarse_cell_size_m", e["coarse_cell_size_m"]},
+                                                    {"estimate", e[k]}}
+                                             : json{{"status", e.value("status", std::string("unknown"))}};
+    } else {
+      d["error_estimate_3d"] = nullptr;
+    }
     designs.push_back(d);
     if (!r.ok) {
       failures.push_back(label + ": " + status);
@@ -225,7 +351,7 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
     const double sgn = o.maximize ? -1.0 : 1.0;
     x.push_back(sgn * f1[o.metric].get<double>());
     y.push_back(sgn * f3[o.metric].get<double>());
-    yerr.push_back(error_bar_3d(r.summary, o.metric));
+    yerr.push_back(bar.is_number() ? bar.get<double>() : 0.0);
     used.push_back(i);
     labels.push_back(label);
   }
@@ -235,6 +361,8 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
                  {"goal", o.maximize ? "max" : "min"},
                  {"grid_3d", o.section.contains("grid") ? o.section["grid"] : json("the design scene's full3d.grid")},
                  {"threads_3d", o.threads},
+                 {"error_estimate_3d", estimate},
+                 {"designs_with_error_bar_3d", 0},
                  {"designs_confirmed", cands.size()},
                  {"designs_failed_3d", failures.size()},
                  {"failures_3d", failures},
@@ -259,6 +387,9 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
     report["misranked_designs"] = json::array();
     report["agreement_absent_because"] = "fewer than two designs have a finished 3D run with the metric";
   }
+  std::size_t with_bar = 0;
+  for (const auto& d : designs) with_bar += d["error_bar_3d"].is_number();
+  report["designs_with_error_bar_3d"] = with_bar;
   report["designs"] = designs;
   return report;
 }
@@ -290,23 +421,36 @@ std::string confirm_markdown(const json& r, const std::string& title) {
   if (r["agreement"].is_object()) {
     const json& a = r["agreement"];
     s += "| rank agreement over " + std::to_string(a["designs"].get<int>()) + " designs | value | 95 % interval |\n|---|---|---|\n";
-    s += "| Kendall τ-b | " + num(a["kendall_tau"]) + " | [" + num(a["kendall_tau_ci_95"][0]) + ", " + num(a["kendall_tau_ci_95"][1]) + "] |\n";
+    if (a["kendall_tau"].is_number())
+      s += "| Kendall τ-b | " + num(a["kendall_tau"]) + " | [" + num(a["kendall_tau_ci_95"][0]) + ", " + num(a["kendall_tau_ci_95"][1]) + "] |\n";
+    else
+      s += "| Kendall τ-b | – (" + a["kendall_tau_absent_because"].get<std::string>() + ") | – |\n";
     s += "| Spearman ρ | " + num(a["spearman_rho"]) + " | [" + num(a["spearman_rho_ci_95"][0]) + ", " + num(a["spearman_rho_ci_95"][1]) + "] |\n\n";
     s += "Method: " + a["method"].get<std::string>() + ".\n\n";
     std::string mis;
     for (const auto& p : a["misranked_pairs"]) mis += (mis.empty() ? "" : "; ") + p[0].get<std::string>() + " / " + p[1].get<std::string>();
-    s += "Misranked pairs (1D orders them one way, 3D the other): " + (mis.empty() ? std::string("none") : mis) + ".\n\n";
+    s += "Misranked pairs (1D orders them one way, 3D the other beyond the 3D error bars): " +
+         (mis.empty() ? std::string("none") : mis) + ".\n\n";
+    s += "Pairs tied in 3D by their error bars (3D values apart by no more than the sum of their error bars): " +
+         std::to_string(a["pairs_tied_by_3d_error_bars"].get<int>()) + " of " +
+         std::to_string(a["designs"].get<int>() * (a["designs"].get<int>() - 1) / 2) + ".\n\n";
   } else {
     s += "No rank agreement: " + r["agreement_absent_because"].get<std::string>() + ".\n\n";
   }
-  s += "| design | values | selected as | rank 1D (sweep) | rank 1D / 3D (confirmed) | " + m + " 1D | 3D | Δ | displacement per cycle 1D | 3D | cycle time 1D | 3D | mean velocity 1D | 3D | 3D status |\n";
-  s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  if (r.value("error_estimate_3d", false))
+    s += "3D error bars: each finished 3D run also ran on a coarser grid (`swim run --error-estimate`); the error bar is "
+         "the largest distance from the run's value to the interval of its extrapolations to h → 0 at the orders 0.5 "
+         "to 2 (" + std::to_string(r["designs_with_error_bar_3d"].get<int>()) + " of " +
+         std::to_string(r["designs"].size()) + " designs have one).\n\n";
+  s += "| design | values | selected as | rank 1D (sweep) | rank 1D / 3D (confirmed) | " + m + " 1D | 3D | 3D error bar | Δ | displacement per cycle 1D | 3D | cycle time 1D | 3D | mean velocity 1D | 3D | 3D status |\n";
+  s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
   for (const auto& d : r["designs"]) {
     const json &f1 = d["figures_1d"], &f3 = d["figures_3d"], &rel = d["relative_difference_3d_vs_1d"];
     s += "| " + std::to_string(d["design"].get<int>()) + " | " + d["values"].get<std::string>() + " | " +
          d["selected_as"].get<std::string>() + " | " + std::to_string(d["rank_in_sweep_1d"].get<long>()) + " | " +
          num(d.value("rank_1d", json(nullptr)), 6) + " / " + num(d.value("rank_3d", json(nullptr)), 6) + " | " +
-         fig(f1[m], m) + " | " + fig(f3[m], m) + " | " + pct(rel[m]) + " | " + fig(f1["displacement_per_cycle_m"], "displacement_per_cycle_m") +
+         fig(f1[m], m) + " | " + fig(f3[m], m) + " | " + (d["error_bar_3d"].is_number() ? "± " + fig(d["error_bar_3d"], m) : "–") +
+         " | " + pct(rel[m]) + " | " + fig(f1["displacement_per_cycle_m"], "displacement_per_cycle_m") +
          " | " + fig(f3["displacement_per_cycle_m"], "displacement_per_cycle_m") + " | " + fig(f1["cycle_time_s"], "cycle_time_s") +
          " | " + fig(f3["cycle_time_s"], "cycle_time_s") + " | " + fig(f1["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " +
          fig(f3["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " + d["status_3d"].get<std::string>() + " |\n";

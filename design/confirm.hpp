@@ -4,8 +4,12 @@
 //
 //   figures compared per design: the sweep's metric, displacement per cycle [m], cycle time [s],
 //   mean velocity [m/s]; relative difference (3D - 1D) / |3D|.
-//   error bars: a 3D summary's "error_bars" object ({"<figure key>": value in the figure's unit}),
-//   when a run writes one; the 3D tier's single runs write none today, so no pair is tied by them.
+//   error bars (confirm.error_estimate, default true): each 3D run that finishes is followed by
+//   the coarse-grid run of `swim run --error-estimate` (validation/error_estimate.hpp) in its
+//   folder's error_estimate/coarse/, and its summary.json gets the same `error_estimate`, with
+//   the sweep's metric estimated too. The error bar of a figure f is the largest distance from f
+//   to the estimate's interval of extrapolations, max(|f - interval_low|, |f - interval_high|):
+//   how far the run's own figure may lie from its value on ever finer grids.
 #pragma once
 
 #include <functional>
@@ -25,10 +29,28 @@ const std::vector<std::string>& metrics_in_3d();
 /// Throws InputError naming `key` when the 3D tier does not report `metric`.
 void check_metric_in_3d(const std::string& metric, const std::string& key);
 
-/// A "confirm" section ({"grid": {"cells_across": n} | {"cell_size": "<length>"}}) read and
-/// checked; `where` names it in messages. Absent (null): the design scene's own full3d.grid,
-/// which is the 3D tier's default (32 cells across the container) when the scene sets none.
+/// A "confirm" section ({"grid": {"cells_across": n} | {"cell_size": "<length>"},
+/// "error_estimate": true | false}, both optional) read and checked; `where` names it in
+/// messages. No grid: the design scene's own full3d.grid, which is the 3D tier's default (32
+/// cells across the container) when the scene sets none.
 json read_confirm_section(const json& section, const std::string& where);
+
+/// confirm.error_estimate of a read section: absent is true (kErrorEstimateDefault).
+constexpr bool kErrorEstimateDefault = true;
+bool wants_error_estimate(const json& section);
+
+/// A confirm section as part of a folder's identity: without error_estimate, which adds coarse
+/// runs beside the 3D runs and changes none of them (so a sweep or spec confirmed with and
+/// without it is the same, its finished runs reused); null when nothing else is left.
+json confirm_identity(const json& section);
+
+/// With the error estimate on: throws InputError naming `where`.error_estimate when the 3D
+/// scene (confirm_scene) has no coarse grid (validation::coarse_grid).
+void check_error_estimate(const json& scene3d, const json& section, const std::string& where);
+
+/// The summary key of the estimate that carries a sweep metric: cycle_time_s for
+/// mean_cycle_time_s (the same mean of the cycles), the metric itself otherwise.
+std::string estimated_figure(const std::string& metric);
 
 /// A design scene prepared for its 3D run: the section's grid, `threads`, no VTK frames.
 json confirm_scene(json scene, const json& section, int threads);
@@ -39,6 +61,9 @@ struct Confirmed {
   bool reused = false; ///< a finished run found in the runs folder
   bool ok = false;     ///< status "ok"
   double cell_size_m = 0;  ///< the grid's h
+  /// the error estimate's coarse run: run (or reused), its wall time (0 when none)
+  bool coarse_run = false, coarse_reused = false;
+  double coarse_wall_time_s = 0;
 };
 
 /// A Confirmed as JSON and back (how an MPI rank sends it to rank 0; the summary round-trips exactly).
@@ -47,14 +72,21 @@ Confirmed confirmed_from_json(const json& j);
 
 /// The 3D run of `scene` (validated by the 3D reader) in runs_dir/<label>-<hash of the
 /// resolved scene>: reused when finished, continued from a matching checkpoint, else run.
-Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const std::string& label, int progress);
+/// error_estimate: when the run finished with its per-cycle figures, then also its coarse run
+/// (reused, continued or run the same way) and `error_estimate` in its summary, with `metric`'s
+/// figure (estimated_figure) estimated too; a run whose summary has that estimate already is
+/// left as it is.
+Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const std::string& label, int progress,
+                        bool error_estimate = false, const std::string& metric = "");
 
 /// One tier's figures of a design: {"<metric>", "displacement_per_cycle_m", "cycle_time_s",
 /// "mean_velocity_m_per_s"}; a figure the run did not produce (no completed cycle) is null.
 json figures_1d(const reduced1d::Metrics& m, const std::string& metric);
 json figures_3d(const json& summary, const std::string& metric);
-/// The error bar of a 3D figure (0 when the run reports none).
-double error_bar_3d(const json& summary, const std::string& figure);
+/// The error bar of a 3D figure from the summary's `error_estimate` (estimated_figure of it):
+/// max(|f - interval_low|, |f - interval_high|) with f the run's own value; null when the
+/// summary has no estimate of it.
+json error_bar_3d(const json& summary, const std::string& figure);
 
 /// {"<figure>": (3D - 1D) / |3D|} for every figure both tiers have (null otherwise).
 json relative_differences(const json& fig1d, const json& fig3d);

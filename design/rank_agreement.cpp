@@ -81,7 +81,8 @@ RankAgreement rank_agreement(const std::vector<double>& x, const std::vector<dou
   const double den = std::sqrt((n0 - double(a.tied_x)) * (n0 - double(a.tied_y)));
   a.kendall_tau = den > 0 ? (double(a.concordant) - double(a.discordant)) / den : 0.0;
   a.spearman_rho = pearson(mid_ranks(x), mid_ranks(y));
-  a.kendall_ci = interval_of(a.kendall_tau, a.n, 0.437, 4, 2.0 / n0);
+  a.kendall_defined = den > 0;
+  a.kendall_ci = a.kendall_defined ? interval_of(a.kendall_tau, a.n, 0.437, 4, 2.0 / n0) : Interval{-1, 1};
   a.spearman_ci = interval_of(a.spearman_rho, a.n, 1.06, 3, 12.0 / (double(a.n) * (double(a.n) * double(a.n) - 1.0)));
   return a;
 }

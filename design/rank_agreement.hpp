@@ -12,6 +12,8 @@
 //   Ties from error bars: a pair whose y values differ by no more than the sum of their error
 //     bars (y_err, when given) counts as tied in y, for tau-b and for the misranked pairs.
 //   Misranked pair: x orders it one way, y (beyond the error bars) strictly the other way.
+//   With every pair tied in x or in y (for instance every 3D difference within its error bars)
+//   tau-b is 0/0: undefined (kendall_defined false), not 0.
 #pragma once
 
 #include <cstddef>
@@ -28,6 +30,9 @@ struct RankAgreement {
   std::size_t n = 0;
   double kendall_tau = 0;
   Interval kendall_ci;
+  /// false when every pair is tied in x or in y (tau-b's 0/0): kendall_tau is then 0 and
+  /// kendall_ci the whole [-1, 1], and neither says anything
+  bool kendall_defined = true;
   double spearman_rho = 0;
   Interval spearman_ci;
   std::size_t concordant = 0, discordant = 0, tied_x = 0, tied_y = 0;

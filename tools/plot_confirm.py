@@ -2,8 +2,9 @@
 diagonal (1D = 3D), and the designs' ranks in both tiers.
 
 usage: plot_confirm.py CONFIRM_JSON OUT_PNG TITLE_NAME
-Axes carry SI-prefixed units; each point is labelled with its design number. Designs whose
-3D run failed are left out (confirm.md lists them).
+Axes carry SI-prefixed units; each point is labelled with its design number, with its 3D error
+bar when the run estimated its own error (confirm.error_estimate). Designs whose 3D run failed
+are left out (confirm.md lists them).
 """
 import json
 import os
@@ -23,7 +24,7 @@ def main(path, png, name):
         rep = json.load(f)
     metric = rep["metric"]
     unit = LABELS.get(metric, (metric, ""))[1]
-    pts = [(d["design"], d["figures_1d"][metric], d["figures_3d"][metric], d.get("error_bar_3d", 0.0),
+    pts = [(d["design"], d["figures_1d"][metric], d["figures_3d"][metric], d.get("error_bar_3d") or 0.0,
             d.get("rank_1d"), d.get("rank_3d"), d["selected_as"])
            for d in rep["designs"] if d["status_3d"] == "ok" and d["figures_3d"].get(metric) is not None]
     if not pts:
@@ -39,8 +40,10 @@ def main(path, png, name):
     agreement = rep.get("agreement")
     sub = ""
     if agreement:
-        sub = (f"\nKendall \u03c4 = {agreement['kendall_tau']:.2f} "
-               f"[{agreement['kendall_tau_ci_95'][0]:.2f}, {agreement['kendall_tau_ci_95'][1]:.2f}], "
+        tau = agreement.get("kendall_tau")
+        tau_text = (f"{tau:.2f} [{agreement['kendall_tau_ci_95'][0]:.2f}, {agreement['kendall_tau_ci_95'][1]:.2f}]"
+                    if tau is not None else "undefined (every pair tied within the 3D error bars)")
+        sub = (f"\nKendall \u03c4 = {tau_text}, "
                f"Spearman \u03c1 = {agreement['spearman_rho']:.2f} "
                f"[{agreement['spearman_rho_ci_95'][0]:.2f}, {agreement['spearman_rho_ci_95'][1]:.2f}] (95 %)")
     fig.suptitle(f"3D confirmation of {name}: {len(pts)} design(s), {LABELS.get(metric, (metric,))[0]}{sub}")

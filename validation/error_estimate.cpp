@@ -2,9 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 #include "common/errors.hpp"
-#include <cstdio>
+#include "common/scene_shared.hpp"
 
 namespace swim::validation {
 
@@ -66,11 +68,16 @@ scene::json to_json(const TwoGridEstimate& e) {
 }
 
 scene::json error_estimate_json(const scene::json& fine, const scene::json& coarse, int coarse_cells_across,
-                                double h_fine, double h_coarse) {
+                                double h_fine, double h_coarse, const std::vector<std::string>& more_figures) {
+  std::vector<std::string> figures(std::begin(kEstimatedFigures), std::end(kEstimatedFigures));
+  for (const auto& k : more_figures)
+    if (std::find(figures.begin(), figures.end(), k) == figures.end()) figures.push_back(k);
   for (const auto* s : {&fine, &coarse}) {
     const char* which = s == &fine ? "the run" : "the coarse run";
-    for (const char* k : kEstimatedFigures)
+    for (const auto& k : figures)
       if (!s->contains(k) || !(*s)[k].is_number()) {
+        const bool per_cycle = std::find(std::begin(kEstimatedFigures), std::end(kEstimatedFigures), k) != std::end(kEstimatedFigures);
+        if (!per_cycle) return {{"status", std::string("failed: ") + which + " reports no " + k}};
         std::string why = s->contains("per_cycle_absent_because") && (*s)["per_cycle_absent_because"].is_string()
                               ? (*s)["per_cycle_absent_because"].get<std::string>()
                               : std::string("no ") + k;
@@ -86,11 +93,44 @@ scene::json error_estimate_json(const scene::json& fine, const scene::json& coar
                    {"coarse_cell_size_m", h_coarse},
                    {"fine_cell_size_m", h_fine},
                    {"order_range", {kImmersedBoundaryOrders.lo, kImmersedBoundaryOrders.hi}}};
-  for (const char* k : kEstimatedFigures) {
-    const bool positive = std::string(k) == "cycle_time_s";
+  for (const auto& k : figures) {
+    const bool positive = k == "cycle_time_s";
     j[k] = to_json(two_grid_estimate(fine[k].get<double>(), coarse[k].get<double>(), h_fine, h_coarse, positive));
   }
   return j;
+}
+
+CoarseGrid coarse_grid(const scene::json& sc, const full3d::Params3d& p, const std::string& key) {
+  const double width = 2.0 * p.container_radius;
+  const int n = int(std::lround(width / p.h));
+  const double target = 0.75 * n;
+  int best = 0;
+  for (int c = 4; c < n; ++c) {
+    if (!scene::multiple_of(p.period, width / c)) continue;
+    const double dc = std::abs(c - target), db = std::abs(best - target);
+    if (best == 0 || dc < db - 1e-9 || (std::abs(dc - db) <= 1e-9 && c % 2 == 0 && best % 2 != 0)) best = c;
+  }
+  if (best == 0)
+    throw InputError(key, "full3d.grid.cells_across = " + std::to_string(n),
+                     "the error estimate needs a coarser grid of at least 4 cells across whose cell size divides "
+                     "container.period; refine the grid or leave the error estimate out");
+  CoarseGrid c;
+  c.cells = best;
+  c.scene = sc;
+  scene::apply_override(c.scene, "full3d.grid.cell_size=null");
+  scene::apply_override(c.scene, "full3d.grid.cells_across=" + std::to_string(best));
+  try {
+    c.p = full3d::read_scene3d(c.scene, c.resolved);
+  } catch (const InputError& e) {
+    throw InputError(key, "the coarse grid full3d.grid.cells_across = " + std::to_string(best),
+                     std::string("the coarse run's scene is refused (") + e.what() +
+                         "); refine the grid or leave the error estimate out");
+  }
+  return c;
+}
+
+std::string coarse_folder(const std::string& run_dir) {
+  return (std::filesystem::path(run_dir) / "error_estimate" / "coarse").string();
 }
 
 }  // namespace swim::validation

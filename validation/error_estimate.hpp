@@ -18,8 +18,10 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include "common/scene.hpp"
+#include "full3d/scene3d.hpp"
 #include "validation/richardson.hpp"
 
 namespace swim::validation {
@@ -55,9 +57,27 @@ constexpr const char* kEstimatedFigures[3] = {"displacement_per_cycle_m", "cycle
                                               "mean_velocity_per_cycle_m_per_s"};
 
 /// summary.json's `error_estimate` object from the two runs' summaries: method, the grids,
-/// order_range and an object per figure of kEstimatedFigures; {"status": "failed: ..."} (no
-/// numbers) when either summary has no per-cycle figures.
+/// order_range and an object per figure of kEstimatedFigures and of `more_figures` (further
+/// summary keys, e.g. a sweep's metric); {"status": "failed: ..."} (no numbers) when either
+/// summary has no per-cycle figures or lacks one of `more_figures`.
 scene::json error_estimate_json(const scene::json& fine_summary, const scene::json& coarse_summary, int coarse_cells_across,
-                                double h_fine, double h_coarse);
+                                double h_fine, double h_coarse, const std::vector<std::string>& more_figures = {});
+
+/// The coarse grid of a 3D run's estimate: the same scene on the grid the 3D reader accepts
+/// (the container period a multiple of the cell size) nearest to 3/4 of the run's cells
+/// across, coarser than it (an even count on a tie); the scene's cell_size replaced by
+/// cells_across, everything else unchanged.
+struct CoarseGrid {
+  int cells = 0;
+  scene::json scene;     ///< the scene as given, on the coarse grid
+  scene::json resolved;  ///< as the 3D reader resolved it
+  full3d::Params3d p;
+};
+/// Throws InputError naming `key` (the option or scene key that asked for the estimate) when
+/// there is no such grid of at least 4 cells, or the 3D reader refuses the coarse scene.
+CoarseGrid coarse_grid(const scene::json& scene, const full3d::Params3d& p, const std::string& key);
+
+/// The coarse run's folder inside the run's: RUN/error_estimate/coarse.
+std::string coarse_folder(const std::string& run_dir);
 
 }  // namespace swim::validation

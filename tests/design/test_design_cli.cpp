@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -13,6 +14,7 @@
 #include <iterator>
 #include <sstream>
 #include <string>
+#include <vector>
 
 #include "common/scene.hpp"
 #include "tests/support/files.hpp"
@@ -114,6 +116,93 @@ TEST(ScreenConfirm, RunsTheBestAndTheSpreadIn3dReportsTheAgreementAndReusesFinis
   fs::remove_all(d);
 }
 
+// Two quick designs of the tiny duct swimmer (duct_confirm's: L = 0.32 um, R_f/R0 = 0.84 and
+// 0.88, one cycle of about 0.5 s in 3D, vtk off, 3 s cap), confirmed first without and then with
+// the error estimate: the second invocation reuses both finished runs and adds only their coarse
+// runs (12 -> 9 cells across); confirm.json carries each run's error bar, and the pair is tied
+// in 3D exactly when the values lie within their summed error bars; a third invocation reuses
+// the coarse runs too.
+TEST(ScreenConfirm, TheErrorEstimateGivesEachRunItsErrorBarAndTiesThePairsWithinThem) {
+  const fs::path d = tmpdir("confirm_error_bars");
+  json base = json::parse(slurp(kTiny));
+  base["full3d"]["output"]["vtk"] = false;
+  base["full3d"]["time_limit"] = "3 s";
+  base["swimmer"]["length"] = "0.32 um";
+  json sw = {{"name", "tiny_bars"},
+             {"base", base},
+             {"vary", {{"wave.contracted_ratio", {{"values", {0.84, 0.88}}}}}},
+             {"metric", "mean_velocity_m_per_s"},
+             {"goal", "max"},
+             {"confirm", {{"error_estimate", false}}}};
+  write(d / "off.json", sw);
+  sw["confirm"]["error_estimate"] = true;
+  write(d / "on.json", sw);
+  const fs::path out = d / "out";
+  const std::string tail = " --confirm 2 --jobs 1 --threads 1 --out \"" + out.string() + "\"";
+  Cli c = run_swim("screen \"" + (d / "off.json").string() + "\"" + tail, d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  json off = read(out / "confirm.json");
+  EXPECT_EQ(off["error_estimate_3d"], false);
+  for (const auto& x : off["designs"]) EXPECT_TRUE(x["error_bar_3d"].is_null());
+
+  // the same sweep with the estimate: the folder is the same sweep's, the runs are reused
+  c = run_swim("screen \"" + (d / "on.json").string() + "\"" + tail, d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json r = read(out / "confirm.json");
+  EXPECT_EQ(r["status"], "ok");
+  EXPECT_EQ(r["error_estimate_3d"], true);
+  ASSERT_EQ(r["designs"].size(), 2u);
+  ASSERT_EQ(r["designs_with_error_bar_3d"], 2) << r.dump(1);
+  double coarse_wall = 0;
+  std::vector<double> y, e;
+  for (std::size_t i = 0; i < 2; ++i) {
+    const json& x = r["designs"][i];
+    EXPECT_EQ(x["reused_3d"], true);
+    EXPECT_EQ(x["figures_3d"], off["designs"][i]["figures_3d"]);
+    ASSERT_TRUE(x["error_bar_3d"].is_number());
+    EXPECT_GT(x["error_bar_3d"].get<double>(), 0.0);
+    EXPECT_EQ(x["error_estimate_3d"]["coarse_cells_across"], 9);
+    coarse_wall += x["coarse_wall_time_3d_s"].get<double>();
+    // the run's summary.json carries the estimate of the metric and lists the coarse run's files
+    const fs::path run = out / x["folder_3d"].get<std::string>();
+    const json s = read(run / "summary.json");
+    ASSERT_EQ(s["error_estimate"]["status"], "ok");
+    const json& m = s["error_estimate"]["mean_velocity_m_per_s"];
+    EXPECT_EQ(m["fine"], x["figures_3d"]["mean_velocity_m_per_s"]);
+    const double f = m["fine"].get<double>();
+    EXPECT_DOUBLE_EQ(x["error_bar_3d"].get<double>(), std::max(std::abs(f - m["interval_low"].get<double>()),
+                                                               std::abs(f - m["interval_high"].get<double>())));
+    EXPECT_EQ(read(run / "error_estimate/coarse/summary.json")["status"], "ok");
+    bool listed = false;
+    for (const auto& file : s["files"]) listed = listed || file["name"] == "error_estimate/coarse/summary.json";
+    EXPECT_TRUE(listed);
+    y.push_back(x["figures_3d"]["mean_velocity_m_per_s"].get<double>());
+    e.push_back(x["error_bar_3d"].get<double>());
+  }
+  // this invocation ran the two coarse runs only
+  EXPECT_NEAR(r["wall_time_3d_s"].get<double>(), coarse_wall, 1e-9);
+  const bool tied = std::abs(y[0] - y[1]) <= e[0] + e[1];
+  EXPECT_EQ(r["agreement"]["pairs_tied_by_3d_error_bars"], tied ? 1 : 0);
+  if (tied) {
+    EXPECT_TRUE(r["agreement"]["misranked_pairs"].empty());
+  }
+  EXPECT_NE(slurp(out / "confirm.md").find("3D error bar"), std::string::npos);
+
+  // interrupted before the report: the next invocation reuses the runs and their coarse runs
+  fs::remove(out / "screen.json");
+  fs::remove(out / "confirm.json");
+  c = run_swim("screen \"" + (d / "on.json").string() + "\"" + tail, d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json again = read(out / "confirm.json");
+  EXPECT_DOUBLE_EQ(again["wall_time_3d_s"].get<double>(), 0.0);
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(again["designs"][i]["error_bar_3d"], r["designs"][i]["error_bar_3d"]);
+    EXPECT_EQ(again["designs"][i]["coarse_wall_time_3d_s"], r["designs"][i]["coarse_wall_time_3d_s"]);
+  }
+  EXPECT_EQ(again["agreement"], r["agreement"]);
+  fs::remove_all(d);
+}
+
 TEST(ScreenConfirm, BadInputIsExitTwoNamingTheKeyAndWritesNothing) {
   const fs::path d = tmpdir("confirm_bad");
   json sw = tiny_sweep();
@@ -130,12 +219,21 @@ TEST(ScreenConfirm, BadInputIsExitTwoNamingTheKeyAndWritesNothing) {
   EXPECT_EQ(c.code, 2);
   EXPECT_NE(c.err.find("metric"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("directed_to_diffusive_ratio"), std::string::npos) << c.err;
-  sw = tiny_sweep();
-  sw["confirm"] = {{"grid", {{"cells", 16}}}};
-  write(d / "grid.json", sw);
-  c = run_swim("screen \"" + (d / "grid.json").string() + "\" --confirm 2" + tail, d);
-  EXPECT_EQ(c.code, 2);
-  EXPECT_NE(c.err.find("confirm.grid"), std::string::npos) << c.err;
+  // a confirm section refused: exit 2 naming `key` (and saying `allowed`)
+  auto refused = [&](const json& section, const std::string& key, const std::string& allowed) {
+    json bad = tiny_sweep();
+    bad["confirm"] = section;
+    write(d / "section.json", bad);
+    const Cli r = run_swim("screen \"" + (d / "section.json").string() + "\" --confirm 2" + tail, d);
+    EXPECT_EQ(r.code, 2) << section.dump();
+    EXPECT_NE(r.err.find(key), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(allowed), std::string::npos) << r.err;
+  };
+  refused({{"grid", {{"cells", 16}}}}, "confirm.grid", "cells_across");
+  refused({{"error_estimate", 1}}, "confirm.error_estimate", "true or false");
+  // a grid whose coarse grid the 3D reader refuses (9 cells across the 0.48 um duct: its coarse
+  // grid, 6 cells, leaves the swimmer no room for the kernel's support)
+  refused({{"grid", {{"cells_across", 9}}}}, "confirm.error_estimate", "coarse");
   EXPECT_FALSE(fs::exists(out));
   fs::remove_all(d);
 }

@@ -44,6 +44,18 @@ TEST(RankAgreement, APairWithinItsThreeDErrorBarsIsTiedNotMisranked) {
   EXPECT_EQ(rank_agreement(kX, kY, {0, 0.4, 0.4, 0, 0}).misranked.size(), 1u);
 }
 
+TEST(RankAgreement, EveryPairTiedByItsErrorBarsLeavesKendallTauUndefined) {
+  // every 3D difference within the error bars: tau-b is 0/0, not 0
+  const RankAgreement a = rank_agreement(kX, kY, {5, 5, 5, 5, 5});
+  EXPECT_FALSE(a.kendall_defined);
+  EXPECT_EQ(a.tied_y, 10u);
+  EXPECT_EQ(a.tied_by_error_bars, 9u);  // the pair equal in y is tied without its error bars
+  EXPECT_TRUE(a.misranked.empty());
+  EXPECT_DOUBLE_EQ(a.kendall_ci.lo, -1.0);
+  EXPECT_DOUBLE_EQ(a.kendall_ci.hi, 1.0);
+  EXPECT_TRUE(rank_agreement(kX, kY).kendall_defined);
+}
+
 TEST(RankAgreement, MidRanksShareTheMeanRankOfEqualValues) {
   EXPECT_EQ(mid_ranks({3.0, 1.0, 3.0, 2.0}), (std::vector<double>{3.5, 1.0, 3.5, 2.0}));
 }

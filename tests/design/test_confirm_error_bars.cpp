@@ -1,0 +1,145 @@
+// The 3D error bars of a confirmation: read from the error_estimate a 3D run writes into its
+// summary.json (validation/error_estimate.hpp, the structure swim run --error-estimate writes),
+// and a pair of designs whose 3D values lie within their error bars counted tied, not misranked,
+// by the confirmation report itself (design::confirm_candidates with the runs given).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "design/confirm.hpp"
+#include "validation/error_estimate.hpp"
+
+using namespace swim::design;
+using swim::scene::json;
+
+namespace {
+
+constexpr double kHFine = 1e-8, kHCoarse = 4.0 / 3.0 * 1e-8;  // r = 4/3
+
+// A finished 3D run's summary with the figures the estimate reads, velocity v [m/s].
+json run_summary(double v) {
+  return {{"status", "ok"},
+          {"mean_velocity_m_per_s", v},
+          {"displacement_per_cycle_m", v * 0.5},
+          {"cycle_time_s", 0.5},
+          {"cycle_times_s", {0.5}},
+          {"mean_velocity_per_cycle_m_per_s", v},
+          {"wall_time_s", 1.0}};
+}
+
+// The fine run's summary with the error_estimate of its run and a coarse run of velocity vc,
+// the sweep metric mean_velocity_m_per_s estimated too (as a confirmation run writes it).
+json estimated(double v, double vc) {
+  json s = run_summary(v);
+  s["error_estimate"] =
+      swim::validation::error_estimate_json(s, run_summary(vc), 9, kHFine, kHCoarse, {"mean_velocity_m_per_s"});
+  return s;
+}
+
+// The largest distance from v to its extrapolations E_p, p in [0.5, 2]: |v - vc| / (r^0.5 - 1).
+double expected_bar(double v, double vc) { return std::abs(v - vc) / (std::sqrt(4.0 / 3.0) - 1.0); }
+
+Candidate candidate(std::size_t design, double v1d) {
+  Candidate c;
+  c.design = design;
+  c.values = "design " + std::to_string(design);
+  c.selected_as = "best";
+  c.rank_in_sweep = long(design) + 1;
+  c.scene = json::object();
+  c.metrics.mean_velocity_m_per_s = v1d;
+  return c;
+}
+
+// Three designs: 1D ranks them 0 > 1 > 2; 3D has 1 slightly above 0 (10.5 against 10 nm/s), 2 far below.
+json report(const std::vector<json>& summaries, bool error_estimate) {
+  const std::vector<Candidate> cands = {candidate(0, 3e-9), candidate(1, 2e-9), candidate(2, 1e-9)};
+  ConfirmOptions o;
+  o.metric = "mean_velocity_m_per_s";
+  o.maximize = true;
+  o.section = read_confirm_section(json{{"error_estimate", error_estimate}}, "confirm");
+  o.runs_dir = testing::TempDir() + "/swim_confirm_error_bars/confirm-runs";
+  o.run = [&](std::size_t i, const json&, const std::string&) {
+    Confirmed c;
+    c.summary = summaries[i];
+    c.folder = o.runs_dir + "/design-" + std::to_string(i);
+    c.reused = true;
+    c.ok = true;
+    c.cell_size_m = kHFine;
+    return c;
+  };
+  return confirm_candidates(cands, o);
+}
+
+}  // namespace
+
+TEST(ConfirmErrorBars, TheErrorBarIsTheDistanceToTheRunsOwnExtrapolationInterval) {
+  const json s = estimated(10e-9, 9.9e-9);
+  ASSERT_EQ(s["error_estimate"]["status"], "ok");
+  const json bar = error_bar_3d(s, "mean_velocity_m_per_s");
+  ASSERT_TRUE(bar.is_number());
+  EXPECT_NEAR(bar.get<double>(), expected_bar(10e-9, 9.9e-9), 1e-20);
+  // the sweep metric mean_cycle_time_s is the estimate's cycle_time_s (both grids 0.5 s: no error)
+  EXPECT_EQ(error_bar_3d(s, "mean_cycle_time_s"), json(0.0));
+  // no estimate, a failed estimate, a figure not estimated: no error bar
+  EXPECT_TRUE(error_bar_3d(run_summary(10e-9), "mean_velocity_m_per_s").is_null());
+  json failed = run_summary(10e-9);
+  failed["error_estimate"] = {{"status", "failed: the coarse run (9 cells across): no cycle completed"}};
+  EXPECT_TRUE(error_bar_3d(failed, "mean_velocity_m_per_s").is_null());
+  EXPECT_TRUE(error_bar_3d(s, "pumped_volume_m3").is_null());
+}
+
+TEST(ConfirmErrorBars, DesignsWithinTheirThreeDErrorBarsAreTiedNotMisranked) {
+  // 3D: design 1 above design 0 by 0.5 nm/s; their error bars 0.65 and 0.32 nm/s reach across
+  const std::vector<json> runs = {estimated(10e-9, 9.9e-9), estimated(10.5e-9, 10.45e-9), estimated(1e-9, 1e-9)};
+  ASSERT_LT(0.5e-9, expected_bar(10e-9, 9.9e-9) + expected_bar(10.5e-9, 10.45e-9));
+  const json r = report(runs, true);
+  EXPECT_EQ(r["error_estimate_3d"], true);
+  EXPECT_EQ(r["designs_with_error_bar_3d"], 3);
+  EXPECT_NEAR(r["designs"][0]["error_bar_3d"].get<double>(), expected_bar(10e-9, 9.9e-9), 1e-20);
+  EXPECT_EQ(r["designs"][0]["error_estimate_3d"]["figure"], "mean_velocity_m_per_s");
+  const json& a = r["agreement"];
+  EXPECT_EQ(a["pairs_tied_by_3d_error_bars"], 1);
+  EXPECT_EQ(a["pairs_tied_in_3d"], 1);
+  EXPECT_TRUE(a["misranked_pairs"].empty());
+  EXPECT_TRUE(r["misranked_designs"].empty());
+  // tau-b = (2 - 0) / sqrt(3 * 2): two concordant pairs, the third tied in 3D
+  EXPECT_NEAR(a["kendall_tau"].get<double>(), 2.0 / std::sqrt(6.0), 1e-12);
+
+  // the same runs with confirm.error_estimate false: no error bars, the pair is misranked
+  const json off = report(runs, false);
+  EXPECT_TRUE(off["designs"][0]["error_bar_3d"].is_null());
+  EXPECT_EQ(off["designs"][0]["error_bar_3d_absent_because"], "confirm.error_estimate is false");
+  EXPECT_EQ(off["agreement"]["pairs_tied_by_3d_error_bars"], 0);
+  ASSERT_EQ(off["agreement"]["misranked_pairs"].size(), 1u);
+  EXPECT_EQ(off["agreement"]["misranked_pairs"][0], json({"design 0", "design 1"}));
+  EXPECT_NEAR(off["agreement"]["kendall_tau"].get<double>(), 1.0 / 3.0, 1e-12);
+
+  // bars that reach across every pair: no order in 3D, so no Kendall tau (null, and why)
+  const json all = report({estimated(10e-9, 9e-9), estimated(10.5e-9, 9.5e-9), estimated(1e-9, 0.5e-9)}, true);
+  EXPECT_EQ(all["agreement"]["pairs_tied_by_3d_error_bars"], 3);
+  EXPECT_TRUE(all["agreement"]["kendall_tau"].is_null());
+  EXPECT_TRUE(all["agreement"]["kendall_tau_ci_95"].is_null());
+  EXPECT_TRUE(all["agreement"]["kendall_tau_absent_because"].is_string());
+  EXPECT_NE(confirm_markdown(all, "t").find("tau-b is 0/0"), std::string::npos);
+
+  // bars that do not reach (a coarse grid close to the run's) leave the pair misranked
+  const json tight = report({estimated(10e-9, 9.99e-9), estimated(10.5e-9, 10.49e-9), estimated(1e-9, 1e-9)}, true);
+  EXPECT_EQ(tight["agreement"]["pairs_tied_by_3d_error_bars"], 0);
+  EXPECT_EQ(tight["agreement"]["misranked_pairs"].size(), 1u);
+}
+
+TEST(ConfirmErrorBars, TheSectionTakesOnlyABooleanErrorEstimate) {
+  EXPECT_EQ(wants_error_estimate(read_confirm_section(nullptr, "confirm")), kErrorEstimateDefault);
+  EXPECT_FALSE(wants_error_estimate(read_confirm_section(json{{"error_estimate", false}}, "confirm")));
+  try {
+    read_confirm_section(json{{"error_estimate", "yes"}}, "confirm");
+    FAIL() << "a string was accepted";
+  } catch (const std::exception& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("confirm.error_estimate"), std::string::npos) << m;
+    EXPECT_NE(m.find("\"yes\""), std::string::npos) << m;
+    EXPECT_NE(m.find("true or false"), std::string::npos) << m;
+  }
+}
