@@ -3,15 +3,16 @@
 prescribed kinematics (docs/outer-flow-1d.md, "Where lubrication holds").
 
 A grid of prescribed waves -- a step with a sharp front (w = L/8), a step with a smooth front
-(w = L/2) and a sine (lambda = L) -- on tubes of R0 = 0.125 um with L/R0 = 3.2, 6.4, 12.8 in
-cylinders of Rc/R0 = 1.5, 2, 4 (period about 5 L, a whole number of cells, R_f/R0 = 0.55, 10 um/s), each over one transit, run
-with `swim run --tier axi` (fitted method) and `--tier 1d`. Prints one table row per case:
+(w = L/4, the widest the 1D tier allows) and a sine (lambda = L) -- on tubes of R0 = 0.125 um
+with L/R0 = 3.2, 6.4, 12.8 in cylinders of Rc/R0 = 1.5, 2, 4 (period about 5 L, a whole number of
+cells; R_f/R0 = 0.55, 10 um/s), each over one transit, run with `swim run --tier axi` (fitted method) and `--tier 1d`. Prints one table row per case:
 displacement per transit on both tiers and axi/1D. The axi results are kept in a cache file
-(they do not depend on the 1D model), so the 1D columns can be re-run with other 1D settings:
+(they do not depend on the 1D model). With --set1d the table has a second 1D column, the 1D tier
+with those settings (e.g. --set1d 'model1d.end_effects="open_ends"'), beside the plain one:
 
     tools/flow_model_table.py [--swim build/bin/swim] [--cells 16] [--cache FILE]
                               [--set1d key=value ...] [--only step_sharp,sine] [--L 3.2,6.4]
-                              [--Rc 1.5,2,4] [--markdown]
+                              [--Rc 1.5,2,4] [--markdown] [--cached]
 """
 import argparse
 import json
@@ -21,7 +22,7 @@ import sys
 import tempfile
 
 R0_UM = 0.125
-WAVES = {"step_sharp": ("step", 1 / 8), "step_smooth": ("step", 1 / 2), "sine": ("sine", 1.0)}
+WAVES = {"step_sharp": ("step", 1 / 8), "step_smooth": ("step", 1 / 4), "sine": ("sine", 1.0)}
 
 
 def scene(wave, L_over_R0, Rc_over_R0, cells):
@@ -68,11 +69,13 @@ def main():
     ap.add_argument("--swim", default=os.path.join(os.path.dirname(__file__), "..", "build", "bin", "swim"))
     ap.add_argument("--cells", type=int, default=16, help="axi cells across the container (default 16)")
     ap.add_argument("--cache", default="flow_model_table_axi.json", help="axi results cache (JSON)")
-    ap.add_argument("--set1d", action="append", default=[], help="a --set for the 1D runs (repeatable)")
+    ap.add_argument("--set1d", action="append", default=[],
+                    help="a --set for a second 1D column (repeatable)")
     ap.add_argument("--only", default=",".join(WAVES), help="waves: " + ",".join(WAVES))
     ap.add_argument("--L", default="3.2,6.4,12.8", help="L/R0 values")
     ap.add_argument("--Rc", default="1.5,2,4", help="Rc/R0 values")
     ap.add_argument("--markdown", action="store_true", help="print a markdown table")
+    ap.add_argument("--cached", action="store_true", help="only the cases whose axi result is cached")
     a = ap.parse_args()
     cache = {}
     if os.path.exists(a.cache):
@@ -84,21 +87,31 @@ def main():
             for L in [float(x) for x in a.L.split(",")]:
                 sc = scene(wave, L, Rc, a.cells)
                 key = f"{sc['name']}_n{a.cells}"
+                if key not in cache and a.cached:
+                    continue
                 if key not in cache:
                     cache[key] = run(a.swim, sc, "axi", [])
                     with open(a.cache, "w") as f:
                         json.dump(cache, f, indent=1)
                 x_axi, wall = cache[key]
-                x_1d, _ = run(a.swim, sc, "1d", a.set1d)
-                rows.append((wave, L, Rc, x_axi, x_1d, wall))
+                x_1d, _ = run(a.swim, sc, "1d", [])
+                x_set = run(a.swim, sc, "1d", a.set1d)[0] if a.set1d else None
+                rows.append((wave, L, Rc, x_axi, x_1d, x_set, wall))
                 if not a.markdown:
-                    print(f"{wave:12s} L/R0 {L:5.1f} Rc/R0 {Rc:4.1f}  axi {x_axi * 1e9:9.3f} nm ({wall:5.1f} s)"
-                          f"  1D {x_1d * 1e9:9.3f} nm  axi/1D {x_axi / x_1d:6.3f}", flush=True)
+                    line = (f"{wave:12s} L/R0 {L:5.1f} Rc/R0 {Rc:4.1f}  axi {x_axi * 1e9:9.3f} nm ({wall:5.1f} s)"
+                            f"  1D {x_1d * 1e9:9.3f} nm  axi/1D {x_axi / x_1d:6.3f}")
+                    if x_set is not None:
+                        line += f"  1D (set) {x_set * 1e9:9.3f} nm  axi/1D {x_axi / x_set:6.3f}"
+                    print(line, flush=True)
     if a.markdown:
-        print("| wave | L/R0 | Rc/R0 | axi (nm) | 1D (nm) | axi/1D |")
-        print("|---|---|---|---|---|---|")
-        for wave, L, Rc, xa, x1, _ in rows:
-            print(f"| {wave} | {L:g} | {Rc:g} | {xa * 1e9:.3f} | {x1 * 1e9:.3f} | {xa / x1:.3f} |")
+        extra = " 1D with --set1d (nm) | axi/1D with --set1d |" if a.set1d else ""
+        print("| wave | L/R0 | Rc/R0 | axi (nm) | 1D (nm) | axi/1D |" + extra)
+        print("|---|---|---|---|---|---|" + ("---|---|" if a.set1d else ""))
+        for wave, L, Rc, xa, x1, xs, _ in rows:
+            line = f"| {wave} | {L:g} | {Rc:g} | {xa * 1e9:.2f} | {x1 * 1e9:.2f} | {xa / x1:.3f} |"
+            if xs is not None:
+                line += f" {xs * 1e9:.2f} | {xa / xs:.3f} |"
+            print(line)
 
 
 if __name__ == "__main__":
