@@ -101,7 +101,9 @@ TEST(EndEffects, TowedTubeDragWithTheOpenEnds) {
       EXPECT_LT(std::abs(ends.drag / a.drag - 1), std::abs(plain.drag / a.drag - 1));
       EXPECT_GT(fitted[i], 0.15);
       EXPECT_LT(fitted[i], 0.45);
-      if (rc <= 2.0) EXPECT_LT(std::abs(ends.lumen_flux / a.lumen_flux - 1), 0.05) << "Rc/R0 " << rc;
+      if (rc <= 2.0) {
+        EXPECT_LT(std::abs(ends.lumen_flux / a.lumen_flux - 1), 0.05) << "Rc/R0 " << rc;
+      }
     }
     EXPECT_NEAR(fitted[0], fitted[1], 0.02) << "Rc/R0 " << rc;
   }
