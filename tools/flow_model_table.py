@@ -5,8 +5,9 @@ prescribed kinematics (docs/outer-flow-1d.md, "Where lubrication holds").
 A grid of prescribed waves -- a step with a sharp front (w = L/8), a step with a smooth front
 (w = L/4, the widest the 1D tier allows) and a sine (lambda = L) -- on tubes of R0 = 0.125 um
 with L/R0 = 3.2, 6.4, 12.8 in cylinders of Rc/R0 = 1.5, 2, 4 (period about 5 L, a whole number of
-cells; R_f/R0 = 0.55, 10 um/s), each over one transit, run with `swim run --tier axi` (fitted method) and `--tier 1d`. Prints one table row per case:
-displacement per transit on both tiers and axi/1D. The axi results are kept in a cache file
+cells; R_f/R0 = 0.55, 10 um/s), each over one transit, run with `swim run --tier axi` (fitted
+method) and `--tier 1d`. Prints one table row per case: displacement per transit on both tiers
+and axi/1D. The axi results are kept in a cache file
 (they do not depend on the 1D model). With --set1d the table has a second 1D column, the 1D tier
 with those settings (e.g. --set1d 'model1d.end_effects="open_ends"'), beside the plain one:
 
@@ -67,7 +68,7 @@ def run(swim, sc, tier, extra):
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--swim", default=os.path.join(os.path.dirname(__file__), "..", "build", "bin", "swim"))
-    ap.add_argument("--cells", type=int, default=16, help="axi cells across the container (default 16)")
+    ap.add_argument("--cells", type=int, default=16, help="axi.grid.cells_across (default 16: h = Rc/8)")
     ap.add_argument("--cache", default="flow_model_table_axi.json", help="axi results cache (JSON)")
     ap.add_argument("--set1d", action="append", default=[],
                     help="a --set for a second 1D column (repeatable)")
