@@ -144,3 +144,79 @@ TEST(EndEffects, PrescribedStepWaveMovesTowardsTheReference) {
   EXPECT_LT(std::abs(x_axi / x1[1] - 1), std::abs(x_axi / x1[0] - 1));
   EXPECT_GT(x_axi / x1[1], 1.3);
 }
+
+// What the open ends' resistance leaves out, as a steady flow: a straight tube (L = 6.4 R0 in
+// Rc = 2 R0) whose wall moves radially only in a band one R0 wide (dR/dt = -v cos^2), centred a
+// distance d from the rear end; the force-free velocity U(d) on both tiers at that instant (one
+// solve each). On a uniform tube the plain lubrication model gives U = 0 wherever the band is
+// (the displaced flux leaves by lumen and annulus, and no pressure difference acts on the tube);
+// in Stokes flow a band near an end propels the tube away from that end. Measured (16 cells
+// across): U = 11.4, 8.10, 6.22, 4.40, 2.57 nm/s at d = 0.5, 1, 1.5, 2, 2.5 R0 (0 at the
+// midplane, 3.2 R0, by symmetry); 1D plain: 1e-20 m/s (round-off); 1D with the open ends 1.70,
+// 1.38, 1.07, 0.755, 0.440 nm/s: the right sign and shape (axi/1D 5.8 within 1 % for d >= 1 R0,
+// 6.7 at 0.5 R0) and 6 times too small. This end thrust of a moving wall is what the steady end
+// resistance cannot supply (docs/outer-flow-1d.md §6). Asserted: the plain 1D U below 1e-10
+// of the axi U; the axi U positive and falling from the end by more than a factor 3; with the
+// ends, the same sign and axi/1D above 3.
+TEST(EndEffects, WallBandNearAnEnd) {
+  const double R0 = kR0, L = 6.4 * R0, Rc = 2 * R0, w = R0, v = 1e-6;
+  auto band = [=](double z, double d) {
+    const double x = (z - d) / w;
+    return std::abs(x) < 0.5 ? std::pow(std::cos(M_PI * x), 2) : 0.0;
+  };
+  const Tow geo = axi_tow(6.4, 2.0, 16);  // the container and period of the axi runs
+  double U_near = 0, U_far = 0;
+  for (double d_over_R0 : {0.5, 1.0, 1.5, 2.0, 2.5}) {
+    const double d = d_over_R0 * R0;
+    // axi
+    auto um = [](double x) {
+      char b[40];
+      std::snprintf(b, sizeof b, "%.12g um", x * 1e6);
+      return std::string(b);
+    };
+    json sc = {{"name", "band"},
+               {"swimmer", {{"radius", um(R0)}, {"length", um(L)}}},
+               {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(geo.P)}}},
+               {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
+               {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
+               {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", 16}}}}}};
+    json resolved;
+    const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+    swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
+    swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& R, Eigen::VectorXd& Rt) {
+      R = Eigen::VectorXd::Constant(Eigen::Index(z.size()), R0);
+      Rt.resize(Eigen::Index(z.size()));
+      for (std::size_t k = 0; k < z.size(); ++k) Rt[Eigen::Index(k)] = -v * band(z[k], d);
+    };
+    swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), p.base.fluid.mu, wall.reference_positions(), kin,
+                                    p.x_start());
+    const double U_axi = sw.evaluate(0.0).velocity;
+    // 1D, N = 400 cells, the solver's point set
+    const int N = 400;
+    const double h = L / N;
+    std::vector<double> dd(N + 1, h), R(N + 2, R0), s(N + 1, 0.0);
+    dd[0] = dd[N] = 0.5 * h;
+    double cum = 0;
+    for (int i = 0; i < N; ++i) {
+      s[i] = cum;
+      cum += h * 2 * M_PI * R0 * (-v * band((i + 0.5) * h, d));
+    }
+    s[N] = cum;
+    double U1[2];
+    for (int e = 0; e < 2; ++e) {
+      outer::ConfinedSystem sys(N + 2, dd, p.base.fluid.mu, 0.0, 0.0, Rc, geo.P, L);
+      if (e == 1) sys.ends = outer::kOpenEnds;
+      ASSERT_TRUE(sys.geometry(R.data()));
+      sys.kinematic(s.data());
+      U1[e] = sys.U;
+    }
+    std::printf("band at d = %.1f R0: U axi %.4e m/s, 1D %.4e, with the ends %.4e (axi/1D %.3f)\n", d_over_R0, U_axi,
+                U1[0], U1[1], U_axi / U1[1]);
+    EXPECT_GT(U_axi, 0.0);
+    EXPECT_LT(std::abs(U1[0]), 1e-10 * U_axi) << "a band on a uniform tube: lubrication gives no thrust";
+    EXPECT_GT(U_axi / U1[1], 3.0);
+    if (d_over_R0 == 0.5) U_near = U_axi;
+    U_far = U_axi;
+  }
+  EXPECT_GT(U_near, 3.0 * U_far);
+}
