@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdio>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "axi/prescribed_axi.hpp"
 #include "axi/run_axi.hpp"
@@ -32,17 +34,19 @@ struct Tow {
   double drag = 0, lumen_flux = 0, Rc = 0, P = 0, L = 0, mu = 0;
 };
 
-/// The axi tier's towed straight tube (radius R0, length L in Rc, period about 5 L), the fitted
-/// method's mesh of the prescribed-wave runs at `cells` across.
-Tow axi_tow(double L_over_R0, double Rc_over_R0, int cells) {
-  const double L = L_over_R0 * kR0, Rc = Rc_over_R0 * kR0, h = Rc / cells;
-  const double P = std::round(5 * L / h) * h;
+/// One steady solve on the axi tier: a straight tube of radius R0 and length L in the cylinder
+/// Rc (period about 5 L), the fitted method's mesh of the prescribed-wave runs at `cells` across,
+/// the wall's radial velocity from `kin` at t = 0.
+swim::axi::PrescribedState axi_steady(double L, double Rc, int cells, swim::axi::RingKinematics kin, double& P,
+                                      double& mu) {
+  const double h = Rc / cells;
+  P = std::round(5 * L / h) * h;
   auto um = [](double v) {
     char b[40];
     std::snprintf(b, sizeof b, "%.12g um", v * 1e6);
     return std::string(b);
   };
-  json sc = {{"name", "tow"},
+  json sc = {{"name", "steady"},
              {"swimmer", {{"radius", um(kR0)}, {"length", um(L)}}},
              {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(P)}}},
              {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
@@ -50,17 +54,27 @@ Tow axi_tow(double L_over_R0, double Rc_over_R0, int cells) {
              {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", cells}}}}}};
   json resolved;
   const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  mu = p.base.fluid.mu;
   swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
+  swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), mu, wall.reference_positions(), std::move(kin),
+                                  p.x_start());
+  return sw.evaluate(0.0);
+}
+
+/// The axi tier's towed straight tube (a rigid wall: U = 0, the drag and lumen flux of flow (b)).
+Tow axi_tow(double L_over_R0, double Rc_over_R0, int cells) {
+  Tow t;
+  t.L = L_over_R0 * kR0, t.Rc = Rc_over_R0 * kR0;
   swim::axi::RingKinematics rigid = [](double, const std::vector<double>& z, Eigen::VectorXd& R,
                                        Eigen::VectorXd& Rt) {
     R = Eigen::VectorXd::Constant(Eigen::Index(z.size()), kR0);
     Rt = Eigen::VectorXd::Zero(Eigen::Index(z.size()));
   };
-  swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), p.base.fluid.mu, wall.reference_positions(),
-                                  rigid, p.x_start());
-  const swim::axi::PrescribedState s = sw.evaluate(0.0);
+  const swim::axi::PrescribedState s = axi_steady(t.L, t.Rc, cells, rigid, t.P, t.mu);
   EXPECT_EQ(s.velocity, 0.0);
-  return {s.drag, s.towed_lumen_flux, Rc, P, L, p.base.fluid.mu};
+  t.drag = s.drag;
+  t.lumen_flux = s.towed_lumen_flux;
+  return t;
 }
 
 outer::TowedTube one_d_tow(const Tow& t, const outer::EndEffects& e) {
@@ -164,33 +178,16 @@ TEST(EndEffects, WallBandNearAnEnd) {
     const double x = (z - d) / w;
     return std::abs(x) < 0.5 ? std::pow(std::cos(M_PI * x), 2) : 0.0;
   };
-  const Tow geo = axi_tow(6.4, 2.0, 16);  // the container and period of the axi runs
   double U_near = 0, U_far = 0;
   for (double d_over_R0 : {0.5, 1.0, 1.5, 2.0, 2.5}) {
     const double d = d_over_R0 * R0;
-    // axi
-    auto um = [](double x) {
-      char b[40];
-      std::snprintf(b, sizeof b, "%.12g um", x * 1e6);
-      return std::string(b);
-    };
-    json sc = {{"name", "band"},
-               {"swimmer", {{"radius", um(R0)}, {"length", um(L)}}},
-               {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(geo.P)}}},
-               {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
-               {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
-               {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", 16}}}}}};
-    json resolved;
-    const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
-    swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
     swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& R, Eigen::VectorXd& Rt) {
       R = Eigen::VectorXd::Constant(Eigen::Index(z.size()), R0);
       Rt.resize(Eigen::Index(z.size()));
       for (std::size_t k = 0; k < z.size(); ++k) Rt[Eigen::Index(k)] = -v * band(z[k], d);
     };
-    swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), p.base.fluid.mu, wall.reference_positions(), kin,
-                                    p.x_start());
-    const double U_axi = sw.evaluate(0.0).velocity;
+    double P = 0, mu = 0;
+    const double U_axi = axi_steady(L, Rc, 16, kin, P, mu).velocity;
     // 1D, N = 400 cells, the solver's point set
     const int N = 400;
     const double h = L / N;
@@ -204,7 +201,7 @@ TEST(EndEffects, WallBandNearAnEnd) {
     s[N] = cum;
     double U1[2];
     for (int e = 0; e < 2; ++e) {
-      outer::ConfinedSystem sys(N + 2, dd, p.base.fluid.mu, 0.0, 0.0, Rc, geo.P, L);
+      outer::ConfinedSystem sys(N + 2, dd, mu, 0.0, 0.0, Rc, P, L);
       if (e == 1) sys.ends = outer::kOpenEnds;
       ASSERT_TRUE(sys.geometry(R.data()));
       sys.kinematic(s.data());
