@@ -685,6 +685,9 @@ FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen:
     throw NumericalError("the towed tube's drag is not positive (" + significant(res.drag) + " N s/m)",
                          "check the wall's shape; change axi.grid");
   res.velocity = -res.force / res.drag;
+  sol_ = xb;
+  solved_ = true;
+  res.towed_lumen_flux = end_disc_flux(0, 1.0);
   sol_ = xa + res.velocity * xb;
   solved_ = true;
   last_iters_ = 0;

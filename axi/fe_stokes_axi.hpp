@@ -174,6 +174,10 @@ class FittedStokes {
     double velocity = 0.0;  ///< U, the force-free axial velocity, m/s
     double force = 0.0;     ///< F_a, axial force of V alone (U = 0) on the fluid, N
     double drag = 0.0;      ///< F_b, axial force on the fluid per unit U, N s/m (> 0)
+    /// The towed tube's lumen flux: the rear end-disc flux of flow (b) (the rigid tube towed at
+    /// U = 1, no radial velocity) relative to the rings, m^3/s per m/s (negative: the lumen's fluid
+    /// passes the tube towards -x). A steady flow, for calibrating the 1D tier's end effects.
+    double towed_lumen_flux = 0.0;
   };
   PrescribedWall prescribed_wall_velocity(const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& V);
 

@@ -112,6 +112,7 @@ PrescribedState PrescribedSwimmer::evaluate(double t) {
   ++evaluations_;
   s.velocity = w.velocity;
   s.drag = w.drag;
+  s.towed_lumen_flux = w.towed_lumen_flux;
   s.flux_rear = stokes_->end_disc_flux(0, w.velocity);
   s.flux_front = stokes_->end_disc_flux(1, w.velocity);
   s.volume = lumen_volume(z_, s.R);

@@ -37,6 +37,7 @@ struct PrescribedState {
   double t = 0;             ///< s
   double velocity = 0;      ///< U, m/s
   double drag = 0;          ///< F_b, the towed tube's drag, N s/m
+  double towed_lumen_flux = 0;  ///< lumen flux of the towed tube relative to it, m^3/s per m/s
   double flux_rear = 0;     ///< through the rear end disc, relative to the rings, towards +x, m^3/s
   double flux_front = 0;    ///< through the front end disc, likewise, m^3/s
   double volume = 0;        ///< lumen volume inside the rings' meridian polygon (frustums), m^3

@@ -21,6 +21,19 @@ double confined_drag_coefficient(double R, double L, double a_in, double a_out, 
   return sys.drag_coefficient();
 }
 
+TowedTube confined_tow(double R, double L, double a_in, double a_out, double Rc, double P, double mu,
+                       const EndEffects& ends) {
+  ConfinedSystem sys(2, {L}, mu, a_in, a_out, Rc, P, L);
+  sys.ends = ends;
+  const double Rp[2] = {R, R}, s[1] = {0.0};
+  TowedTube t;
+  if (!sys.geometry(Rp)) return t;
+  sys.kinematic(s, 1.0);  // a unit external force: U = 1 / drag
+  t.drag = 1.0 / sys.U;
+  t.lumen_flux = sys.Q_in[0] / sys.U;
+  return t;
+}
+
 LumenForce lumen_wall_force(const double* R, const double* p, int npoints) {
   LumenForce f;
   for (int k = 0; k + 1 < npoints; ++k) {
@@ -109,6 +122,8 @@ ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, doubl
 
 bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   const double Ro_max = Rc * (1.0 - 1e-3);
+  R_end_[0] = Rpt[0];
+  R_end_[1] = Rpt[np - 1];
   if (derivatives)
     for (int p = 0; p < np; ++p) {
       const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
@@ -249,6 +264,26 @@ void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {
     SC += c.S * c.c;
     E += c.e;
   }
+  rl_end_[0] = rl_end_[1] = 0.0;
+  if (ends.any()) {
+    // each end: a rigid extension at the end's radius, through which the end's fluxes pass
+    // unchanged (s = 0 at the rear, the whole displaced flux s_N at the front)
+    for (int b = 0; b < 2; ++b) {
+      const double s = b == 0 ? 0.0 : s_cum[ni - 1];
+      const double Ri = R_end_[b] - a_in, Ro = R_end_[b] + a_out;
+      const AnnulusPoint<double>& a = pts_[b == 0 ? 0 : np - 1];
+      const double rl = (8.0 * mu / pi) * ends.lumen / (Ri * Ri * Ri);  // 8 mu (c R_i) / (pi R_i^4)
+      const double da = ends.annulus * (Rc - Ro);
+      const double ra = da * a.rho, cc = da * a.kappa;
+      rl_end_[b] = rl;
+      RL += rl, RLs += rl * s;
+      RA += ra, RAs += ra * s;
+      C += cc;
+      SRA += a.S * ra, SRAs += a.S * ra * s;
+      SC += a.S * cc;
+      E += da * a.e;
+    }
+  }
   Eigen::Matrix4d A;
   Eigen::Vector4d b;
   A << RL, 0, 0, 1, /**/ -RA, RA, C, 1, /**/ 0, -r_free, -r_free * A_c, 1, /**/ SRA, -SRA, E - SC, 0;
@@ -263,7 +298,7 @@ void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {
 
 void ConfinedSystem::lumen_pressure(std::vector<double>& p) const {
   p.resize(np);
-  p[0] = -0.5 * dp_tube;
+  p[0] = -0.5 * dp_tube - rl_end_[0] * Q_in[0];
   for (int j = 0; j < ni; ++j) p[j + 1] = p[j] - k[j].rl * Q_in[j];
 }
 

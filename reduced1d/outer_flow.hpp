@@ -66,6 +66,24 @@ struct IntervalCoef {
   T rl, ra, c, S, e;
 };
 
+/// The open ends' flow (docs/outer-flow-1d.md §2b): at each end the lumen and the annulus
+/// rejoin the free pipe through a region about a gap long, whose extra resistance lubrication
+/// leaves out. Each end then acts as a rigid extension of the lumen by `lumen` R_i and of the
+/// annulus by `annulus` (Rc - R_o), at the end's radius (resistance, Couette flux, force weight
+/// and drag of the annulus all extended). Zero: the plain lubrication junction.
+struct EndEffects {
+  double lumen = 0.0;    ///< lumen end length per end / the end's lumen radius R_i
+  double annulus = 0.0;  ///< annulus end length per end / the end's gap Rc - R_o
+  bool any() const { return lumen > 0.0 || annulus > 0.0; }
+};
+
+/// `model1d.end_effects = "open_ends"`, calibrated on a steady flow of the axi tier, the straight
+/// tube towed through the container (L/R0 = 6.4 and 12.8, Rc/R0 = 1.5 to 4; tests/axi/
+/// test_end_effects.cpp): 0.2 R_i per lumen end, 0.25 gaps per annulus end (the drag's fit,
+/// 0.21 to 0.37 gaps). Below the flanged orifice's 3 pi / 16 R_i (Sampson; Dagan, Weinbaum &
+/// Pfeffer): the thin tube's end is not a hole in a wall (docs/outer-flow-1d.md §2b).
+inline constexpr EndEffects kOpenEnds{0.2, 0.25};
+
 /// The confined lubrication system on the point set {0, z_0, ..., z_{N-1}, L} (N + 2 points,
 /// N + 1 intervals; interval j contains face j). Two ways to close it:
 ///  - transmural(): force-driven wave, Pi = p_in - p_out known at the points (0 at both ends);
@@ -85,9 +103,11 @@ class ConfinedSystem {
   void transmural(const double* Pi, double F_ext = 0.0);
   /// d/dR_o of the point functions at point p (valid after geometry()).
   const AnnulusPoint<double>& point_derivative(int p) const { return dpts_[p]; }
+  /// With `ends` (set before the call) the two ends' extensions join the sums.
   void kinematic(const double* s_cum, double F_ext = 0.0);
 
-  /// Lumen pressures at the points, gauge: mean free-pipe pressure = 0 (p0 + pL = 0).
+  /// Lumen pressures at the points, gauge: mean free-pipe pressure = 0 (the two ends' junction
+  /// pressures sum to zero; with end effects the lumen's end points lie an end resistance away).
   void lumen_pressure(std::vector<double>& p) const;
   /// Drag coefficient of the current shape towed rigidly (no wall pressure): F = -zeta U.
   double drag_coefficient() const;
@@ -101,11 +121,14 @@ class ConfinedSystem {
   std::vector<double> w;                ///< 1 / (rl + ra) per interval (valid after geometry())
   double U = 0, Q_tot = 0, dp_tube = 0;  ///< velocity, total swimmer-frame flux, pL - p0
   double W = 0;                          ///< Q_tot + U pi Rc^2: lab-frame flux through the free pipe
+  EndEffects ends;                       ///< the open ends' extensions (kinematic() only)
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
 
  private:
   std::vector<AnnulusPoint<double>> pts_, dpts_;
   std::vector<double> lambda_, last_Ro_;  // geometry() workspace and the radii of pts_
+  double R_end_[2] = {0, 0};               // membrane radius at the two ends (geometry())
+  double rl_end_[2] = {0, 0};              // the lumen end resistances of the last kinematic()
   std::vector<int> changed_;
   bool interval_valid_ = false;  // k and w match last_Ro_ (set by a plain geometry() call)
 };
@@ -141,6 +164,16 @@ double duct_equivalent_radius(double half_width);
 /// Drag coefficient of a straight tube of radius R (uniform) towed through the confined
 /// container: F = -zeta U with lumen carried along and the annulus/free-pipe return flow.
 double confined_drag_coefficient(double R, double L, double a_in, double a_out, double Rc, double P, double mu);
+
+/// A straight rigid tube of radius R towed at U through the container by the kinematic (prescribed-
+/// wave) system with the end effects `ends`: its drag coefficient (F = -drag U, N s/m) and its lumen
+/// flux relative to the tube per unit U (m^3/s per m/s; negative: the lumen's fluid passes towards
+/// -z). The two steady figures the end coefficients are checked on (docs/outer-flow-1d.md §2b).
+struct TowedTube {
+  double drag = 0, lumen_flux = 0;
+};
+TowedTube confined_tow(double R, double L, double a_in, double a_out, double Rc, double P, double mu,
+                       const EndEffects& ends);
 
 /// Resistive-force coefficient per length of a slender body of length L and local radius R,
 /// 2 pi mu / (ln(2 L / R) - 1/2); the logarithm is floored at 0.1 (ln(2L/R) - 1/2 reaches 0

@@ -133,6 +133,10 @@ struct Swimmer {
   OuterFlow outer = OuterFlow::Confined;
   double a_in = 0.0;   ///< hydraulic offset of the lumen: the lumen conducts as radius R - a_in [m]
   double a_out = 0.0;  ///< hydraulic offset of the outside: the outer flow sees radius R + a_out [m]
+  /// End effects of the open ends (confined force-free model, prescribed waves): each end acts as
+  /// a rigid extension of the lumen by end_lumen R_i and of the annulus by end_annulus (Rc - R_o)
+  /// (docs/outer-flow-1d.md §2b). 0: the plain lubrication junction.
+  double end_lumen = 0.0, end_annulus = 0.0;
   /// Short-wave wall traction (force-driven wave only): the viscous normal stress 2 mu |k| Rdot
   /// that each fluid (lumen, outside) exerts on a wall moving at axial wavenumbers the
   /// lubrication flow does not resolve, added to the tube law (docs/outer-flow-1d.md, 3b).

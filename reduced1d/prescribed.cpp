@@ -81,6 +81,7 @@ struct PrescribedModel {
     if (confined) {
       sys = std::make_unique<outer::ConfinedSystem>(N + 2, dpt, mu, a_in, a_out, p.container.radius_eff,
                                                     p.container.period, L);
+      sys->ends = {p.swimmer.end_lumen, p.swimmer.end_annulus};
     } else if (force_free) {
       zc.assign(zpt.begin() + 1, zpt.end() - 1);
       faces.resize(N + 1);

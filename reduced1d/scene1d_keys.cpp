@@ -14,7 +14,8 @@ const scene::json& section_keys() {
           {"thrust", "boolean"},
           {"external_drag", "choice:none|resistive_force"}}},
         {"wall_inertia", "boolean"},
-        {"short_wave_traction", "boolean"}}},
+        {"short_wave_traction", "boolean"},
+        {"end_effects", "choice:none|open_ends"}}},
       {"numerics1d", {{"cells", "integer"}, {"rtol", "number"}, {"atol_scale", "number"}, {"max_steps", "integer"}}}};
   return keys;
 }

@@ -1,7 +1,8 @@
 // Outer flows of the force-free 1D swimmer (reduced1d/outer_flow.hpp), checked against
 // closed forms and exact properties: the lumen force cancellation, the rigid tube towed
 // through the confined container, mirror symmetry, flux balance per channel, and the
-// scallop theorem for a reciprocal stroke.
+// scallop theorem for a reciprocal stroke; the open ends' extensions (EndEffects): the towed tube
+// against the closed form of the extended channels, mirror symmetry and the scallop theorem.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -241,4 +242,99 @@ TEST(OuterFlow, ReciprocalStrokesGiveNoNetDisplacement) {
   const double wave = integrate([&](double t) { return velocity(0, 0, true, t); }, 0.0, kL / 1e-5, 40);
   EXPECT_GT(std::abs(wave), 1e-4 * std::abs(forward));
   EXPECT_GT(wave, 0.0) << "confined: the tube swims against its wave (the wave here travels in -z)";
+}
+
+// A rigid straight tube towed by a force F: with end effects it is the closed form of the
+// three channels with the lumen longer by 2 c_l R_i and the annulus (resistance, Couette flux,
+// force weight and drag) longer by 2 c_a (Rc - R), the free pipe unchanged:
+//   dp [1 + (G_l / L_l + G_a / L_a)(P - L) / G_c] = U S (P - L) / G_c,  F = S dp + 2 pi mu U L_a / lambda,
+// and the lumen flux relative to the tube is -G_l dp / L_l.
+TEST(OuterFlowEnds, TowedTubeIsTheClosedFormOfTheExtendedChannels) {
+  for (double R : {0.6 * kR0, kR0, 1.5 * kR0})
+    for (const EndEffects e : {EndEffects{}, kOpenEnds, EndEffects{0.9, 0.05}}) {
+      const double lam = std::log(kRc / R);
+      const double Gl = pi * std::pow(R, 4) / (8 * kMu);
+      const double Ga = pi / (8 * kMu) * (std::pow(kRc, 4) - std::pow(R, 4) - std::pow(kRc * kRc - R * R, 2) / lam);
+      const double Gc = pi * std::pow(kRc, 4) / (8 * kMu);
+      const double S = pi * (kRc * kRc - R * R) / (2 * lam);
+      const double Ll = kL + 2 * e.lumen * R, La = kL + 2 * e.annulus * (kRc - R);
+      const double dp_per_U = S * (kP - kL) / Gc / (1 + (Gl / Ll + Ga / La) * (kP - kL) / Gc);
+      const double drag = S * dp_per_U + 2 * pi * kMu * La / lam;
+      const TowedTube t = confined_tow(R, kL, 0.0, 0.0, kRc, kP, kMu, e);
+      EXPECT_NEAR(t.drag, drag, 1e-11 * drag) << "R/R0 " << R / kR0 << " ends " << e.lumen << ", " << e.annulus;
+      EXPECT_NEAR(t.lumen_flux, -Gl * dp_per_U / Ll, 1e-10 * Gl * dp_per_U / Ll);
+    }
+  // the ends add drag: the open ends' extra drag of the paper's geometry is a few per cent
+  const double d0 = confined_tow(kR0, kL, 0, 0, kRc, kP, kMu, {}).drag;
+  const double d1 = confined_tow(kR0, kL, 0, 0, kRc, kP, kMu, kOpenEnds).drag;
+  EXPECT_GT(d1, d0);
+  EXPECT_LT(d1, 1.2 * d0);
+}
+
+// Mirror z -> L - z with the ends on: the mirrored shape and wall velocities swim the other way.
+TEST(OuterFlowEnds, MirroredProfilesSwimTheOtherWay) {
+  std::mt19937 g(13);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.5, 1.3);
+  for (int N : {8, 33}) {
+    const auto d = intervals(N, kL);
+    std::vector<double> R(N + 2);
+    for (auto& r : R) r = u(g) * kR0;
+    std::vector<double> Rm(R.rbegin(), R.rend());
+    ConfinedSystem a(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL), b(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
+    a.ends = b.ends = kOpenEnds;
+    ASSERT_TRUE(a.geometry(R.data()));
+    ASSERT_TRUE(b.geometry(Rm.data()));
+    std::vector<double> s(N + 1), sm(N + 1);
+    const double h = kL / N;
+    for (int j = 0; j < N; ++j) s[j + 1] = s[j] + h * 1e-15 * n(g);
+    for (int j = 0; j <= N; ++j) sm[j] = s[N] - s[N - j];
+    a.kinematic(s.data());
+    b.kinematic(sm.data());
+    EXPECT_GT(std::abs(a.U), 0.0);
+    EXPECT_NEAR(b.U, -a.U, 1e-11 * std::abs(a.U));
+    // and the ends change the answer (asymmetric end radii)
+    ConfinedSystem c(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
+    ASSERT_TRUE(c.geometry(R.data()));
+    c.kinematic(s.data());
+    EXPECT_GT(std::abs(c.U - a.U), 1e-6 * std::abs(a.U));
+  }
+}
+
+// Scallop theorem with the ends on: a reciprocal stroke (an asymmetric contraction near the
+// rear, forward in 0.1 s and back in 0.3 s) returns the tube to its start; U is still linear in
+// the wall velocity at a given shape.
+TEST(OuterFlowEnds, ReciprocalStrokeGivesNoNetDisplacement) {
+  const int N = 60;
+  const double h = kL / N, a = 0.35 * kR0;
+  ConfinedSystem sys(N + 2, intervals(N, kL), kMu, 0, 0, kRc, kP, kL);
+  sys.ends = kOpenEnds;
+  std::vector<double> zpt(N + 2), R(N + 2), s(N + 1);
+  zpt[0] = 0, zpt[N + 1] = kL;
+  for (int i = 0; i < N; ++i) zpt[i + 1] = (i + 0.5) * h;
+  // the contraction reaches the rear end, so the end radius changes during the stroke
+  auto shape = [&](double z) { return std::exp(-std::pow((z - 0.1 * kL) / (0.15 * kL), 2)); };
+  auto velocity = [&](double amp, double rate) {
+    for (int k = 0; k < N + 2; ++k) R[k] = kR0 - a * amp * shape(zpt[k]);
+    double cum = 0;
+    for (int i = 0; i < N; ++i) {
+      s[i] = cum;
+      cum += h * 2 * pi * R[i + 1] * (-a * rate * shape(zpt[i + 1]));
+    }
+    s[N] = cum;
+    if (!sys.geometry(R.data())) ADD_FAILURE();
+    sys.kinematic(s.data());
+    return sys.U;
+  };
+  const double T1 = 0.1, T2 = 0.3;
+  const double forward = swim::test::gauss_legendre10([&](double t) {
+    const double x = pi * t / (2 * T1);
+    return velocity(std::sin(x) * std::sin(x), 2 * std::sin(x) * std::cos(x) * pi / (2 * T1));
+  }, 0.0, T1, 20);
+  const double back = swim::test::gauss_legendre10([&](double t) {
+    const double x = pi * (t - T1) / (2 * T2);
+    return velocity(std::cos(x) * std::cos(x), -2 * std::sin(x) * std::cos(x) * pi / (2 * T2));
+  }, T1, T1 + T2, 20);
+  EXPECT_GT(std::abs(forward), 1e-3 * kR0);
+  EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
 }

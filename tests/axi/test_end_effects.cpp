@@ -1,0 +1,219 @@
+// The 1D tier's end effects (reduced1d/outer_flow.hpp EndEffects, docs/outer-flow-1d.md §2b)
+// against steady flows of the axisymmetric reference: a straight rigid tube towed through the
+// periodic container, its drag F_b and the lumen flux relative to it. These two steady figures
+// are what the end coefficients are calibrated on; no dynamic (wave) run enters.
+#include <gtest/gtest.h>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <cstdio>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "axi/prescribed_axi.hpp"
+#include "axi/run_axi.hpp"
+#include "axi_test_support.hpp"
+#include "axi/scene_axi.hpp"
+#include "axi/wall_axi.hpp"
+#include "common/scene.hpp"
+#include "reduced1d/outer_flow.hpp"
+#include "reduced1d/params.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "reduced1d/solver.hpp"
+
+namespace {
+
+using swim::scene::json;
+namespace outer = swim::reduced1d::outer;
+
+constexpr double kR0 = 0.125e-6;
+
+struct Tow {
+  double drag = 0, lumen_flux = 0, Rc = 0, P = 0, L = 0, mu = 0;
+};
+
+/// One steady solve on the axi tier: a straight tube of radius R0 and length L in the cylinder
+/// Rc (period about 5 L), the fitted method's mesh of the prescribed-wave runs at `cells` across,
+/// the wall's radial velocity from `kin` at t = 0.
+swim::axi::PrescribedState axi_steady(double L, double Rc, int cells, swim::axi::RingKinematics kin, double& P,
+                                      double& mu) {
+  const double h = Rc / cells;
+  P = std::round(5 * L / h) * h;
+  auto um = [](double v) {
+    char b[40];
+    std::snprintf(b, sizeof b, "%.12g um", v * 1e6);
+    return std::string(b);
+  };
+  json sc = {{"name", "steady"},
+             {"swimmer", {{"radius", um(kR0)}, {"length", um(L)}}},
+             {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(P)}}},
+             {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
+             {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
+             {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", cells}}}}}};
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  mu = p.base.fluid.mu;
+  swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
+  swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), mu, wall.reference_positions(), std::move(kin),
+                                  p.x_start());
+  return sw.evaluate(0.0);
+}
+
+/// The axi tier's towed straight tube (a rigid wall: U = 0, the drag and lumen flux of flow (b)).
+Tow axi_tow(double L_over_R0, double Rc_over_R0, int cells) {
+  Tow t;
+  t.L = L_over_R0 * kR0, t.Rc = Rc_over_R0 * kR0;
+  swim::axi::RingKinematics rigid = [](double, const std::vector<double>& z, Eigen::VectorXd& R,
+                                       Eigen::VectorXd& Rt) {
+    R = Eigen::VectorXd::Constant(Eigen::Index(z.size()), kR0);
+    Rt = Eigen::VectorXd::Zero(Eigen::Index(z.size()));
+  };
+  const swim::axi::PrescribedState s = axi_steady(t.L, t.Rc, cells, rigid, t.P, t.mu);
+  EXPECT_EQ(s.velocity, 0.0);
+  t.drag = s.drag;
+  t.lumen_flux = s.towed_lumen_flux;
+  return t;
+}
+
+outer::TowedTube one_d_tow(const Tow& t, const outer::EndEffects& e) {
+  return outer::confined_tow(kR0, t.L, 0.0, 0.0, t.Rc, t.P, t.mu, e);
+}
+
+}  // namespace
+
+// Calibration and check on the towed tube. The drag of a straight tube towed through the
+// container is mostly the annulus's; the annulus coefficient that makes the 1D drag (with the
+// lumen's coefficient 0.2) equal to the axi drag is an end length per end, in gaps. Measured at
+// 16 cells across, L/R0 = 6.4 and 12.8: 0.368 / 0.377 (Rc/R0 = 1.5), 0.213 / 0.212 (2), 0.313 /
+// 0.317 (3), 0.321 / 0.325 (4): the same at both lengths, an end effect. kOpenEnds takes 0.25.
+// The lumen's coefficient: the one that, with the drag's annulus coefficient, reproduces the
+// towed lumen flux is 0.3-0.4 at Rc/R0 = 1.3-1.5 and 0.05 at 2 (both fitted together); 0.2 keeps
+// the flux within 4 % there. In wider containers (Rc/R0 >= 2.5) the lubrication split of the
+// towed flux between lumen and annulus misses by 20-55 % and the miss does not fall as 1/L: not
+// an end effect, and not fitted.
+// Asserted: the fitted annulus coefficient the same within 0.02 at both lengths and within
+// [0.15, 0.45]; with kOpenEnds the 1D drag within 3 % of the axi drag (the plain junction: 2-18 %
+// low) and closer than without; the towed lumen flux within 5 % at Rc/R0 <= 2.
+TEST(EndEffects, TowedTubeDragWithTheOpenEnds) {
+  for (double rc : {1.5, 2.0, 3.0, 4.0}) {
+    double fitted[2];
+    for (int i = 0; i < 2; ++i) {
+      const double l = i == 0 ? 6.4 : 12.8;
+      const Tow a = axi_tow(l, rc, 16);
+      // drag(c_a) is linear in c_a at a fixed lumen coefficient: two evaluations
+      const double d0 = one_d_tow(a, {outer::kOpenEnds.lumen, 0.0}).drag;
+      const double d1 = one_d_tow(a, {outer::kOpenEnds.lumen, 1.0}).drag;
+      fitted[i] = (a.drag - d0) / (d1 - d0);
+      const outer::TowedTube plain = one_d_tow(a, {}), ends = one_d_tow(a, outer::kOpenEnds);
+      std::printf("Rc/R0 %.1f L/R0 %.1f: axi drag %.5e N s/m, 1D %.5e (%+.2f %%) -> with the ends %.5e (%+.2f %%); "
+                  "annulus coefficient from the drag %.3f; lumen flux axi %.4e, 1D %.4e -> %.4e m^3/s per m/s\n",
+                  rc, l, a.drag, plain.drag, 100 * (plain.drag / a.drag - 1), ends.drag,
+                  100 * (ends.drag / a.drag - 1), fitted[i], a.lumen_flux, plain.lumen_flux, ends.lumen_flux);
+      EXPECT_LT(std::abs(ends.drag / a.drag - 1), 0.03) << "Rc/R0 " << rc << " L/R0 " << l;
+      EXPECT_LT(std::abs(ends.drag / a.drag - 1), std::abs(plain.drag / a.drag - 1));
+      EXPECT_GT(fitted[i], 0.15);
+      EXPECT_LT(fitted[i], 0.45);
+      if (rc <= 2.0) {
+        EXPECT_LT(std::abs(ends.lumen_flux / a.lumen_flux - 1), 0.05) << "Rc/R0 " << rc;
+      }
+    }
+    EXPECT_NEAR(fitted[0], fitted[1], 0.02) << "Rc/R0 " << rc;
+  }
+}
+
+// The dynamic check the coefficients were not fitted to: a step wave (front L/8 wide) over one
+// transit of a short tube (L = 0.4 um = 3.2 R0 in Rc = 2 R0, period 2 um, 8 cells across, about
+// 2 s) on the axi tier and on the 1D tier with and without the open ends. Measured: axi 65.05 nm,
+// 1D 40.39 nm -> 43.66 nm with the ends: axi/1D 1.61 -> 1.49. The ends move 1D towards the
+// reference but close only a small part of the gap (docs/outer-flow-1d.md "Where lubrication
+// holds"). Asserted: the ratio improves, and stays above 1.3 (the rest is not an end effect).
+TEST(EndEffects, PrescribedStepWaveMovesTowardsTheReference) {
+  json sc = {{"name", "ends_step"},
+             {"swimmer", {{"radius", "0.125 um"}, {"length", "0.4 um"}}},
+             {"container", {{"kind", "cylinder"}, {"radius", "0.25 um"}, {"period", "2 um"}}},
+             {"wave", {{"kind", "step"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"width", "0.05 um"}}},
+             {"time", {{"output_interval", "0.005 s"}}},
+             {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
+             {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", 8}}}}}};
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  swim::axi::testing::TempDir dir("swim-axi-end-effects");
+  swim::axi::RunControlAxi ctl;
+  ctl.progress = 0;
+  const swim::axi::RunOutcomeAxi out = swim::axi::run_axi(p, resolved, dir.path.string(), ctl);
+  ASSERT_FALSE(out.failed) << out.message;
+  const double x_axi = out.summary["displacement_m"].get<double>();
+  double x1[2];
+  for (int i = 0; i < 2; ++i) {
+    json s1 = sc, r1;
+    s1["model1d"] = {{"end_effects", i == 0 ? "none" : "open_ends"}};
+    const swim::reduced1d::Result r = swim::reduced1d::solve(swim::reduced1d::read_scene(s1, r1));
+    ASSERT_FALSE(r.failure.has_value());
+    x1[i] = r.series.back().X;
+  }
+  std::printf("step wave, L = 3.2 R0, Rc = 2 R0: axi %.4e m; 1D %.4e m -> %.4e m with the ends; axi/1D %.3f -> %.3f\n",
+              x_axi, x1[0], x1[1], x_axi / x1[0], x_axi / x1[1]);
+  EXPECT_LT(std::abs(x_axi / x1[1] - 1), std::abs(x_axi / x1[0] - 1));
+  EXPECT_GT(x_axi / x1[1], 1.3);
+}
+
+// What the open ends' resistance leaves out, as a steady flow: a straight tube (L = 6.4 R0 in
+// Rc = 2 R0) whose wall moves radially only in a band one R0 wide (dR/dt = -v cos^2), centred a
+// distance d from the rear end; the force-free velocity U(d) on both tiers at that instant (one
+// solve each). On a uniform tube the plain lubrication model gives U = 0 wherever the band is
+// (the displaced flux leaves by lumen and annulus, and no pressure difference acts on the tube);
+// in Stokes flow a band near an end propels the tube away from that end. Measured (16 cells
+// across): U = 11.4, 8.10, 6.22, 4.40, 2.57 nm/s at d = 0.5, 1, 1.5, 2, 2.5 R0 (0 at the
+// midplane, 3.2 R0, by symmetry); 1D plain: 1e-20 m/s (round-off); 1D with the open ends 1.70,
+// 1.38, 1.07, 0.755, 0.440 nm/s: the right sign and shape (axi/1D 5.8 within 1 % for d >= 1 R0,
+// 6.7 at 0.5 R0) and 6 times too small. This end thrust of a moving wall is what the steady end
+// resistance cannot supply (docs/outer-flow-1d.md §6). Asserted: the plain 1D U below 1e-10
+// of the axi U; the axi U positive and falling from the end by more than a factor 3; with the
+// ends, the same sign and axi/1D above 3.
+TEST(EndEffects, WallBandNearAnEnd) {
+  const double R0 = kR0, L = 6.4 * R0, Rc = 2 * R0, w = R0, v = 1e-6;
+  auto band = [=](double z, double d) {
+    const double x = (z - d) / w;
+    return std::abs(x) < 0.5 ? std::pow(std::cos(M_PI * x), 2) : 0.0;
+  };
+  double U_near = 0, U_far = 0;
+  for (double d_over_R0 : {0.5, 1.0, 1.5, 2.0, 2.5}) {
+    const double d = d_over_R0 * R0;
+    swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& R, Eigen::VectorXd& Rt) {
+      R = Eigen::VectorXd::Constant(Eigen::Index(z.size()), R0);
+      Rt.resize(Eigen::Index(z.size()));
+      for (std::size_t k = 0; k < z.size(); ++k) Rt[Eigen::Index(k)] = -v * band(z[k], d);
+    };
+    double P = 0, mu = 0;
+    const double U_axi = axi_steady(L, Rc, 16, kin, P, mu).velocity;
+    // 1D, N = 400 cells, the solver's point set
+    const int N = 400;
+    const double h = L / N;
+    std::vector<double> dd(N + 1, h), R(N + 2, R0), s(N + 1, 0.0);
+    dd[0] = dd[N] = 0.5 * h;
+    double cum = 0;
+    for (int i = 0; i < N; ++i) {
+      s[i] = cum;
+      cum += h * 2 * M_PI * R0 * (-v * band((i + 0.5) * h, d));
+    }
+    s[N] = cum;
+    double U1[2];
+    for (int e = 0; e < 2; ++e) {
+      outer::ConfinedSystem sys(N + 2, dd, mu, 0.0, 0.0, Rc, P, L);
+      if (e == 1) sys.ends = outer::kOpenEnds;
+      ASSERT_TRUE(sys.geometry(R.data()));
+      sys.kinematic(s.data());
+      U1[e] = sys.U;
+    }
+    std::printf("band at d = %.1f R0: U axi %.4e m/s, 1D %.4e, with the ends %.4e (axi/1D %.3f)\n", d_over_R0, U_axi,
+                U1[0], U1[1], U_axi / U1[1]);
+    EXPECT_GT(U_axi, 0.0);
+    EXPECT_LT(std::abs(U1[0]), 1e-10 * U_axi) << "a band on a uniform tube: lubrication gives no thrust";
+    EXPECT_GT(U_axi / U1[1], 3.0);
+    if (d_over_R0 == 0.5) U_near = U_axi;
+    U_far = U_axi;
+  }
+  EXPECT_GT(U_near, 3.0 * U_far);
+}

@@ -1,0 +1,97 @@
+// The open ends' flow of the confined force-free model on the 1D tier (`model1d.end_effects`,
+// docs/outer-flow-1d.md §2b): the correction's limit on long tubes and the scene key's refusals.
+// (The closed form of the towed tube, mirror symmetry and the scallop theorem with the ends on:
+// test_outer_flow.cpp.)
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "common/scene.hpp"
+#include "reduced1d/outer_flow.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "reduced1d/solver.hpp"
+
+using namespace swim::reduced1d::outer;
+using swim::scene::json;
+
+namespace {
+
+/// Displacement over one transit of a prescribed wave on the 1D tier (confined force-free model).
+double transit_displacement(const std::string& kind, double L_um, double lambda_um, const std::string& ends) {
+  auto um = [](double v) { return std::to_string(v) + " um"; };
+  json sc = {{"name", "ends"},
+             {"swimmer", {{"radius", "0.125 um"}, {"length", um(L_um)}}},
+             {"container", {{"kind", "cylinder"}, {"radius", "0.25 um"}, {"period", um(5 * L_um)}}},
+             {"wave", {{"kind", kind}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}}},
+             {"model1d", {{"end_effects", ends}}},
+             {"numerics1d", {{"cells", 400}}}};
+  if (kind == "step") sc["wave"]["width"] = um(lambda_um);
+  if (kind == "sine") sc["wave"]["wavelength"] = um(lambda_um);
+  json resolved;
+  const auto r = swim::reduced1d::solve(swim::reduced1d::read_scene(sc, resolved));
+  EXPECT_FALSE(r.failure.has_value());
+  return r.series.back().X;
+}
+
+}  // namespace
+
+// The correction is an end effect: at a fixed wave shape (a sine of wavelength 0.4 um, a whole
+// number of wavelengths on the tube) its relative change of the displacement per transit falls
+// as 1/L, halving with each doubling of the tube, and vanishes as L/Rc grows.
+TEST(EndEffects, CorrectionVanishesAsOneOverTheTubeLength) {
+  double prev = 0.0;
+  for (double L : {0.8, 1.6, 3.2, 6.4}) {
+    const double off = transit_displacement("sine", L, 0.4, "none");
+    const double on = transit_displacement("sine", L, 0.4, "open_ends");
+    const double rel = on / off - 1.0;
+    std::printf("L = %.1f um (L/Rc = %.1f): displacement %.4e -> %.4e m, relative change %+.4f, times L/Rc %.3f\n", L,
+                L / 0.25, off, on, rel, rel * L / 0.25);
+    EXPECT_GT(std::abs(rel), 0.0);
+    if (prev != 0.0) {
+      EXPECT_GT(rel / prev, 0.4) << "L = " << L;
+      EXPECT_LT(rel / prev, 0.6) << "L = " << L;
+    }
+    prev = rel;
+  }
+  EXPECT_LT(std::abs(prev), 0.02);
+}
+
+// The scene key: a value outside the choice names the key and the allowed values; the ends
+// are refused with a force-driven wave and with the unbounded outer flow.
+TEST(EndEffects, SceneKeyRefusesBadValuesAndOtherModels) {
+  auto scene = [](json model1d, std::string wave) {
+    json sc = {{"name", "ends"},
+               {"swimmer", {{"radius", "0.125 um"}, {"length", "0.4 um"}}},
+               {"container", {{"kind", "cylinder"}, {"radius", "0.25 um"}, {"period", "2 um"}}},
+               {"model1d", model1d}};
+    if (wave != "force_driven")
+      sc["wave"] = {{"kind", wave}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"width", "0.05 um"}};
+    return sc;
+  };
+  auto message = [](const json& sc) {
+    json resolved;
+    try {
+      (void)swim::reduced1d::read_scene(sc, resolved);
+    } catch (const swim::InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  const std::string bad = message(scene({{"end_effects", "sampson"}}, "step"));
+  EXPECT_NE(bad.find("model1d.end_effects"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("sampson"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("open_ends"), std::string::npos) << bad;
+  const std::string forced = message(scene({{"end_effects", "open_ends"}}, "force_driven"));
+  EXPECT_NE(forced.find("model1d.end_effects"), std::string::npos) << forced;
+  const std::string unbounded = message(scene({{"end_effects", "open_ends"}, {"outer_flow", "unbounded"}}, "step"));
+  EXPECT_NE(unbounded.find("model1d.end_effects"), std::string::npos) << unbounded;
+  EXPECT_EQ(message(scene({{"end_effects", "open_ends"}}, "step")), "");
+  json resolved;
+  const auto p = swim::reduced1d::read_scene(scene({{"end_effects", "open_ends"}}, "step"), resolved);
+  EXPECT_EQ(p.swimmer.end_lumen, kOpenEnds.lumen);
+  EXPECT_EQ(p.swimmer.end_annulus, kOpenEnds.annulus);
+  EXPECT_EQ(resolved["model1d"]["end_effects"], "open_ends");
+}
