@@ -161,14 +161,7 @@ class Runner {
     f("X", self.X_.data(), std::size_t(self.X_.size()));
     f("U", self.U_.data(), std::size_t(self.U_.size()));
     f("energy", self.energy_.data(), self.energy_.size());
-    auto& st = self.protocol_.state();
-    f("phase", st.phase);
-    f("active", st.active);
-    f("cycles_completed", st.cycles_completed);
-    f("switches", st.switches);
-    f("cycle_start", st.cycle_start);
-    f("cycle_end", st.cycle_end);
-    f("segment_reached", st.segment_reached);
+    full3d::protocol_records(self.protocol_.state(), f);
     f("dt_next", self.dt_);
     f("dt_last", self.dt_last_);
     f("dt_min_taken", self.dt_min_taken_);

@@ -123,7 +123,8 @@ CheckpointReader::CheckpointReader(const std::string& path, std::uint64_t scene_
   if (stored_scene != scene_hash)
     throw InputError("--resume", path_,
                      "the checkpoint was written for a different scene (only full3d.checkpoint_interval, "
-                     "full3d.threads and full3d.time_limit may change on resume); resume with the scene it was "
+                     "full3d.threads, full3d.time_limit, axi.checkpoint_interval and axi.time_limit may change on "
+                     "resume); resume with the scene it was "
                      "written for, or run this scene without --resume (with --overwrite to replace the folder's "
                      "results, or into another folder)");
   // the record index: every record well formed, names unique

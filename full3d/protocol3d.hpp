@@ -84,6 +84,19 @@ struct ProtocolState {
   std::vector<double> segment_reached;  ///< times at which segments reached R_f, in order
 };
 
+/// The protocol state's checkpoint records, listed once as calls f(name, member)
+/// (full3d/checkpoint.hpp): the 3D and the axisymmetric tiers' checkpoints both use it.
+template <class State, class F>
+void protocol_records(State& st, F&& f) {
+  f("phase", st.phase);
+  f("active", st.active);
+  f("cycles_completed", st.cycles_completed);
+  f("switches", st.switches);
+  f("cycle_start", st.cycle_start);
+  f("cycle_end", st.cycle_end);
+  f("segment_reached", st.segment_reached);
+}
+
 class Protocol3d {
  public:
   /// e_ref: energy of the tube uniformly at R_f (J). Throws InputError (key

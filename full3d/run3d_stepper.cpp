@@ -233,14 +233,7 @@ void Stepper::records(Self& self, F&& f) {
   f("V_prev", self.s_.V_prev.data(), std::size_t(self.s_.V_prev.size()));
   if (self.ib_)
     for (int c = 0; c < 3; ++c) f(kVelocityRecords[c], self.s_.u.c[c].data(), self.s_.u.c[c].size());
-  auto& st = self.protocol_.state();
-  f("phase", st.phase);
-  f("active", st.active);
-  f("cycles_completed", st.cycles_completed);
-  f("switches", st.switches);
-  f("cycle_start", st.cycle_start);
-  f("cycle_end", st.cycle_end);
-  f("segment_reached", st.segment_reached);
+  protocol_records(self.protocol_.state(), f);
   f("step_marks", self.step_marks_);
   f("dt_next", self.dt_next_);
   f("dt_last", self.dt_last_);
