@@ -216,7 +216,10 @@ json figures_1d(const reduced1d::Metrics& m, const std::string& metric) {
 }
 
 json figures_3d(const json& s, const std::string& metric) {
-  auto get = [&](const char* k) { return s.contains(k) && s[k].is_number() ? s[k] : json(nullptr); };
+  // a run that did not finish has only partial figures (its mean velocity up to the failure):
+  // none of them is the design's
+  const bool finished = s.value("status", std::string()) == "ok";
+  auto get = [&](const char* k) { return finished && s.contains(k) && s[k].is_number() ? s[k] : json(nullptr); };
   json f = {{"displacement_per_cycle_m", get("displacement_per_cycle_m")},
             {"cycle_time_s", get("cycle_time_s")},
             {"mean_velocity_m_per_s", get("mean_velocity_m_per_s")}};

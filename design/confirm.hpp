@@ -80,7 +80,8 @@ Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const st
                         bool error_estimate = false, const std::string& metric = "");
 
 /// One tier's figures of a design: {"<metric>", "displacement_per_cycle_m", "cycle_time_s",
-/// "mean_velocity_m_per_s"}; a figure the run did not produce (no completed cycle) is null.
+/// "mean_velocity_m_per_s"}; a figure the run did not produce (no completed cycle) is null, and
+/// so is every figure of a 3D run that did not finish (status other than "ok").
 json figures_1d(const reduced1d::Metrics& m, const std::string& metric);
 json figures_3d(const json& summary, const std::string& metric);
 /// The error bar of a 3D figure from the summary's `error_estimate` (estimated_figure of it):
