@@ -113,6 +113,9 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   VectorField& u = work_u_;
   const Eigen::Matrix3Xd accel = (s.V - s.V_prev) / dt;
   Eigen::Matrix3Xd U, Xnew;
+  // the fluid's inertia step (IbOptions::inertia_step): the step's own (half) step, or fixed
+  const double tau = opt_.inertia_step > 0.0 ? opt_.inertia_step : dt;
+  const double tau_half = opt_.inertia_step > 0.0 ? opt_.inertia_step : 0.5 * dt;
 
   Eigen::Matrix3Xd F = fluid_force(s.X, s.t, accel);
   guard_finite(F, "membrane force", s.t);
@@ -120,7 +123,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   if (opt_.scheme == IbScheme::ForwardEuler) {
     spread(grid_, s.X, F, f, opt_.threads);
     lap(st.time_spread);
-    const StokesStats ss = stokes_.step(s.u, u, f, dt);
+    const StokesStats ss = stokes_.step(s.u, u, f, tau);
     lap(st.time_fluid);
     st.stokes_iterations = ss.iterations;
     st.max_divergence = ss.max_divergence;
@@ -132,7 +135,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     spread(grid_, s.X, F, f, opt_.threads);
     lap(st.time_spread);
     VectorField& uh = work_uh_;
-    const StokesStats s1 = stokes_.step(s.u, uh, f, 0.5 * dt);
+    const StokesStats s1 = stokes_.step(s.u, uh, f, tau_half);
     lap(st.time_fluid);
     interpolate(grid_, uh, s.X, U, opt_.threads);
     if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, s.X, U);
@@ -145,7 +148,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     lap(st.time_forces);
     spread(grid_, Xh, F, f, opt_.threads);
     lap(st.time_spread);
-    const StokesStats s2 = stokes_.step(s.u, u, f, dt);
+    const StokesStats s2 = stokes_.step(s.u, u, f, tau);
     lap(st.time_fluid);
     st.stokes_iterations = s1.iterations + s2.iterations;
     st.max_divergence = s2.max_divergence;
@@ -221,7 +224,7 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
     v /= vmax;
     const Eigen::Matrix3Xd dF = (elastic_forces(mesh_, s.X + eps * v, membrane_, opt_.threads) - F0) / eps;
     spread(grid_, s.X, dF, f, opt_.threads);
-    stokes_.step_from_rest(u, f, dt);
+    stokes_.step_from_rest(u, f, opt_.inertia_step > 0.0 ? opt_.inertia_step : dt);
     interpolate(grid_, u, s.X, U, opt_.threads);
     lambda = U.norm() / v.norm();  // |A v| / |v|
     v = -U;

@@ -45,6 +45,13 @@ struct IbOptions {
   /// along each node's own radial direction (no azimuthal or lobed motion), so the rings stay
   /// circles about the tube axis (full3d.membrane.axisymmetric, docs/full3d.md "Wall wrinkling").
   bool axisymmetric_wall = false;
+  /// The step tau of the fluid's inertia term, rho (u^{n+1} - u^n) / tau (s); 0: each step's
+  /// own dt. In creeping flow the term is a relaxation of the quasi-steady Stokes solution,
+  /// rho / tau being 1e-4 to 1e-2 of mu |g|^2 on the grid's smallest wavenumber, so a fixed tau
+  /// changes the flow by that fraction of one step's velocity change; the adaptive run driver
+  /// sets tau = full3d.adaptive.dt_max, and the Stokes solver then factorises once per run
+  /// instead of once per step size (docs/full3d.md, "Adaptive time step").
+  double inertia_step = 0.0;
   StokesOptions stokes{};
 };
 

@@ -37,6 +37,7 @@ Stepper::Stepper(const RunSetup& run)
     IbOptions o = run.options;
     o.reject_on_cfl = run.adaptive;
     o.dt_key = run.dt_key;
+    if (run.adaptive) o.inertia_step = p.adaptive.dt_max;  // one Stokes factorisation per run
     ib_ = run.solver(o, p.wall_inertia ? run.mass : Eigen::VectorXd());
     ib_->set_external_force([this](double, const Eigen::Matrix3Xd& X) { return protocol_.force(X); });
     s_ = ib_->initial_state();
