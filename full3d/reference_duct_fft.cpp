@@ -122,8 +122,8 @@ class DiagonalSolver {
 };
 
 void require_duct(const MacGrid& g, const char* what) {
-  if (g.kind() != ContainerKind::SquareDuct)
-    throw InputError("container", to_string(g.kind()), std::string(what) + " needs a square_duct grid");
+  if (g.boundary() != GridBoundary::SquareDuct)
+    throw InputError("container", to_string(g.boundary()), std::string(what) + " needs a square_duct grid");
 }
 
 }  // namespace
