@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "full3d/operators.hpp"
-#include "full3d/reference_duct_fft.hpp"
+#include "full3d/reference/duct_fft.hpp"
 #include "full3d/stokes.hpp"
 #include "tests/full3d/reference/reference_stokes.hpp"
 #include "tests/full3d/test_support.hpp"

@@ -1,4 +1,4 @@
-#include "full3d/reference_duct_fft.hpp"
+#include "full3d/reference/duct_fft.hpp"
 
 #include <algorithm>
 #include <cmath>
