@@ -28,7 +28,7 @@
 #include "reduced1d/solver.hpp"
 #include "full3d/fft.hpp"
 #include "full3d/protocol3d.hpp"
-#include "full3d/reference_duct_fft.hpp"
+#include "full3d/reference/duct_fft.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 #include "full3d/world3d.hpp"
@@ -382,7 +382,7 @@ StepTiming time_steps(int across, const std::string& container, int thr, int ste
   t.spread_s = sum.time_spread / steps;
   t.interp_s = sum.time_interp / steps;
   t.forces_s = sum.time_forces / steps;
-  // bare FFT solve (reference::PressureCorrectionStep, full3d/reference_duct_fft.hpp) with the
+  // bare FFT solve (reference::PressureCorrectionStep, full3d/reference/duct_fft.hpp) with the
   // same forcing size
   full3d::VectorField u(grid), f(grid);
   for (auto& c : f.c)

@@ -11,6 +11,7 @@
 
 #include "common/errors.hpp"
 #include "common/output.hpp"
+#include "common/run_figures.hpp"
 
 namespace swim::record {
 
@@ -283,24 +284,40 @@ void check_plausible(RunRecord& r) {
     r.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
 }
 
-json summary(const RunRecord& r, const json& resolved) {
-  const CycleFigures c = cycle_figures(r);
+RunFigures run_figures(const RunRecord& r) {
+  RunFigures f;
+  f.cycles = cycle_figures(r);
   const Series& s = r.series;
-  const bool any = s.count() > 0;
-  const double t_end = r.t_end(), x = r.displacement();
+  f.t_end_s = r.t_end();
+  f.displacement_m = r.displacement();
+  f.mean_velocity_m_per_s = f.t_end_s > 0 ? f.displacement_m / f.t_end_s : 0.0;
+  f.body_lengths_per_s = f.t_end_s > 0 && r.length_m > 0 ? f.displacement_m / f.t_end_s / r.length_m : 0.0;
+  if (s.count() == 0) return f;
+  f.max_displacement_m = s.max("x_center_m");
+  f.final_velocity_m_per_s = s.last()[s.index("velocity_m_per_s")];
+  f.max_velocity_m_per_s = s.max("velocity_m_per_s");
+  f.min_radius_m = s.min("min_radius_m");
+  f.pumped_volume_m3 = -s.last()[s.index("volume_rear_m3")];
+  return f;
+}
+
+json summary(const RunRecord& r, const json& resolved) {
+  const RunFigures f = run_figures(r);
+  const CycleFigures& c = f.cycles;
+  const Series& s = r.series;
   json j = json::object();
   j["tier"] = r.tier;
   j["model"] = r.model;
   j["scene"] = resolved;
   j["status"] = r.status;
-  j["t_end_s"] = t_end;
-  j["displacement_m"] = x;
-  j["max_displacement_m"] = any ? s.max("x_center_m") : 0.0;
-  j["mean_velocity_m_per_s"] = t_end > 0 ? x / t_end : 0.0;
-  j["body_lengths_per_s"] = t_end > 0 && r.length_m > 0 ? x / t_end / r.length_m : 0.0;
-  j["final_velocity_m_per_s"] = any ? s.last()[2] : 0.0;
-  j["max_velocity_m_per_s"] = any ? s.max("velocity_m_per_s") : 0.0;
-  j["min_radius_m"] = any ? s.min("min_radius_m") : 0.0;
+  j["t_end_s"] = f.t_end_s;
+  j["displacement_m"] = f.displacement_m;
+  j["max_displacement_m"] = f.max_displacement_m;
+  j["mean_velocity_m_per_s"] = f.mean_velocity_m_per_s;
+  j["body_lengths_per_s"] = f.body_lengths_per_s;
+  j["final_velocity_m_per_s"] = f.final_velocity_m_per_s;
+  j["max_velocity_m_per_s"] = f.max_velocity_m_per_s;
+  j["min_radius_m"] = f.min_radius_m;
   j["cycles_completed"] = c.cycles_completed;
   j["cycle_start_times_s"] = r.events.cycle_start_s;
   j["cycle_end_times_s"] = r.events.cycle_end_s;
@@ -319,8 +336,7 @@ json summary(const RunRecord& r, const json& resolved) {
     j["body_lengths_per_cycle_per_s"] = nullptr;
     j["per_cycle_absent_because"] = c.absent_because;
   }
-  // the lumen volume expelled backwards through the rear end (z = 0)
-  j["pumped_volume_m3"] = any ? -s.last()[s.index("volume_rear_m3")] : 0.0;
+  j["pumped_volume_m3"] = f.pumped_volume_m3;
   j["protocol_switches"] = r.events.switches;
   j["segment_reached_s"] = r.events.segment_reached_s;
   j["plausible"] = r.implausible.empty();

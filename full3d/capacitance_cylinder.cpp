@@ -79,7 +79,7 @@ CylinderLayout cylinder_layout(const MacGrid& g, double radius) {
 }
 
 bool cylinder_radius_valid(const MacGrid& g, double radius) {
-  return g.kind() == ContainerKind::SquareDuct && radius > 0.0 &&
+  return g.boundary() == GridBoundary::SquareDuct && radius > 0.0 &&
          2.0 * radius <= std::min(g.length(1), g.length(2)) * (1.0 + 1e-12);
 }
 

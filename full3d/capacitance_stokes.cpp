@@ -34,8 +34,8 @@ CapacitanceStokes::Impl::Impl(const MacGrid& g, double mu_, const CylinderOption
                               const FftOptions& fft_in)
     : grid(g), mu(mu_), threads(std::max(1, thr)), nx(g.nx()), ny(g.ny()), nz(g.nz()), nxh(g.nx() / 2 + 1),
       dy(g.ny(), g.h()), dz(g.nz(), g.h()) {
-  if (g.kind() != ContainerKind::SquareDuct)
-    throw InputError("container", to_string(g.kind()), "the capacitance Stokes solver needs a square_duct grid");
+  if (g.boundary() != GridBoundary::SquareDuct)
+    throw InputError("container", to_string(g.boundary()), "the capacitance Stokes solver needs a square_duct grid");
   off[0] = 0;
   for (int c = 0; c < 4; ++c) {
     const auto d = g.dims(c);

@@ -20,8 +20,8 @@ bool cylinder_outside(const MacGrid& g, double radius, int c, int j, int k, doub
 }
 
 void VelocityConstraints::check_geometry(const MacGrid& g, double radius) {
-  if (g.kind() != ContainerKind::SquareDuct)
-    throw InputError("container", to_string(g.kind()), "the circular cylinder is built inside a square_duct grid");
+  if (g.boundary() != GridBoundary::SquareDuct)
+    throw InputError("container", to_string(g.boundary()), "the circular cylinder is built inside a square_duct grid");
   if (!(radius > 0.0) || 2.0 * radius > std::min(g.length(1), g.length(2)) * (1.0 + 1e-12))
     throw InputError("container.radius", num(radius),
                      "a positive radius Rc with 2 Rc <= the duct side (" + num(std::min(g.length(1), g.length(2))) +

@@ -66,7 +66,7 @@ class VelocityConstraints {
   const MacGrid& grid() const { return grid_; }
 
  private:
-  MacGrid grid_{1, 2, 2, 1.0, ContainerKind::SquareDuct};
+  MacGrid grid_{1, 2, 2, 1.0, GridBoundary::SquareDuct};
   double rc_ = 0.0;
   std::array<std::size_t, 4> offset_{};  // global face index of component c starts at offset_[c]
   std::size_t n_mask_ = 0;

@@ -7,18 +7,18 @@
 
 namespace swim::full3d {
 
-std::string to_string(ContainerKind kind) {
-  return kind == ContainerKind::PeriodicBox ? "periodic_box" : "square_duct";
+std::string to_string(GridBoundary boundary) {
+  return boundary == GridBoundary::PeriodicBox ? "periodic_box" : "square_duct";
 }
 
-ContainerKind container_kind_from_string(const std::string& key, const std::string& value) {
-  if (value == "periodic_box") return ContainerKind::PeriodicBox;
-  if (value == "square_duct") return ContainerKind::SquareDuct;
+GridBoundary grid_boundary_from_string(const std::string& key, const std::string& value) {
+  if (value == "periodic_box") return GridBoundary::PeriodicBox;
+  if (value == "square_duct") return GridBoundary::SquareDuct;
   throw InputError(key, value, "one of periodic_box, square_duct");
 }
 
-MacGrid::MacGrid(int nx, int ny, int nz, double h, ContainerKind kind) : n_{nx, ny, nz}, h_(h), kind_(kind) {
-  const int nmin = kind == ContainerKind::SquareDuct ? 2 : 1;
+MacGrid::MacGrid(int nx, int ny, int nz, double h, GridBoundary boundary) : n_{nx, ny, nz}, h_(h), boundary_(boundary) {
+  const int nmin = boundary == GridBoundary::SquareDuct ? 2 : 1;
   const char* names[3] = {"grid.nx", "grid.ny", "grid.nz"};
   for (int d = 0; d < 3; ++d) {
     const int lo = d == 0 ? 1 : nmin;

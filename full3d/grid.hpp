@@ -8,7 +8,8 @@
 //   w (z-velocity) on z-faces   at ((i+1/2) h,  (j+1/2) h,  k h      )
 //   p (pressure)   at centres   at ((i+1/2) h,  (j+1/2) h, (k+1/2) h )
 //
-// Containers:
+// Boundaries of the grid (GridBoundary; the scene's container shape maps onto one: box ->
+// PeriodicBox, duct and cylinder -> SquareDuct, the cylinder immersed inside the duct):
 //   PeriodicBox  periodic in x, y and z; every component has nx*ny*nz values.
 //   SquareDuct   periodic in x, no-slip walls at y = 0, Ly and z = 0, Lz.
 //                v has ny+1 face layers in y (j = 0 and j = ny lie on the walls
@@ -26,24 +27,24 @@
 
 namespace swim::full3d {
 
-enum class ContainerKind { PeriodicBox, SquareDuct };
+enum class GridBoundary { PeriodicBox, SquareDuct };
 
-std::string to_string(ContainerKind kind);
+std::string to_string(GridBoundary boundary);
 /// Parses "periodic_box" / "square_duct"; throws swim::InputError(key, value, allowed).
-ContainerKind container_kind_from_string(const std::string& key, const std::string& value);
+GridBoundary grid_boundary_from_string(const std::string& key, const std::string& value);
 
 class MacGrid {
  public:
   /// Throws swim::InputError for non-positive sizes, h <= 0, or (duct) ny, nz < 2.
-  MacGrid(int nx, int ny, int nz, double h, ContainerKind kind);
+  MacGrid(int nx, int ny, int nz, double h, GridBoundary boundary);
 
   int nx() const { return n_[0]; }
   int ny() const { return n_[1]; }
   int nz() const { return n_[2]; }
   int n(int dir) const { return n_[dir]; }
   double h() const { return h_; }
-  ContainerKind kind() const { return kind_; }
-  bool periodic(int dir) const { return dir == 0 || kind_ == ContainerKind::PeriodicBox; }
+  GridBoundary boundary() const { return boundary_; }
+  bool periodic(int dir) const { return dir == 0 || boundary_ == GridBoundary::PeriodicBox; }
   double length(int dir) const { return n_[dir] * h_; }
   std::size_t cells() const { return std::size_t(n_[0]) * n_[1] * n_[2]; }
 
@@ -77,7 +78,7 @@ class MacGrid {
  private:
   std::array<int, 3> n_;
   double h_;
-  ContainerKind kind_;
+  GridBoundary boundary_;
 };
 
 /// Velocity on the MAC faces: three contiguous arrays sized by MacGrid::dims(c).

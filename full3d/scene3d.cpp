@@ -26,8 +26,8 @@ std::string fmt(double v, const char* unit) { return scene::format_quantity(v, u
 
 double Params3d::c1_estimate() const { return scene::c1_from_spring_constant(membrane.ks, R0); }
 
-ContainerKind Params3d::container_kind() const {
-  return container == "box" ? ContainerKind::PeriodicBox : ContainerKind::SquareDuct;  // cylinder: inside a duct
+GridBoundary Params3d::grid_boundary() const {
+  return container == "box" ? GridBoundary::PeriodicBox : GridBoundary::SquareDuct;  // cylinder: inside a duct
 }
 
 Eigen::Vector3d Params3d::axis_start() const {

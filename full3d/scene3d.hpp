@@ -100,7 +100,7 @@ struct Params3d {
   int threads = 1;
 
   double c1_estimate() const;      ///< 2 ks / (sqrt(3) R0^2), Pa/m
-  ContainerKind container_kind() const;
+  GridBoundary grid_boundary() const;
   /// Axis start (centre of ring 0): the swimmer is centred in the container.
   Eigen::Vector3d axis_start() const;
 };

@@ -41,9 +41,9 @@ struct StokesSolver::Impl {
     if (!(f.rho > 0.0)) throw InputError("fluid.rho", std::to_string(f.rho), "a positive density in kg/m^3");
     if (!(f.mu > 0.0)) throw InputError("fluid.mu", std::to_string(f.mu), "a positive dynamic viscosity in Pa s");
     const int nx = g.nx(), ny = g.ny(), nz = g.nz();
-    if (g.kind() == ContainerKind::PeriodicBox) {
+    if (g.boundary() == GridBoundary::PeriodicBox) {
       if (o.cylinder.enabled)
-        throw InputError("container", to_string(g.kind()), "the circular cylinder needs a square_duct grid");
+        throw InputError("container", to_string(g.boundary()), "the circular cylinder needs a square_duct grid");
       const std::size_t nc = std::size_t(nz) * ny * (nx / 2 + 1);
       for (int c = 0; c < 3; ++c) {
         real[c] = FftwBuffer(g.cells());

@@ -34,7 +34,8 @@
 //
 // Test references (an iterative PCG and a per-mode sparse LU solving the same duct and
 // cylinder systems) live in tests/full3d/reference/; the bench's cost unit, one incremental
-// pressure-correction step, in reference_duct_fft.hpp. None is reachable from `swim run`.
+// pressure-correction step, in full3d/reference/duct_fft.hpp (library swim_full3d_duct_fft,
+// outside swim_full3d). None is reachable from `swim run`.
 #pragma once
 
 #include <cstddef>

@@ -26,7 +26,7 @@ World3d::World3d(const Params3d& params)
     : p(params), mesh(make_mesh(params)), e_ref(uniform_contraction_energy(mesh, params.membrane, params.protocol.R_f)),
       options(ib_options(params)) {}
 
-MacGrid World3d::grid() const { return MacGrid(p.nx, p.ny, p.nz, p.h, p.container_kind()); }
+MacGrid World3d::grid() const { return MacGrid(p.nx, p.ny, p.nz, p.h, p.grid_boundary()); }
 
 Protocol3d World3d::protocol() const { return Protocol3d(effective_protocol(p, mesh), mesh, e_ref); }
 

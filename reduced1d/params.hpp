@@ -53,8 +53,9 @@ enum class OuterFlow {
   Unbounded,  ///< slender-body outer flow in unbounded fluid
 };
 
-/// Rigid container shared with the 3D tier (scene section `container`).
-enum class ContainerKind { Cylinder, Duct, Box };
+/// Shape of the rigid container (scene key `container.kind`), shared with the 3D tier.
+/// Not the 3D grid's boundary (full3d::GridBoundary), onto which the 3D tier maps it.
+enum class ContainerShape { Cylinder, Duct, Box };
 
 /// Pressure gradient used in the swimmer-velocity relation (45)/(51) (paper mode).
 enum class Closure {
@@ -83,7 +84,7 @@ struct Fluid {
 /// the cylinder's own radius, or for the square duct of half-width `radius` the radius of
 /// the circular pipe with the same Poiseuille conductance (1.0939 x half-width).
 struct Container {
-  ContainerKind kind = ContainerKind::Duct;
+  ContainerShape shape = ContainerShape::Duct;
   double radius = 0.25e-6;      ///< cylinder radius or duct half-width [m]
   double period = 2.0e-6;       ///< axial period [m]
   double radius_eff = 0.25e-6;  ///< circular radius the 1D tier uses [m]

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "common/output.hpp"
+#include "common/run_figures.hpp"
 
 namespace swim::reduced1d {
 
@@ -22,18 +23,19 @@ Metrics metrics(const Params& p, const Result& r) {
   const record::RunRecord& rec = own ? r.record : built;
   const record::Series& s = rec.series;
   if (s.count() == 0) return m;
-  const auto last = s.last();
-  m.t_end_s = rec.t_end();
-  m.displacement_m = rec.displacement();
-  m.mean_velocity_m_per_s = m.t_end_s > 0 ? m.displacement_m / m.t_end_s : 0.0;
-  m.body_lengths_per_s = m.mean_velocity_m_per_s / p.geometry.L;
-  m.final_velocity_m_per_s = last[s.index("velocity_m_per_s")];
-  m.pumped_volume_m3 = -last[s.index("volume_rear_m3")];
-  m.pumped_volume_lab_m3 = -last[s.index("volume_rear_lab_m3")];
-  m.min_radius_m = s.min("min_radius_m");
-  m.max_velocity_m_per_s = s.max("velocity_m_per_s");
-  m.max_displacement_m = s.max("x_center_m");
-  const record::CycleFigures c = record::cycle_figures(rec);
+  // the figures every tier's summary carries, from the one place that computes them
+  const record::RunFigures f = record::run_figures(rec);
+  m.t_end_s = f.t_end_s;
+  m.displacement_m = f.displacement_m;
+  m.mean_velocity_m_per_s = f.mean_velocity_m_per_s;
+  m.body_lengths_per_s = f.body_lengths_per_s;
+  m.final_velocity_m_per_s = f.final_velocity_m_per_s;
+  m.pumped_volume_m3 = f.pumped_volume_m3;
+  m.pumped_volume_lab_m3 = -s.last()[s.index("volume_rear_lab_m3")];
+  m.min_radius_m = f.min_radius_m;
+  m.max_velocity_m_per_s = f.max_velocity_m_per_s;
+  m.max_displacement_m = f.max_displacement_m;
+  const record::CycleFigures& c = f.cycles;
   m.cycles_completed = c.cycles_completed;
   m.cycle_times_s = c.cycle_times_s;
   m.cycle_displacements_m = c.cycle_displacements_m;

@@ -134,9 +134,9 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   const double R0 = p.geometry.R0, L = p.geometry.L;
   {
     const scene::ContainerSpec c = scene::read_container(top, R0, L);
-    p.container.kind = c.kind == "cylinder" ? ContainerKind::Cylinder
-                       : c.kind == "box"    ? ContainerKind::Box
-                                            : ContainerKind::Duct;
+    p.container.shape = c.kind == "cylinder" ? ContainerShape::Cylinder
+                       : c.kind == "box"    ? ContainerShape::Box
+                                            : ContainerShape::Duct;
     p.container.radius = c.radius;
     p.container.period = c.period;
     p.container.radius_eff = c.kind == "duct" ? outer::duct_equivalent_radius(c.radius) : c.radius;
@@ -219,7 +219,7 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
         throw InputError("model1d.hydraulic_offsets.inner", fmt(p.swimmer.a_in, "m"),
                          "must be below half the contracted radius (" + fmt(0.5 * R_f, "m") +
                              ") so that the lumen stays open");
-      if (p.swimmer.outer == OuterFlow::Confined && p.container.kind == ContainerKind::Box)
+      if (p.swimmer.outer == OuterFlow::Confined && p.container.shape == ContainerShape::Box)
         throw InputError(m.path("outer_flow"), "\"confined\"",
                          "container.kind = \"box\" (a periodic box, 3D only) has no wall: use container.kind = "
                          "\"cylinder\" or \"duct\", or model1d.outer_flow = \"unbounded\"");

@@ -58,7 +58,7 @@ double max_diff(const VectorField& a, const VectorField& b) { return max_abs_dif
 TEST(Advection, SecondOrderInSpace) {
   double prev = 0;
   for (int n : {16, 32, 64}) {
-    MacGrid g(n, n, n, 1.0 / n, ContainerKind::PeriodicBox);
+    MacGrid g(n, n, n, 1.0 / n, GridBoundary::PeriodicBox);
     VectorField u(g), N(g), ex(g);
     sample(g, u, field);
     sample(g, ex, exact_term);
@@ -75,7 +75,7 @@ TEST(Advection, SecondOrderInSpace) {
 }
 
 TEST(Advection, TimeOrderOfTheIntegrators) {
-  MacGrid g(16, 16, 16, 1.0 / 16, ContainerKind::PeriodicBox);
+  MacGrid g(16, 16, 16, 1.0 / 16, GridBoundary::PeriodicBox);
   VectorField u0(g);
   sample(g, u0, field);
   const double T = 0.05;  // max|u| ~ 1.3: CFL sum ~ 3.5 dt/h
@@ -102,7 +102,7 @@ TEST(Advection, TaylorGreenThroughTheLieStep) {
   double prev = 0;
   for (int n : {16, 32, 64}) {
     const double h = 2 * kPi / n;
-    MacGrid g(n, n, 1, h, ContainerKind::PeriodicBox);
+    MacGrid g(n, n, 1, h, GridBoundary::PeriodicBox);
     StokesOptions opt;
     opt.advection.enabled = true;
     StokesSolver solver(g, FluidParams{1.0, nu}, opt);
@@ -140,7 +140,7 @@ TEST(Advection, TaylorGreenThroughTheLieStep) {
 }
 
 TEST(Advection, OffIsTheStokesStepAndGuardThrows) {
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(12, 8, 10, 0.1, kind);
     StokesOptions off;  // default: advection off
     StokesOptions off2;
@@ -150,7 +150,7 @@ TEST(Advection, OffIsTheStokesStepAndGuardThrows) {
     VectorField ua(g), f(g);
     sample(g, ua, field);
     for (auto& x : f.c[1]) x = 1.0;
-    if (kind == ContainerKind::SquareDuct) {
+    if (kind == GridBoundary::SquareDuct) {
       for (int c = 1; c < 3; ++c) {  // zero wall faces
         const auto d = g.dims(c);
         for (int k = 0; k < d[2]; ++k)

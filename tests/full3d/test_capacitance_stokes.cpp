@@ -132,30 +132,30 @@ void compare_with_direct(const MacGrid& g, double dt) {
 
 TEST(CapacitanceStokes, MatchesDirectQuasiSteadyEvenNx) {
   // rho/dt = 1e8 << mu/h^2 = 4.8e11: viscous (quasi-steady) regime
-  compare_with_direct(MacGrid(12, 10, 8, 0.5e-6 / 10, ContainerKind::SquareDuct), 1e-5);
+  compare_with_direct(MacGrid(12, 10, 8, 0.5e-6 / 10, GridBoundary::SquareDuct), 1e-5);
 }
 
 TEST(CapacitanceStokes, MatchesDirectInertialOddNx) {
   // rho/dt = 1e12 > mu/h^2 = 3e11: inertia-dominated
-  compare_with_direct(MacGrid(9, 8, 11, 0.5e-6 / 8, ContainerKind::SquareDuct), 1e-9);
+  compare_with_direct(MacGrid(9, 8, 11, 0.5e-6 / 8, GridBoundary::SquareDuct), 1e-9);
 }
 
 TEST(CapacitanceStokes, MatchesDirectSceneDt) {
   // the scenes' default dt = 1 ms at the demo's h: rho/dt is 1e-5 of mu lambda_1, and 1e-8 of
   // it at dt = 1 s (the free-slip base damps the axial plug flow by rho/dt only; the solver
   // takes that mode from the no-slip sine basis, so no accuracy is lost)
-  compare_with_direct(MacGrid(16, 16, 16, 0.5e-6 / 16, ContainerKind::SquareDuct), 1e-3);
-  compare_with_direct(MacGrid(10, 12, 9, 0.5e-6 / 12, ContainerKind::SquareDuct), 1.0);
+  compare_with_direct(MacGrid(16, 16, 16, 0.5e-6 / 16, GridBoundary::SquareDuct), 1e-3);
+  compare_with_direct(MacGrid(10, 12, 9, 0.5e-6 / 12, GridBoundary::SquareDuct), 1.0);
 }
 
 TEST(CapacitanceStokes, MatchesDirectThinDuct) {
   // ny = 2 (a single interior y face), odd nz, nx = 1 (only the axial mean mode)
-  compare_with_direct(MacGrid(5, 2, 7, 1e-7, ContainerKind::SquareDuct), 1e-6);
-  compare_with_direct(MacGrid(1, 6, 5, 1e-7, ContainerKind::SquareDuct), 1e-6);
+  compare_with_direct(MacGrid(5, 2, 7, 1e-7, GridBoundary::SquareDuct), 1e-6);
+  compare_with_direct(MacGrid(1, 6, 5, 1e-7, GridBoundary::SquareDuct), 1e-6);
 }
 
 TEST(CapacitanceStokes, ThreadsAgreeAndRepeat) {
-  const MacGrid g(14, 12, 10, 0.5e-6 / 12, ContainerKind::SquareDuct);
+  const MacGrid g(14, 12, 10, 0.5e-6 / 12, GridBoundary::SquareDuct);
   StokesSolver s1(g, kWater, options(1));
   StokesSolver s2(g, kWater, options(2));
   StokesSolver s2b(g, kWater, options(2));
@@ -175,7 +175,7 @@ TEST(CapacitanceStokes, ThreadsAgreeAndRepeat) {
 }
 
 TEST(CapacitanceStokes, CachesTwoDtValues) {
-  const MacGrid g(8, 8, 8, 1e-7, ContainerKind::SquareDuct);
+  const MacGrid g(8, 8, 8, 1e-7, GridBoundary::SquareDuct);
   StokesSolver s(g, kWater, options());
   VectorField u(g), f(g);
   random_state(g, u, f, 7);
@@ -201,7 +201,7 @@ TEST(CapacitanceStokes, DuctPaddingAroundTheCylinderChangesNothing) {
   o.cylinder.enabled = true;
   o.cylinder.radius = 5 * h;  // 10 cells across
   auto solve = [&](int n) {
-    const MacGrid g(8, n, n, h, ContainerKind::SquareDuct);
+    const MacGrid g(8, n, n, h, GridBoundary::SquareDuct);
     StokesSolver s(g, kWater, o);
     VectorField u(g), f(g);
     const double c0 = 0.5 * n * h;
@@ -255,7 +255,7 @@ TEST(FftFriendlySize, SmallestSevenSmoothSizeOfTheSameParity) {
 // holds them all, least recently used replaced beyond the capacity, and a dt whose factors were
 // dropped and rebuilt gives the bit-identical step.
 TEST(CapacitanceStokes, CacheKeepsTheLadderOfDtValues) {
-  const MacGrid g(8, 8, 8, 1e-7, ContainerKind::SquareDuct);
+  const MacGrid g(8, 8, 8, 1e-7, GridBoundary::SquareDuct);
   VectorField u0(g), f(g);
   random_state(g, u0, f, 11);
   std::vector<double> dts;
@@ -288,7 +288,7 @@ TEST(CapacitanceStokes, CacheKeepsTheLadderOfDtValues) {
 }
 
 TEST(CapacitanceStokes, GuardsOfTheProductPath) {
-  const MacGrid duct(8, 12, 12, 1e-7, ContainerKind::SquareDuct);
+  const MacGrid duct(8, 12, 12, 1e-7, GridBoundary::SquareDuct);
   StokesOptions o;
   EXPECT_NO_THROW(StokesSolver(duct, kWater, o));
   o.memory_limit_gib = 0.0;  // the factors of the cached dt values do not fit
@@ -304,10 +304,10 @@ TEST(CapacitanceStokes, GuardsOfTheProductPath) {
   o.cylinder.radius = 0.58e-6;  // wall-adjacent faces at r < Rc: not the scenes' geometry
   EXPECT_FALSE(CapacitanceStokes::supports_cylinder(duct, o.cylinder));
   EXPECT_THROW(StokesSolver(duct, kWater, o), swim::InputError);
-  const MacGrid box(8, 8, 8, 1e-7, ContainerKind::PeriodicBox);
+  const MacGrid box(8, 8, 8, 1e-7, GridBoundary::PeriodicBox);
   EXPECT_THROW(StokesSolver(box, kWater, o), swim::InputError);
   EXPECT_EQ(StokesSolver(box, kWater, StokesOptions{}).factor_bytes(), 0u);
-  EXPECT_THROW(CapacitanceStokes(MacGrid(4, 4, 4, 1.0, ContainerKind::PeriodicBox), 1.0, 1, FftOptions{}),
+  EXPECT_THROW(CapacitanceStokes(MacGrid(4, 4, 4, 1.0, GridBoundary::PeriodicBox), 1.0, 1, FftOptions{}),
                swim::InputError);
 }
 
@@ -339,7 +339,7 @@ struct Exact {
 // (the Laplacian of u_e by a fourth-order central difference with step 1e-3, and grad p_e
 // likewise: both far below the O(h^2) discretisation error of the grids used).
 double manufactured_error(int n) {
-  MacGrid g(n, n, n, 1.0 / n, ContainerKind::SquareDuct);
+  MacGrid g(n, n, n, 1.0 / n, GridBoundary::SquareDuct);
   const FluidParams fl{1.0, 1.0};
   const double dt = 0.05, alpha = fl.rho / dt;
   StokesSolver solver(g, fl, options());
@@ -399,7 +399,7 @@ TEST(CapacitanceStokes, ManufacturedSecondOrder) {
 
 TEST(CapacitanceStokes, SolveWithGivenRightHandSideEqualsStep) {
   // CapacitanceStokes::solve(b) with b = alpha u^n + f is the step (the fused form) bit for bit
-  const MacGrid g(6, 7, 5, 1e-7, ContainerKind::SquareDuct);
+  const MacGrid g(6, 7, 5, 1e-7, GridBoundary::SquareDuct);
   const double alpha = 1e8;
   CapacitanceStokes a(g, kWater.mu, 2, FftOptions{}), b(g, kWater.mu, 2, FftOptions{});
   EXPECT_EQ(a.wall_nodes(), 4 * 7 + 4 * 5 - 8);
@@ -528,7 +528,7 @@ void compare_cylinder_with_direct(const MacGrid& g, double rc, double dt, int ex
 TEST(CapacitanceStokes, CylinderMatchesDirectSceneGeometry) {
   // duct two cells wider than the cylinder, as in scene3d.cpp (here 16 x 12 x 12, Rc = 5 h)
   const double h = 0.5e-6 / 10;
-  const MacGrid g(16, 12, 12, h, ContainerKind::SquareDuct);
+  const MacGrid g(16, 12, 12, h, GridBoundary::SquareDuct);
   compare_cylinder_with_direct(g, 5 * h, 1e-3);
   compare_cylinder_with_direct(g, 5 * h, 1e-6);
   compare_cylinder_with_direct(g, 5 * h, 1e-9);
@@ -537,30 +537,30 @@ TEST(CapacitanceStokes, CylinderMatchesDirectSceneGeometry) {
 
 TEST(CapacitanceStokes, CylinderMatchesDirectOddShapes) {
   const double h = 0.5e-6 / 11;
-  compare_cylinder_with_direct(MacGrid(9, 13, 13, h, ContainerKind::SquareDuct), 5.5 * h, 1e-4);
-  compare_cylinder_with_direct(MacGrid(10, 11, 14, h, ContainerKind::SquareDuct), 4.5 * h, 1e-8);
-  compare_cylinder_with_direct(MacGrid(1, 12, 12, h, ContainerKind::SquareDuct), 5 * h, 1e-5);
+  compare_cylinder_with_direct(MacGrid(9, 13, 13, h, GridBoundary::SquareDuct), 5.5 * h, 1e-4);
+  compare_cylinder_with_direct(MacGrid(10, 11, 14, h, GridBoundary::SquareDuct), 4.5 * h, 1e-8);
+  compare_cylinder_with_direct(MacGrid(1, 12, 12, h, GridBoundary::SquareDuct), 5 * h, 1e-5);
 }
 
 TEST(CapacitanceStokes, CylinderMatchesDirectThinCylinder) {
   // a cylinder well inside the duct: fully outside cells, outside groups cut off from the
   // fluid (null vectors of the capacitance for every kx)
   const double h = 0.5e-6 / 12;
-  compare_cylinder_with_direct(MacGrid(8, 14, 14, h, ContainerKind::SquareDuct), 3.7 * h, 1e-3);
-  compare_cylinder_with_direct(MacGrid(7, 14, 14, h, ContainerKind::SquareDuct), 4.3 * h, 1e-9);
+  compare_cylinder_with_direct(MacGrid(8, 14, 14, h, GridBoundary::SquareDuct), 3.7 * h, 1e-3);
+  compare_cylinder_with_direct(MacGrid(7, 14, 14, h, GridBoundary::SquareDuct), 4.3 * h, 1e-9);
 }
 
 TEST(CapacitanceStokes, CylinderMatchesDirectAsymmetricMask) {
   // Rc = 2.5 h in a 7-cell duct: faces at r = Rc to round-off fall on different sides of the
   // floating-point mask test at mirrored positions, so the staircase is not exactly symmetric;
   // the solver detects it and factorises one unsplit block
-  compare_cylinder_with_direct(MacGrid(6, 7, 7, 1e-7, ContainerKind::SquareDuct), 2.5e-7, 1e-4, 1);
-  compare_cylinder_with_direct(MacGrid(5, 7, 7, 1e-7, ContainerKind::SquareDuct), 2.0e-7, 1e-8, 1);
+  compare_cylinder_with_direct(MacGrid(6, 7, 7, 1e-7, GridBoundary::SquareDuct), 2.5e-7, 1e-4, 1);
+  compare_cylinder_with_direct(MacGrid(5, 7, 7, 1e-7, GridBoundary::SquareDuct), 2.0e-7, 1e-8, 1);
 }
 
 TEST(CapacitanceStokes, CylinderThreadsAgreeAndCache) {
   const double h = 0.5e-6 / 10;
-  const MacGrid g(14, 12, 12, h, ContainerKind::SquareDuct);
+  const MacGrid g(14, 12, 12, h, GridBoundary::SquareDuct);
   StokesSolver s1(g, kWater, cyl_options(5 * h, 1));
   StokesSolver s2(g, kWater, cyl_options(5 * h, 2));
   StokesSolver s2b(g, kWater, cyl_options(5 * h, 2));
@@ -598,7 +598,7 @@ TEST(CapacitanceStokes, PressureOffLeavesTheVelocityAndTheLastPressure) {
   // for bit and leaves the pressure of the last step that computed it; out-of-place steps from
   // u^n and from rest equal the in-place step with u^n and with zero
   const double h = 0.5e-6 / 10;
-  const MacGrid g(14, 12, 12, h, ContainerKind::SquareDuct);
+  const MacGrid g(14, 12, 12, h, GridBoundary::SquareDuct);
   for (int threads : {1, 2})
     for (bool cylinder : {false, true}) {
       const StokesOptions o = cylinder ? cyl_options(5 * h, threads) : options(threads);

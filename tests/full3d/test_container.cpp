@@ -75,7 +75,7 @@ struct PoiseuilleResult {
 PoiseuilleResult poiseuille(int n, CylinderWall wall, bool use_pcg) {
   const double Rc = 0.25e-6, side = 2.25 * Rc, h = side / n;
   const double mu = 1.2e-3, rho = 1.0e3, g = 1.0e6;  // g in N/m^3
-  MacGrid grid(4, n, n, h, ContainerKind::SquareDuct);
+  MacGrid grid(4, n, n, h, GridBoundary::SquareDuct);
   CylinderSolver solver(grid, FluidParams{rho, mu}, Rc, wall, use_pcg);
   VectorField u(grid), f(grid);
   std::fill(f.c[0].begin(), f.c[0].end(), g);
@@ -165,7 +165,7 @@ void swimmer_regime(bool use_pcg) {
   // inside the cylinder: converges, divergence at round-off, constraint kept.
   const double Rc = 0.25e-6, side = 2.25 * Rc;
   const int n = 32;
-  MacGrid grid(64, n, n, side / n, ContainerKind::SquareDuct);
+  MacGrid grid(64, n, n, side / n, GridBoundary::SquareDuct);
   CylinderSolver solver(grid, FluidParams{1.0e3, 1.2e-3}, Rc, CylinderWall::Staircase, use_pcg);
   VectorField u(grid), f(grid);
   std::mt19937 rng(5);
@@ -200,12 +200,12 @@ TEST(CylinderContainer, SwimmerRegimeStepReferencePcg) {
 }
 
 TEST(CylinderContainer, RejectsBadGeometry) {
-  MacGrid duct(4, 16, 16, 1e-6 / 16, ContainerKind::SquareDuct);
+  MacGrid duct(4, 16, 16, 1e-6 / 16, GridBoundary::SquareDuct);
   StokesOptions opt;
   opt.cylinder.enabled = true;
   opt.cylinder.radius = 0.6e-6;  // 2 Rc > side
   EXPECT_THROW(StokesSolver(duct, FluidParams{}, opt), swim::InputError);
-  MacGrid box(8, 8, 8, 1e-6 / 8, ContainerKind::PeriodicBox);
+  MacGrid box(8, 8, 8, 1e-6 / 8, GridBoundary::PeriodicBox);
   opt.cylinder.radius = 0.25e-6;
   EXPECT_THROW(StokesSolver(box, FluidParams{}, opt), swim::InputError);
 }
@@ -221,7 +221,7 @@ TEST(CylinderContainer, StaircaseHydraulicRadiusIsWithinHalfACellOfRc) {
   for (int n : {24, 32, 40, 48, 56, 64}) {
     const double h = 2.0 * Rc / n;
     const int nd = fft_friendly_size(n + 2);
-    MacGrid grid(4, nd, nd, h, ContainerKind::SquareDuct);
+    MacGrid grid(4, nd, nd, h, GridBoundary::SquareDuct);
     CylinderSolver solver(grid, FluidParams{rho, mu}, Rc, CylinderWall::Staircase, false);
     VectorField u(grid), f(grid);
     std::fill(f.c[0].begin(), f.c[0].end(), g);

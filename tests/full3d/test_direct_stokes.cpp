@@ -151,24 +151,24 @@ void compare_with_iterative(const MacGrid& g, bool cylinder, double dt) {
 }  // namespace
 
 TEST(DirectStokes, MatchesIterativeDuctEvenNx) {
-  compare_with_iterative(MacGrid(12, 10, 8, 0.5e-6 / 10, ContainerKind::SquareDuct), false, 1e-5);
+  compare_with_iterative(MacGrid(12, 10, 8, 0.5e-6 / 10, GridBoundary::SquareDuct), false, 1e-5);
 }
 
 TEST(DirectStokes, MatchesIterativeDuctOddNxUnitParameters) {
   // a non-quasi-steady regime too: rho/dt comparable with mu/h^2
-  compare_with_iterative(MacGrid(9, 8, 11, 0.5e-6 / 8, ContainerKind::SquareDuct), false, 1e-9);
+  compare_with_iterative(MacGrid(9, 8, 11, 0.5e-6 / 8, GridBoundary::SquareDuct), false, 1e-9);
 }
 
 TEST(DirectStokes, MatchesIterativeCylinder) {
-  compare_with_iterative(MacGrid(8, 18, 18, 2.25 * kRc / 18, ContainerKind::SquareDuct), true, 1e-5);
+  compare_with_iterative(MacGrid(8, 18, 18, 2.25 * kRc / 18, GridBoundary::SquareDuct), true, 1e-5);
 }
 
 TEST(DirectStokes, MatchesIterativeCylinderOddNx) {
-  compare_with_iterative(MacGrid(7, 16, 16, 2.25 * kRc / 16, ContainerKind::SquareDuct), true, 1e-8);
+  compare_with_iterative(MacGrid(7, 16, 16, 2.25 * kRc / 16, GridBoundary::SquareDuct), true, 1e-8);
 }
 
 TEST(DirectStokes, RefactorisesWhenDtChanges) {
-  const MacGrid g(8, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
+  const MacGrid g(8, 12, 12, 2.25 * kRc / 12, GridBoundary::SquareDuct);
   const FluidParams water{1.0e3, 1.2e-3};
   reference::ReferenceStokes s(g, water, options(true, reference::Method::SparseLu));
   VectorField u(g), f(g);
@@ -198,7 +198,7 @@ TEST(DirectStokes, RefactorisesWhenDtChanges) {
 }
 
 TEST(DirectStokes, ThreadsGiveIdenticalResults) {
-  const MacGrid g(10, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
+  const MacGrid g(10, 12, 12, 2.25 * kRc / 12, GridBoundary::SquareDuct);
   const FluidParams water{1.0e3, 1.2e-3};
   reference::ReferenceStokes s1(g, water, options(true, reference::Method::SparseLu, 1));
   reference::ReferenceStokes s2(g, water, options(true, reference::Method::SparseLu, 2));
@@ -212,19 +212,19 @@ TEST(DirectStokes, ThreadsGiveIdenticalResults) {
 }
 
 TEST(DirectStokes, StaircaseWallOnly) {
-  const MacGrid duct(8, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
+  const MacGrid duct(8, 12, 12, 2.25 * kRc / 12, GridBoundary::SquareDuct);
   reference::Options o = options(true, reference::Method::SparseLu);
   EXPECT_NO_THROW(reference::ReferenceStokes(duct, FluidParams{}, o));
   o.wall.wall = reference::CylinderWall::GhostLinear;
   EXPECT_THROW(reference::ReferenceStokes(duct, FluidParams{}, o), swim::InputError);
   o.method = reference::Method::Pcg;
   EXPECT_NO_THROW(reference::ReferenceStokes(duct, FluidParams{}, o));
-  const MacGrid box(8, 8, 8, 1e-7, ContainerKind::PeriodicBox);
+  const MacGrid box(8, 8, 8, 1e-7, GridBoundary::PeriodicBox);
   EXPECT_THROW(reference::ReferenceStokes(box, FluidParams{}, reference::Options{}), swim::InputError);
 }
 
 TEST(DirectStokes, SetPressure) {
-  const MacGrid g(8, 12, 12, 2.25 * kRc / 12, ContainerKind::SquareDuct);
+  const MacGrid g(8, 12, 12, 2.25 * kRc / 12, GridBoundary::SquareDuct);
   StokesSolver s(g, FluidParams{});
   ScalarField p(g);
   for (std::size_t i = 0; i < p.v.size(); ++i) p.v[i] = double(i);

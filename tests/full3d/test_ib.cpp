@@ -29,7 +29,7 @@ Eigen::Vector3d field_total(const MacGrid& g, const VectorField& f) {
 
 TEST(ImmersedBoundary, SpreadConservesTotalForcePeriodicBox) {
   std::mt19937 rng(1);
-  MacGrid g(12, 10, 9, 0.1, ContainerKind::PeriodicBox);
+  MacGrid g(12, 10, 9, 0.1, GridBoundary::PeriodicBox);
   // points anywhere, including outside [0, L) (periodic images)
   Eigen::Matrix3Xd X = random_points(g, 50, -0.3, rng);
   const Eigen::Matrix3Xd F = random_forces(50, rng);
@@ -41,7 +41,7 @@ TEST(ImmersedBoundary, SpreadConservesTotalForcePeriodicBox) {
 
 TEST(ImmersedBoundary, SpreadConservesTotalForceAwayFromDuctWalls) {
   std::mt19937 rng(2);
-  MacGrid g(12, 10, 9, 0.1, ContainerKind::SquareDuct);
+  MacGrid g(12, 10, 9, 0.1, GridBoundary::SquareDuct);
   const Eigen::Matrix3Xd X = random_points(g, 50, 2.01 * g.h(), rng);
   const Eigen::Matrix3Xd F = random_forces(50, rng);
   VectorField f(g);
@@ -51,7 +51,7 @@ TEST(ImmersedBoundary, SpreadConservesTotalForceAwayFromDuctWalls) {
 
 TEST(ImmersedBoundary, SpreadAndInterpolateAreAdjoint) {
   std::mt19937 rng(3);
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(10, 8, 12, 0.05, kind);
     const Eigen::Matrix3Xd X = random_points(g, 40, 0.0, rng);  // includes nodes near walls
     const Eigen::Matrix3Xd F = random_forces(40, rng);
@@ -74,7 +74,7 @@ TEST(ImmersedBoundary, SpreadAndInterpolateAreAdjoint) {
 
 TEST(ImmersedBoundary, InterpolationReproducesConstantsAndLinearFields) {
   std::mt19937 rng(4);
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(16, 14, 12, 0.1, kind);
     const double a[3] = {0.3, -1.2, 2.0};
     const double b[3][3] = {{1.0, -2.0, 0.5}, {0.7, 0.1, -0.4}, {-1.5, 0.9, 2.2}};
@@ -93,7 +93,7 @@ TEST(ImmersedBoundary, InterpolationReproducesConstantsAndLinearFields) {
         EXPECT_NEAR(Uc(c, k), a[c], 1e-14);
         EXPECT_NEAR(Ul(c, k), a[c] + b[c][0] * X(0, k) + b[c][1] * X(1, k) + b[c][2] * X(2, k), 1e-13);
       }
-    if (kind == ContainerKind::PeriodicBox) {  // constants everywhere, across the seams
+    if (kind == GridBoundary::PeriodicBox) {  // constants everywhere, across the seams
       const Eigen::Matrix3Xd Y = random_points(g, 30, -0.5, rng);
       interpolate(g, cst, Y, Uc);
       for (int k = 0; k < Y.cols(); ++k)

@@ -75,7 +75,7 @@ TEST(ImmersedBoundaryParallel, KernelWeightsMatchEquation18) {
 
 TEST(ImmersedBoundaryParallel, SpreadAndInterpolateIndependentOfThreads) {
   std::mt19937 rng(11);
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(24, 10, 9, 0.05, kind);
     const Eigen::Matrix3Xd X = random_cloud(g, 400, rng);
     const Eigen::Matrix3Xd F = random_forces(400, rng);
@@ -112,7 +112,7 @@ TEST(ImmersedBoundaryParallel, ClusteredNodesAndMoreThreadsThanPlanes) {
   std::mt19937 rng(12);
   // all nodes within one x cell next to the seam and one z cell next to a wall (duct) or
   // the seam (box): most threads own no node
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
   MacGrid g(16, 8, 12, 0.1, kind);
   Eigen::Matrix3Xd X = random_cloud(g, 60, rng);
   for (int k = 0; k < X.cols(); ++k) {
@@ -129,7 +129,7 @@ TEST(ImmersedBoundaryParallel, ClusteredNodesAndMoreThreadsThanPlanes) {
   }
   }
   // n < stencil width, more threads than z planes, fewer nodes than threads
-  MacGrid s(3, 4, 3, 0.2, ContainerKind::PeriodicBox);
+  MacGrid s(3, 4, 3, 0.2, GridBoundary::PeriodicBox);
   const Eigen::Matrix3Xd Y = random_cloud(s, 2, rng), G = random_forces(2, rng);
   VectorField s1(s);
   spread(s, Y, G, s1, 1);
@@ -142,7 +142,7 @@ TEST(ImmersedBoundaryParallel, ClusteredNodesAndMoreThreadsThanPlanes) {
 
 TEST(ImmersedBoundaryParallel, AdjointAndConservativeWithThreads) {
   std::mt19937 rng(13);
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(20, 8, 12, 0.05, kind);
     const Eigen::Matrix3Xd X = random_cloud(g, 300, rng);
     const Eigen::Matrix3Xd F = random_forces(300, rng);
@@ -162,7 +162,7 @@ TEST(ImmersedBoundaryParallel, AdjointAndConservativeWithThreads) {
       lhs *= g.h() * g.h() * g.h();
       const double rhs = (F.array() * Ui.array()).sum();
       EXPECT_NEAR(lhs, rhs, 1e-12 * std::abs(rhs)) << to_string(kind) << " threads " << thr;
-      if (kind == ContainerKind::PeriodicBox) {  // no wall truncation: total force is conserved
+      if (kind == GridBoundary::PeriodicBox) {  // no wall truncation: total force is conserved
         Eigen::Vector3d tot = Eigen::Vector3d::Zero();
         for (int c = 0; c < 3; ++c)
           for (double x : f.c[c]) tot[c] += x;
@@ -172,7 +172,7 @@ TEST(ImmersedBoundaryParallel, AdjointAndConservativeWithThreads) {
     }
   }
   // duct, nodes kept 2h from the walls: total force conserved too
-  MacGrid g(20, 10, 10, 0.05, ContainerKind::SquareDuct);
+  MacGrid g(20, 10, 10, 0.05, GridBoundary::SquareDuct);
   Eigen::Matrix3Xd X = random_cloud(g, 200, rng);
   for (int k = 0; k < X.cols(); ++k)
     for (int d = 1; d < 3; ++d) X(d, k) = 2.01 * g.h() + std::fmod(std::abs(X(d, k)), g.length(d) - 4.02 * g.h());

@@ -16,7 +16,7 @@ constexpr double kR0 = 0.125e-6, kL = 0.4e-6, kBox = 0.5e-6;
 constexpr int kN = 16;
 
 struct Problem {
-  MacGrid grid{kN, kN, kN, kBox / kN, ContainerKind::PeriodicBox};
+  MacGrid grid{kN, kN, kN, kBox / kN, GridBoundary::PeriodicBox};
   CylinderMesh mesh = make_cylinder_for_grid(kR0, kL, kBox / kN, Eigen::Vector3d(0.05e-6, 0.25e-6, 0.25e-6));
 };
 

@@ -28,10 +28,10 @@ void randomise(const MacGrid& g, VectorField& u, std::mt19937& rng) {
 }  // namespace
 
 TEST(MacGrid, LayoutAndValidation) {
-  MacGrid box(8, 6, 4, 0.1, ContainerKind::PeriodicBox);
+  MacGrid box(8, 6, 4, 0.1, GridBoundary::PeriodicBox);
   EXPECT_EQ(box.size(0), 8u * 6 * 4);
   EXPECT_EQ(box.size(1), 8u * 6 * 4);
-  MacGrid duct(8, 6, 4, 0.1, ContainerKind::SquareDuct);
+  MacGrid duct(8, 6, 4, 0.1, GridBoundary::SquareDuct);
   EXPECT_EQ(duct.size(0), 8u * 6 * 4);
   EXPECT_EQ(duct.size(1), 8u * 7 * 4);
   EXPECT_EQ(duct.size(2), 8u * 6 * 5);
@@ -39,14 +39,14 @@ TEST(MacGrid, LayoutAndValidation) {
   EXPECT_DOUBLE_EQ(x[0], 0.25);
   EXPECT_DOUBLE_EQ(x[1], 0.0);
   EXPECT_DOUBLE_EQ(x[2], 0.15);
-  EXPECT_THROW(MacGrid(8, 1, 4, 0.1, ContainerKind::SquareDuct), swim::InputError);
-  EXPECT_THROW(MacGrid(8, 4, 4, -1.0, ContainerKind::PeriodicBox), swim::InputError);
-  EXPECT_THROW(container_kind_from_string("container", "cylinder?"), swim::InputError);
+  EXPECT_THROW(MacGrid(8, 1, 4, 0.1, GridBoundary::SquareDuct), swim::InputError);
+  EXPECT_THROW(MacGrid(8, 4, 4, -1.0, GridBoundary::PeriodicBox), swim::InputError);
+  EXPECT_THROW(grid_boundary_from_string("container", "cylinder?"), swim::InputError);
 }
 
 TEST(MacOperators, DivergenceIsMinusGradientTranspose) {
   std::mt19937 rng(3);
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(6, 5, 4, 0.3, kind);
     VectorField u(g), gp(g);
     ScalarField p(g), du(g);
@@ -63,7 +63,7 @@ TEST(MacOperators, DivergenceIsMinusGradientTranspose) {
 
 TEST(MacOperators, LaplacianIsSymmetricNegative) {
   std::mt19937 rng(5);
-  for (auto kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     MacGrid g(5, 4, 6, 0.2, kind);
     VectorField a(g), b(g), La(g), Lb(g);
     randomise(g, a, rng);
@@ -77,7 +77,7 @@ TEST(MacOperators, LaplacianIsSymmetricNegative) {
 
 TEST(MacOperators, PeriodicLaplacianSymbol) {
   // L e^{i k x} = -(4/h^2) sin^2(k h / 2) e^{i k x}: check on a cosine mode of u.
-  MacGrid g(16, 8, 8, 0.5, ContainerKind::PeriodicBox);
+  MacGrid g(16, 8, 8, 0.5, GridBoundary::PeriodicBox);
   VectorField u(g), Lu(g);
   const auto d = g.dims(0);
   const double k = 2 * std::numbers::pi * 3 / g.length(0);
@@ -93,7 +93,7 @@ TEST(MacOperators, DivergenceMaximumIsNaNForAnyNonFiniteVelocity) {
   // max |D u| without storing D u: equal to the stored divergence's maximum on 1 and 3 threads,
   // and NaN when any one face value (interior, wall or seam face) is NaN or infinite
   std::mt19937 rng(5);
-  for (ContainerKind kind : {ContainerKind::PeriodicBox, ContainerKind::SquareDuct}) {
+  for (GridBoundary kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
     const MacGrid g(8, 6, 5, 0.1, kind);
     VectorField u(g);
     randomise(g, u, rng);

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "full3d/operators.hpp"
-#include "full3d/reference_duct_fft.hpp"
+#include "full3d/reference/duct_fft.hpp"
 #include "full3d/stokes.hpp"
 #include "tests/full3d/reference/reference_stokes.hpp"
 #include "tests/full3d/test_support.hpp"
@@ -120,7 +120,7 @@ struct AnySolver {
 
 // One step from u^n = 0.3 u_e to the exact u_e with forcing
 // f = rho (u_e - u^n)/dt - mu Lap u_e + grad p_e, evaluated at the faces.
-Errors run_manufactured(ContainerKind kind, int n, const Manufactured& m, StokesStats* stats = nullptr,
+Errors run_manufactured(GridBoundary kind, int n, const Manufactured& m, StokesStats* stats = nullptr,
                         Path path = Path::Product) {
   MacGrid g(n, n, n, 1.0 / n, kind);
   const FluidParams fl{1.0, 1.0};
@@ -161,7 +161,7 @@ Errors run_manufactured(ContainerKind kind, int n, const Manufactured& m, Stokes
   return e;
 }
 
-void check_orders(ContainerKind kind, const Manufactured& m, double min_order_u, double min_order_p,
+void check_orders(GridBoundary kind, const Manufactured& m, double min_order_u, double min_order_p,
                   Path path = Path::Product) {
   const int ns[3] = {16, 32, 64};
   Errors e[3];
@@ -187,7 +187,7 @@ void check_orders(ContainerKind kind, const Manufactured& m, double min_order_u,
   }
 }
 
-double divergence_ratio(ContainerKind kind, Path path = Path::Product) {
+double divergence_ratio(GridBoundary kind, Path path = Path::Product) {
   MacGrid g(24, 16, 20, 0.01, kind);
   AnySolver solver(g, FluidParams{1.0e3, 1.2e-3}, path);
   VectorField u(g), f(g);
@@ -211,26 +211,26 @@ double divergence_ratio(ContainerKind kind, Path path = Path::Product) {
 }  // namespace
 
 TEST(StokesStep, DivergenceFreeToRoundOffPeriodicBox) {
-  const double r = divergence_ratio(ContainerKind::PeriodicBox);
+  const double r = divergence_ratio(GridBoundary::PeriodicBox);
   std::printf("box: max|Du| / (max|u|/h) = %.2e\n", r);
   EXPECT_LT(r, 1e-12);
 }
 
 TEST(StokesStep, DivergenceFreeToRoundOffSquareDuct) {
-  const double r = divergence_ratio(ContainerKind::SquareDuct);
+  const double r = divergence_ratio(GridBoundary::SquareDuct);
   std::printf("duct (capacitance, production): max|Du| / (max|u|/h) = %.2e\n", r);
   EXPECT_LT(r, 1e-12);
-  const double ri = divergence_ratio(ContainerKind::SquareDuct, Path::ReferencePcg);
+  const double ri = divergence_ratio(GridBoundary::SquareDuct, Path::ReferencePcg);
   std::printf("duct (reference PCG): max|Du| / (max|u|/h) = %.2e\n", ri);
   EXPECT_LT(ri, 1e-12);
-  const double rb = divergence_ratio(ContainerKind::SquareDuct, Path::PressureCorrection);
+  const double rb = divergence_ratio(GridBoundary::SquareDuct, Path::PressureCorrection);
   std::printf("duct (bench's pressure-correction step): max|Du| / (max|u|/h) = %.2e\n", rb);
   EXPECT_LT(rb, 1e-12);
 }
 
 TEST(StokesStep, SecondOrderPeriodicBox) {
   // Every operator is second order and the solve is exact: order 2 in u and p.
-  check_orders(ContainerKind::PeriodicBox, box_solution(), 1.9, 1.9);  // measured 1.97..2.01 (p: 1.88, 1.97)
+  check_orders(GridBoundary::PeriodicBox, box_solution(), 1.9, 1.9);  // measured 1.97..2.01 (p: 1.88, 1.97)
 }
 
 TEST(StokesStep, SquareDuctOrder) {
@@ -238,9 +238,9 @@ TEST(StokesStep, SquareDuctOrder) {
   // O(1) local truncation error in the first cell layer (the error it induces is
   // O(h^2) globally, as for a Dirichlet problem). Pressure: measured 1.79 -> 1.91,
   // approaching 2; asserted >= 1.8 on the finest pair.
-  check_orders(ContainerKind::SquareDuct, duct_solution(), 1.9, 1.8);  // capacitance (production)
+  check_orders(GridBoundary::SquareDuct, duct_solution(), 1.9, 1.8);  // capacitance (production)
 }
 
 TEST(StokesStep, SquareDuctOrderReferencePcg) {
-  check_orders(ContainerKind::SquareDuct, duct_solution(), 1.9, 1.8, Path::ReferencePcg);
+  check_orders(GridBoundary::SquareDuct, duct_solution(), 1.9, 1.8, Path::ReferencePcg);
 }

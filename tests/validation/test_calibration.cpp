@@ -100,6 +100,23 @@ TEST(HydraulicRadii, HeldTubeInPaperCylinder) {
   EXPECT_NEAR(r.container_radius_effective_m, p.container_radius, p.h);
 }
 
+// A grid whose lumen is too coarse for the Poiseuille fit (tiny_3d_cycle: 12 cells across
+// the duct, R0 = 3.1 h, one distinct radius inside R0 - 2h) is refused before the held-tube
+// solve, for that reason and with the remedy that helps (a finer grid), rather than by the
+// solve's slip check with the opposite advice.
+TEST(HydraulicRadii, ALumenTooCoarseForTheFitIsRefusedBeforeTheSolve) {
+  scene::json resolved;
+  const full3d::Params3d p =
+      full3d::read_scene3d(scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json"), resolved);
+  try {
+    validation::measure_hydraulic_radii(p);
+    FAIL() << "the hydraulic radii were measured on a lumen of " << p.R0 / p.h << " cells";
+  } catch (const NumericalError& e) {
+    EXPECT_NE(e.cause().find("distinct radii"), std::string::npos) << e.what();
+    EXPECT_NE(e.remedy().find("refine"), std::string::npos) << e.what();
+  }
+}
+
 // The wet confirmation of a static load: the immersed tube, its wall held axisymmetric (the
 // branch the static path computes), settles on the static displacement. Coarse grid, 5 % of
 // the load that holds R_f.

@@ -93,8 +93,8 @@ struct DirectStokes::Impl {
 
   Impl(const MacGrid& g, double mu_, const CylinderOptions* cyl, int thr, const FftOptions& fft)
       : grid(g), mu(mu_), sigma(mu_ / g.h()), threads(std::max(1, thr)), nx(g.nx()), nxh(g.nx() / 2 + 1) {
-    if (g.kind() != ContainerKind::SquareDuct)
-      throw InputError("container", to_string(g.kind()), "the direct Stokes solver needs a square_duct grid");
+    if (g.boundary() != GridBoundary::SquareDuct)
+      throw InputError("container", to_string(g.boundary()), "the direct Stokes solver needs a square_duct grid");
     const int ny = g.ny(), nz = g.nz();
     for (int c = 0; c < 4; ++c) dims[c] = g.dims(c);
     off[0] = 0;

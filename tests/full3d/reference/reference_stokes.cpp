@@ -7,7 +7,7 @@
 
 #include "common/errors.hpp"
 #include "full3d/operators.hpp"
-#include "full3d/reference_duct_fft.hpp"
+#include "full3d/reference/duct_fft.hpp"
 #include "tests/full3d/reference/direct_stokes.hpp"
 
 namespace swim::full3d::reference {

@@ -1,7 +1,8 @@
-// REFERENCE, not a production Stokes path: the transform-diagonal pieces of the square duct
-// and the incremental pressure-correction step built from them. `swim run` never uses them;
-// the product's duct and cylinder step is the capacitance solver (capacitance_stokes.hpp,
-// behind StokesSolver). Two users:
+// The reference duct solver of `swim bench` and of the tests: the transform-diagonal pieces of
+// the square duct and the incremental pressure-correction step built from them. Not a
+// production Stokes path and not in the product library swim_full3d: it is its own library,
+// swim_full3d_duct_fft, which `swim run` never reaches; the product's duct and cylinder step
+// is the capacitance solver (capacitance_stokes.hpp, behind StokesSolver). Two users:
 //   * `swim bench` times PressureCorrectionStep::step as its cost unit ("bare FFT solve":
 //     the fewest transforms one divergence-free duct step can take);
 //   * the test references of tests/full3d/reference/ (the Cahouet-Chabard PCG) build on

@@ -1,4 +1,4 @@
-#include "full3d/reference_duct_fft.hpp"
+#include "full3d/reference/duct_fft.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -122,8 +122,8 @@ class DiagonalSolver {
 };
 
 void require_duct(const MacGrid& g, const char* what) {
-  if (g.kind() != ContainerKind::SquareDuct)
-    throw InputError("container", to_string(g.kind()), std::string(what) + " needs a square_duct grid");
+  if (g.boundary() != GridBoundary::SquareDuct)
+    throw InputError("container", to_string(g.boundary()), std::string(what) + " needs a square_duct grid");
 }
 
 }  // namespace
