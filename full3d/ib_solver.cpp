@@ -96,6 +96,11 @@ void project_axisymmetric(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, E
   }
 }
 
+namespace {
+// The step of the fluid's inertia term for a (half) step dt: IbOptions::inertia_step when set.
+double inertia_step(const IbOptions& o, double dt) { return o.inertia_step > 0.0 ? o.inertia_step : dt; }
+}  // namespace
+
 IbStepStats IbSolver::step(IbState& s, double dt) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(opt_.dt_key, significant(dt, 4), "a positive time step in s");
   IbStepStats st;
@@ -113,9 +118,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   VectorField& u = work_u_;
   const Eigen::Matrix3Xd accel = (s.V - s.V_prev) / dt;
   Eigen::Matrix3Xd U, Xnew;
-  // the fluid's inertia step (IbOptions::inertia_step): the step's own (half) step, or fixed
-  const double tau = opt_.inertia_step > 0.0 ? opt_.inertia_step : dt;
-  const double tau_half = opt_.inertia_step > 0.0 ? opt_.inertia_step : 0.5 * dt;
+  const double tau = inertia_step(opt_, dt), tau_half = inertia_step(opt_, 0.5 * dt);
 
   Eigen::Matrix3Xd F = fluid_force(s.X, s.t, accel);
   guard_finite(F, "membrane force", s.t);
@@ -224,7 +227,7 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
     v /= vmax;
     const Eigen::Matrix3Xd dF = (elastic_forces(mesh_, s.X + eps * v, membrane_, opt_.threads) - F0) / eps;
     spread(grid_, s.X, dF, f, opt_.threads);
-    stokes_.step_from_rest(u, f, opt_.inertia_step > 0.0 ? opt_.inertia_step : dt);
+    stokes_.step_from_rest(u, f, inertia_step(opt_, dt));
     interpolate(grid_, u, s.X, U, opt_.threads);
     lambda = U.norm() / v.norm();  // |A v| / |v|
     v = -U;

@@ -225,6 +225,17 @@ void RunCache::reject(const std::string& path, const std::string& reason) {
   rejected_.push_back({{"path", path}, {"reason", reason}});
 }
 
+bool RunCache::resumes(const std::string& dir, const std::function<void()>& check) {
+  if (!interrupted_run(dir)) return false;
+  try {
+    check();
+    return true;
+  } catch (const InputError& e) {
+    reject(dir, std::string("interrupted run not resumed: ") + e.what());
+    return false;
+  }
+}
+
 /// A finished run (summary status not "running") in `dir` whose files pass their checks
 /// (output::verify_folder: summary.json's own checksum, every listed file's size and checksum,
 /// kCachedRunFiles listed), or null. A finished run that fails them is recorded as rejected,
@@ -318,15 +329,7 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   r.cached = !summary.is_null();
   // a run of this physics stopped part way (the suite was interrupted) continues from its
   // checkpoint when the checkpoint matches the scene
-  bool resume = false;
-  if (!r.cached && interrupted_run(dir)) {
-    try {
-      full3d::check_resumable(p, resolved, dir);
-      resume = true;
-    } catch (const InputError& e) {
-      reject(dir, std::string("interrupted run not resumed: ") + e.what());
-    }
-  }
+  const bool resume = !r.cached && resumes(dir, [&] { full3d::check_resumable(p, resolved, dir); });
   if (!r.cached && !resume) {
     fs::remove_all(dir);
     output::reset_ledger(dir);  // the folder's files are this run's alone
@@ -378,15 +381,7 @@ RunAxi RunCache::run_axi(const json& sc, int progress) {
   RunAxi r;
   r.cached = !summary.is_null();
   // an interrupted run of this physics continues from its checkpoint (as run_3d's)
-  bool resume = false;
-  if (!r.cached && interrupted_run(dir)) {
-    try {
-      axi::check_resumable_axi(p, resolved, dir);
-      resume = true;
-    } catch (const InputError& e) {
-      reject(dir, std::string("interrupted run not resumed: ") + e.what());
-    }
-  }
+  const bool resume = !r.cached && resumes(dir, [&] { axi::check_resumable_axi(p, resolved, dir); });
   if (!r.cached) {
     if (!resume) {
       fs::remove_all(dir);

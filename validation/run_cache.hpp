@@ -120,6 +120,9 @@ class RunCache {
   json find_finished(std::string& dir, const std::string& key, bool axi_tier);
   std::string cached_calibration(const json& physics);
   void reject(const std::string& path, const std::string& reason);
+  /// Whether the interrupted run in dir continues from its checkpoint: `check` (the tier's
+  /// check_resumable) accepts it; a checkpoint it refuses is recorded as rejected.
+  bool resumes(const std::string& dir, const std::function<void()>& check);
 
   std::string runs_dir_, cal_dir_;
   int threads_;
