@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <vector>
 
 #include "common/errors.hpp"
 #include "full3d/ib.hpp"
@@ -11,7 +13,8 @@ namespace swim::full3d {
 const std::vector<std::string> kSeriesColumns = [] {
   std::vector<std::string> c = record::common_series_columns();
   for (const char* k : {"elastic_energy_J", "bending_energy_J", "kinetic_energy_J", "active_segment",
-                        "cycles_completed", "cfl", "stokes_iterations", "max_divergence_per_s", "max_edge_m", "dt_s", "wrinkle_m"})
+                        "cycles_completed", "cfl", "stokes_iterations", "max_divergence_per_s", "max_edge_m", "dt_s", "wrinkle_m",
+                        "wrinkle_mode"})
     c.push_back(k);
   return c;
 }();
@@ -27,6 +30,42 @@ double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, con
     worst = std::max(worst, std::sqrt(s2 / mesh.n_theta));
   }
   return worst;
+}
+
+int wall_wrinkle_mode(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
+                      const Eigen::VectorXd& ring_r) {
+  const int nt = mesh.n_theta;
+  int worst = 0;
+  double worst_s2 = -1.0;
+  for (int r = 0; r < mesh.n_rings; ++r) {
+    double s2 = 0.0;
+    for (int i = 0; i < nt; ++i) s2 += std::pow(node_r[mesh.node(r, i)] - ring_r[r], 2);
+    if (s2 > worst_s2) worst_s2 = s2, worst = r;
+  }
+  if (!(std::sqrt(worst_s2 / nt) > 1e-9 * ring_r[worst])) return 0;
+  double yc = 0.0, zc = 0.0;
+  for (int i = 0; i < nt; ++i) yc += X(1, mesh.node(worst, i)), zc += X(2, mesh.node(worst, i));
+  yc /= nt, zc /= nt;
+  // e^{i m phi_i} by repeated multiplication (one complex product per node and mode)
+  std::vector<std::complex<double>> z(nt), w(nt);
+  std::vector<double> d(nt);
+  for (int i = 0; i < nt; ++i) {
+    const int k = mesh.node(worst, i);
+    z[i] = std::polar(1.0, std::atan2(X(2, k) - zc, X(1, k) - yc));
+    w[i] = z[i];
+    d[i] = node_r[k] - ring_r[worst];
+  }
+  int best = 0;
+  double best_a = -1.0;
+  for (int m = 2; 2 * m <= nt; ++m) {
+    std::complex<double> a = 0.0;
+    for (int i = 0; i < nt; ++i) {
+      w[i] *= z[i];
+      a += d[i] * w[i];
+    }
+    if (std::norm(a) > best_a) best_a = std::norm(a), best = m;
+  }
+  return best;
 }
 
 void WallSplit::add_step(const IbStepStats& st) {
@@ -170,12 +209,15 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
   }
   for (int r = 0; r + 1 < mesh.n_rings; ++r)
     vol += 0.5 * M_PI * (rr[r] * rr[r] + rr[r + 1] * rr[r + 1]) * (xr[r + 1] - xr[r]);
+  const double wrinkle = wall_wrinkle(mesh, rn, rr);
+  const int wrinkle_mode = wall_wrinkle_mode(mesh, s.X, rn, rr);
+  if (wrinkle > max_wrinkle_) max_wrinkle_ = wrinkle, max_wrinkle_mode_ = wrinkle_mode;
   const double row[] = {s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                         rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                         double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
                         last_divergence_, max_edge_t_ == s.t ? max_edge_ : max_edge_length(mesh, s.X),
                         n > 0 ? dt_last : 0.0,
-                        wall_wrinkle(mesh, rn, rr)};
+                        wrinkle, double(wrinkle_mode)};
   // a row that passes output.max_bytes ends the run (NumericalError) once it is written: its
   // radius snapshot is still written, and the run's failure path does not record it again
   last_recorded_ = n;
@@ -211,6 +253,8 @@ void Measurements::records(Self& self, F&& f) {
   f("last_stokes_iterations", self.last_iterations_);
   f("last_divergence", self.last_divergence_);
   f("last_recorded", self.last_recorded_);
+  f("max_wrinkle", self.max_wrinkle_);
+  f("max_wrinkle_mode", self.max_wrinkle_mode_);
 }
 
 void Measurements::save(CheckpointWriter& w) const {

@@ -31,6 +31,12 @@ extern const std::vector<std::string> kSeriesColumns;
 /// 0; a hoop-compressed lattice that buckles into azimuthal lobes (docs/full3d.md, "Wall
 /// wrinkling") gives the lobes' RMS amplitude.
 double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, const Eigen::VectorXd& ring_r);
+/// The lobe number of the wall's wrinkle: on the ring with the largest RMS deviation (as
+/// wall_wrinkle), the m in [2, n_theta / 2] with the largest Fourier amplitude
+/// |sum_i (r_i - r_ring) exp(-i m phi_i)| of the node radii against their angles phi_i about the
+/// ring's centroid. 0 when that ring's deviation is below 1e-9 of its radius (a round wall).
+int wall_wrinkle_mode(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
+                      const Eigen::VectorXd& ring_r);
 
 /// An empty record of a 3D run (tier, model, length, columns, reference ring positions).
 record::RunRecord new_record(const RunSetup& run);
@@ -89,6 +95,9 @@ class Measurements {
   double pumped_volume() const { return -vol_rear_; }
   double max_cfl() const { return max_cfl_; }
   long stokes_iterations() const { return iterations_total_; }
+  /// The largest wall wrinkle of the recorded rows (m) and its lobe number (wall_wrinkle_mode).
+  double max_wrinkle() const { return max_wrinkle_; }
+  int max_wrinkle_mode() const { return int(max_wrinkle_mode_); }
   WallSplit& split() { return split_; }
   const WallSplit& split() const { return split_; }
 
@@ -115,6 +124,7 @@ class Measurements {
   double max_cfl_ = 0, last_cfl_ = 0, last_divergence_ = 0;
   long iterations_total_ = 0, last_iterations_ = 0;
   long last_recorded_ = -1;
+  double max_wrinkle_ = 0.0, max_wrinkle_mode_ = 0.0;
   mutable double parts_t_ = -1.0;
   mutable const double* parts_x_ = nullptr;
   mutable std::array<double, 2> parts_{};

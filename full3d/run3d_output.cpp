@@ -6,12 +6,37 @@
 #include <filesystem>
 
 #include "common/output.hpp"
+#include "full3d/buckling_estimate.hpp"
 
 namespace swim::full3d {
 
 using scene::json;
 
 namespace {
+// The linear estimate of the contracted wall's buckling (buckling_estimate.hpp) for the scene:
+// per stage of the contraction, the fastest-growing lobe number in the fluid and its rate.
+scene::json buckling_estimate(const Params3d& p) {
+  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);  // the equilateral network's 2D Young's modulus
+  const double N = p.protocol.q * p.R0;                   // hoop compression holding R_f
+  const auto stages = contraction_buckling(p.L, p.protocol.segments, p.protocol.first_ratio, p.protocol.R_f, N,
+                                           p.bending_rigidity, Y, p.fluid.mu);
+  scene::json j = {{"model", "Donnell shell, segment of the loaded length between round parts (the whole tube: free "
+                             "ends), at R_f, Stokes drag 4 mu k"},
+                   {"hoop_compression_N_per_m", N},
+                   {"stretching_modulus_N_per_m", Y},
+                   {"mode", stages.back().mode},
+                   {"growth_rate_per_s", stages.back().growth_rate}};
+  scene::json st = scene::json::array();
+  for (const auto& s : stages)
+    st.push_back({{"loaded_length_m", s.loaded_length},
+                  {"mode", s.mode},
+                  {"growth_rate_per_s", s.growth_rate},
+                  {"critical_mode", s.critical_mode},
+                  {"critical_compression_N_per_m", s.critical_compression}});
+  j["stages"] = st;
+  return j;
+}
+
 std::string frame_name(const char* kind, const char* ext, std::size_t index) {
   char name[64];
   std::snprintf(name, sizeof name, "vtk/%s_%06d.%s", kind, int(index), ext);
@@ -150,6 +175,7 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                   {"seed_mode", p.seed_mode},
                   {"seed_amplitude", p.seed_amplitude},
                   {"segment_boundaries_m", protocol.boundaries()}};
+  if (!p.dry && p.protocol.q > 0.0 && !p.axisymmetric_wall) rec_.derived["buckling_estimate"] = buckling_estimate(p);
   // the largest edge at the output steps; the no-leak guard needs < 0.5 h
   const double emax = rec_.series.count() ? rec_.series.max("max_edge_m") : 0.0;
   // the wall's largest departure from axisymmetry at the output steps (docs/full3d.md, "Wall wrinkling")
@@ -157,6 +183,7 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
   rec_.extras = {{"max_edge_over_h", emax / p.h},
                  {"max_wrinkle_m", wmax},
                  {"max_wrinkle_over_h", wmax / p.h},
+                 {"max_wrinkle_mode", measured.max_wrinkle_mode()},
                  {"steps", n},
                  {"steps_per_cycle", stepper.steps_per_cycle()}};
   record::check_plausible(rec_);

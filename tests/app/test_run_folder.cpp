@@ -358,7 +358,8 @@ TEST(RunFolderCli, BothTiersWriteTheSameKeysAndColumns) {
   const json a = summary_of(d / "a"), b = summary_of(d / "b");
   // the tier-specific summary keys, documented in docs/outputs.md
   const std::set<std::string> only1d = {"pumped_volume_lab_m3", "brownian"};
-  const std::set<std::string> only3d = {"steps", "steps_per_cycle", "max_edge_over_h", "max_wrinkle_m", "max_wrinkle_over_h"};
+  const std::set<std::string> only3d = {"steps", "steps_per_cycle", "max_edge_over_h", "max_wrinkle_m", "max_wrinkle_over_h",
+                                           "max_wrinkle_mode"};
   std::set<std::string> ka, kb;
   for (const auto& [k, v] : a.items())
     if (!only1d.count(k)) ka.insert(k);

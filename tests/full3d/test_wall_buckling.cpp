@@ -13,12 +13,14 @@
 #include <cmath>
 #include <complex>
 #include <cstdio>
+#include <limits>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "common/errors.hpp"
 #include "common/scene.hpp"
+#include "full3d/buckling_estimate.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/run3d_measure.hpp"
 #include "full3d/scene3d.hpp"
@@ -343,4 +345,77 @@ TEST(WallSeed, SceneKeysSeedTheRunsMesh) {
             "full3d.membrane.seed_amplitude");
   EXPECT_EQ(refused_key({"full3d.membrane.seed_mode=64", "full3d.membrane.seed_amplitude=0.01", "full3d.grid.cells_across=12"}),
             "full3d.membrane.seed_mode");
+}
+
+// Donnell's segment estimate (buckling_estimate.hpp). Without an axial variation (the free
+// tube) its buckling compression is the ring's m^2 D / R^2 and the growth rate changes sign
+// there; a long segment's lowest buckling pressure over m is the classical short-cylinder
+// result p = 0.855 E t^(5/2) / ((1 - nu^2)^(3/4) ell R^(3/2)) (Windenburg and Trilling 1934;
+// Batdorf 1947), with Y = E t and D = E t^3 / (12 (1 - nu^2)) of the network's nu = 1/3. The
+// integer lobe number puts the discrete minimum at most 2 % above the continuous one.
+TEST(SegmentBuckling, FreeTubeIsTheRingAndLongSegmentsBuckleAtTheClassicalPressure) {
+  const double R = kR0, D = kD, Y = 6.35e-8, inf = std::numeric_limits<double>::infinity();
+  for (int m : {2, 5, 8}) {
+    const double Nm = segment_buckling_compression(m, D, Y, R, inf);
+    EXPECT_NEAR(Nm, m * m * D / (R * R), 1e-12 * Nm) << m;
+    for (WallDrag drag : {WallDrag::Dry, WallDrag::Stokes}) {
+      EXPECT_LT(segment_mode_growth_rate(m, 0.99 * Nm, D, Y, R, inf, drag, 1e-3), 0.0);
+      EXPECT_GT(segment_mode_growth_rate(m, 1.01 * Nm, D, Y, R, inf, drag, 1e-3), 0.0);
+    }
+  }
+  EXPECT_TRUE(std::isinf(segment_buckling_compression(1, D, Y, R, inf)));
+  // a thin shell, R / t = 1000
+  const double nu = 1.0 / 3.0, E = 1.0, Rs = 1.0, t = 1e-3, Ys = E * t, Ds = E * t * t * t / (12 * (1 - nu * nu));
+  for (double ell : {5.0, 10.0}) {
+    double pmin = inf;
+    for (int m = 2; m <= 64; ++m) pmin = std::min(pmin, segment_buckling_compression(m, Ds, Ys, Rs, ell) / Rs);
+    const double classical = 0.855 * E * std::pow(t, 2.5) / (std::pow(1 - nu * nu, 0.75) * ell * std::pow(Rs, 1.5));
+    EXPECT_GE(pmin / classical, 1.0) << ell;
+    EXPECT_LE(pmin / classical, 1.02) << ell;
+  }
+  // a shorter segment is stiffer, and buckles in more lobes
+  const double N_short = segment_buckling_compression(4, D, Y, 0.55 * R, 50e-9),
+               N_long = segment_buckling_compression(4, D, Y, 0.55 * R, 200e-9);
+  EXPECT_GT(N_short, N_long);
+}
+
+// The estimate for the paper's L = 0.2 µm tube at R_f = 0.55 R0 under 0.32 Pa (the numbers of
+// docs/full3d.md, "Ring buckling and the seed imperfection", computed there independently):
+// the first 20 nm segment holds (its critical compression is 2.5 times the load's 4e-8 N/m),
+// and from the second stage on the fastest-growing mode in the fluid is m = 8, at 530–640 /s.
+// A dry wall (constant drag) favours more lobes (m = 9–10): the fluid's drag grows with k.
+TEST(SegmentBuckling, ThePapersShortTubeGrowsEightLobesInTheFluid) {
+  const double R0 = 0.125e-6, D = 1.009e-24, Y = 2.0 * 5.5e-8 / std::sqrt(3.0), N = 0.32 * R0, mu = 1.2e-3;
+  const auto stages = contraction_buckling(0.2e-6, 4, 1.0 / 3.0, 0.55 * R0, N, D, Y, mu);
+  ASSERT_EQ(stages.size(), 4u);
+  EXPECT_NEAR(stages[0].loaded_length, 20e-9, 1e-15);
+  EXPECT_NEAR(stages[1].loaded_length, 80e-9, 1e-15);
+  EXPECT_TRUE(std::isinf(stages[3].ell));
+  EXPECT_EQ(stages[0].mode, 0);
+  EXPECT_NEAR(stages[0].critical_compression / N, 2.49, 0.02);
+  for (int j = 1; j < 4; ++j) {
+    EXPECT_EQ(stages[std::size_t(j)].mode, 8) << j;
+    EXPECT_GT(stages[std::size_t(j)].growth_rate, 500.0) << j;
+    EXPECT_LT(stages[std::size_t(j)].growth_rate, 650.0) << j;
+  }
+  EXPECT_GE(fastest_segment_mode(N, D, Y, 0.55 * R0, 140e-9, WallDrag::Dry, 1.0), 9);
+}
+
+// The runs' lobe measure (wall_wrinkle_mode): the seeded lobe number of a lobed wall, the larger
+// of two superposed lobe numbers, and 0 on a round wall.
+TEST(WallSeed, TheWrinkleModeIsTheLobeNumberOfTheMostWrinkledRing) {
+  for (int m : {3, 7, 12}) {
+    CylinderMesh mesh = tube(40);
+    seed_ring_mode(mesh, m, 0.01);
+    const Eigen::VectorXd rn = node_radii(mesh, mesh.X0);
+    EXPECT_EQ(wall_wrinkle_mode(mesh, mesh.X0, rn, ring_radii(mesh, rn)), m);
+  }
+  CylinderMesh mesh = tube(40);
+  seed_ring_mode(mesh, 5, 0.01);
+  const Eigen::Matrix3Xd X = inextensional_lobes(mesh, mesh.X0, 9, 0.004 * kR0);
+  const Eigen::VectorXd rn = node_radii(mesh, X);
+  EXPECT_EQ(wall_wrinkle_mode(mesh, X, rn, ring_radii(mesh, rn)), 5);
+  const CylinderMesh round = tube(40);
+  const Eigen::VectorXd r0 = node_radii(round, round.X0);
+  EXPECT_EQ(wall_wrinkle_mode(round, round.X0, r0, ring_radii(round, r0)), 0);
 }
