@@ -23,11 +23,8 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   const scene::json s = validation::load_suite(suite, data_dir());  // bad input stops here, before anything is written
   for (const auto& n : only) {
     bool found = false;
-    for (const auto& cs : s["cases"]) {
-      const std::string stem = fs::path(cs["scene"].get<std::string>()).stem().string();
-      found = found || n == stem || n == stem + ".json";
-    }
-    if (!found) throw InputError("--case", n, "the scene file name of a case of " + suite);
+    for (const auto& cs : s["cases"]) found = found || validation::case_selected_by(cs, n);
+    if (!found) throw InputError("--case", n, "the scene file name or the name of a case of " + suite);
   }
   const std::string name = s.value("name", fs::path(suite).stem().string());
   const std::string out = out_opt.empty() ? "out/validation-" + name : out_opt;

@@ -135,7 +135,7 @@ int main(int argc, char** argv) {
   val->add_option("--out", val_out, "Output directory (default out/validation-<suite name>); completed runs in it are reused");
   val->add_option("--threads", val_threads, "Threads of the 3D runs and calibrations (default 2)");
   std::vector<std::string> val_cases;
-  val->add_option("--case", val_cases, "Run only this case (its scene file name); repeatable");
+  val->add_option("--case", val_cases, "Run only this case (its scene file name, or the case's own name); repeatable");
   add_progress(val);
 
   // a mistyped subcommand is named as such (CLI11 alone would say "arguments were not expected")

@@ -26,7 +26,7 @@ json run_suite(const SuiteOptions& o) {
   const auto t_suite = std::chrono::steady_clock::now();
   const std::vector<json> cases = selected_cases(suite, o.only);
   if (cases.empty())
-    throw InputError("--case", o.only.empty() ? "" : o.only.front(), "the scene file name of a case of the suite");
+    throw InputError("--case", o.only.empty() ? "" : o.only.front(), "the scene file name or the name of a case of the suite");
   FolderKeys keys;
   RunCache cache(runs_dir, cal_dir, o.threads, keys);
   const Say say = [&](const std::string& s) {

@@ -178,12 +178,18 @@ void apply_sets(json& sc, const json& sets) {
   for (const auto& [k, v] : sets.items()) set_key(sc, k, v);
 }
 
+bool case_selected_by(const json& cs, const std::string& name) {
+  const std::string stem = fs::path(cs["scene"].get<std::string>()).stem().string();
+  if (name == stem || name == stem + ".json") return true;
+  const json* set = cs.contains("set") && cs["set"].is_object() ? &cs["set"] : nullptr;
+  return set && set->contains("name") && (*set)["name"].is_string() && (*set)["name"].get<std::string>() == name;
+}
+
 std::vector<json> selected_cases(const json& suite, const std::vector<std::string>& only) {
   std::vector<json> cases;
   for (const json& cs : suite["cases"]) {
-    const std::string stem = fs::path(cs["scene"].get<std::string>()).stem().string();
     bool take = only.empty();
-    for (const auto& n : only) take = take || n == stem || n == stem + ".json";
+    for (const auto& n : only) take = take || case_selected_by(cs, n);
     if (take) cases.push_back(cs);
   }
   return cases;

@@ -41,8 +41,11 @@ void set_key(json& sc, const std::string& dotted, const json& value);
 /// Applies a `set` ({"dotted.key": value}, or null for none) to a scene with set_key.
 void apply_sets(json& sc, const json& sets);
 
-/// The cases of the suite a run takes: those whose scene file name (with or without .json) is
-/// in `only`, every case when `only` is empty.
+/// Whether `name` selects the case: its scene file name (with or without .json) or its own
+/// name (the `name` its `set` gives the scene).
+bool case_selected_by(const json& cs, const std::string& name);
+/// The cases of the suite a run takes: those selected by a name in `only` (case_selected_by),
+/// every case when `only` is empty.
 std::vector<json> selected_cases(const json& suite, const std::vector<std::string>& only);
 
 /// The scene of one reference grid: the case's scene (after its own set), the reference's

@@ -153,3 +153,27 @@ TEST(ReferenceSuite, TheAxiSeriesIsTheReferenceOfTheCase) {
     EXPECT_TRUE(r3["cases"][0]["runs3d"][g]["cached"].get<bool>()) << g;
   }
 }
+
+// `swim validate --case NAME`: a name selects the cases of that scene file (with or without
+// .json) or the one case whose own name (its set.name) it is, so that two cases of one scene
+// (the shipped converged suite's round and buckling walls of paper_aspect_L0.2) can run apart.
+TEST(ReferenceSuite, ACaseIsSelectedByItsSceneFileOrByItsOwnName) {
+  const scene::json suite = {
+      {"cases",
+       {{{"scene", "paper_aspect_L0.2.json"}, {"set", {{"name", "paper_aspect_L0.2_round_wall"}}}},
+        {{"scene", "paper_aspect_L0.2.json"}, {"set", {{"name", "paper_aspect_L0.2_seeded"}}}},
+        {{"scene", "paper_aspect_L0.4.json"}}}}};
+  auto names = [&](const std::vector<std::string>& only) {
+    std::vector<std::string> n;
+    for (const auto& c : validation::selected_cases(suite, only))
+      n.push_back(c.contains("set") ? c["set"]["name"].get<std::string>() : c["scene"].get<std::string>());
+    return n;
+  };
+  EXPECT_EQ(names({"paper_aspect_L0.2"}).size(), 2u);
+  EXPECT_EQ(names({"paper_aspect_L0.2.json"}).size(), 2u);
+  EXPECT_EQ(names({"paper_aspect_L0.2_seeded"}), std::vector<std::string>{"paper_aspect_L0.2_seeded"});
+  EXPECT_EQ(names({"paper_aspect_L0.2_round_wall", "paper_aspect_L0.4"}),
+            (std::vector<std::string>{"paper_aspect_L0.2_round_wall", "paper_aspect_L0.4.json"}));
+  EXPECT_TRUE(names({"paper_aspect_L0.3"}).empty());
+  EXPECT_TRUE(names({"paper_aspect_L0.2_round"}).empty());
+}
