@@ -252,12 +252,13 @@ def reference_convergence_figure(case, path):
         ea = ref.get(key)
         if p3:
             ax.plot(*zip(*p3), "ko-", ms=5, label=f"3D runs: {order_text(e3)}")
-            if e3 and e3.get("method") == "expansion_fit" and len(p3) >= 4:
-                # the fitted error expansion, from h = 0 to the coarsest grid
-                hh, ff = zip(*p3)
-                c = np.polyfit(hh, ff, 2)
-                hs = np.linspace(0.0, max(hh), 60)
-                ax.plot(hs, np.polyval(c, hs), "k--", lw=0.8, label="3D: fitted f0 + a h + b h²")
+            fit = (e3 or {}).get("expansion")
+            if e3 and e3.get("method") == "expansion_fit" and fit and None not in fit.values():
+                # the suite's fitted error expansion f0 + a h + b h² (report.json), from h = 0 to
+                # the coarsest grid
+                hs = np.linspace(0.0, max(h for h, _ in p3), 60) * 1e-9
+                ff = fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs
+                ax.plot(hs * 1e9, ff * scale, "k--", lw=0.8, label="3D: fitted f0 + a h + b h²")
         if pa:
             ax.plot(*zip(*pa), "s-", color="tab:blue", ms=5,
                     label=f"axisymmetric runs ({ref.get('method', 'axi')}): {order_text(ea)}")

@@ -16,10 +16,13 @@ namespace {
 json num(double x) { return std::isfinite(x) ? json(x) : json(nullptr); }
 
 json extrapolation_json(const Extrapolation& e) {
-  return json{{"value", num(e.value)},         {"error", num(e.error)},
-              {"order", num(e.order)},         {"observed_order", num(e.observed_order)},
-              {"asymptotic", e.asymptotic},    {"method", e.method},
-              {"note", e.note}};
+  json j{{"value", num(e.value)},         {"error", num(e.error)},
+         {"order", num(e.order)},         {"observed_order", num(e.observed_order)},
+         {"asymptotic", e.asymptotic},    {"method", e.method},
+         {"note", e.note}};
+  // the fitted expansion f0 + a h + b h^2, in the figure's unit per m and per m^2 of h
+  if (e.method == "expansion_fit") j["expansion"] = {{"f0", num(e.value)}, {"a_per_m", num(e.expansion_a)}, {"b_per_m2", num(e.expansion_b)}};
+  return j;
 }
 
 std::string percent_text(double x) {

@@ -164,8 +164,9 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
 
 namespace {
 
-/// f0 of the least-squares fit f = f0 + a h + b h^2 (h in units of the finest spacing).
-double expansion_f0(const std::vector<double>& h, const std::vector<double>& f, double h_unit) {
+/// The least-squares fit f = f0 + a h + b h^2: (f0, a, b), with h in units of h_unit for the
+/// solve (the coefficients returned are per m and per m^2).
+Eigen::Vector3d expansion_coefficients(const std::vector<double>& h, const std::vector<double>& f, double h_unit) {
   Eigen::MatrixXd A(h.size(), 3);
   Eigen::VectorXd y(h.size());
   for (std::size_t i = 0; i < h.size(); ++i) {
@@ -175,7 +176,12 @@ double expansion_f0(const std::vector<double>& h, const std::vector<double>& f, 
     A(i, 2) = x * x;
     y(i) = f[i];
   }
-  return A.colPivHouseholderQr().solve(y)(0);
+  const Eigen::Vector3d c = A.colPivHouseholderQr().solve(y);
+  return {c(0), c(1) / h_unit, c(2) / (h_unit * h_unit)};
+}
+
+double expansion_f0(const std::vector<double>& h, const std::vector<double>& f, double h_unit) {
+  return expansion_coefficients(h, f, h_unit)(0);
 }
 
 }  // namespace
@@ -200,7 +206,8 @@ Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderR
   if (!(range.lo <= 1.0 && 1.0 <= range.hi && range.hi <= kImmersedBoundaryOrders.hi))
     return refuse("the scheme's order range " + range.text() + " is not that of a first-order method");
   const double unit = hs.back();
-  const double f0 = expansion_f0(hs, fs, unit);
+  const Eigen::Vector3d coef = expansion_coefficients(hs, fs, unit);
+  const double f0 = coef(0);
   double loo = 0;
   for (std::size_t i = 0; i < n; ++i) {
     std::vector<double> hh, ff;
@@ -228,6 +235,8 @@ Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderR
   e.order = 1.0;
   e.asymptotic = false;
   e.method = "expansion_fit";
+  e.expansion_a = coef(1);
+  e.expansion_b = coef(2);
   char b[320];
   std::snprintf(b, sizeof b,
                 "error expansion f0 + a h + b h^2 fitted to %zu grids (not in the asymptotic range); error = the largest "

@@ -53,6 +53,10 @@ struct Extrapolation {
   /// "richardson" (or two grids with the assumed order), "expansion_fit", "finest_grid"
   std::string method = "finest_grid";
   std::string note;      ///< how the value was obtained
+  /// method "expansion_fit": the fitted a (per m of h) and b (per m^2) of f0 + a h + b h^2;
+  /// NaN otherwise
+  double expansion_a = std::numeric_limits<double>::quiet_NaN();
+  double expansion_b = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Root of f in [lo, hi], where f(lo) and f(hi) differ in sign (GSL Brent, to 1e-14 relative).

@@ -64,6 +64,10 @@ TEST(ExpansionFit, RecoversTheLimitOfAFirstOrderSeriesBeforeItsAsymptoticRange) 
   const double rh = f[4] + (f[4] - f[3]) / (std::sqrt(h[3] / h[4]) - 1.0);
   EXPECT_NEAR(e.error, std::max(std::abs(r1 - 40.0), std::abs(rh - 40.0)), 1e-9);
   EXPECT_DOUBLE_EQ(e.order, 1.0);
+  // the fitted coefficients, which the report's convergence figure draws (report.json "expansion")
+  EXPECT_NEAR(e.expansion_a, -1.8, 1e-9);
+  EXPECT_NEAR(e.expansion_b, 0.05, 1e-9);
+  EXPECT_TRUE(std::isnan(r.expansion_a));
   // noise on one grid: the fit moves, and the leave-one-out error covers the move
   f[2] += 0.3;
   const Extrapolation n = expansion_fit(h, f);
