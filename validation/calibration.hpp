@@ -60,6 +60,12 @@ struct StaticCalibration {
   std::string no_static_state_reason;
 };
 
+/// The scene's tube without its seed imperfection (full3d.membrane.seed_mode, seed_amplitude):
+/// the round tube whose law the calibration measures. The seed starts the buckling of the
+/// dynamic runs; the static loads find the round tube's buckling on their own
+/// (StaticCalibration's stability check, the tube law's buckled branch).
+full3d::CylinderMesh round_tube(const full3d::Params3d& p);
+
 /// Loads as fractions of the static load C1_net (R0 - R_f) that holds the scene's target
 /// radius (C1_net the spring-network estimate): thirteen loads from 1 % to 150 %, dense below 20 % where ring buckling sets in.
 std::vector<double> default_loads(const full3d::Params3d& p);

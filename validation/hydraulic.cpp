@@ -137,9 +137,13 @@ double mean(const std::vector<double>& v) { return gsl_stats_mean(v.data(), 1, v
 double sample_std(const std::vector<double>& v) { return v.size() < 2 ? 0.0 : gsl_stats_sd(v.data(), 1, v.size()); }
 
 
-// The scene for the rigid-tube measurements: a duct (or box) replaced by its inscribed cylinder.
+// The scene for the rigid-tube measurements: a duct (or box) replaced by its inscribed cylinder,
+// and the round tube (a seed imperfection is the dynamics' start of buckling, not part of the
+// round tube the 1D tier's offsets describe).
 full3d::Params3d in_cylinder(const full3d::Params3d& scene) {
   full3d::Params3d p = scene;
+  p.seed_mode = 0;
+  p.seed_amplitude = 0.0;
   if (p.container != "cylinder") {
     p.container = "cylinder";
     p.ny += 2;
