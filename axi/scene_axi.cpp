@@ -56,7 +56,7 @@ FittedMeshParams fitted_mesh_params(const ParamsAxi& p) {
 ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   ParamsAxi p;
   // 1. The shared physics, read by the 3D tier's reader (the axi section is passed through).
-  // Prescribed waves (step, sine) are read as by the 1D tier (common/scene_shared.hpp read_wave).
+  // Prescribed waves (step, sine) are read by the shared reader (common/scene_shared.hpp SharedScene).
   p.base = full3d::read_scene3d(sc, resolved, /*prescribed_waves=*/true);
   const full3d::Params3d& b = p.base;
   const json& f3 = section_or_empty(sc, "full3d");

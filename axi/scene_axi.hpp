@@ -1,15 +1,15 @@
 // Scene -> parameters of the axisymmetric reference tier (`swim run SCENE --tier axi`).
 //
 // The tier solves the same scene as the 3D tier's round wall: the shared sections (swimmer,
-// fluid, wall, wave, protocol, time, container) and the wall's network keys are read by the
-// 3D tier's own reader (full3d/scene3d.hpp), with the same keys, defaults and rules, so
+// fluid, wall, wave, protocol, time, container; common/scene_shared.hpp) and the full3d
+// section's wall keys are read through the 3D tier's own reader (full3d/scene3d.hpp), so
 // that both tiers run the same physics; the `axi` section holds this tier's numerics
 // (docs/axi.md, docs/scenes.md "The axi section"). Model only what the scene asks for:
 //   - the wall must be held round: full3d.membrane.axisymmetric = true;
 //   - the container must be the rigid cylinder (container.kind = "cylinder");
 //   - Stokes flow, no wall inertia, no dry swimmer (full3d.navier_stokes, full3d.wall_inertia,
 //     full3d.dry must be false), the reference-angle bending form;
-//   - wave.kind = step | sine (the prescribed waves, read as by the 1D tier; the protocol
+//   - wave.kind = step | sine (the prescribed waves, as on the 1D tier; the protocol
 //     section is then refused) with axi.method = fitted only.
 // Anything else is an InputError (exit 2) naming the key, before anything is written.
 #pragma once

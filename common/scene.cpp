@@ -124,6 +124,8 @@ std::string Reader::path(const std::string& key) const { return path_.empty() ? 
 
 bool Reader::has(const std::string& key) const { return node_->contains(key); }
 
+const json& Reader::given(const std::string& key) const { return node_->at(key); }
+
 void Reader::mark(const std::string& key) {
   if (std::find(known_.begin(), known_.end(), key) == known_.end()) known_.push_back(key);
 }

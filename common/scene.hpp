@@ -59,6 +59,8 @@ class Reader {
   void pass_through(const std::string& key);
 
   bool has(const std::string& key) const;
+  /// The value given for a key that `has` (as written in the scene), for messages and tests.
+  const json& given(const std::string& key) const;
   /// Full dotted path of a key of this object, for messages.
   std::string path(const std::string& key) const;
   /// Throw InputError for the first key present in the scene that was not read.

@@ -32,6 +32,8 @@ bool multiple_of(double a, double h) {
   return n >= 1 && std::abs(a - n * h) <= 1e-9 * a;
 }
 
+namespace {
+
 Body read_body(Reader& top) {
   Body b;
   {
@@ -98,12 +100,6 @@ double read_contracted_radius(Reader& w, double R0) {
   return R0 * w.number("contracted_ratio", 0.55, Range::open(0.0, 1.0));
 }
 
-double WaveSpec::transit(double L) const {
-  if (kind == "step") return L / speed;
-  if (kind == "sine") return wavelength / speed;
-  return 0.0;
-}
-
 WaveSpec read_wave(Reader& top, double R0, double L) {
   WaveSpec s;
   Reader w = top.child("wave");
@@ -123,7 +119,7 @@ WaveSpec read_wave(Reader& top, double R0, double L) {
   return s;
 }
 
-ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1, double static_load) {
+ProtocolSpec read_protocol_section(Reader& top, double R0, double L, double R_f, double C1, double static_load) {
   ProtocolSpec p;
   Reader r = top.child("protocol");
   const double area = 2.0 * M_PI * R0 * L;
@@ -153,6 +149,56 @@ ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double 
     throw InputError(r.path("tolerance_ratio"), format_quantity(p.delta / R0, ""),
                      "the tolerance delta must be below half of both R0 - R_f and R_f");
   return p;
+}
+
+}  // namespace
+
+double WaveSpec::transit(double L) const {
+  if (kind == "step") return L / speed;
+  if (kind == "sine") return wavelength / speed;
+  return 0.0;
+}
+
+SharedScene SharedScene::read(Reader& top, const WallRule& wall_rule) {
+  SharedScene s;
+  s.name = top.text("name", "unnamed");
+  check_name(s.name);
+  top.text("description", "");
+  s.body = read_body(top);
+  s.container = read_container(top, s.body.R0, s.body.L);
+  s.wall = read_wall(top, s.body.R0);
+  if (wall_rule) wall_rule(s.body, s.wall);
+  s.wave = read_wave(top, s.body.R0, s.body.L);
+  return s;
+}
+
+void SharedScene::read_protocol(Reader& top, double C1, double static_load) {
+  if (wave.prescribed()) {
+    if (top.has("protocol"))
+      throw InputError(top.path("protocol"), show(top.given("protocol")),
+                       "is only used when wave.kind = \"force_driven\"");
+    return;
+  }
+  protocol = read_protocol_section(top, body.R0, body.L, wave.R_f, C1, static_load);
+}
+
+void SharedScene::read_time(Reader& top) {
+  Reader t = top.child("time");
+  // duration: a quantity, or "auto" (a prescribed wave: its transit time; a force-driven wave:
+  // until protocol.cycles cycles are complete)
+  if (t.has("duration") && t.given("duration") != "auto") {
+    time.duration = t.quantity("duration", "s", "", Range::positive());
+  } else {
+    t.text("duration", "auto");
+    time.duration = 0;
+  }
+  const double span = time.duration > 0 ? time.duration : wave.transit(body.L);
+  const std::string def = span > 0 ? format_quantity(span / 200.0, "s") : "0.5 ms";
+  time.output_interval = t.quantity("output_interval", "s", def, Range::positive());
+  if (span > 0 && time.output_interval > span)
+    throw InputError(t.path("output_interval"), format_quantity(time.output_interval, "s"),
+                     "must not exceed the run duration " + format_quantity(span, "s"));
+  t.finish();
 }
 
 double c1_from_spring_constant(double k_s, double R0) { return 2.0 * k_s / (std::sqrt(3.0) * R0 * R0); }

@@ -1,8 +1,11 @@
-// The scene sections both tiers read the same way: swimmer, fluid, wall, the contracted
-// radius of the wave, and the force-driven protocol. Each tier reads its own sections
-// (model1d/numerics1d, full3d) and the tier-specific keys of `wave` around these.
+// The scene sections every tier reads the same way: name and description, swimmer, fluid,
+// container, wall, wave, protocol and time. SharedScene reads and validates each of their keys
+// here and only here; a tier's reader (reduced1d/scene1d.cpp, full3d/scene3d.cpp, and through
+// the 3D reader axi/scene_axi.cpp) maps them onto its own parameters, applies its own rules
+// and reads its own sections (model1d/numerics1d, full3d, axi).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -21,13 +24,12 @@ std::string format_quantity(double v, const char* unit);
 /// 3D and axisymmetric tiers.
 bool multiple_of(double a, double h);
 
+/// The swimmer and fluid sections.
 struct Body {
   double R0 = 0, L = 0;     ///< swimmer.radius, swimmer.length [m]
   double mu = 0, rho = 0;   ///< fluid.viscosity [Pa s], fluid.density [kg/m^3]
   double temperature = 0;   ///< fluid.temperature [K]
 };
-/// Reads (and finishes) the swimmer and fluid sections.
-Body read_body(Reader& top);
 
 /// The rigid periodic container both tiers run in (scene section `container`).
 struct ContainerSpec {
@@ -35,9 +37,8 @@ struct ContainerSpec {
   double radius = 0;      ///< cylinder radius or duct half-width [m]
   double period = 0;      ///< axial period [m]
 };
-/// Reads (and finishes) the container section; the swimmer must fit (R0 < radius, L < period).
-ContainerSpec read_container(Reader& top, double R0, double L);
 
+/// The wall section.
 struct WallSpec {
   std::string stiffness;    ///< the key given: "C1", "spring_constant", "stretching_modulus" or "calibration"
   /// C1 [Pa/m], or the spring constant k_s [N/m] of the network (wall.spring_constant, or
@@ -53,17 +54,11 @@ struct WallSpec {
   /// wall is the membrane itself and ignores it)
   std::string law = "linear";
 };
-/// Reads (and finishes) the wall section.
-WallSpec read_wall(Reader& top, double R0);
 
 /// The spring network's small-strain wall stiffness C1 = 2 k_s / (sqrt(3) R0^2) [Pa/m] of a
 /// tube of radius R0 [m] with spring constant k_s [N/m] (plane stress of the triangulated
 /// network; docs/source-equations.md). The one formula of both tiers and the calibration.
 double c1_from_spring_constant(double k_s, double R0);
-
-/// wave.contracted_ratio | wave.contracted_radius -> R_f [m]; the caller reads the other
-/// wave keys and finishes `wave`.
-double read_contracted_radius(Reader& wave, double R0);
 
 /// The wave section (docs/scenes.md "wave.*"): its kind, the contracted radius and the
 /// prescribed waves' kinematics (reduced1d/params.hpp StepWave, SineWave).
@@ -77,9 +72,8 @@ struct WaveSpec {
   /// The default end time of a prescribed wave: L/s (step), lambda/s (sine); 0 (force_driven).
   double transit(double L) const;
 };
-/// Reads (and finishes) the wave section of a swimmer of radius R0 and length L [m].
-WaveSpec read_wave(Reader& top, double R0, double L);
 
+/// The protocol section of a force-driven wave.
 struct ProtocolSpec {
   double q = 0;             ///< actuation pressure [Pa], inward positive
   int segments = 0;
@@ -87,11 +81,58 @@ struct ProtocolSpec {
   double delta = 0;         ///< radius tolerance [m]
   double energy_tol = 0;
   int cycles = 0;
+  /// Copies these values into a tier's protocol parameters (the fields of the same names).
+  template <class Params>
+  void assign_to(Params& out) const {
+    out.q = q;
+    out.segments = segments;
+    out.first_ratio = first_ratio;
+    out.delta = delta;
+    out.energy_tol = energy_tol;
+    out.cycles = cycles;
+  }
 };
-/// Reads (and finishes) the protocol section of a force-driven wave. C1 [Pa/m] is the wall
-/// stiffness used to check that the actuation can reach R_f (static load C1 (R0 - R_f)).
-/// `static_load` > 0: the static load that holds R_f under a nonlinear wall law, in place of
-/// C1 (R0 - R_f).
-ProtocolSpec read_protocol(Reader& top, double R0, double L, double R_f, double C1, double static_load = 0.0);
+
+/// The time section.
+struct TimeSpec {
+  /// time.duration [s]; 0 for "auto" (the default): a prescribed wave's transit time, or until
+  /// protocol.cycles cycles are complete
+  double duration = 0;
+  /// time.output_interval [s]; default 1/200 of the run (the duration, else the transit), else 0.5 ms
+  double output_interval = 0;
+};
+
+/// The shared sections of one scene, each key read and validated once, for whichever tier
+/// runs it. A tier's reader calls the three phases in its own order, which is the order of
+/// the resolved scene's keys, and reads its own sections between them:
+///   SharedScene s = SharedScene::read(top, wall_rule);  // name, description, swimmer, fluid,
+///                                                       // container, wall, wave
+///   s.read_protocol(top, C1);                           // protocol, or its refusal
+///   s.read_time(top);                                   // time
+struct SharedScene {
+  std::string name;
+  Body body;
+  ContainerSpec container;
+  WallSpec wall;
+  WaveSpec wave;
+  ProtocolSpec protocol;  ///< a force_driven wave's; zero for a prescribed wave
+  TimeSpec time;
+
+  bool force_driven() const { return !wave.prescribed(); }
+
+  /// A tier's own rule on the wall (its stiffness model), applied as soon as the wall section
+  /// is read, before the wave section; it throws InputError for a wall the tier cannot model.
+  using WallRule = std::function<void(const Body&, const WallSpec&)>;
+  /// Reads (and finishes) name, description, swimmer, fluid, container, wall and wave of the
+  /// top-level reader.
+  static SharedScene read(Reader& top, const WallRule& wall_rule = {});
+  /// A force_driven wave: reads (and finishes) the protocol section. C1 [Pa/m] is the wall
+  /// stiffness used to check that the actuation can reach R_f (static load C1 (R0 - R_f));
+  /// `static_load` > 0: the static load that holds R_f under a nonlinear wall law, in place of
+  /// C1 (R0 - R_f). A prescribed wave: a protocol section is an InputError.
+  void read_protocol(Reader& top, double C1, double static_load = 0.0);
+  /// Reads (and finishes) the time section.
+  void read_time(Reader& top);
+};
 
 }  // namespace swim::scene

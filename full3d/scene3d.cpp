@@ -68,24 +68,8 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   Params3d p;
   resolved = json::object();
   Reader top(scene, "", resolved);
-  p.name = top.text("name", "unnamed");
-  scene::check_name(p.name);
-  top.text("description", "");
-
-  const scene::Body body = scene::read_body(top);
-  p.R0 = body.R0;
-  p.L = body.L;
-  p.fluid.mu = body.mu;
-  p.fluid.rho = body.rho;
-  const double R0 = p.R0, L = p.L;
-  {
-    const scene::ContainerSpec c = scene::read_container(top, R0, L);
-    p.container = c.kind;
-    p.container_radius = c.radius;
-    p.period = c.period;
-  }
-  {
-    const scene::WallSpec w = scene::read_wall(top, R0);
+  // the 3D wall is the spring network
+  scene::SharedScene s = scene::SharedScene::read(top, [&](const scene::Body&, const scene::WallSpec& w) {
     if (!w.network())
       throw InputError("wall." + w.stiffness, scene::show(scene.at("wall").at(w.stiffness)),
                        "the 3D tier models the wall as a spring network and needs its spring constant: give "
@@ -93,49 +77,30 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
                        "are 1D lumped stiffnesses");
     p.membrane.ks = w.value;
     p.mass_per_area = w.mass_per_area;
-  }
-  {
-    p.wave = scene::read_wave(top, R0, L);
-    if (p.wave.prescribed() && !prescribed_waves)
-      throw InputError("wave.kind", "\"" + p.wave.kind + "\"",
-                       "the 3D tier drives the wall by forces only (prescribed kinematics are not implemented): "
-                       "use \"force_driven\" or run --tier 1d or --tier axi");
-  }
-  const double R_f = p.wave.R_f;
-  p.protocol.R_f = R_f;
-  if (p.wave.prescribed()) {
-    if (top.has("protocol"))
-      throw InputError("protocol", scene::show(scene.at("protocol")), "is only used when wave.kind = \"force_driven\"");
-  } else {
-    const scene::ProtocolSpec r = scene::read_protocol(top, R0, L, R_f, p.c1_estimate());
-    p.protocol.q = r.q;
-    p.protocol.segments = r.segments;
-    p.protocol.first_ratio = r.first_ratio;
-    p.protocol.delta = r.delta;
-    p.protocol.energy_tol = r.energy_tol;
-    p.protocol.cycles = r.cycles;
-  }
+  });
+  p.name = s.name;
+  p.R0 = s.body.R0;
+  p.L = s.body.L;
+  p.fluid.mu = s.body.mu;
+  p.fluid.rho = s.body.rho;
+  const double R0 = p.R0, L = p.L;
+  p.container = s.container.kind;
+  p.container_radius = s.container.radius;
+  p.period = s.container.period;
+  p.wave = s.wave;
+  if (p.wave.prescribed() && !prescribed_waves)
+    throw InputError("wave.kind", "\"" + p.wave.kind + "\"",
+                     "the 3D tier drives the wall by forces only (prescribed kinematics are not implemented): "
+                     "use \"force_driven\" or run --tier 1d or --tier axi");
+  p.protocol.R_f = p.wave.R_f;
+  s.read_protocol(top, p.c1_estimate());
+  if (s.force_driven()) s.protocol.assign_to(p.protocol);
   top.pass_through("model1d");
   top.pass_through("numerics1d");
   top.pass_through("axi");  // the axisymmetric tier's numerics (axi/scene_axi.hpp)
-  {
-    Reader t = top.child("time");
-    const json& tn = scene.contains("time") ? scene["time"] : json::object();
-    if (tn.is_object() && tn.contains("duration") && tn["duration"] != "auto") {
-      p.duration = t.quantity("duration", "s", "", Range::positive());
-    } else {
-      t.text("duration", "auto");
-      p.duration = 0;
-    }
-    // a prescribed wave (axi tier): auto is its transit time, the output interval 1/200 of the run
-    const double span = p.duration > 0 ? p.duration : p.wave.transit(L);
-    const std::string def = span > 0 ? fmt(span / 200.0, "s") : "0.5 ms";
-    p.output_interval = t.quantity("output_interval", "s", def, Range::positive());
-    if (span > 0 && p.output_interval > span)
-      throw InputError(t.path("output_interval"), fmt(p.output_interval, "s"),
-                       "must not exceed the run duration " + fmt(span, "s"));
-    t.finish();
-  }
+  s.read_time(top);
+  p.duration = s.time.duration;
+  p.output_interval = s.time.output_interval;
   p.protocol.repeat_until_duration = p.duration > 0;
 
   {

@@ -1,8 +1,8 @@
-// Scene -> 3D parameters. Reads the physical sections shared with the 1D tier
-// (swimmer, fluid, wall, wave, protocol, time) with the same keys, defaults and
-// rules as reduced1d/scene1d.cpp, and the 3D section "full3d"; the 1D sections
-// (model1d, numerics1d) are passed through unchanged. Every value used is echoed
-// into `resolved`. Everything is validated here, before anything is written.
+// Scene -> 3D parameters. The sections every tier shares (name, swimmer, fluid, container,
+// wall, wave, protocol, time) are read by scene::SharedScene (common/scene_shared.hpp) and
+// mapped here; the 3D section "full3d" is read here, the 1D sections (model1d, numerics1d)
+// and the axi section passed through unchanged. Every value used is echoed into `resolved`.
+// Everything is validated here, before anything is written.
 //
 // 3D-specific rules (docs/scenes.md, "The full3d section"):
 //   - the spring network needs k_s: wall.C1 and wall.calibration (1D lumped

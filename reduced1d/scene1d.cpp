@@ -10,7 +10,6 @@
 #include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/scene_shared.hpp"
-#include "reduced1d/outer_flow.hpp"
 #include "common/units.hpp"
 #include "reduced1d/outer_flow.hpp"
 #include "reduced1d/tube_law.hpp"
@@ -121,30 +120,9 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   Params p;
   resolved = json::object();
   Reader top(scene, "", resolved);
-  p.name = top.text("name", "unnamed");
-  scene::check_name(p.name);
-  top.text("description", "");
-
-  const scene::Body body = scene::read_body(top);
-  p.geometry.R0 = body.R0;
-  p.geometry.L = body.L;
-  p.fluid.mu = body.mu;
-  p.fluid.rho = body.rho;
-  p.fluid.temperature = body.temperature;
-  const double R0 = p.geometry.R0, L = p.geometry.L;
-  {
-    const scene::ContainerSpec c = scene::read_container(top, R0, L);
-    p.container.shape = c.kind == "cylinder" ? ContainerShape::Cylinder
-                       : c.kind == "box"    ? ContainerShape::Box
-                                            : ContainerShape::Duct;
-    p.container.radius = c.radius;
-    p.container.period = c.period;
-    p.container.radius_eff = c.kind == "duct" ? outer::duct_equivalent_radius(c.radius) : c.radius;
-  }
-  std::string calibration;
-  {
-    const scene::WallSpec w = scene::read_wall(top, R0);
-    calibration = w.calibration;
+  // the 1D wall: its stiffness C1 from the network or the calibration file, and the file's tube law
+  scene::SharedScene s = scene::SharedScene::read(top, [&](const scene::Body& body, const scene::WallSpec& w) {
+    const double R0 = body.R0;
     if (w.stiffness == "C1")
       p.wall.C1 = w.value;
     else if (w.network())
@@ -161,13 +139,29 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
       p.wall.law = tube_law_from_calibration("wall.calibration", w.calibration, scene_dir,
                                              w.law == "calibrated_round" ? "round" : "buckled", R0);
     }
-  }
-
-  double R_f = 0;
+  });
+  p.name = s.name;
+  p.geometry.R0 = s.body.R0;
+  p.geometry.L = s.body.L;
+  p.fluid.mu = s.body.mu;
+  p.fluid.rho = s.body.rho;
+  p.fluid.temperature = s.body.temperature;
+  const double R0 = p.geometry.R0, L = p.geometry.L;
   {
-    const scene::WaveSpec w = scene::read_wave(top, R0, L);
+    const scene::ContainerSpec& c = s.container;
+    p.container.shape = c.kind == "cylinder" ? ContainerShape::Cylinder
+                       : c.kind == "box"    ? ContainerShape::Box
+                                            : ContainerShape::Duct;
+    p.container.radius = c.radius;
+    p.container.period = c.period;
+    p.container.radius_eff = c.kind == "duct" ? outer::duct_equivalent_radius(c.radius) : c.radius;
+  }
+  const std::string& calibration = s.wall.calibration;
+
+  const double R_f = s.wave.R_f;
+  {
+    const scene::WaveSpec& w = s.wave;
     p.wave = w.kind == "step" ? WaveKind::Step : w.kind == "sine" ? WaveKind::Sine : WaveKind::ForceDriven;
-    R_f = w.R_f;
     if (p.wave == WaveKind::Step) {
       p.step.R_min = R_f;
       p.step.speed = w.speed;
@@ -179,19 +173,11 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     }
   }
 
-  const bool forced = p.wave == WaveKind::ForceDriven;
-  if (!forced && top.has("protocol"))
-    throw InputError("protocol", scene::show(scene.at("protocol")), "is only used when wave.kind = \"force_driven\"");
+  const bool forced = s.force_driven();
+  s.read_protocol(top, p.wall.C1, forced && p.wall.law ? -(*p.wall.law)(R_f) : 0.0);
   if (forced) {
-    const scene::ProtocolSpec r =
-        scene::read_protocol(top, R0, L, R_f, p.wall.C1, p.wall.law ? -(*p.wall.law)(R_f) : 0.0);
     p.protocol.R_f = R_f;
-    p.protocol.q = r.q;
-    p.protocol.segments = r.segments;
-    p.protocol.first_ratio = r.first_ratio;
-    p.protocol.delta = r.delta;
-    p.protocol.energy_tol = r.energy_tol;
-    p.protocol.cycles = r.cycles;
+    s.protocol.assign_to(p.protocol);
   }
 
   {
@@ -295,31 +281,9 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
                              "); need at least " + std::to_string(needed));
     }
   }
-  {
-    Reader t = top.child("time");
-    const json& tn = scene.contains("time") ? scene["time"] : json::object();
-    // duration: a quantity, or "auto" (prescribed: wave transit time; force-driven: until
-    // protocol.cycles cycles are complete)
-    if (tn.is_object() && tn.contains("duration") && tn["duration"] == "auto") {
-      t.text("duration", "auto");
-      p.duration = 0;
-    } else if (tn.is_object() && tn.contains("duration")) {
-      p.duration = t.quantity("duration", "s", "", Range::positive());
-    } else {
-      t.text("duration", "auto");
-      p.duration = 0;
-    }
-    double transit = 0;
-    if (p.wave == WaveKind::Step) transit = L / p.step.speed;
-    if (p.wave == WaveKind::Sine) transit = p.sine.wavelength / p.sine.speed;
-    const double span = p.duration > 0 ? p.duration : transit;
-    const std::string def = span > 0 ? fmt(span / 200.0, "s") : "0.5 ms";
-    p.numerics.output_interval = t.quantity("output_interval", "s", def, Range::positive());
-    if (span > 0 && p.numerics.output_interval > span)
-      throw InputError(t.path("output_interval"), fmt(p.numerics.output_interval, "s"),
-                       "must not exceed the run duration " + fmt(span, "s"));
-    t.finish();
-  }
+  s.read_time(top);
+  p.duration = s.time.duration;
+  p.numerics.output_interval = s.time.output_interval;
   top.pass_through("full3d");
   top.pass_through("axi");  // the axisymmetric tier's numerics (axi/scene_axi.hpp)
   scene::read_output(top);

@@ -14,6 +14,7 @@
 #include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "common/scene.hpp"
+#include "common/scene_shared.hpp"
 #include "common/strict_json.hpp"
 #include "common/units.hpp"
 #include "full3d/scene3d.hpp"
@@ -385,4 +386,75 @@ TEST(StrictScene, OtherTierValuesOutOfRangeAreRefusedAsByTheirOwnReader) {
   EXPECT_EQ(read1d_key(json::parse(R"({"full3d": {"dt": "-1 ms"}})"), &msg), "full3d.dt") << msg;
   EXPECT_NE(msg.find("must be > 0"), std::string::npos) << msg;
   EXPECT_EQ(read1d_key(json::parse(R"({"axi": {"grid": {"cells_across": 4}}})"), &msg), "axi.grid.cells_across") << msg;
+}
+
+// One scene, one validation: the shared sections (name, swimmer, fluid, container, wall, wave,
+// protocol, time) are read by scene::SharedScene alone. A bad value in any of them is refused
+// with the same message whether the shared reader, the 1D, the 3D or the axisymmetric tier
+// reads the scene, and a good scene resolves to the same shared sections on every tier.
+TEST(StrictScene, TheSharedSectionsAreReadOnceForEveryTier) {
+  json base = swim::scene::load_file(SWIM_SOURCE_DIR "/data/scenes/demo.json");
+  base["full3d"]["membrane"]["axisymmetric"] = true;  // a round wall in the cylinder: every tier reads it
+  const auto shared = [](const json& sc) {
+    json r = json::object();
+    swim::scene::Reader top(sc, "", r);
+    swim::scene::SharedScene s = swim::scene::SharedScene::read(top);
+    s.read_protocol(top, swim::scene::c1_from_spring_constant(s.wall.value, s.body.R0));
+    s.read_time(top);
+    return r;
+  };
+  const std::vector<std::pair<std::string, std::vector<std::string>>> bad = {
+      {"name", {"name=../x"}},
+      {"swimmer.length", {"swimmer.length=0.4 s"}},
+      {"swimmer.lenght", {"swimmer.lenght=0.4 um"}},
+      {"fluid.temperature", {"fluid.temperature=20000 K"}},
+      {"container.radius", {"container.radius=0.1 um"}},
+      {"container.period", {"container.period=0.3 um"}},
+      {"wall.stretching_modulus", {"wall.stretching_modulus=1 N/m"}},
+      {"wall.mass_per_length", {"wall.mass_per_length=0 kg/m"}},
+      {"wave.kind", {"wave.kind=square"}},
+      {"wave.contracted_ratio", {"wave.contracted_ratio=1.5"}},
+      {"wave.contracted_radius", {"wave.contracted_radius=0.2 um"}},
+      {"protocol.segments", {"protocol.segments=1"}},
+      {"protocol.total_force", {"protocol.total_force=1e-6 pN"}},
+      {"protocol.tolerance_ratio", {"protocol.tolerance_ratio=0.5"}},
+      {"protocol.foo", {"protocol.foo=1"}},
+      {"time.duration", {"time.duration=0 s"}},
+      {"time.duration", {"time.duration=5"}},
+      {"time.output_interval", {"time.duration=10 ms", "time.output_interval=1 s"}},
+      {"time.step", {"time.step=1 ms"}},
+  };
+  for (const auto& [key, sets] : bad) {
+    json sc = base;
+    for (const auto& s : sets) swim::scene::apply_override(sc, s);
+    std::string own, m1, m3, ma;
+    EXPECT_EQ(rejected_key([&] { shared(sc); }, &own), key) << own;
+    EXPECT_EQ(rejected_key([&] { json r; swim::reduced1d::read_scene(sc, r); }, &m1), key) << m1;
+    EXPECT_EQ(rejected_key([&] { json r; swim::full3d::read_scene3d(sc, r); }, &m3), key) << m3;
+    EXPECT_EQ(rejected_key([&] { json r; swim::axi::read_scene_axi(sc, r); }, &ma), key) << ma;
+    EXPECT_EQ(m1, own);
+    EXPECT_EQ(m3, own);
+    EXPECT_EQ(ma, own);
+  }
+  // a prescribed wave refuses the protocol section on the tiers that run it
+  json step = base;
+  swim::scene::apply_override(step, "wave.kind=step");
+  std::string own, m1, ma;
+  EXPECT_EQ(rejected_key([&] { shared(step); }, &own), "protocol") << own;
+  EXPECT_EQ(rejected_key([&] { json r; swim::reduced1d::read_scene(step, r); }, &m1), "protocol") << m1;
+  EXPECT_EQ(rejected_key([&] { json r; swim::axi::read_scene_axi(step, r); }, &ma), "protocol") << ma;
+  EXPECT_EQ(m1, own);
+  EXPECT_EQ(ma, own);
+  // a good scene: the same values used for every shared key, on every tier
+  const json s = shared(base);
+  json r1, r3, ra;
+  swim::reduced1d::read_scene(base, r1);
+  swim::full3d::read_scene3d(base, r3);
+  swim::axi::read_scene_axi(base, ra);
+  for (const char* section : {"name", "description", "swimmer", "fluid", "container", "wall", "wave", "protocol", "time"}) {
+    ASSERT_TRUE(s.contains(section)) << section;
+    EXPECT_EQ(r1.at(section), s.at(section)) << section;
+    EXPECT_EQ(r3.at(section), s.at(section)) << section;
+    EXPECT_EQ(ra.at(section), s.at(section)) << section;
+  }
 }
