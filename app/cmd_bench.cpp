@@ -20,6 +20,7 @@
 #include "axi/run_axi.hpp"
 #include "axi/scene_axi.hpp"
 #include "axi/wall_axi.hpp"
+#include "common/errors.hpp"
 #include "common/output.hpp"
 #include "common/scene.hpp"
 #include "reduced1d/report.hpp"
@@ -476,34 +477,39 @@ scene::json steps_json(const StepTiming& t) {
   return row;
 }
 
-/// The paper's single-cycle scene run end to end.
+/// One cycle of a paper scene run end to end.
 struct PaperCycle {
+  std::string scene;     ///< the scene file's stem
   full3d::Params3d p;
   unsigned threads = 0;
   full3d::RunOutcome run;
   double wall_s = 0;
   bool done = false;     ///< the cycle ended
   double t_cycle = 0;    ///< its end, or the run's end
+  double target_s = 0;   ///< the cycle's wall-time target
   std::vector<std::pair<double, std::string>> split;  ///< wall time parts, largest first
 };
 
-/// The paper's single-cycle scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution and
-/// time step, run end to end on all cores as shipped (recovery included; a 3D cycle lasts
-/// several times the 1D tier's because the recovery is slow), into out/paper_cycle.
-PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
-  scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.55.json");
+/// One cycle of data/scenes/SCENE.json with `sets`, as shipped otherwise (adaptive step,
+/// recovery included; without VTK frames), on all cores, into out/DIR.
+PaperCycle run_cycle(const std::string& out, unsigned cores, const std::string& scene_stem,
+                     const std::vector<std::string>& sets, const std::string& dir_name, double target_s) {
+  scene::json sc = scene::load_file(data_dir() + "/scenes/" + scene_stem + ".json");
+  for (const auto& s : sets) scene::apply_override(sc, s);
   scene::apply_override(sc, "full3d.threads=" + std::to_string(cores));
   scene::apply_override(sc, "full3d.output.vtk=false");
   scene::json resolved;
   PaperCycle c;
+  c.scene = scene_stem;
+  c.target_s = target_s;
   c.p = full3d::read_scene3d(sc, resolved);
   c.threads = cores;
-  const std::string dir = out + "/paper_cycle";
+  const std::string dir = out + "/" + dir_name;
   output::make_dir(dir);
   full3d::RunControl ctl;
   ctl.progress = 1;
   ctl.quiet_vtk = true;
-  std::printf("paper single-cycle scene (paper_amplitude_0.55, %dx%dx%d, %s, %u threads) ...\n", c.p.nx, c.p.ny, c.p.nz,
+  std::printf("%s, one cycle (%dx%dx%d, %s, %u threads) ...\n", scene_stem.c_str(), c.p.nx, c.p.ny, c.p.nz,
               c.p.adaptive.enabled ? "adaptive step" : ("dt = " + std::to_string(c.p.dt) + " s").c_str(), cores);
   std::fflush(stdout);
   const auto t0 = std::chrono::steady_clock::now();
@@ -520,12 +526,35 @@ PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
   return c;
 }
 
+/// The paper's single-cycle scene (L = 0.4 um, R_f = 0.55 R0) at the default resolution, into
+/// out/paper_cycle (a 3D cycle lasts several times the 1D tier's because the recovery is slow).
+PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
+  return run_cycle(out, cores, "paper_amplitude_0.55", {}, "paper_cycle", 60.0);
+}
+
+/// The paper's buckling wall on a fine grid: paper_aspect_L0.2 at `cells` across, seeded as
+/// the converged suite's paper_aspect_L0.2_seeded (m = 8 lobes of 1e-2 R0), into
+/// out/fine_cycle_N. Targets: 4 min at 96 cells, 12 min at 128 (none on other grids).
+PaperCycle run_fine_cycle(const std::string& out, unsigned cores, int cells) {
+  const double target = cells == 96 ? 240.0 : cells == 128 ? 720.0 : 0.0;
+  return run_cycle(out, cores, "paper_aspect_L0.2",
+                   {"full3d.grid.cells_across=" + std::to_string(cells), "full3d.membrane.seed_mode=8",
+                    "full3d.membrane.seed_amplitude=0.01"},
+                   "fine_cycle_" + std::to_string(cells), target);
+}
+
 void print_paper_cycle(const PaperCycle& c) {
   const full3d::RunOutcome& r = c.run;
-  std::printf("  %s at t = %.3g s after %ld steps, displacement %.4g m, wall %.0f s (%.3g s/step; target: cycle "
-              "in <= 60 s)%s\n",
+  char target[64] = "";
+  if (c.target_s > 0) std::snprintf(target, sizeof target, "; target: cycle in <= %.0f s", c.target_s);
+  std::printf("  %s at t = %.3g s after %ld steps, displacement %.4g m, wall %.0f s (%.3g s/step%s)%s\n",
               c.done ? "cycle ended" : "cycle NOT ended", c.t_cycle, r.steps, r.summary.value("displacement_m", 0.0),
-              c.wall_s, r.steps > 0 ? c.wall_s / double(r.steps) : 0.0, r.failed ? ("  FAILED: " + r.message).c_str() : "");
+              c.wall_s, r.steps > 0 ? c.wall_s / double(r.steps) : 0.0, target,
+              r.failed ? ("  FAILED: " + r.message).c_str() : "");
+  const scene::json& ts = r.record.stats.value("time_step", scene::json::object());
+  if (ts.contains("steps_by_bound"))
+    std::printf("  steps by bound: %s; largest explicit rate %.0f /s\n", ts["steps_by_bound"].dump().c_str(),
+                ts.value("explicit_rate_max_per_s", 0.0));
   std::string line;
   for (std::size_t i = 0; i < c.split.size() && i < 6; ++i) {
     char b[96];
@@ -538,20 +567,24 @@ void print_paper_cycle(const PaperCycle& c) {
 scene::json paper_cycle_json(const PaperCycle& c) {
   const full3d::Params3d& p = c.p;
   const auto& sm = c.run.summary;
-  return {{"scene", "paper_amplitude_0.55"}, {"threads", c.threads},
-          {"grid", std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz)},
-          {"adaptive_step", p.adaptive.enabled}, {"dt_s", p.dt},
-          {"steps_per_cycle", sm.value("steps_per_cycle", scene::json::array())},
-          {"cycle_completed", c.done}, {"cycle_end_s", c.t_cycle},
-          {"steps", c.run.steps}, {"wall_time_s", c.wall_s},
-          {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", c.run.failed},
-          {"wall_time_split_s", c.run.record.stats.value("wall_time_split_s", scene::json::object())}};
+  scene::json j = {{"scene", c.scene}, {"threads", c.threads},
+                   {"grid", std::to_string(p.nx) + "x" + std::to_string(p.ny) + "x" + std::to_string(p.nz)},
+                   {"adaptive_step", p.adaptive.enabled}, {"dt_s", p.dt},
+                   {"steps_per_cycle", sm.value("steps_per_cycle", scene::json::array())},
+                   {"cycle_completed", c.done}, {"cycle_end_s", c.t_cycle},
+                   {"steps", c.run.steps}, {"wall_time_s", c.wall_s},
+                   {"displacement_m", sm.value("displacement_m", 0.0)}, {"failed", c.run.failed},
+                   {"time_step", c.run.record.stats.value("time_step", scene::json::object())},
+                   {"wall_time_split_s", c.run.record.stats.value("wall_time_split_s", scene::json::object())}};
+  if (c.target_s > 0) j["target_wall_time_s"] = c.target_s;
+  return j;
 }
 
 /// The 3D part: time per coupled step on the demo scene (duct, paper's container size) at three
 /// resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
 /// with 1 and 2 threads; then the paper's single cycle (minutes: full bench or --paper-cycle).
-void bench_3d(scene::json& report, const std::string& out, bool quick, bool paper_cycle, unsigned cores) {
+void bench_3d(scene::json& report, const std::string& out, bool quick, bool paper_cycle, unsigned cores,
+              const std::vector<int>& fine_cycles) {
   std::printf("== 3D tier ==\n");
   print_step_header();
   scene::json grids = scene::json::array();
@@ -576,6 +609,11 @@ void bench_3d(scene::json& report, const std::string& out, bool quick, bool pape
     report["full3d_paper_cycle"] = paper_cycle_json(c);
   } else {
     std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
+  }
+  for (int cells : fine_cycles) {
+    const PaperCycle c = run_fine_cycle(out, cores, cells);
+    print_paper_cycle(c);
+    report["full3d_fine_cycle"].push_back(paper_cycle_json(c));
   }
 }
 
@@ -674,7 +712,13 @@ void bench_axi(scene::json& report, const std::string& out, int cells) {
 
 }  // namespace
 
-int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const std::string& tier) {
+int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const std::string& tier,
+          const std::vector<int>& fine_cycles) {
+  for (int n : fine_cycles)
+    if (n < 8 || n > 512 || n % 2)
+      throw InputError("--fine-cycle", std::to_string(n), "an even number of cells across from 8 to 512");
+  if (!fine_cycles.empty() && tier != "3d" && tier != "all")
+    throw InputError("--fine-cycle", std::to_string(fine_cycles.front()), "a 3D figure: with --tier 3d or all");
   const bool do1d = tier == "1d" || tier == "all", do3d = tier == "3d" || tier == "all";
   const bool do_axi = tier == "axi" || tier == "all";
   const bool paper_cycle = do3d && (paper_cycle_opt || !quick);
@@ -685,7 +729,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   report["hardware_threads"] = cores;
   if (do1d) bench_1d(report, quick, reps, cores);
-  if (do3d) bench_3d(report, out, quick, paper_cycle, cores);
+  if (do3d) bench_3d(report, out, quick, paper_cycle, cores, fine_cycles);
   if (do_axi) bench_axi(report, out, quick ? 16 : 32);
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());

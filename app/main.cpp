@@ -4,7 +4,7 @@
 //                       [--error-estimate]
 //   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
 //   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
-//   swim bench [--out DIR] [--quick] [--paper-cycle] [--tier 1d|3d|axi|all]
+//   swim bench [--out DIR] [--quick] [--paper-cycle] [--fine-cycle N ...] [--tier 1d|3d|axi|all]
 //   swim scenes
 //   swim demo [--out DIR]
 //   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--tube-law] [--overwrite] [--threads N] [--progress|--quiet]
@@ -104,6 +104,10 @@ int main(int argc, char** argv) {
       ->check(CLI::IsMember({"1d", "3d", "axi", "all"}));
   ben->add_flag("--paper-cycle", paper_cycle,
                 "Also run the paper's single-cycle 3D scene end to end with --quick (minutes)");
+  std::vector<int> fine_cycles;
+  ben->add_option("--fine-cycle", fine_cycles,
+                  "Also run one cycle of the paper's buckling wall (paper_aspect_L0.2, seeded) at N cells across "
+                  "(targets: 4 min at 96, 12 min at 128); repeatable");
 
   CLI::App* sc = cli.add_subcommand("scenes", "List the shipped scenes");
 
@@ -186,7 +190,7 @@ int main(int argc, char** argv) {
     if (*demo) return app::demo(out, progress);
     if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite, scr_confirm, threads3d);
     if (*opt) return app::optimize(opt_spec, out, progress, opt_overwrite, !opt_no_confirm, threads3d);
-    if (*ben) return app::bench(out, quick, paper_cycle, bench_tier);
+    if (*ben) return app::bench(out, quick, paper_cycle, bench_tier, fine_cycles);
     if (*sc) return app::scenes();
     if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite, cal_threads, cal_law, progress);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);

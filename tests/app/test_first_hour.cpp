@@ -246,6 +246,20 @@ TEST(CommandLine, AnUnknownSubcommandIsNamedAndTheHelpNamesSwim) {
   fs::remove_all(d);
 }
 
+// swim bench --fine-cycle N (one cycle of the paper's buckling wall on a fine grid): a grid it
+// cannot run, or the flag without the 3D tier, is exit 2 naming the flag, before anything is
+// written.
+TEST(CommandLine, BenchRefusesAFineCycleItCannotRun) {
+  const fs::path d = swim::test::scratch_dir("swim_first_hour_bench");
+  for (const std::string args : {"--fine-cycle 7", "--fine-cycle 1000", "--tier 1d --fine-cycle 96"}) {
+    const Cli c = swim_cli("bench --quick " + args + " --out \"" + (d / "b").string() + "\"", d);
+    EXPECT_EQ(c.code, 2) << args;
+    EXPECT_NE(c.err.find("--fine-cycle"), std::string::npos) << c.err;
+    EXPECT_FALSE(fs::exists(d / "b")) << args;
+  }
+  fs::remove_all(d);
+}
+
 // --threads sets the 3D run's threads (full3d.threads, in the resolved scene); the 1D tier
 // runs on one thread and refuses it naming the flag; swim calibrate takes it too.
 TEST(CommandLine, RunAndCalibrateAcceptThreads) {
