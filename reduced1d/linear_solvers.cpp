@@ -509,6 +509,29 @@ struct BlockTri {
   void solve_cells(double* b) {
     constexpr int ld = lead(s);
     constexpr std::size_t SS = std::size_t(s) * ld;
+    if constexpr (s == ld) {  // whole vectors in place, no copies (blocks of 4, 8, 12)
+      constexpr int nv = ld / 4;
+      alignas(32) double T[ld] = {}, y[ld] = {}, Ly[ld] = {};
+      for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} b_k - (D_k^{-1} L_k) y_{k-1}
+        double* bk = b + o + k * s;
+        matvec<s>(Dinv.data() + k * SS, bk, Ly);
+        if (k > 0) {
+          matvec<s>(DL.data() + k * SS, y, T);
+          for (int v = 0; v < nv; ++v) store4(y + 4 * v, load4(Ly + 4 * v) - load4(T + 4 * v));
+        } else {
+          for (int v = 0; v < nv; ++v) store4(y + 4 * v, load4(Ly + 4 * v));
+        }
+        for (int v = 0; v < nv; ++v) store4(bk + 4 * v, load4(y + 4 * v));
+      }
+      const double* x = b + o + (N - 1) * s;
+      for (long k = N - 2; k >= 0; --k) {  // x_k = y_k - Up_k x_{k+1}
+        double* xk = b + o + k * s;
+        matvec<s>(Up.data() + k * SS, x, T);
+        for (int v = 0; v < nv; ++v) store4(xk + 4 * v, load4(xk + 4 * v) - load4(T + 4 * v));
+        x = xk;
+      }
+      return;
+    }
     alignas(32) double T[ld] = {}, y[ld] = {}, x[ld] = {}, Ly[ld] = {};
     for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} b_k - (D_k^{-1} L_k) y_{k-1}
       double* bk = b + o + k * s;
