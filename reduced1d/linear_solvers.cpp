@@ -274,12 +274,12 @@ struct BlockTri {
     return true;
   }
 
-  /// invert() for blocks of at most 8 (two 4-wide vectors per row): the same operations in
-  /// the same order, with the rows held in vector registers through the whole elimination
-  /// (every loop unrolled at compile time) and the pivot's row chosen and interchanged by
-  /// selects instead of branches. The elimination is a chain of s dependent pivot steps;
-  /// through memory each step waited on its stores and on the branches of the pivot search,
-  /// which the data decide (docs/performance-1d.md: 3 times faster per block of 8).
+  /// invert() for blocks of at most 8 (two 4-wide vectors per row): the same elimination in
+  /// the same order, with the rows held in vector registers throughout (every loop unrolled
+  /// at compile time) and the pivot's row chosen by selects instead of branches. The
+  /// elimination is a chain of s dependent pivot steps; through memory each step waited on
+  /// its stores and on the branches of the pivot search, which the data decide
+  /// (docs/performance-1d.md: 2.7 times faster per block of 8).
   template <int s>
   static bool invert_in_registers(const double* src, double* Dm) {
     constexpr int ld = lead(s);
