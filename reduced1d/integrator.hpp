@@ -54,8 +54,8 @@ class Integrator {
   void set_max_steps(long n);
   /// Advance to tout or to a root: one solver step per call from t_n, on_step after each
   /// accepted step, y(tout) interpolated within the last step; a root found beyond tout is
-  /// held back until the outputs before it are reported. (The solvers' normal modes take the
-  /// same steps, but interpolate y and y' at every output and search the rest of the step
+  /// held back until the outputs before it are reported. (The solvers' normal modes have the
+  /// same step control, but interpolate y and y' at every output and search the rest of the step
   /// for roots again at the next call: 4 % of the demo cycle's instructions at N = 50, whose
   /// 0.5 ms output interval is shorter than most steps; docs/performance-1d.md.)
   /// 0: reached tout, 1: root found, 2: stop time, -1: step budget exhausted; throws
