@@ -90,11 +90,6 @@ void Integrator::harvest(std::map<std::string, long>& stats) {
 }
 
 int Integrator::advance(double tout, double& t) {
-  if (on_step) return advance_by_steps(tout, t);
-  return solve(tout, t, false);
-}
-
-int Integrator::advance_by_steps(double tout, double& t) {
   double tn = current_time();
   if (pending_root_) {
     if (tout < root_t_) {
@@ -109,10 +104,10 @@ int Integrator::advance_by_steps(double tout, double& t) {
   }
   for (long k = 0; tn < tout; ++k) {
     if (k >= max_steps_) return -1;
-    const int kind = solve(tout, t, true);
+    const int kind = solve(tout, t);
     if (kind == 1) {
       if (t <= tout) return 1;
-      on_step(t, y());  // the step up to the root, laws before the switch
+      if (on_step) on_step(t, y());  // the step up to the root, laws before the switch
       pending_root_ = true;
       root_t_ = t;
       root_y_.assign(y(), y() + size());
@@ -121,7 +116,7 @@ int Integrator::advance_by_steps(double tout, double& t) {
       return 0;
     }
     tn = t;
-    on_step(tn, y());
+    if (on_step) on_step(tn, y());
     if (kind == 2) return 2;
   }
   interpolate(tout);
@@ -188,11 +183,10 @@ class CvodeIntegrator final : public Integrator {
   void root_info(int* found) override { sun::check(CVodeGetRootInfo(mem_.get(), found), "CVodeGetRootInfo"); }
 
  protected:
-  int solve(double tout, double& t, bool one_step) override {
-    const int flag = CVode(mem_.get(), tout, y_.get(), &t, one_step ? CV_ONE_STEP : CV_NORMAL);
+  int solve(double tout, double& t) override {
+    const int flag = CVode(mem_.get(), tout, y_.get(), &t, CV_ONE_STEP);
     if (flag == CV_ROOT_RETURN) return 1;
     if (flag == CV_TSTOP_RETURN) return 2;
-    if (!one_step && flag == CV_TOO_MUCH_WORK) return -1;
     sun::check(flag, "CVode", last_msg);
     return 0;
   }
@@ -354,11 +348,10 @@ class IdaIntegrator final : public Integrator {
   void root_info(int* found) override { sun::check(IDAGetRootInfo(mem_.get(), found), "IDAGetRootInfo"); }
 
  protected:
-  int solve(double tout, double& t, bool one_step) override {
-    const int flag = IDASolve(mem_.get(), tout, &t, y_.get(), yp_.get(), one_step ? IDA_ONE_STEP : IDA_NORMAL);
+  int solve(double tout, double& t) override {
+    const int flag = IDASolve(mem_.get(), tout, &t, y_.get(), yp_.get(), IDA_ONE_STEP);
     if (flag == IDA_ROOT_RETURN) return 1;
     if (flag == IDA_TSTOP_RETURN) return 2;
-    if (!one_step && flag == IDA_TOO_MUCH_WORK) return -1;
     sun::check(flag, "IDASolve", last_msg);
     return 0;
   }

@@ -52,6 +52,12 @@ class Integrator {
   virtual void set_roots(int n) = 0;  ///< n root functions, all reported on falling crossings
   virtual void set_stop_time(double t) = 0;
   void set_max_steps(long n);
+  /// Advance to tout or to a root: one solver step per call from t_n, on_step after each
+  /// accepted step, y(tout) interpolated within the last step; a root found beyond tout is
+  /// held back until the outputs before it are reported. (The solvers' normal modes have the
+  /// same step control, but interpolate y and y' at every output and search the rest of the step
+  /// for roots again at the next call: 4 % of the demo cycle's instructions at N = 50, whose
+  /// 0.5 ms output interval is shorter than most steps; docs/performance-1d.md.)
   /// 0: reached tout, 1: root found, 2: stop time, -1: step budget exhausted; throws
   /// sun::SundialsError otherwise. t: the time reached.
   int advance(double tout, double& t);
@@ -60,8 +66,7 @@ class Integrator {
   /// Add the solver's counters since the last restart to `stats`.
   void harvest(std::map<std::string, long>& stats);
   std::string last_msg;  ///< the solver's last error message
-  /// Called after every accepted step with (t_n, y_n) (advance then steps one at a time and
-  /// interpolates to tout, the same steps as CV_NORMAL / IDA_NORMAL).
+  /// Called after every accepted step with (t_n, y_n), when set.
   std::function<void(double, const double*)> on_step;
 
  protected:
@@ -70,9 +75,9 @@ class Integrator {
     const char* key;
     int (*get)(void*, long*);
   };
-  /// One call of the solver towards tout, in one-step or normal mode: 0, 1 (root), 2 (stop
-  /// time) or -1 (step budget, normal mode only) as advance(); throws otherwise.
-  virtual int solve(double tout, double& t, bool one_step) = 0;
+  /// One step of the solver towards tout (its one-step mode): 0, 1 (root) or 2 (stop time)
+  /// as advance(); throws otherwise.
+  virtual int solve(double tout, double& t) = 0;
   virtual void interpolate(double tout) = 0;  ///< y(tout) into y() (within the last step)
   virtual double current_time() = 0;          ///< t_n of the last step
   virtual void solver_max_steps(long n) = 0;
@@ -82,10 +87,6 @@ class Integrator {
   virtual int size() const = 0;
 
  private:
-  /// advance() with on_step: one step at a time from tn to tout, on_step after each accepted
-  /// step, y(tout) interpolated. A root found beyond tout is held back until the outputs
-  /// before it are reported, as the normal modes do.
-  int advance_by_steps(double tout, double& t);
   long max_steps_ = 500;
   bool pending_root_ = false;
   double root_t_ = 0;

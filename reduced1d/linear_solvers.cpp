@@ -152,9 +152,10 @@ struct BlockTri {
   // from lbeg[k] to lbeg[k + 1]
   std::vector<int> lpos, lbeg;
   std::vector<double> lval;
-  // the same L_k dense (S x S column-major, stride lead(S)), for the solves: a dense product
-  // of whole vectors costs less than the scattered updates over the nonzeros
-  std::vector<double> Ld;
+  // D_k^{-1} L_k dense (S x S column-major, stride lead(S)), for the solves' forward sweep
+  // y_k = D_k^{-1} b_k - (D_k^{-1} L_k) y_{k-1}: one dense product of whole vectors on the
+  // chain from cell to cell (D_k^{-1} b_k does not wait for y_{k-1}) instead of two
+  std::vector<double> DL;
   struct Entry {
     int row;
     long col;
@@ -197,7 +198,7 @@ struct BlockTri {
       if (i < o || i >= o + S * N) bpos[i] = int(border.size()), border.push_back(i);
     nb = int(border.size());
     const std::size_t blk = std::size_t(S) * lead(S) * N;
-    Dinv.assign(blk, 0.0), Up.assign(blk, 0.0), Ld.assign(blk, 0.0);
+    Dinv.assign(blk, 0.0), Up.assign(blk, 0.0), DL.assign(blk, 0.0);
     lpos.clear(), lval.clear(), lbeg.assign(N + 1, 0);
     G.assign(std::size_t(nb) * nb, 0.0);
     gpiv.assign(nb, 0);
@@ -273,15 +274,93 @@ struct BlockTri {
     return true;
   }
 
-  /// Gauss-Jordan inverse with partial pivoting, in place, of the column-major s x s matrix
-  /// Dm (stride lead(s), padding rows zero). Row-major elimination on a column-major buffer
+  /// invert() for blocks of at most 8 (two 4-wide vectors per row): the same elimination in
+  /// the same order, with the rows held in vector registers throughout (every loop unrolled
+  /// at compile time) and the pivot's row chosen by selects instead of branches. The
+  /// elimination is a chain of s dependent pivot steps; through memory each step waited on
+  /// its stores and on the branches of the pivot search, which the data decide
+  /// (docs/performance-1d.md: 2.7 times faster per block of 8).
+  template <int s>
+  static bool invert_in_registers(const double* src, double* Dm) {
+    constexpr int ld = lead(s);
+    constexpr int nv = ld / 4;
+    V4 a[s][nv];
+#pragma GCC unroll 16
+    for (int r = 0; r < s; ++r)
+#pragma GCC unroll 4
+      for (int v = 0; v < nv; ++v) a[r][v] = load4(src + r * ld + 4 * v);
+    int perm[s];
+#pragma GCC unroll 16
+    for (int k = 0; k < s; ++k) {
+      // pivot: the first row of largest |entry| in column k (as invert's strict comparison)
+      int p = k;
+      double best = std::abs(a[k][k / 4][k % 4]);
+#pragma GCC unroll 16
+      for (int r = k + 1; r < s; ++r) {
+        const double v = std::abs(a[r][k / 4][k % 4]);
+        const bool g = v > best;
+        best = g ? v : best;
+        p = g ? r : p;
+      }
+      perm[k] = p;
+      if (best == 0.0) return false;
+      // pr = row p; row p takes row k. The Newton matrices' blocks pivot on their diagonal
+      // (the demo cycle at N = 50: no interchange in 65 600 pivot steps), so the interchange
+      // is a branch that is not taken rather than selects on every row.
+      if (p != k) {
+#pragma GCC unroll 4
+        for (int v = 0; v < nv; ++v) {
+          V4 rp = a[k][v];
+#pragma GCC unroll 16
+          for (int r = k + 1; r < s; ++r) rp = (r == p) ? a[r][v] : rp;
+#pragma GCC unroll 16
+          for (int r = k + 1; r < s; ++r) a[r][v] = (r == p) ? a[k][v] : a[r][v];
+          a[k][v] = rp;
+        }
+      }
+      V4 pr[nv];
+#pragma GCC unroll 4
+      for (int v = 0; v < nv; ++v) pr[v] = a[k][v];
+      const double inv = 1.0 / pr[k / 4][k % 4];
+#pragma GCC unroll 4
+      for (int v = 0; v < nv; ++v) pr[v] *= inv;
+      pr[k / 4][k % 4] = inv;
+      // entry k of every other row is cleared by a product with a constant 0/1 vector: a
+      // lane write or a mask compiles to a register form of vmovq that valgrind (3.19)
+      // cannot decode, which would end every callgrind measurement of the tier
+      const V4 keep = {double(k % 4 != 0), double(k % 4 != 1), double(k % 4 != 2), double(k % 4 != 3)};
+#pragma GCC unroll 16
+      for (int r = 0; r < s; ++r) {
+        if (r == k) continue;
+        const double f = a[r][k / 4][k % 4];
+        a[r][k / 4] *= keep;
+#pragma GCC unroll 4
+        for (int v = 0; v < nv; ++v) a[r][v] -= f * pr[v];
+      }
+#pragma GCC unroll 4
+      for (int v = 0; v < nv; ++v) a[k][v] = pr[v];
+    }
+#pragma GCC unroll 16
+    for (int r = 0; r < s; ++r)
+#pragma GCC unroll 4
+      for (int v = 0; v < nv; ++v) store4(Dm + r * ld + 4 * v, a[r][v]);
+    for (int k = s - 1; k >= 0; --k)
+      if (perm[k] != k)
+        for (int r = 0; r < s; ++r) std::swap(Dm[r * ld + k], Dm[r * ld + perm[k]]);
+    return true;
+  }
+
+  /// Gauss-Jordan inverse with partial pivoting of the column-major s x s matrix src (stride
+  /// lead(s), padding rows zero) into Dm (which may be src). Row-major elimination on a column-major buffer
   /// inverts the transpose, whose inverse read column-major is D^{-1}; its pivots are D's
   /// columns. In place: each step leaves the inverse's column k where the eliminated column
   /// was (s^3 multiply-adds instead of 2 s^3 with a separate identity), and the row
   /// interchanges are undone as column interchanges at the end.
   template <int s>
-  static bool invert(double* Dm) {
+  static bool invert(const double* src, double* Dm) {
+    if constexpr (lead(s) <= 8) return invert_in_registers<s>(src, Dm);
     constexpr int ld = lead(s);
+    copy_block<std::size_t(s) * ld>(src, Dm);
     int perm[s];
     for (int k = 0; k < s; ++k) {
       int p = k;
@@ -311,6 +390,21 @@ struct BlockTri {
     return true;
   }
 
+  /// Copies and zeroes of whole blocks as 4-wide vectors (a library call's start-up costs
+  /// more than the 16 stores of a block of 8).
+  template <std::size_t m>
+  static void copy_block(const double* src, double* dst) {
+    static_assert(m % 4 == 0);
+#pragma GCC unroll 16
+    for (std::size_t e = 0; e < m; e += 4) store4(dst + e, load4(src + e));
+  }
+  template <std::size_t m>
+  static void zero_block(double* dst) {
+    static_assert(m % 4 == 0);
+#pragma GCC unroll 16
+    for (std::size_t e = 0; e < m; e += 4) store4(dst + e, V4{});
+  }
+
   /// Largest |x_e| of m entries, in four independent chains.
   template <std::size_t m>
   static double max_abs(const double* x) {
@@ -331,7 +425,7 @@ struct BlockTri {
     constexpr std::size_t SS = std::size_t(s) * ld;
     growth = 0;
     // local copies: the compiler sees that they do not alias, and vectorises the updates
-    alignas(32) double L[SS] = {}, Dm[SS] = {}, Uk[SS] = {}, Di[SS];
+    alignas(32) double L[SS] = {}, Dm[SS] = {}, Uk[SS] = {};
     lpos.clear(), lval.clear();
     for (long k = 0; k < N; ++k) {
       if (!gather<s>(M, k, L, Dm, Uk)) return false;
@@ -339,7 +433,6 @@ struct BlockTri {
       for (int e = 0; e < int(SS); ++e)
         if (L[e] != 0.0) lpos.push_back(e), lval.push_back(L[e]);
       lbeg[k + 1] = int(lpos.size());
-      std::copy(L, L + SS, Ld.data() + k * SS);
       if (k > 0) {  // D -= L_k Up_{k-1} over the nonzeros of L_k (about one per column)
         const double* Pp = Up.data() + (k - 1) * SS;
         for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) {
@@ -349,13 +442,21 @@ struct BlockTri {
         }
       }
       const double dmax = max_abs<SS>(Dm);
-      std::copy(Dm, Dm + SS, Di);
-      if (!invert<s>(Di)) return false;
+      double* Di = Dinv.data() + k * SS;
+      if (!invert<s>(Dm, Di)) return false;
       growth = std::max(growth, dmax * max_abs<SS>(Di) * s);
-      std::copy(Di, Di + SS, Dinv.data() + k * SS);
+      if (k > 0) {  // D_k^{-1} L_k: column c takes D^{-1}'s column r times L(r, c)
+        double* P = DL.data() + k * SS;
+        zero_block<SS>(P);
+        for (int e = lbeg[k]; e < lbeg[k + 1]; ++e) {
+          const int r = lpos[e] % ld, c = lpos[e] / ld;
+          const V4 l = V4{} + lval[e];
+          for (int q = 0; q < ld; q += 4) store4(P + c * ld + q, load4(P + c * ld + q) + load4(Di + r * ld + q) * l);
+        }
+      }
       if (k + 1 < N) {  // Up_k = D_k^{-1} U_k: column c takes D^{-1}'s column r times U(r, c)
         double* P = Up.data() + k * SS;
-        std::fill(P, P + SS, 0.0);
+        zero_block<SS>(P);
         for (int c = 0; c < s; ++c)
           for (int r = 0; r < s; ++r) {
             const double u = Uk[c * ld + r];
@@ -408,16 +509,40 @@ struct BlockTri {
   void solve_cells(double* b) {
     constexpr int ld = lead(s);
     constexpr std::size_t SS = std::size_t(s) * ld;
-    alignas(32) double T[ld] = {}, y[ld] = {}, x[ld] = {}, Ly[ld] = {};
-    for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} (b_k - L_k y_{k-1})
-      double* bk = b + o + k * s;
-      if (k > 0) {
-        matvec<s>(Ld.data() + k * SS, y, Ly);
-        for (int i = 0; i < s; ++i) T[i] = bk[i] - Ly[i];
-      } else {
-        for (int i = 0; i < s; ++i) T[i] = bk[i];
+    if constexpr (s == ld) {  // whole vectors in place, no copies (blocks of 4, 8, 12)
+      constexpr int nv = ld / 4;
+      alignas(32) double T[ld] = {}, y[ld] = {}, Ly[ld] = {};
+      for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} b_k - (D_k^{-1} L_k) y_{k-1}
+        double* bk = b + o + k * s;
+        matvec<s>(Dinv.data() + k * SS, bk, Ly);
+        if (k > 0) {
+          matvec<s>(DL.data() + k * SS, y, T);
+          for (int v = 0; v < nv; ++v) store4(y + 4 * v, load4(Ly + 4 * v) - load4(T + 4 * v));
+        } else {
+          for (int v = 0; v < nv; ++v) store4(y + 4 * v, load4(Ly + 4 * v));
+        }
+        for (int v = 0; v < nv; ++v) store4(bk + 4 * v, load4(y + 4 * v));
       }
-      matvec<s>(Dinv.data() + k * SS, T, y);
+      const double* x = b + o + (N - 1) * s;
+      for (long k = N - 2; k >= 0; --k) {  // x_k = y_k - Up_k x_{k+1}
+        double* xk = b + o + k * s;
+        matvec<s>(Up.data() + k * SS, x, T);
+        for (int v = 0; v < nv; ++v) store4(xk + 4 * v, load4(xk + 4 * v) - load4(T + 4 * v));
+        x = xk;
+      }
+      return;
+    }
+    alignas(32) double T[ld] = {}, y[ld] = {}, x[ld] = {}, Ly[ld] = {};
+    for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} b_k - (D_k^{-1} L_k) y_{k-1}
+      double* bk = b + o + k * s;
+      for (int i = 0; i < s; ++i) T[i] = bk[i];
+      matvec<s>(Dinv.data() + k * SS, T, Ly);
+      if (k > 0) {
+        matvec<s>(DL.data() + k * SS, y, T);
+        for (int i = 0; i < s; ++i) y[i] = Ly[i] - T[i];
+      } else {
+        for (int i = 0; i < s; ++i) y[i] = Ly[i];
+      }
       for (int i = 0; i < s; ++i) bk[i] = y[i];
     }
     for (int i = 0; i < ld; ++i) x[i] = y[i];  // x_{N-1} = y_{N-1}

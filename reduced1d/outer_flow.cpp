@@ -177,8 +177,11 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
       dpts_[p] = a.df;
     }
   }
-  // Intervals whose two points kept their radii keep their coefficients (cache above).
-  const bool all = derivatives || changed_.size() == std::size_t(np) || !interval_valid_;
+  // Intervals whose two points kept their radii keep their coefficients (cache above). An
+  // interval's coefficients depend on its two points only, so recomputing every interval
+  // gives the same values; when at least half the points changed (a Newton iteration moves
+  // every cell, and only the end radii may stay), that is cheaper than finding the intervals.
+  const bool all = derivatives || 2 * changed_.size() >= std::size_t(np) || !interval_valid_;
   const double kl = 8.0 * mu / (3.0 * pi), ain = a_in;
   const double* dd = d.data();
   const AnnulusPoint<double>* pt = pts_.data();

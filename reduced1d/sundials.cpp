@@ -88,7 +88,7 @@ Vector make_vector(long n, SUNContext ctx) {
 }
 
 Matrix make_band_matrix(long n, long mu, long ml, SUNContext ctx) {
-  Matrix A(check_ptr(SUNBandMatrix(n, mu, ml, ctx), "SUNBandMatrix"));
+  Matrix A(check_ptr(SUNBandMatrixStorage(n, mu, ml, mu, ctx), "SUNBandMatrixStorage"));
   install_band_kernels(A.get());
   return A;
 }

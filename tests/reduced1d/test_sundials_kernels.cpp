@@ -292,3 +292,45 @@ TEST(SundialsKernels, LowRankBlockSolverMatchesADenseSolve) {
                 << "S=" << S << " cells=" << cells << " rank=" << rank << " foreign=" << foreign << " i=" << i;
         }
 }
+
+// Blocks of at most 8 unknowns (the default traction model at N = 50: 8) are inverted with
+// their rows held in vector registers (linear_solvers.cpp, invert_in_registers); every
+// third diagonal entry of fill_cells is small, so the inversions pivot. Against a dense LU
+// of the assembled matrix, with and without the low-rank term.
+TEST(SundialsKernels, LowRankBlockSolverWithBlocksOfAtMostEightMatchesADenseSolve) {
+  auto ctx = sun::make_context();
+  Rng rng{41};
+  for (int S : {4, 5, 8})
+    for (long cells : {1L, 2L, 40L})
+      for (int rank : {0, 3}) {
+        const long n = 1 + cells * S + 5;
+        auto y = sun::make_vector(n, ctx.get());
+        sun::Matrix A(SUNBandMatrix(n, S, S + 2, ctx.get()));
+        sun::LowRankTerm term;
+        auto solver = sun::make_low_rank_block_solver(y.get(), A.get(), &term, sun::CellBlocks{1, S, cells}, ctx.get());
+        Eigen::MatrixXd D = fill_cells(A.get(), cells, S, rng);
+        term.rank = rank;
+        term.U.assign(std::size_t(n) * rank, 0.0);
+        term.V.assign(std::size_t(n) * rank, 0.0);
+        for (int k = 0; k < rank; ++k)
+          for (long i = 0; i < n; ++i) {
+            term.U[std::size_t(k) * n + i] = rng();
+            term.V[std::size_t(k) * n + i] = 0.1 * rng();
+          }
+        for (int k = 0; k < rank; ++k)
+          for (long i = 0; i < n; ++i)
+            for (long j = 0; j < n; ++j) D(i, j) += term.U[std::size_t(k) * n + i] * term.V[std::size_t(k) * n + j];
+        ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
+        EXPECT_TRUE(sun::factored_by_blocks(solver.get())) << "S=" << S << " cells=" << cells;
+        auto b = sun::make_vector(n, ctx.get()), x = sun::make_vector(n, ctx.get());
+        Eigen::VectorXd bb(n);
+        for (long i = 0; i < n; ++i) bb(i) = sun::data(b.get())[i] = rng();
+        ASSERT_EQ(SUNLinSolSolve(solver.get(), A.get(), x.get(), b.get(), 0.0), 0);
+        const auto lu = D.partialPivLu();
+        const Eigen::VectorXd ref = lu.solve(bb);
+        const double scale = ref.cwiseAbs().maxCoeff(), cond = 1.0 / lu.rcond();
+        for (long i = 0; i < n; ++i)
+          EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-15 * cond * scale + 1e-13 * scale)
+              << "S=" << S << " cells=" << cells << " rank=" << rank << " i=" << i;
+      }
+}
