@@ -9,18 +9,14 @@
 #include <cstring>
 #include <string>
 
+#include "reduced1d/v4.hpp"
+
 namespace swim::reduced1d::detail {
 
 namespace {
-// Four doubles as one vector register (GCC/Clang vector extension), loaded and stored through
-// memcpy (no alignment or aliasing assumptions).
-using V4 = double __attribute__((vector_size(32)));
-inline V4 load4(const double* p) {
-  V4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store4(double* p, V4 v) { std::memcpy(p, &v, sizeof v); }
+using v4::V4;
+using v4::load4;
+using v4::store4;
 
 /// Whether every x[k] is finite, without a branch per entry: x * 0 is 0 for a finite x and
 /// NaN otherwise, summed in four lanes.

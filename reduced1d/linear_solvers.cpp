@@ -12,24 +12,18 @@
 #include <vector>
 
 #include "common/dot.hpp"
+#include "reduced1d/v4.hpp"
 
 namespace swim::reduced1d::sun {
 
 namespace {
 
-// Four doubles as one AVX register (GCC/Clang vector extension). The block kernels below
-// update whole padded rows and columns with it: left to itself the compiler fully unrolls
-// those 4- to 16-element loops into scalar operations. Loads and stores go through memcpy
-// (no alignment or aliasing assumptions); a - f * b contracts to a fused multiply-add as the
-// scalar code did (blocks of 8, the default model at N = 50: the same results bit for bit;
-// other block sizes differ in the last bits, docs/performance-1d.md).
-using V4 = double __attribute__((vector_size(32)));
-inline V4 load4(const double* p) {
-  V4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store4(double* p, V4 v) { std::memcpy(p, &v, sizeof v); }
+// The block kernels below update whole padded rows and columns as V4 (v4.hpp); with blocks of
+// 8, the default model at N = 50, the results are those of scalar code bit for bit; other
+// block sizes differ in the last bits (docs/performance-1d.md).
+using v4::V4;
+using v4::load4;
+using v4::store4;
 
 // Band LU with partial pivoting (LAPACK dgbtf2 layout: A(i, j) at ab[j * ldab + kv + i - j],
 // kv = ku + kl, ldab = 2 kl + ku + 1), compiled with the project's flags (the distribution's

@@ -8,20 +8,15 @@
 #include <cstring>
 
 #include "common/dot.hpp"
+#include "reduced1d/v4.hpp"
 
 namespace swim::reduced1d::sun {
 
 namespace fast {
-// Four doubles as one vector register (GCC/Clang vector extension), loaded and stored
-// through memcpy (no alignment or aliasing assumptions).
-using V4 = double __attribute__((vector_size(32)));
-inline V4 load4(const double* p) {
-  V4 v;
-  std::memcpy(&v, p, sizeof v);
-  return v;
-}
-inline void store4(double* p, V4 v) { std::memcpy(p, &v, sizeof v); }
-inline double hsum(V4 v) { return (v[0] + v[1]) + (v[2] + v[3]); }
+using v4::V4;
+using v4::load4;
+using v4::store4;
+using v4::hsum;
 inline double* d(N_Vector v) { return NV_DATA_S(v); }
 inline sunindextype len(N_Vector v) { return NV_LENGTH_S(v); }
 void linearsum(double a, N_Vector x, double b, N_Vector y, N_Vector z) {
