@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <string>
 #include <vector>
 
 #include "reduced1d/linear_solvers.hpp"
@@ -242,6 +243,37 @@ Eigen::MatrixXd fill_cells(SUNMatrix A, long cells, int S, Rng& rng) {
     }
   return D;
 }
+
+// A random low-rank term U V^T of `rank` columns in `term`, added to the dense matrix D too.
+void add_random_low_rank_term(sun::LowRankTerm& term, Eigen::MatrixXd& D, long n, int rank, Rng& rng) {
+  term.rank = rank;
+  term.U.assign(std::size_t(n) * rank, 0.0);
+  term.V.assign(std::size_t(n) * rank, 0.0);
+  for (int k = 0; k < rank; ++k)
+    for (long i = 0; i < n; ++i) {
+      term.U[std::size_t(k) * n + i] = rng();
+      term.V[std::size_t(k) * n + i] = 0.1 * rng();
+    }
+  for (int k = 0; k < rank; ++k)
+    for (long i = 0; i < n; ++i)
+      for (long j = 0; j < n; ++j) D(i, j) += term.U[std::size_t(k) * n + i] * term.V[std::size_t(k) * n + j];
+}
+
+// The solver's solution of a random right-hand side against a dense LU of D, to round-off
+// times D's condition number.
+void expect_solve_matches_dense(SUNLinearSolver solver, SUNMatrix A, const Eigen::MatrixXd& D, Rng& rng,
+                                SUNContext ctx, const std::string& what) {
+  const long n = D.rows();
+  auto b = sun::make_vector(n, ctx), x = sun::make_vector(n, ctx);
+  Eigen::VectorXd bb(n);
+  for (long i = 0; i < n; ++i) bb(i) = sun::data(b.get())[i] = rng();
+  ASSERT_EQ(SUNLinSolSolve(solver, A, x.get(), b.get(), 0.0), 0);
+  const auto lu = D.partialPivLu();
+  const Eigen::VectorXd ref = lu.solve(bb);
+  const double scale = ref.cwiseAbs().maxCoeff(), cond = 1.0 / lu.rcond();
+  for (long i = 0; i < n; ++i)
+    EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-15 * cond * scale + 1e-13 * scale) << what << " i=" << i;
+}
 }  // namespace
 
 // The block-tridiagonal factorisation of the 1D tier's Newton matrix (cells of 9 unknowns,
@@ -267,29 +299,12 @@ TEST(SundialsKernels, LowRankBlockSolverMatchesADenseSolve) {
             SM_ELEMENT_B(A.get(), 1, 0) = 0.7;
             D(1, 0) = 0.7;
           }
-          term.rank = rank;
-          term.U.assign(std::size_t(n) * rank, 0.0);
-          term.V.assign(std::size_t(n) * rank, 0.0);
-          for (int k = 0; k < rank; ++k)
-            for (long i = 0; i < n; ++i) {
-              term.U[std::size_t(k) * n + i] = rng();
-              term.V[std::size_t(k) * n + i] = 0.1 * rng();
-            }
-          for (int k = 0; k < rank; ++k)
-            for (long i = 0; i < n; ++i)
-              for (long j = 0; j < n; ++j) D(i, j) += term.U[std::size_t(k) * n + i] * term.V[std::size_t(k) * n + j];
+          add_random_low_rank_term(term, D, n, rank, rng);
           ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
           EXPECT_EQ(sun::factored_by_blocks(solver.get()), !foreign) << "S=" << S << " cells=" << cells;
-          auto b = sun::make_vector(n, ctx.get()), x = sun::make_vector(n, ctx.get());
-          Eigen::VectorXd bb(n);
-          for (long i = 0; i < n; ++i) bb(i) = sun::data(b.get())[i] = rng();
-          ASSERT_EQ(SUNLinSolSolve(solver.get(), A.get(), x.get(), b.get(), 0.0), 0);
-          const auto lu = D.partialPivLu();
-          const Eigen::VectorXd ref = lu.solve(bb);
-          const double scale = ref.cwiseAbs().maxCoeff(), cond = 1.0 / lu.rcond();
-          for (long i = 0; i < n; ++i)
-            EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-15 * cond * scale + 1e-13 * scale)
-                << "S=" << S << " cells=" << cells << " rank=" << rank << " foreign=" << foreign << " i=" << i;
+          expect_solve_matches_dense(solver.get(), A.get(), D, rng, ctx.get(),
+                                     "S=" + std::to_string(S) + " cells=" + std::to_string(cells) +
+                                         " rank=" + std::to_string(rank) + " foreign=" + std::to_string(foreign));
         }
 }
 
@@ -309,28 +324,11 @@ TEST(SundialsKernels, LowRankBlockSolverWithBlocksOfAtMostEightMatchesADenseSolv
         sun::LowRankTerm term;
         auto solver = sun::make_low_rank_block_solver(y.get(), A.get(), &term, sun::CellBlocks{1, S, cells}, ctx.get());
         Eigen::MatrixXd D = fill_cells(A.get(), cells, S, rng);
-        term.rank = rank;
-        term.U.assign(std::size_t(n) * rank, 0.0);
-        term.V.assign(std::size_t(n) * rank, 0.0);
-        for (int k = 0; k < rank; ++k)
-          for (long i = 0; i < n; ++i) {
-            term.U[std::size_t(k) * n + i] = rng();
-            term.V[std::size_t(k) * n + i] = 0.1 * rng();
-          }
-        for (int k = 0; k < rank; ++k)
-          for (long i = 0; i < n; ++i)
-            for (long j = 0; j < n; ++j) D(i, j) += term.U[std::size_t(k) * n + i] * term.V[std::size_t(k) * n + j];
+        add_random_low_rank_term(term, D, n, rank, rng);
         ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
         EXPECT_TRUE(sun::factored_by_blocks(solver.get())) << "S=" << S << " cells=" << cells;
-        auto b = sun::make_vector(n, ctx.get()), x = sun::make_vector(n, ctx.get());
-        Eigen::VectorXd bb(n);
-        for (long i = 0; i < n; ++i) bb(i) = sun::data(b.get())[i] = rng();
-        ASSERT_EQ(SUNLinSolSolve(solver.get(), A.get(), x.get(), b.get(), 0.0), 0);
-        const auto lu = D.partialPivLu();
-        const Eigen::VectorXd ref = lu.solve(bb);
-        const double scale = ref.cwiseAbs().maxCoeff(), cond = 1.0 / lu.rcond();
-        for (long i = 0; i < n; ++i)
-          EXPECT_NEAR(sun::data(x.get())[i], ref(i), 1e-15 * cond * scale + 1e-13 * scale)
-              << "S=" << S << " cells=" << cells << " rank=" << rank << " i=" << i;
+        expect_solve_matches_dense(solver.get(), A.get(), D, rng, ctx.get(),
+                                   "S=" + std::to_string(S) + " cells=" + std::to_string(cells) +
+                                       " rank=" + std::to_string(rank));
       }
 }
