@@ -289,45 +289,57 @@ GRID_MARKERS = ("o", "s", "^", "D", "v", "P")
 
 
 def convergence_figure(case, path):
+    """The 3D grid series against h with its extrapolation h -> 0, one panel per figure:
+    displacement per cycle and, when the runs have it, the cycle time."""
     if case.get("reference"):
         return reference_convergence_figure(case, path)
     runs = [r for r in case["runs3d"] if r.get("has_cycle")]
     if not runs:
         return False
-    fig, ax = plt.subplots(figsize=(9.5, 4.6))
+    panels = [("displacement_per_cycle_m", "displacement per cycle [nm]", 1e9, "nm")]
+    if all(r.get("cycle_time_s") is not None for r in runs):
+        panels.append(("cycle_time_s", "cycle time [s]", 1.0, "s"))
+    fig, axes = plt.subplots(1, len(panels), figsize=(8.0 * len(panels), 6.2), squeeze=False)
     h = [r["cell_size_m"] * 1e9 for r in runs]
-    d = [r["displacement_per_cycle_m"] * 1e9 for r in runs]
-    ax.plot(h, d, "k-", lw=1, label="3D runs")
-    for k, (hk, dk) in enumerate(zip(h, d)):  # each grid its own marker, its cell size beside it
-        ax.plot([hk], [dk], GRID_MARKERS[k % len(GRID_MARKERS)], color="k", ms=6)
-        ax.annotate(f"h = {hk:.3g} nm", (hk, dk), xytext=(6, 4), textcoords="offset points", fontsize=7)
-    ref = case["reference3d"].get("displacement_per_cycle_m")
-    if ref:
-        rng = case["reference3d"].get("order_range")
-        rng_text = f"[{rng[0]:g}, {rng[1]:g}]" if rng else "the scheme's range"
-        obs = ref.get("observed_order")
-        if ref["asymptotic"]:
-            what = f" (order {ref['order']:.2f}, accepted in {rng_text})" if ref["order"] else ""
-        elif ref.get("method") == "expansion_fit":
-            what = " (not asymptotic: f0 + a h + b h² fitted to the grids, error = leave-one-out change)"
-        else:
-            what = (" (not asymptotic: finest ± spread" +
-                    (f"; observed order {obs:.2f} outside {rng_text}" if obs is not None and
-                     not (rng and rng[0] <= obs <= rng[1]) else "") + ")")
-        ax.errorbar([0], [ref["value"] * 1e9], yerr=[ref["error"] * 1e9], fmt="rs", capsize=4,
-                    label="3D reference h → 0 ± error" + what)
-    for k, m in enumerate(case["models1d"]):
-        if m.get("has_cycle") and ref and abs(m["displacement_per_cycle_m"]) < 20 * abs(ref["value"]):
-            ax.axhline(m["displacement_per_cycle_m"] * 1e9, color=f"C{k + 1}", ls="--", lw=1, label=f"1D: {m['label']}")
-    paper = (case.get("paper") or {}).get("max_displacement_m")
-    if paper:
-        ax.axhline(paper * 1e9, color="0.4", ls=":", lw=1.2, label="paper: maximum displacement over the cycle")
-    ax.set(xlabel="cell size h [nm]", ylabel="displacement per cycle [nm]",
-           title=f"{case['name']}: 3D grid convergence")
-    ax.set_xlim(left=-0.05 * max(h), right=1.2 * max(h))
-    handles, labels = ax.get_legend_handles_labels()
-    ax.legend(handles, [textwrap.fill(t, 48) for t in labels], loc="center left", bbox_to_anchor=(1.0, 0.5),
-              fontsize="small", frameon=False)
+    rng = case["reference3d"].get("order_range")
+    rng_text = f"[{rng[0]:g}, {rng[1]:g}]" if rng else "the scheme's range"
+    for ax, (key, ylabel, scale, unit) in zip(axes[0], panels):
+        v = [r[key] * scale for r in runs]
+        ax.plot(h, v, "k-", lw=1, label="3D runs")
+        for k, (hk, vk) in enumerate(zip(h, v)):  # each grid its own marker, its cell size beside it
+            ax.plot([hk], [vk], GRID_MARKERS[k % len(GRID_MARKERS)], color="k", ms=6)
+            ax.annotate(f"h = {hk:.3g} nm", (hk, vk), xytext=(6, 4), textcoords="offset points", fontsize=7)
+        ref = case["reference3d"].get(key)
+        if ref:
+            obs = ref.get("observed_order")
+            if ref["asymptotic"]:
+                what = f" (order {ref['order']:.2f}, accepted in {rng_text})" if ref["order"] else ""
+            elif ref.get("method") == "expansion_fit":
+                what = " (not asymptotic: f0 + a h + b h² fitted to the grids, error = leave-one-out change)"
+                fit = ref.get("expansion")
+                if fit and None not in fit.values():  # the suite's fitted expansion (report.json)
+                    hs = np.linspace(0.0, max(h), 60) * 1e-9
+                    ax.plot(hs * 1e9, (fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs) * scale, "k--",
+                            lw=0.8, label="3D: fitted f0 + a h + b h²")
+            else:
+                what = (" (not asymptotic: finest ± spread" +
+                        (f"; observed order {obs:.2f} outside {rng_text}" if obs is not None and
+                         not (rng and rng[0] <= obs <= rng[1]) else "") + ")")
+            ax.errorbar([0], [ref["value"] * scale], yerr=[ref["error"] * scale], fmt="rs", capsize=4,
+                        label="3D reference h → 0 ± error" + what)
+        for k, m in enumerate(case["models1d"]):
+            if m.get("has_cycle") and m.get(key) is not None and ref and abs(m[key]) < 20 * abs(ref["value"]):
+                ax.axhline(m[key] * scale, color=f"C{k + 1}", ls="--", lw=1, label=f"1D: {m['label']}")
+        paper = (case.get("paper") or {}).get("max_displacement_m")
+        if paper and key == "displacement_per_cycle_m":
+            ax.axhline(paper * 1e9, color="0.4", ls=":", lw=1.2, label="paper: maximum displacement over the cycle")
+        ax.set(xlabel="cell size h [nm]", ylabel=ylabel)
+        ax.set_xlim(left=-0.05 * max(h), right=1.2 * max(h))
+        ax.grid(alpha=0.3)
+        handles, labels = ax.get_legend_handles_labels()
+        ax.legend(handles, [textwrap.fill(t, 60) for t in labels], loc="upper center", bbox_to_anchor=(0.5, -0.13),
+                  fontsize="small", frameon=False, ncol=1)
+    fig.suptitle(f"{case['name']}: 3D grid convergence")
     save(fig, path)
     return True
 

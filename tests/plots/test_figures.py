@@ -290,6 +290,28 @@ class ValidationFigures(unittest.TestCase):
         self.assertIn("not asymptotic", legend)
         self.assertIn("observed order 2.94", legend.replace("\n", " "))
 
+    def test_convergence_has_a_cycle_time_panel_and_draws_the_reports_expansion(self):
+        runs = [{"has_cycle": True, "cell_size_m": h, "displacement_per_cycle_m": d, "cycle_time_s": t}
+                for h, d, t in ((1.04e-8, 2.70e-8, 1.10), (7.8e-9, 2.92e-8, 0.88), (6.25e-9, 3.03e-8, 0.80),
+                                (5.2e-9, 3.12e-8, 0.72))]
+        fit = {"f0": 3.46e-8, "a_per_m": -0.8, "b_per_m2": 1e6}
+        ref = {"value": 3.46e-8, "error": 6e-9, "asymptotic": False, "method": "expansion_fit", "order": 1,
+               "observed_order": None, "expansion": fit}
+        case = {"name": "c", "runs3d": runs, "models1d": [], "reference3d": {
+            "order_range": [0.5, 2], "displacement_per_cycle_m": ref,
+            "cycle_time_s": {"value": 0.59, "error": 0.69, "asymptotic": False, "method": "finest_grid",
+                             "order": None, "observed_order": None}}}
+        self.assertTrue(self.mod.convergence_figure(case, f"{self.d}/c2.png"))
+        axes = self.closed[-1].axes
+        self.assertEqual(len(axes), 2)
+        self.assertEqual(axes[1].get_ylabel(), "cycle time [s]")
+        fitted = [ln for ln in axes[0].get_lines() if ln.get_label().startswith("3D: fitted")]
+        self.assertEqual(len(fitted), 1)
+        x, y = fitted[0].get_xdata(), fitted[0].get_ydata()
+        self.assertAlmostEqual(x[0], 0.0)
+        self.assertAlmostEqual(y[0], 34.6, places=6)  # f0 in nm, from the report's coefficients
+        self.assertFalse([ln for ln in axes[1].get_lines() if ln.get_label().startswith("3D: fitted")])
+
     def test_pareto_labels_do_not_overlap(self):
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots()
