@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <utility>
 #include <vector>
 
 #include "common/errors.hpp"
@@ -19,41 +20,38 @@ const std::vector<std::string> kSeriesColumns = [] {
   return c;
 }();
 
-double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, const Eigen::VectorXd& ring_r) {
-  double worst = 0.0;
+namespace {
+// The ring with the largest RMS deviation of its node radii from its mean radius, and that RMS.
+std::pair<int, double> most_wrinkled_ring(const CylinderMesh& mesh, const Eigen::VectorXd& node_r,
+                                          const Eigen::VectorXd& ring_r) {
+  int worst = 0;
+  double worst_s2 = 0.0;
   for (int r = 0; r < mesh.n_rings; ++r) {
     double s2 = 0.0;
     for (int i = 0; i < mesh.n_theta; ++i) {
       const double d = node_r[mesh.node(r, i)] - ring_r[r];
       s2 += d * d;
     }
-    worst = std::max(worst, std::sqrt(s2 / mesh.n_theta));
-  }
-  return worst;
-}
-
-int wall_wrinkle_mode(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
-                      const Eigen::VectorXd& ring_r) {
-  const int nt = mesh.n_theta;
-  int worst = 0;
-  double worst_s2 = -1.0;
-  for (int r = 0; r < mesh.n_rings; ++r) {
-    double s2 = 0.0;
-    for (int i = 0; i < nt; ++i) s2 += std::pow(node_r[mesh.node(r, i)] - ring_r[r], 2);
     if (s2 > worst_s2) worst_s2 = s2, worst = r;
   }
-  if (!(std::sqrt(worst_s2 / nt) > 1e-9 * ring_r[worst])) return 0;
+  return {worst, std::sqrt(worst_s2 / mesh.n_theta)};
+}
+
+// The m in [2, n_theta / 2] with the largest |sum_i (r_i - r_ring) exp(-i m phi_i)| on `ring`.
+int lobe_mode(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
+              const Eigen::VectorXd& ring_r, int ring) {
+  const int nt = mesh.n_theta;
   double yc = 0.0, zc = 0.0;
-  for (int i = 0; i < nt; ++i) yc += X(1, mesh.node(worst, i)), zc += X(2, mesh.node(worst, i));
+  for (int i = 0; i < nt; ++i) yc += X(1, mesh.node(ring, i)), zc += X(2, mesh.node(ring, i));
   yc /= nt, zc /= nt;
   // e^{i m phi_i} by repeated multiplication (one complex product per node and mode)
   std::vector<std::complex<double>> z(nt), w(nt);
   std::vector<double> d(nt);
   for (int i = 0; i < nt; ++i) {
-    const int k = mesh.node(worst, i);
+    const int k = mesh.node(ring, i);
     z[i] = std::polar(1.0, std::atan2(X(2, k) - zc, X(1, k) - yc));
     w[i] = z[i];
-    d[i] = node_r[k] - ring_r[worst];
+    d[i] = node_r[k] - ring_r[ring];
   }
   int best = 0;
   double best_a = -1.0;
@@ -66,6 +64,17 @@ int wall_wrinkle_mode(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const
     if (std::norm(a) > best_a) best_a = std::norm(a), best = m;
   }
   return best;
+}
+}  // namespace
+
+double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, const Eigen::VectorXd& ring_r) {
+  return most_wrinkled_ring(mesh, node_r, ring_r).second;
+}
+
+WallWrinkle wall_wrinkle_shape(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
+                               const Eigen::VectorXd& ring_r) {
+  const auto [ring, rms] = most_wrinkled_ring(mesh, node_r, ring_r);
+  return {rms, rms > 1e-9 * ring_r[ring] ? lobe_mode(mesh, X, node_r, ring_r, ring) : 0};
 }
 
 void WallSplit::add_step(const IbStepStats& st) {
@@ -209,15 +218,14 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
   }
   for (int r = 0; r + 1 < mesh.n_rings; ++r)
     vol += 0.5 * M_PI * (rr[r] * rr[r] + rr[r + 1] * rr[r + 1]) * (xr[r + 1] - xr[r]);
-  const double wrinkle = wall_wrinkle(mesh, rn, rr);
-  const int wrinkle_mode = wall_wrinkle_mode(mesh, s.X, rn, rr);
-  if (wrinkle > max_wrinkle_) max_wrinkle_ = wrinkle, max_wrinkle_mode_ = wrinkle_mode;
+  const WallWrinkle wrinkle = wall_wrinkle_shape(mesh, s.X, rn, rr);
+  if (wrinkle.amplitude > max_wrinkle_) max_wrinkle_ = wrinkle.amplitude, max_wrinkle_mode_ = wrinkle.mode;
   const double row[] = {s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                         rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                         double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
                         last_divergence_, max_edge_t_ == s.t ? max_edge_ : max_edge_length(mesh, s.X),
                         n > 0 ? dt_last : 0.0,
-                        wrinkle, double(wrinkle_mode)};
+                        wrinkle.amplitude, double(wrinkle.mode)};
   // a row that passes output.max_bytes ends the run (NumericalError) once it is written: its
   // radius snapshot is still written, and the run's failure path does not record it again
   last_recorded_ = n;

@@ -31,12 +31,16 @@ extern const std::vector<std::string> kSeriesColumns;
 /// 0; a hoop-compressed lattice that buckles into azimuthal lobes (docs/full3d.md, "Wall
 /// wrinkling") gives the lobes' RMS amplitude.
 double wall_wrinkle(const CylinderMesh& mesh, const Eigen::VectorXd& node_r, const Eigen::VectorXd& ring_r);
-/// The lobe number of the wall's wrinkle: on the ring with the largest RMS deviation (as
-/// wall_wrinkle), the m in [2, n_theta / 2] with the largest Fourier amplitude
+/// The wall's wrinkle and its lobe number: `amplitude` as wall_wrinkle, `mode` on that most
+/// wrinkled ring the m in [2, n_theta / 2] with the largest Fourier amplitude
 /// |sum_i (r_i - r_ring) exp(-i m phi_i)| of the node radii against their angles phi_i about the
-/// ring's centroid. 0 when that ring's deviation is below 1e-9 of its radius (a round wall).
-int wall_wrinkle_mode(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
-                      const Eigen::VectorXd& ring_r);
+/// ring's centroid; 0 when that ring's deviation is below 1e-9 of its radius (a round wall).
+struct WallWrinkle {
+  double amplitude = 0.0;  ///< m
+  int mode = 0;
+};
+WallWrinkle wall_wrinkle_shape(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
+                               const Eigen::VectorXd& ring_r);
 
 /// An empty record of a 3D run (tier, model, length, columns, reference ring positions).
 record::RunRecord new_record(const RunSetup& run);
@@ -95,7 +99,7 @@ class Measurements {
   double pumped_volume() const { return -vol_rear_; }
   double max_cfl() const { return max_cfl_; }
   long stokes_iterations() const { return iterations_total_; }
-  /// The largest wall wrinkle of the recorded rows (m) and its lobe number (wall_wrinkle_mode).
+  /// The largest wall wrinkle of the recorded rows (m) and its lobe number (wall_wrinkle_shape).
   double max_wrinkle() const { return max_wrinkle_; }
   int max_wrinkle_mode() const { return int(max_wrinkle_mode_); }
   WallSplit& split() { return split_; }

@@ -42,8 +42,12 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh) {
   return q;
 }
 
+CylinderMesh make_round_mesh(const Params3d& p) {
+  return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor);
+}
+
 CylinderMesh make_mesh(const Params3d& p) {
-  CylinderMesh mesh = make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor);
+  CylinderMesh mesh = make_round_mesh(p);
   seed_ring_mode(mesh, p.seed_mode, p.seed_amplitude);
   return mesh;
 }
@@ -271,7 +275,7 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   // The wall's bending rigidity D and eq. (8)'s k_b on this mesh (D / k_b scales with the edge
   // length; measured on the unseeded mesh, the seed being an imperfection of the same wall)
   const double per_kb_run = bending_rigidity_per_kb(
-      p.seed_amplitude > 0.0 ? make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor) : mesh,
+      p.seed_amplitude > 0.0 ? make_round_mesh(p) : mesh,
       p.membrane.bending);
   if (p.bending_model == Params3d::BendingModel::FixedKb) {
     p.bending_rigidity = p.membrane.kb * per_kb_run;

@@ -116,6 +116,9 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh);
 /// The reference mesh of the scene (no-leak rule with the scene's spacing factor), with the
 /// scene's seed imperfection (full3d.membrane.seed_mode, seed_amplitude) in its stress-free shape.
 CylinderMesh make_mesh(const Params3d& p);
+/// The same tube without the seed imperfection: the round tube whose law the calibration
+/// measures and on which D / k_b is measured.
+CylinderMesh make_round_mesh(const Params3d& p);
 
 /// The default of full3d.membrane.reference_edge, m: the longest-edge bound of the default
 /// grid of the paper's container, 0.6 * (0.5 um / 32) / 2 = 4.6875 nm.

@@ -156,13 +156,6 @@ double lowest_hessian_eigenvalue(const full3d::CylinderMesh& mesh, const full3d:
 
 }  // namespace
 
-full3d::CylinderMesh round_tube(const full3d::Params3d& p) {
-  full3d::Params3d round = p;
-  round.seed_mode = 0;
-  round.seed_amplitude = 0.0;
-  return full3d::make_mesh(round);
-}
-
 std::vector<double> default_loads(const full3d::Params3d& p) {
   const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
   std::vector<double> out;
@@ -173,7 +166,7 @@ std::vector<double> default_loads(const full3d::Params3d& p) {
 StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures,
                                    const std::function<void(std::size_t)>& on_load) {
   StaticCalibration c;
-  const full3d::CylinderMesh mesh = round_tube(p);
+  const full3d::CylinderMesh mesh = full3d::make_round_mesh(p);  // the round tube, without the seed
   c.n_theta = mesh.n_theta;
   c.n_rings = mesh.n_rings;
   c.nodes = int(mesh.X0.cols());
@@ -568,7 +561,7 @@ TubeLawCalibration calibrate_tube_law(const full3d::Params3d& p, double c1, doub
   TubeLawCalibration t;
   t.c1_fit = c1;
   t.c1_fit_stderr = c1_stderr;
-  const full3d::CylinderMesh mesh = round_tube(p);
+  const full3d::CylinderMesh mesh = full3d::make_round_mesh(p);  // the round tube, without the seed
   const double R0 = mesh.radius;
   t.closed_form_c1 = round_closed_form_c1(mesh, p.membrane.ks);
   const double Pscale = p.c1_estimate() * R0;

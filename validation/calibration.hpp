@@ -60,12 +60,6 @@ struct StaticCalibration {
   std::string no_static_state_reason;
 };
 
-/// The scene's tube without its seed imperfection (full3d.membrane.seed_mode, seed_amplitude):
-/// the round tube whose law the calibration measures. The seed starts the buckling of the
-/// dynamic runs; the static loads find the round tube's buckling on their own
-/// (StaticCalibration's stability check, the tube law's buckled branch).
-full3d::CylinderMesh round_tube(const full3d::Params3d& p);
-
 /// Loads as fractions of the static load C1_net (R0 - R_f) that holds the scene's target
 /// radius (C1_net the spring-network estimate): thirteen loads from 1 % to 150 %, dense below 20 % where ring buckling sets in.
 std::vector<double> default_loads(const full3d::Params3d& p);
@@ -77,6 +71,9 @@ std::vector<double> default_loads(const full3d::Params3d& p);
 /// Points that are unstable to ring buckling (LoadPoint::stable) are reported and left out of
 /// the fits.
 /// on_load (optional): called after each load with the number of loads relaxed so far.
+/// The loads act on the round tube (full3d::make_round_mesh): a scene's seed imperfection starts
+/// the buckling of its dynamic runs and is left out; the static loads find the round tube's
+/// buckling on their own (the stability checks).
 StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures,
                                    const std::function<void(std::size_t)>& on_load = {});
 

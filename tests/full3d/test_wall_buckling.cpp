@@ -401,21 +401,21 @@ TEST(SegmentBuckling, ThePapersShortTubeGrowsEightLobesInTheFluid) {
   EXPECT_GE(fastest_segment_mode(N, D, Y, 0.55 * R0, 140e-9, WallDrag::Dry, 1.0), 9);
 }
 
-// The runs' lobe measure (wall_wrinkle_mode): the seeded lobe number of a lobed wall, the larger
+// The runs' lobe measure (wall_wrinkle_shape): the seeded lobe number of a lobed wall, the larger
 // of two superposed lobe numbers, and 0 on a round wall.
 TEST(WallSeed, TheWrinkleModeIsTheLobeNumberOfTheMostWrinkledRing) {
   for (int m : {3, 7, 12}) {
     CylinderMesh mesh = tube(40);
     seed_ring_mode(mesh, m, 0.01);
     const Eigen::VectorXd rn = node_radii(mesh, mesh.X0);
-    EXPECT_EQ(wall_wrinkle_mode(mesh, mesh.X0, rn, ring_radii(mesh, rn)), m);
+    EXPECT_EQ(wall_wrinkle_shape(mesh, mesh.X0, rn, ring_radii(mesh, rn)).mode, m);
   }
   CylinderMesh mesh = tube(40);
   seed_ring_mode(mesh, 5, 0.01);
   const Eigen::Matrix3Xd X = inextensional_lobes(mesh, mesh.X0, 9, 0.004 * kR0);
   const Eigen::VectorXd rn = node_radii(mesh, X);
-  EXPECT_EQ(wall_wrinkle_mode(mesh, X, rn, ring_radii(mesh, rn)), 5);
+  EXPECT_EQ(wall_wrinkle_shape(mesh, X, rn, ring_radii(mesh, rn)).mode, 5);
   const CylinderMesh round = tube(40);
   const Eigen::VectorXd r0 = node_radii(round, round.X0);
-  EXPECT_EQ(wall_wrinkle_mode(round, round.X0, r0, ring_radii(round, r0)), 0);
+  EXPECT_EQ(wall_wrinkle_shape(round, round.X0, r0, ring_radii(round, r0)).mode, 0);
 }
