@@ -57,9 +57,11 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
              ? abs_k_quadrature(P.geometry.L, P.geometry.L / P.numerics.cells)
              : AbsKQuadrature{}),
       J(int(tq.s.size())),
-      dae(P.wall.inertia || J > 0),
+      D_axial(P.wall.D_axial),
+      bending(P.wall.D_axial > 0),
+      dae(P.wall.inertia || J > 0 || bending),
       velocity_quadrature(step_velocity && force_free && !confined),
-      stride(dae ? 3 + J : 1),
+      stride(dae ? 3 + J + (bending ? 1 : 0) : 1),
       Rb0_static(R0),
       RbL_static(R0) {
   wall = wall_law(P);
@@ -86,6 +88,14 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
   // stay inside.
   band_mu = stride;
   band_ml = stride + 2;
+  if (bending) {
+    // kappa last in its cell: the wall row reaches kappa_{i+1} (2 stride - 2 above), the
+    // kappa row reaches a_{i-1} (2 stride - 1 below); still within the neighbouring cells.
+    ik = 3 + J;
+    bend_c = D_axial * R0 / (h * h * h * h);
+    band_mu = 2 * stride - 2;
+    band_ml = 2 * stride - 1;
+  }
   const double f_s = bal.per_length ? pi * C1 * R0 * R0 * R0 / L : C1 * R0 * R0 / (2.0 * L);
   D_s = f_s * T_s;
   X_s = force_free ? R0 : D_s * T_s / (bal.m_eff + bal.c_ext * T_s);
@@ -283,14 +293,27 @@ disc::PressureIntegrals ForceModel::integrals(const ModelState& st) const {
   return s;
 }
 
-double ForceModel::energy(const ModelState& s) const {
+double ForceModel::wall_energy(const double* R) const {
   double e = 0;
   if (wall.law) {
-    for (int i = 0; i < N; ++i) e += wall.law->energy(s.R[i]);
+    for (int i = 0; i < N; ++i) e += wall.law->energy(R[i]);
     e *= 2.0 * pi * R0 * h;
   } else {
-    e = disc::elastic_energy(s.R.data(), N, R0, C1, h);
+    e = disc::elastic_energy(R, N, R0, C1, h);
   }
+  if (bending) {
+    double b = 0;
+    for (int i = 1; i + 1 < N; ++i) {
+      const double c = (R[i + 1] - 2.0 * R[i] + R[i - 1]) / (h * h);
+      b += c * c;
+    }
+    e += 0.5 * D_axial * b * 2.0 * pi * R0 * h;
+  }
+  return e;
+}
+
+double ForceModel::energy(const ModelState& s) const {
+  double e = wall_energy(s.R.data());
   if (inertia) {
     double k = 0;
     for (int i = 0; i < N; ++i) k += s.V[i] * s.V[i];
@@ -580,6 +603,11 @@ int ForceModel::res(const double* y, const double* yp, double* F, ModelState& s)
         F[k + 3 + j] = (tr_s2[j] * (y[k + 3 + j] - y[k + 1]) - d2p) * tr_w[j];
       }
     }
+    if (bending) {  // kappa = 0 beyond the ends and at the end cells (free ends)
+      const double km1 = i > 0 ? y[k - S + ik] : 0.0, kp1 = i + 1 < N ? y[k + S + ik] : 0.0;
+      F[k + 1] += cv * bend_c * (km1 - 2.0 * y[k + ik] + kp1);
+      F[k + ik] = (i > 0 && i + 1 < N) ? y[k + ik] - (R[i + 1] - 2.0 * R[i] + R[i - 1]) / R0 : y[k + ik];
+    }
   }
   if (!s.geometry_ok) return 1;
   double d[6];
@@ -627,6 +655,17 @@ void ForceModel::ida_band(const Linearisation& s, const double* y, double cj, co
       band(row, k + 1, -tr_s2[j] * w);
       if (i > 0) band(row, row - S, -w);
       if (i + 1 < N) band(row, row + S, -w);
+    }
+    if (bending) {
+      band(k + 1, k + ik, -2.0 * cv * bend_c);
+      if (i > 0) band(k + 1, k + ik - S, cv * bend_c);
+      if (i + 1 < N) band(k + 1, k + ik + S, cv * bend_c);
+      band(k + ik, k + ik, 1.0);
+      if (i > 0 && i + 1 < N) {
+        band(k + ik, k - S, -dRda(i - 1) / R0);
+        band(k + ik, k, 2.0 * dRda(i) / R0);
+        band(k + ik, k + S, -dRda(i + 1) / R0);
+      }
     }
   }
   // end volumes: F = V' - Q_end / V_s

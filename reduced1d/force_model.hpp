@@ -119,7 +119,14 @@ struct ForceModel {
   disc::BalanceCoefficients bal;
   AbsKQuadrature tq;   // short-wave traction: |k| quadrature (empty without it)
   int J;               // traction fields per cell (tq nodes)
-  bool dae;            // IDA path: wall inertia or short-wave traction
+  // Axial bending D d^4R/dz^4 (P.wall.D_axial > 0): one more algebraic unknown per cell, the
+  // scaled curvature kappa_i = (R_{i+1} - 2 R_i + R_{i-1}) / R0 of the interior cells (0 at
+  // the two end cells), at offset ik of the cell; the wall row gains
+  // (D R0 / h^4) (kappa_{i-1} - 2 kappa_i + kappa_{i+1}), the gradient of the bending energy
+  // sum_i (D/2) (R0 kappa_i / h^2)^2 2 pi R0 h (free ends: no moment, no shear).
+  double D_axial;
+  bool bending;
+  bool dae;            // IDA path: wall inertia, short-wave traction or axial bending
   // Unbounded: U does not feed back into the radii. With velocity_quadrature the right-hand
   // side leaves it out (X and the U parts of the lab-frame volumes are then integrated along
   // the accepted steps by the event loop) and fluxes() computes it only when asked to.
@@ -127,7 +134,9 @@ struct ForceModel {
   std::vector<double> zc, faces;  // unbounded: cell centres and faces
 
   // ---- layout of the state vector
-  int stride;          // unknowns per cell: 1 (a) or 3 + J (a, V, p, phi_0..phi_{J-1})
+  int stride;          // unknowns per cell: 1 (a) or 3 + J [+ 1] (a, V, p, phi_0..phi_{J-1} [, kappa])
+  int ik = 0;          // offset of kappa in a cell (bending only)
+  double bend_c = 0;   // D R0 / h^4, Pa per unit scaled curvature
   int band_mu = 0, band_ml = 0;  // IDA band of the interleaved layout
   int iD, iX, iVr, iVf, iVrl, iVfl, n;  // extras and total size
 
@@ -174,6 +183,8 @@ struct ForceModel {
   disc::PressureIntegrals integrals(const ModelState& s) const;
 
   double energy(const ModelState& s) const;
+  /// The wall's elastic energy at cell radii R (the static law and the axial bending), J.
+  double wall_energy(const double* R) const;
 
   /// Extras' derivatives (scaled) from the state's R, p, Q: dd = (D, X, V_rear, V_front,
   /// V_rear_lab, V_front_lab); W_out the swimmer velocity.

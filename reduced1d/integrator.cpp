@@ -39,13 +39,7 @@ void RootFunctions::eval(const double* y, double* g) {
   if (machine->phase() == 0) {
     g[1] = (machine->segment_mean(machine->active(), Rbuf.data()) - Rf) / M->R0;
   } else {
-    double E = 0;
-    if (M->wall.law) {
-      for (int i = 0; i < N; ++i) E += M->wall.law->energy(Rbuf[i]);
-      E *= 2.0 * pi * M->R0 * M->h;
-    } else {
-      E = disc::elastic_energy(Rbuf.data(), N, M->R0, M->C1, M->h);
-    }
+    double E = M->wall_energy(Rbuf.data());
     if (M->inertia) {
       double k = 0;
       for (int i = 0; i < N; ++i) {
@@ -287,6 +281,7 @@ class IdaIntegrator final : public Integrator {
       if (!M.inertia) id[k + 1] = 0.0;       // V is algebraic without wall inertia
       id[k + 2] = 0.0;                       // p is algebraic
       for (int j = 0; j < M.J; ++j) id[k + 3 + j] = 0.0;  // traction fields are algebraic
+      if (M.bending) id[k + M.ik] = 0.0;                     // so is the curvature
     }
     ic_step_ = 1e-3 * M.T_s;
     mem_ = sun::make_ida(ctx_.get());

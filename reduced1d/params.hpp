@@ -98,6 +98,11 @@ struct Wall {
   /// nullptr: the linear law. Force-free model, force-driven wave only. C1 then is the law's
   /// calibrated small-load stiffness and sets the scales (time, pressure) only.
   std::shared_ptr<const TubeLaw> law;
+  /// Bending rigidity of the wall along the axis, D [J] (model1d.axial_bending): the term
+  /// D d^4R/dz^4 of an axisymmetric thin shell in the wall equation, so that a load of axial
+  /// wavenumber k meets the stiffness C1 + D k^4 (docs/reduced1d.md, section 5). 0: the
+  /// local law alone. Force-free model, force-driven wave only.
+  double D_axial = 0.0;
 };
 
 /// Prescribed smoothed step, eq. (53): R = R_min + (R0 - R_min) H((z*(t) - z)/w),

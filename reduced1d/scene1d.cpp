@@ -74,6 +74,18 @@ std::pair<double, double> hydraulic_offsets_from_calibration(const std::string& 
   return {v[0], v[1]};
 }
 
+double axial_bending_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir) {
+  const json j = load_calibration(key, path, scene_dir);
+  if (!j.is_object() || !j.contains("axial_bending_rigidity_J") || !j["axial_bending_rigidity_J"].is_number())
+    throw InputError(key, "\"" + path + "\"",
+                     "calibration file must hold a number \"axial_bending_rigidity_J\" (written by swim calibrate: "
+                     "the wall's stiffness under static loads along the axis) for model1d.axial_bending.source = "
+                     "\"calibration\"");
+  const double D = j["axial_bending_rigidity_J"].get<double>();
+  if (!(D > 0) || !std::isfinite(D)) throw InputError(key, "\"" + path + "\"", "axial_bending_rigidity_J must be > 0");
+  return D;
+}
+
 double c1_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir) {
   const json j = load_calibration(key, path, scene_dir);
   if (!j.is_object() || !j.contains("C1_Pa_per_m") || !j["C1_Pa_per_m"].is_number())
@@ -257,6 +269,24 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     if (p.wall.inertia && !forced)
       throw InputError(m.path("wall_inertia"), "true", "wall inertia only applies to wave.kind = \"force_driven\" "
                                                        "(a prescribed wave fixes R(z,t))");
+    if (m.has("axial_bending")) {  // (not echoed when absent: scenes without it resolve as before)
+      Reader ab = m.child("axial_bending");
+      const std::string src = ab.choice("source", "none", {"none", "scene", "calibration"});
+      if (src == "calibration") {
+        if (calibration.empty())
+          throw InputError(ab.path("source"), "\"calibration\"",
+                           "needs wall.calibration (the calibration file that holds the measured "
+                           "axial_bending_rigidity_J)");
+        p.wall.D_axial = axial_bending_from_calibration("wall.calibration", calibration, scene_dir);
+      } else if (src == "scene") {
+        p.wall.D_axial = ab.quantity("rigidity", "J", "", Range::positive());
+      }
+      ab.finish();
+      if (src != "none" && (p.swimmer.model != SwimmerModel::ForceFree || !forced))
+        throw InputError(ab.path("source"), "\"" + src + "\"",
+                         "the wall's axial bending belongs to the force-free model (model1d.model = \"force_free\") "
+                         "with wave.kind = \"force_driven\" (a prescribed wave fixes R(z,t)); use \"none\" here");
+    }
     m.finish();
   }
   {

@@ -18,6 +18,10 @@ namespace swim::reduced1d {
 /// `scene_dir` is used to find a calibration file given by a relative path.
 Params read_scene(const scene::json& scene, scene::json& resolved, const std::string& scene_dir = ".");
 
+/// The wall's bending rigidity along the axis [J], `axial_bending_rigidity_J` of a calibration
+/// file (model1d.axial_bending.source = "calibration"). InputError naming `key` when absent or
+/// not positive.
+double axial_bending_from_calibration(const std::string& key, const std::string& path, const std::string& scene_dir);
 /// Read the hydraulic offsets (a_in, a_out) [m] from a calibration.json (keys
 /// "hydraulic_offset_inner_m", "hydraulic_offset_outer_m"). Throws InputError for `key`.
 std::pair<double, double> hydraulic_offsets_from_calibration(const std::string& key, const std::string& path,
