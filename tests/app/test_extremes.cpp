@@ -171,3 +171,64 @@ TEST(Extremes, PrescribedWavesOverTheWholeRange) {
           check(std::string(kind) + ", R_f/R0 = " + ratio + ", L = " + length + ", " + model, sets, {"ok", ""});
         }
 }
+
+TEST(Extremes, ForceDrivenOnTheCalibratedWallAndWithAxialBending) {
+  // The nonlinear wall measured on the 3D membrane (docs/tube-law/calibration.json, R0 =
+  // 0.125 um), its buckled branch: w(R) rises to 0.020 Pa by 0.96 R0, stays on a plateau of
+  // 0.020 to 0.023 Pa down to 0.285 R0 and stiffens below. On the plateau the local law has no
+  // unique radius: under the same load one cell collapses to the law's stiff part while its
+  // neighbour stays near R0, so a segment's mean radius can stay above R_f although its
+  // deepest cell is below it. Cases:
+  //  - R_f = 0.1 R0, load factor 1.5: the open ends' static radius on the law is below the
+  //    collapse radius, so the run stops at t = 0 naming the collapse and the load to stay under;
+  //  - R_f = 0.3 R0 (the load factor's 1.5 x 0.022 Pa is only 0.011 Pa above the plateau) and
+  //    the tube as short as it is wide (L = 0.125 um: segments of 3 to 10 cells) at 0.55 and
+  //    0.8 R0: the plateau's localisation keeps the active segment's mean above R_f, and the
+  //    stall guard stops the run naming the actuation to raise (numerical failure);
+  //  - everything else completes, beyond the buckling load (the paper's 0.32 Pa, 15 times the
+  //    plateau) and with the viscosity over four decades (the cycle scales with mu);
+  //  - 1 Pa exceeds the law's static load at the collapse radius (0.35 Pa): the open ends
+  //    collapse at t = 0 (numerical failure naming the load).
+  // The wall's bending along the axis (D = 2.1e-24 J, bending length 27 nm) on the linear
+  // wall: the same collapse below R_f = 1/3 R0 at the open ends (their radius is the local
+  // law's); on the shortest tube (segments of 20 to 40 nm, shorter than the bending length)
+  // the active segment cannot bend down to R_f and the run stalls (numerical failure); the
+  // longer tubes complete. On the buckled law the bending, 30 times stiffer than the plateau
+  // at the segments' scale, holds the segment above R_f: stall.
+  const std::string cal = std::string("wall.calibration=") + SWIM_SOURCE_DIR "/docs/tube-law/calibration.json";
+  const std::string buckled = "wall.law=calibrated_buckled";
+  const Expect ok{"ok", ""}, collapse{"failed", "collapsed"}, stall{"failed", "did not complete"};
+  struct Case {
+    const char* ratio;
+    const char* length;
+    Expect e;
+  };
+  for (const Case& c : {Case{"0.1", "0.4 um", collapse}, Case{"0.1", "0.125 um", collapse},
+                        Case{"0.3", "0.4 um", stall}, Case{"0.3", "0.125 um", stall},
+                        Case{"0.55", "6.25 um", ok}, Case{"0.55", "0.4 um", ok}, Case{"0.55", "0.125 um", stall},
+                        Case{"0.8", "0.4 um", ok}, Case{"0.8", "0.125 um", stall},
+                        Case{"0.95", "6.25 um", ok}, Case{"0.95", "0.4 um", ok}, Case{"0.95", "0.125 um", ok}})
+    check(std::string("force_driven buckled law, R_f/R0 = ") + c.ratio + ", L = " + c.length,
+          {cal, buckled, "protocol.load_factor=1.5", std::string("wave.contracted_ratio=") + c.ratio,
+           std::string("swimmer.length=") + c.length, "container.period=25 um"},
+          c.e);
+  for (const char* ratio : {"0.35", "0.55"}) {
+    check(std::string("force_driven buckled law, 0.32 Pa, R_f/R0 = ") + ratio,
+          {cal, buckled, "protocol.pressure=0.32 Pa", std::string("wave.contracted_ratio=") + ratio}, ok);
+    check(std::string("force_driven buckled law, 1 Pa, R_f/R0 = ") + ratio,
+          {cal, buckled, "protocol.pressure=1 Pa", std::string("wave.contracted_ratio=") + ratio}, collapse);
+  }
+  for (const char* mu : {"1.2e-5 Pa*s", "1.2e-1 Pa*s"})
+    check(std::string("force_driven buckled law, mu = ") + mu,
+          {cal, buckled, "protocol.load_factor=1.5", std::string("fluid.viscosity=") + mu}, ok);
+  const std::string bend = "model1d.axial_bending.source=scene", D = "model1d.axial_bending.rigidity=2.1184615504e-24 J";
+  for (const Case& c : {Case{"0.1", "0.4 um", collapse}, Case{"0.55", "6.25 um", ok}, Case{"0.55", "0.4 um", ok},
+                        Case{"0.55", "0.125 um", stall}, Case{"0.95", "6.25 um", ok}, Case{"0.95", "0.4 um", ok},
+                        Case{"0.95", "0.125 um", stall}})
+    check(std::string("force_driven axial bending, R_f/R0 = ") + c.ratio + ", L = " + c.length,
+          {bend, D, "protocol.load_factor=1.5", std::string("wave.contracted_ratio=") + c.ratio,
+           std::string("swimmer.length=") + c.length, "container.period=25 um"},
+          c.e);
+  check("force_driven axial bending on the buckled law, R_f/R0 = 0.55",
+        {cal, buckled, bend, D, "protocol.load_factor=1.5", "wave.contracted_ratio=0.55"}, stall);
+}
