@@ -281,8 +281,10 @@ void check_section(const json& node, const std::string& path, const json& schema
     } else if (k == "number") {
       if (!v.is_number()) throw InputError(key, show(v), "must be a number (dimensionless)");
       if (!range.contains(v.get<double>())) throw InputError(key, show(v), range.describe(""));
-    } else if (k == "integer") {
-      if (!v.is_number_integer()) throw InputError(key, show(v), "must be an integer");
+    } else if (k == "integer" || k == "integer_or_auto") {
+      if (k == "integer_or_auto" && v.is_string() && v.get<std::string>() == "auto") continue;
+      if (!v.is_number_integer())
+        throw InputError(key, show(v), k == "integer" ? "must be an integer" : "must be an integer or \"auto\"");
       if (!range.contains(v.get<double>())) throw InputError(key, show(v), range.describe(""));
     } else if (k == "boolean") {
       if (!v.is_boolean()) throw InputError(key, show(v), "must be true or false");

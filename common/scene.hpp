@@ -80,7 +80,8 @@ std::string show(const json& value);
 /// The keys and value kinds of a section another tier reads, so that a tier that only
 /// passes the section through still rejects a malformed one (the resolved scene must run on
 /// both tiers). `schema` is an object: key -> nested object (a sub-section) or a kind
-/// string: "quantity:<SI unit>", "number", "integer", "boolean", "text" or
+/// string: "quantity:<SI unit>", "number", "integer", "integer_or_auto" (an integer or the
+/// string "auto"), "boolean", "text" or
 /// "choice:<a>|<b>|...". A quantity, number or integer may end in "@<range>": "@positive",
 /// "@non_negative", or an interval "@(a,b)", "@[a,b]", "@(a,b]", "@[a,b)" (SI values), the
 /// range the owning tier's reader accepts. Values are checked for kind, unit, choice and range.

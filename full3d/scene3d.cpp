@@ -8,6 +8,7 @@
 
 #include "common/errors.hpp"
 #include "common/scene_shared.hpp"
+#include "full3d/buckling_estimate.hpp"
 #include "full3d/fft.hpp"
 
 namespace swim::full3d {
@@ -21,6 +22,10 @@ using scene::multiple_of;
 namespace {
 
 std::string fmt(double v, const char* unit) { return scene::format_quantity(v, unit); }
+
+/// The seed's amplitude with seed_mode = "auto" when none is given: 1 % of R0, above the 1e-3 R0
+/// from which the chosen mode grows rather than the grid's own (docs/full3d.md, "Wall wrinkling").
+constexpr double kAutoSeedAmplitude = 0.01;
 
 }  // namespace
 
@@ -188,12 +193,17 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
                                  fmt(R0, "m") + ")");
         }
       }
-      p.seed_mode = int(m.integer("seed_mode", 0, 0, 64));
-      if (p.seed_mode == 1)
-        throw InputError(m.path("seed_mode"), "1",
-                         "0 (no seed) or a lobe number >= 2 (m = 1 is a sideways shift of the ring, not a lobe)");
-      p.seed_amplitude = m.number("seed_amplitude", 0.0, Range::closed(0.0, 0.1));
-      if (p.seed_amplitude > 0.0 && p.seed_mode == 0)
+      if (m.has("seed_mode") && m.given("seed_mode").is_string()) {
+        p.seed_auto = m.choice("seed_mode", "auto", {"auto"}) == "auto";  // resolved below, once D is known
+      } else {
+        p.seed_mode = int(m.integer("seed_mode", 0, 0, 64));
+        if (p.seed_mode == 1)
+          throw InputError(m.path("seed_mode"), "1",
+                           "0 (no seed), a lobe number >= 2 (m = 1 is a sideways shift of the ring, not a lobe) or "
+                           "\"auto\"");
+      }
+      p.seed_amplitude = m.number("seed_amplitude", p.seed_auto ? kAutoSeedAmplitude : 0.0, Range::closed(0.0, 0.1));
+      if (p.seed_amplitude > 0.0 && p.seed_mode == 0 && !p.seed_auto)
         throw InputError(m.path("seed_amplitude"), fmt(p.seed_amplitude, ""),
                          "a seed needs its lobe number: give full3d.membrane.seed_mode >= 2 as well");
       p.membrane.bending = m.choice("bending_form", "reference_angle", {"reference_angle", "printed"}) == "printed"
@@ -289,7 +299,28 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
     }
     p.membrane.kb = p.bending_rigidity / per_kb_run;
   }
+  if (p.seed_auto) {
+    p.seed_mode = auto_seed_mode(p);
+    if (p.seed_mode == 0) p.seed_amplitude = 0.0;
+    if (!(2 * p.seed_mode < mesh.n_theta))
+      throw InputError("full3d.membrane.seed_mode", "\"auto\"",
+                       "the buckling estimate's mode " + std::to_string(p.seed_mode) + " needs more than " +
+                           std::to_string(2 * p.seed_mode) + " nodes per ring; this grid has " +
+                           std::to_string(mesh.n_theta) + " (refine full3d.grid.cells_across or give a lobe number)");
+  }
   return p;
+}
+
+int auto_seed_mode(const Params3d& p) {
+  if (p.axisymmetric_wall || p.dry || !(p.protocol.q > 0.0)) return 0;
+  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);  // the equilateral network's 2D Young's modulus
+  const auto stages = contraction_buckling(p.L, p.protocol.segments, p.protocol.first_ratio, p.protocol.R_f,
+                                           p.protocol.q * p.R0, p.bending_rigidity, Y, p.fluid.mu);
+  int mode = 0;
+  double rate = 0.0;
+  for (const auto& s : stages)
+    if (s.mode > 0 && s.growth_rate > rate) rate = s.growth_rate, mode = s.mode;
+  return mode;
 }
 
 }  // namespace swim::full3d

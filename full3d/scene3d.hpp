@@ -74,6 +74,10 @@ struct Params3d {
   /// shape (seed_ring_mode); 0: none
   int seed_mode = 0;
   double seed_amplitude = 0.0;
+  /// full3d.membrane.seed_mode = "auto": seed_mode is the lobe number the linear buckling
+  /// estimate of the contraction grows fastest in the fluid (buckling_estimate.hpp,
+  /// auto_seed_mode), 0 when every stage is stable or the wall is held axisymmetric.
+  bool seed_auto = false;
   /// full3d.membrane.axisymmetric: the wall moves in axisymmetric ring motions only
   /// (IbOptions::axisymmetric_wall); false (default): every node follows the fluid.
   bool axisymmetric_wall = false;
@@ -116,6 +120,10 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh);
 /// The reference mesh of the scene (no-leak rule with the scene's spacing factor), with the
 /// scene's seed imperfection (full3d.membrane.seed_mode, seed_amplitude) in its stress-free shape.
 CylinderMesh make_mesh(const Params3d& p);
+/// The lobe number seed_mode = "auto" resolves to for the scene's wall, load and protocol: of the
+/// contraction's stages (contraction_buckling), the mode of the fastest-growing one; 0 when no
+/// stage buckles, for an axisymmetric or dry wall, or without a force-driven load.
+int auto_seed_mode(const Params3d& p);
 /// The same tube without the seed imperfection: the round tube whose law the calibration
 /// measures and on which D / k_b is measured.
 CylinderMesh make_round_mesh(const Params3d& p);

@@ -20,7 +20,7 @@ const scene::json& section_keys() {
         {"bending_rigidity", "quantity:J@positive"},
         {"bending_model", "choice:rigidity|fixed_kb"},
         {"reference_edge", "quantity:m@positive"},
-        {"seed_mode", "integer@[0,64]"},
+        {"seed_mode", "integer_or_auto@[0,64]"},
         {"seed_amplitude", "number@[0,0.1]"},
         {"bending_form", "choice:reference_angle|printed"},
         {"spacing_factor", "number@(0,1)"},

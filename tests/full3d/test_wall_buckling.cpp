@@ -419,3 +419,59 @@ TEST(WallSeed, TheWrinkleModeIsTheLobeNumberOfTheMostWrinkledRing) {
   const Eigen::VectorXd r0 = node_radii(round, round.X0);
   EXPECT_EQ(wall_wrinkle_shape(round, round.X0, r0, ring_radii(round, r0)).mode, 0);
 }
+
+// seed_mode = "auto": the lobe number is the one the contraction's buckling estimate grows fastest
+// in the fluid, for the scene's own D and load, on any grid: 8 for the paper's short tube on 24,
+// 32 and 48 cells across (40, 56 and 84 nodes per ring, whose own symmetry would pick 4 or 8),
+// with the default amplitude 0.01 R0 in the mesh; a wall four times stiffer in bending grows fewer
+// lobes, and one 400 times stiffer is stable (no seed); a wall held axisymmetric gets none. The
+// resolved scene keeps "auto" (it re-reads to the same run), the summary reports the number;
+// another string is refused naming the key.
+TEST(WallSeed, AutoSeedIsTheBucklingEstimatesFastestModeOnEveryGrid) {
+  for (int cells : {24, 32, 48}) {
+    const Params3d p = paper_scene(cells, {"full3d.membrane.seed_mode=auto"});
+    EXPECT_TRUE(p.seed_auto);
+    EXPECT_EQ(p.seed_mode, 8) << cells;
+    EXPECT_EQ(p.seed_amplitude, 0.01);
+    const CylinderMesh mesh = make_mesh(p);
+    const std::vector<double> s = ring_spectrum(mesh, mesh.X0, mesh.n_rings / 2);
+    EXPECT_EQ(dominant_lobes(s), 8) << cells;
+  }
+  const Params3d p = paper_scene(32, {"full3d.membrane.seed_mode=auto"});
+  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);
+  const auto stages = contraction_buckling(p.L, p.protocol.segments, p.protocol.first_ratio, p.protocol.R_f,
+                                           p.protocol.q * p.R0, p.bending_rigidity, Y, p.fluid.mu);
+  int fastest = 0;
+  double rate = 0;
+  for (const auto& st : stages)
+    if (st.growth_rate > rate) rate = st.growth_rate, fastest = st.mode;
+  EXPECT_EQ(p.seed_mode, fastest);
+  const double D = p.bending_rigidity;
+  auto with_D = [&](double factor) {
+    char rigidity[80];
+    std::snprintf(rigidity, sizeof rigidity, "full3d.membrane.bending_rigidity=%.10g J", factor * D);
+    return paper_scene(32, {"full3d.membrane.seed_mode=auto", "full3d.membrane.bending_constant=null",
+                            "full3d.membrane.reference_edge=null", rigidity});
+  };
+  const Params3d stiff = with_D(4.0), stable = with_D(400.0);
+  EXPECT_GE(stiff.seed_mode, 2);
+  EXPECT_LT(stiff.seed_mode, 8);
+  EXPECT_EQ(stable.seed_mode, 0);
+  EXPECT_EQ(stable.seed_amplitude, 0.0);
+  const Params3d round = paper_scene(32, {"full3d.membrane.seed_mode=auto", "full3d.membrane.axisymmetric=true"});
+  EXPECT_EQ(round.seed_mode, 0);
+  scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json"), r1, r2;
+  scene::apply_override(sc, "full3d.membrane.seed_mode=auto");
+  const Params3d a = read_scene3d(sc, r1);
+  EXPECT_EQ(r1["full3d"]["membrane"]["seed_mode"], "auto");
+  const Params3d b = read_scene3d(r1, r2);
+  EXPECT_EQ(r1, r2);
+  EXPECT_EQ(a.seed_mode, b.seed_mode);
+  scene::apply_override(sc, "full3d.membrane.seed_mode=automatic");
+  try {
+    read_scene3d(sc, r1);
+    ADD_FAILURE() << "seed_mode = automatic was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(e.key(), "full3d.membrane.seed_mode");
+  }
+}
