@@ -267,9 +267,10 @@ AxialStiffness measure_axial_stiffness(const full3d::Params3d& p) {
   a.n_theta = mesh.n_theta;
   a.n_rings = mesh.n_rings;
   a.nodes = mesh.nodes();
+  // the scene's D on the long tube (with either bending model: the long tube's edges differ
+  // from the scene mesh's by its axial stretch, about 1 %, and D / k_b with them)
   full3d::MembraneParams mp = p.membrane;
-  if (p.bending_model == full3d::Params3d::BendingModel::Rigidity && a.d_wall > 0)
-    mp.kb = a.d_wall / full3d::bending_rigidity_per_kb(mesh, mp.bending);
+  if (a.d_wall > 0) mp.kb = a.d_wall / full3d::bending_rigidity_per_kb(mesh, mp.bending);
   a.bending_constant_N = mp.kb;
 
   // rings' reference axial positions about the middle, and the window's rings

@@ -124,9 +124,9 @@ struct AxialStiffness {
   int n_theta = 0, n_rings = 0, nodes = 0;
   double wall_time_s = 0;
 };
-/// With BendingModel::Rigidity the long tube's k_b gives it the scene's D (k_b = D / (D / k_b of
-/// the long mesh)); with FixedKb it is the scene's k_b. Throws swim::NumericalError when a load
-/// reaches no static state.
+/// The long tube's k_b gives it the scene's resolved D (k_b = D / (D / k_b of the long mesh)),
+/// with either bending model: with FixedKb the scene's D is that of its own mesh. Throws
+/// swim::NumericalError when a load reaches no static state.
 AxialStiffness measure_axial_stiffness(const full3d::Params3d& p);
 /// calibration.json's "axial_stiffness" section.
 scene::json to_json(const AxialStiffness& a);
