@@ -35,18 +35,36 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   output::RunFolder folder(out, {"calibration", identity, overwrite, false, "--out", "calibration.json"});
   const auto t0 = std::chrono::steady_clock::now();
   const auto loads = validation::default_loads(p);
-  // progress in steps: the loads, then the hydraulic radii and the towed tube (one each)
-  const std::size_t steps = loads.size() + 2;
+  // progress in steps: the loads, then the axial stiffness, the hydraulic radii and the towed
+  // tube (one each)
+  const std::size_t steps = loads.size() + 3;
   Progress progress("calibrate " + p.name, double(steps), progress_mode);
   const validation::StaticCalibration c =
       validation::calibrate_static(p, loads, [&](std::size_t done) {
         progress.step(done, steps, "load " + std::to_string(done) + "/" + std::to_string(loads.size()));
       });
+  // the wall's stiffness along the axis, C(k) (a long round tube of the same wall)
+  // (a failure leaves the section with its reason and no axial_bending_rigidity_J: C1 and the
+  // offsets are still measured)
+  validation::AxialStiffness axial;
+  std::string axial_failed;
+  try {
+    axial = validation::measure_axial_stiffness(p);
+  } catch (const NumericalError& e) {
+    axial_failed = e.what();
+  }
+  progress.step(loads.size() + 1, steps, "axial stiffness");
+  const auto add_axial = [&](scene::json& js) {
+    if (axial_failed.empty())
+      validation::add_axial_stiffness(js, axial);
+    else
+      js["axial_stiffness"] = {{"status", "failed: " + axial_failed}};
+  };
   validation::HydraulicRadii hr;
   validation::TowedCalibration tow;
   try {
     hr = validation::measure_hydraulic_radii(p);
-    progress.step(loads.size() + 1, steps, "hydraulic radii");
+    progress.step(loads.size() + 2, steps, "hydraulic radii");
     tow = validation::calibrate_towed(p, hr);
     progress.step(steps, steps, "towed tube");
     progress.done();
@@ -55,6 +73,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
     // the wall stiffness is measured: keep it, say the offsets are missing and why (exit 3)
     output::make_dir(out);
     scene::json j = validation::to_json(c, p, resolved);
+    add_axial(j);
     j["status"] = "failed: hydraulic radii: " + std::string(e.what());
     j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     output::write_json(out + "/calibration.json", j);
@@ -77,6 +96,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   output::make_dir(out);
   scene::json j = validation::to_json(c, p, resolved);
+  add_axial(j);
   j["status"] = "ok";
   j["wall_time_s"] = wall;
   scene::json hj = validation::to_json(hr);
@@ -117,6 +137,21 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
               c.fit.linear_over_all_loads ? "over every load, up to" : "up to",
               si(c.fit.linear_over_all_loads ? c.loads.back().pressure_Pa : c.fit.linear_up_to_Pa, "Pa").c_str(),
               si(stable_up_to, "Pa").c_str(), stable, c.nodes, si(wall, "s").c_str(), out.c_str());
+  if (!axial_failed.empty()) {
+    std::printf("  axial stiffness C(k): failed (%s)\n", axial_failed.c_str());
+  } else {
+    std::string table;
+    for (std::size_t k = 0; k < axial.wavelengths_m.size(); ++k)
+      table += (k ? ", " : "") + si(axial.wavelengths_m[k], "m", 3) + " " +
+               si(axial.C_Pa_per_m[k], "Pa/m", 4) + " (" + significant(axial.C_Pa_per_m[k] / axial.c1, 4) + " C1)";
+    std::printf("  axial stiffness C(k) = C1 + D K^4 on a %s tube (%d rings): C1 = %s; %s\n"
+                "  D from C(k) = %s +- %s against the wall's D = %s (%+.2f %%); bending length %s; %s\n",
+                si(axial.tube_length_m, "m", 3).c_str(), axial.n_rings, si(axial.c1, "Pa/m", 5).c_str(),
+                table.c_str(), (significant(axial.d_fit, 4) + " J").c_str(),
+                (significant(axial.d_fit_stderr, 2) + " J").c_str(), (significant(axial.d_wall, 4) + " J").c_str(),
+                axial.d_wall > 0 ? 100.0 * (axial.d_fit / axial.d_wall - 1.0) : 0.0,
+                si(axial.bending_length_m, "m", 3).c_str(), si(axial.wall_time_s, "s").c_str());
+  }
   std::printf("  hydraulic offsets: a_in = %s +- %s, a_out = %s +- %s (h = %s; held-tube solve %d CG iterations, %s)\n",
               si(hr.a_in_m, "m").c_str(), si(hr.a_in_uncertainty_m, "m").c_str(), si(hr.a_out_m, "m").c_str(),
               si(hr.a_out_uncertainty_m, "m").c_str(), si(p.h, "m").c_str(), hr.cg_iterations,

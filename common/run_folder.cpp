@@ -133,7 +133,7 @@ bool RunFolder::is_result_name(const std::string& rel) {
                                               "run.png",       "vtk",            kOwner,
                                               // swim screen, swim calibrate
                                               "designs.csv", "screen.json", "screen.png", "calibration.json",
-                                              "calibration.png", "tube_law.png",
+                                              "calibration.png", "tube_law.png", "axial_stiffness.png",
                                               // swim screen --confirm, swim optimize
                                               "confirm.json", "confirm.md", "confirm.png", "trajectory.csv",
                                               "optimum.json", "optimum.scene.json", "optimize.png"};

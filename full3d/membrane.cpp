@@ -460,8 +460,13 @@ Eigen::VectorXd ring_radii(const CylinderMesh& mesh, const Eigen::VectorXd& r) {
   return rr;
 }
 
-PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
-                                      double tol_force, int max_iterations, const Eigen::Matrix3Xd* start) {
+namespace {
+// The ring-stack Newton solve of relax_under_pressure with the inward pressure ring_pressure[k]
+// on the nodes of ring k; `pressure` is the load of the middle ring(s) for the effective C1 and
+// `load_scale` the largest |P| for the default tolerance.
+PressureResponse relax_ring_stack(const CylinderMesh& mesh, const MembraneParams& p,
+                                  const Eigen::VectorXd& ring_pressure, double pressure, double load_scale,
+                                  double tol_force, int max_iterations, const Eigen::Matrix3Xd* start) {
   // The mesh is invariant under rotation by 2 pi / n_theta about the axis and under the
   // mirror theta -> -theta, and so is the load; the equilibrium therefore has every ring a
   // circle of radius r_k at axial position x_k, each node at its reference angle. The
@@ -493,8 +498,9 @@ PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembranePa
   auto gradient = [&](const Eigen::Matrix3Xd& X) {
     Eigen::Matrix3Xd G = -elastic_forces(mesh, X, p);
     for (int i = 0; i < nn; ++i) {
-      G(1, i) += pressure * mesh.node_area[i] * cph[i];
-      G(2, i) += pressure * mesh.node_area[i] * sph[i];
+      const double P = ring_pressure[i / nt];
+      G(1, i) += P * mesh.node_area[i] * cph[i];
+      G(2, i) += P * mesh.node_area[i] * sph[i];
     }
     return G;
   };
@@ -508,7 +514,7 @@ PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembranePa
     return out;
   };
   auto max_node_force = [&](const Eigen::Matrix3Xd& G) { return G.colwise().norm().maxCoeff(); };
-  if (tol_force <= 0.0) tol_force = 1e-7 * std::abs(pressure) * mesh.node_area.maxCoeff() + 1e-30;
+  if (tol_force <= 0.0) tol_force = 1e-7 * load_scale * mesh.node_area.maxCoeff() + 1e-30;
 
   Eigen::VectorXd rk = Eigen::VectorXd::Constant(nr, mesh.radius), xk(nr);
   for (int k = 0; k < nr; ++k) xk[k] = mesh.X0(0, mesh.node(k, 0)) - mesh.axis_start.x();
@@ -588,6 +594,26 @@ PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembranePa
   out.mid_radius = 0.5 * (out.ring_radius[r0] + out.ring_radius[r1]);
   out.c1 = pressure / (mesh.radius - out.mid_radius);
   return out;
+}
+}  // namespace
+
+PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
+                                      double tol_force, int max_iterations, const Eigen::Matrix3Xd* start) {
+  return relax_ring_stack(mesh, p, Eigen::VectorXd::Constant(mesh.n_rings, pressure), pressure, std::abs(pressure),
+                          tol_force, max_iterations, start);
+}
+
+PressureResponse relax_under_ring_pressures(const CylinderMesh& mesh, const MembraneParams& p,
+                                            const Eigen::VectorXd& ring_pressure, double tol_force,
+                                            int max_iterations, const Eigen::Matrix3Xd* start) {
+  if (ring_pressure.size() != mesh.n_rings)
+    throw InputError("ring pressures", std::to_string(ring_pressure.size()) + " values",
+                     "one inward pressure per ring of the mesh (" + std::to_string(mesh.n_rings) + ")");
+  if (!ring_pressure.allFinite())
+    throw InputError("ring pressures", "a non-finite value", "finite pressures in Pa");
+  const int r0 = (mesh.n_rings - 1) / 2, r1 = mesh.n_rings / 2;
+  return relax_ring_stack(mesh, p, ring_pressure, 0.5 * (ring_pressure[r0] + ring_pressure[r1]),
+                          ring_pressure.cwiseAbs().maxCoeff(), tol_force, max_iterations, start);
 }
 
 }  // namespace swim::full3d

@@ -178,5 +178,16 @@ struct PressureResponse {
 PressureResponse relax_under_pressure(const CylinderMesh& mesh, const MembraneParams& p, double pressure,
                                       double tol_force = 0.0, int max_iterations = 50,
                                       const Eigen::Matrix3Xd* start = nullptr);
+/// The same static response under an inward pressure that varies along the axis: the nodes of
+/// ring k carry -ring_pressure[k] * node_area_i * e_r,i (conservative: potential
+/// sum_k P_k sum_{i in ring k} A_i r_i). The load keeps the tube's rotation and mirror
+/// symmetries, so the equilibrium is again a stack of circular rings, found by the same Newton
+/// solve. The default tolerance is 1e-7 of the largest nodal load (max_k |P_k| max_i A_i);
+/// `c1` is the middle ring(s)' pressure over R0 - mid_radius. A constant profile gives
+/// relax_under_pressure's result bit for bit. Throws swim::InputError unless ring_pressure
+/// holds one finite value per ring.
+PressureResponse relax_under_ring_pressures(const CylinderMesh& mesh, const MembraneParams& p,
+                                            const Eigen::VectorXd& ring_pressure, double tol_force = 0.0,
+                                            int max_iterations = 50, const Eigen::Matrix3Xd* start = nullptr);
 
 }  // namespace swim::full3d

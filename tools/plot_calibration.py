@@ -14,6 +14,9 @@ With a tube law (swim calibrate --tube-law) also DIR/tube_law.png: both branches
 law, the loads against the middle radius with the monotone Steffen interpolant through them,
 and the law's slope against the radius.
 
+With the axial stiffness (every swim calibrate) also DIR/axial_stiffness.png: C(k) / C1 against
+the wavelength with the shell law C1 + D K^4, and the rigidity each wavelength gives.
+
 usage: plot_calibration.py DIR   (reads DIR/calibration.json, writes DIR/calibration.png)
 `figure(DIR)` returns (matplotlib figure, choices dict) for tests.
 """
@@ -23,6 +26,7 @@ import sys
 import textwrap
 
 import matplotlib
+import matplotlib.ticker
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
@@ -145,6 +149,8 @@ def main(d):
         c = json.load(f)
     if "tube_law" in c:
         plot_tube_law(d, c)
+    if "C_Pa_per_m" in c.get("axial_stiffness", {}):  # (a failed measurement holds only its status)
+        plot_axial_stiffness(d, c)
 
 
 def steffen(xk, yk, x):
@@ -216,6 +222,54 @@ def plot_tube_law(d, c):
     ax[1].legend(fontsize="small", frameon=False)
     fig.tight_layout()
     fig.savefig(f"{d}/tube_law.png", dpi=110)
+
+
+def plot_axial_stiffness(d, c):
+    """DIR/axial_stiffness.png: the wall's stiffness along the axis, C(k) = C1 + D k^4, measured
+    under loads p0 cos(kx) on a long tube (calibration.json "axial_stiffness"), against the shell
+    law with the wall's D; and the rigidity each wavelength gives, (C - C1) / K^4."""
+    a = c["axial_stiffness"]
+    name = c["scene"].get("name", d)
+    c1, dw, dx = a["C1_Pa_per_m"], a["bending_rigidity_wall_J"], a["ring_spacing_m"]
+    lam = a["wavelengths_m"]
+    fig, ax = plt.subplots(1, 2, figsize=(13, 4.8))
+    fig.suptitle(f"Wall stiffness along the axis: {name} ({a['membrane_nodes']} membrane nodes, "
+                 f"{a['tube_length_m'] * 1e6:.3g} \u00b5m tube, bending length {a['bending_length_m'] * 1e9:.3g} nm)")
+    lo, hi = 0.8 * min(lam), 1.25 * max(lam)
+    xs = [lo * (hi / lo) ** (i / 200) for i in range(201)]
+
+    def lattice(l):
+        k = 2 * math.pi / l
+        return 2 / dx * math.sin(0.5 * k * dx)
+
+    ax[0].loglog([v * 1e9 for v in lam], a["C_over_C1"], "o", label="measured C(k) / C1")
+    ax[0].loglog([v * 1e9 for v in xs], [1 + dw * lattice(v) ** 4 / c1 for v in xs], "k-", lw=1,
+                 label=f"1 + D K\u2074 / C1, wall's D = {dw:.4g} J")
+    ax[0].loglog([v * 1e9 for v in xs], [1 + dw * (2 * math.pi / v) ** 4 / c1 for v in xs], "k:", lw=1,
+                 label="1 + D k\u2074 / C1 (continuum k)")
+    ax[0].set(xlabel="wavelength \u03bb [nm] (log scale)", ylabel="C / C1 [dimensionless] (log scale)",
+              title=f"stiffness against wavelength (C1 = {c1 / 1e6:.5g} MPa/m)")
+    ax[0].legend(fontsize="small", frameon=False)
+    dk = [(cc - c1) / kk ** 4 / dw for cc, kk in zip(a["C_Pa_per_m"], a["lattice_wavenumbers_per_m"])]
+    ax[1].semilogx([v * 1e9 for v in lam], dk, "o", label="(C \u2212 C1) / (D K\u2074) per wavelength")
+    ax[1].axhline(1.0, color="k", lw=1, label=f"wall's D = {dw:.4g} J")
+    ax[1].axhline(a["bending_rigidity_fit_J"] / dw, color="tab:blue", ls="--", lw=1,
+                  label=f"fit C \u2212 C1 = D K\u2074: {a['bending_rigidity_fit_J']:.4g} J")
+    f2 = a["fit_with_k2"]
+    ax[1].semilogx([v * 1e9 for v in xs],
+                   [(f2["k2_coefficient_N_per_m"] * (2 * math.pi / v) ** 2 + f2["bending_rigidity_J"] * lattice(v) ** 4)
+                    / (lattice(v) ** 4 * dw) for v in xs], "-", color="tab:orange", lw=1,
+                   label=f"fit A k\u00b2 + D K\u2074: D = {f2['bending_rigidity_J']:.4g} J, "
+                         f"A = {f2['k2_coefficient_N_per_m']:.3g} N/m")
+    ax[1].set(xlabel="wavelength \u03bb [nm] (log scale)", ylabel="rigidity / wall's D [dimensionless]",
+              title="rigidity along the axis (K = (2/dx) sin(k dx/2))")
+    ax[1].legend(fontsize="small", frameon=False)
+    for a_ in ax:  # ticks at the measured wavelengths
+        a_.set_xticks([v * 1e9 for v in lam])
+        a_.set_xticklabels([f"{v * 1e9:.3g}" for v in lam])
+        a_.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    fig.tight_layout()
+    fig.savefig(f"{d}/axial_stiffness.png", dpi=110)
 
 
 if __name__ == "__main__":

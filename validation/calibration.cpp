@@ -1,6 +1,7 @@
 #include "validation/calibration.hpp"
 
 #include <gsl/gsl_fit.h>
+#include <gsl/gsl_multifit.h>
 
 #include <Eigen/Eigenvalues>
 
@@ -240,6 +241,204 @@ StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<
     c.fit.r2_linear = sstot > 0 ? 1.0 - sumsq / sstot : 1.0;
   }
   return c;
+}
+
+AxialStiffness measure_axial_stiffness(const full3d::Params3d& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  AxialStiffness a;
+  a.d_wall = p.bending_rigidity;
+  // the scene's node spacing: the round calibration mesh's ring count and equilateral spacing
+  const full3d::CylinderMesh scene_mesh = full3d::make_round_mesh(p);
+  const double dx = scene_mesh.ring_spacing;
+  const double c1_net = p.c1_estimate();
+  const double lb = a.d_wall > 0 ? std::pow(a.d_wall / c1_net, 0.25) : 0.0;
+  const double lambda0 = std::max(1.5 * lb, 8.0 * dx);
+  const int n_waves = 4;
+  for (int j = 0; j < n_waves; ++j) {
+    a.wavelengths_m.push_back(lambda0 * double(1 << j));
+    a.wavenumbers_per_m.push_back(2.0 * M_PI / a.wavelengths_m.back());
+  }
+  a.window_m = 2.0 * a.wavelengths_m.back();
+  a.end_margin_m = std::max(10.0 * lb, 2.0 * lambda0);
+  const full3d::CylinderMesh mesh = full3d::make_cylinder(p.R0, a.window_m + 2.0 * a.end_margin_m,
+                                                          scene_mesh.n_theta, Eigen::Vector3d::Zero());
+  a.tube_length_m = mesh.length;
+  a.ring_spacing_m = mesh.ring_spacing;
+  a.n_theta = mesh.n_theta;
+  a.n_rings = mesh.n_rings;
+  a.nodes = mesh.nodes();
+  // the scene's D on the long tube (with either bending model: the long tube's edges differ
+  // from the scene mesh's by its axial stretch, about 1 %, and D / k_b with them)
+  full3d::MembraneParams mp = p.membrane;
+  if (a.d_wall > 0) mp.kb = a.d_wall / full3d::bending_rigidity_per_kb(mesh, mp.bending);
+  a.bending_constant_N = mp.kb;
+
+  // rings' reference axial positions about the middle, and the window's rings
+  const double x_mid = 0.5 * mesh.length;
+  Eigen::VectorXd xi(mesh.n_rings);
+  std::vector<int> window;
+  for (int k = 0; k < mesh.n_rings; ++k) {
+    xi[k] = k * mesh.ring_spacing - x_mid;
+    if (std::abs(xi[k]) <= 0.5 * a.window_m * (1.0 + 1e-12)) window.push_back(k);
+  }
+  // inward displacement of each ring under the ring pressures P(xi)
+  auto relax = [&](const std::function<double(double)>& shape, double p0, int* iterations) {
+    Eigen::VectorXd P(mesh.n_rings);
+    for (int k = 0; k < mesh.n_rings; ++k) P[k] = p0 * shape(xi[k]);
+    const full3d::PressureResponse r = full3d::relax_under_ring_pressures(mesh, mp, P);
+    *iterations = r.iterations;
+    return Eigen::VectorXd(p.R0 - r.ring_radius.array());
+  };
+  const double target = 1e-3 * p.R0;  // response amplitude: linear range
+  {
+    int it = 0;
+    a.c1_load_Pa = c1_net * target;
+    const Eigen::VectorXd d = relax([](double) { return 1.0; }, a.c1_load_Pa, &it);
+    double mean = 0;
+    for (int k : window) mean += d[k] / double(window.size());
+    a.c1_displacement_m = mean;
+    a.c1 = a.c1_load_Pa / mean;
+  }
+  for (int j = 0; j < n_waves; ++j) {
+    const double k = a.wavenumbers_per_m[std::size_t(j)];
+    const double p0 = (c1_net + a.d_wall * std::pow(k, 4)) * target;
+    int it = 0;
+    const Eigen::VectorXd d = relax([k](double x) { return std::cos(k * x); }, p0, &it);
+    // least squares d = A cos + B sin + c over the window
+    Eigen::MatrixXd M(window.size(), 3);
+    Eigen::VectorXd y(window.size());
+    for (std::size_t i = 0; i < window.size(); ++i) {
+      const double x = xi[window[i]];
+      M(Eigen::Index(i), 0) = std::cos(k * x);
+      M(Eigen::Index(i), 1) = std::sin(k * x);
+      M(Eigen::Index(i), 2) = 1.0;
+      y[Eigen::Index(i)] = d[window[i]];
+    }
+    const Eigen::Vector3d c = (M.transpose() * M).ldlt().solve(M.transpose() * y);
+    const double amp = c[0];
+    a.load_amplitudes_Pa.push_back(p0);
+    a.response_amplitudes_m.push_back(amp);
+    a.C_Pa_per_m.push_back(p0 / amp);
+    a.quadrature_ratio.push_back(std::abs(c[1]) / amp);
+    a.profile_residual_ratio.push_back((y - M * c).norm() / std::sqrt(double(window.size())) / amp);
+    a.iterations.push_back(it);
+  }
+  a.bending_length_m = a.d_wall > 0 ? std::pow(a.d_wall / a.c1, 0.25) : 0.0;
+
+  // Fits of C - C1 (GSL), each point weighted by 1 / C^2: every C is measured to the same
+  // relative precision, so the shortest wavelength (C ~ 300 C1) does not outweigh the rest.
+  // The ring lattice's fourth difference: a load cos(k x) on rings dx apart meets the bending
+  // stiffness D K^4 with K = (2 / dx) sin(k dx / 2), below D k^4 by 6-9 % at 8-10 dx per
+  // wavelength (docs/validation.md, "Axial stiffness"); D is fitted on K^4, and on k^4 for
+  // comparison.
+  const std::size_t n = std::size_t(n_waves);
+  for (int j = 0; j < n_waves; ++j) {
+    const double k = a.wavenumbers_per_m[std::size_t(j)];
+    a.lattice_wavenumbers_per_m.push_back(2.0 / a.ring_spacing_m * std::sin(0.5 * k * a.ring_spacing_m));
+  }
+  std::vector<double> y(n), w(n), xk4(n), xK4(n);
+  for (std::size_t j = 0; j < n; ++j) {
+    y[j] = a.C_Pa_per_m[j] - a.c1;
+    w[j] = 1.0 / (a.C_Pa_per_m[j] * a.C_Pa_per_m[j]);
+    xk4[j] = std::pow(a.wavenumbers_per_m[j], 4);
+    xK4[j] = std::pow(a.lattice_wavenumbers_per_m[j], 4);
+  }
+  // through the origin; the standard error from the weighted residual (the weights are relative)
+  auto mul = [&](const std::vector<double>& x, double& d, double& se, double* r2) {
+    double cov, chisq;
+    gsl_fit_wmul(x.data(), 1, w.data(), 1, y.data(), 1, n, &d, &cov, &chisq);
+    se = std::sqrt(cov * chisq / double(n - 1));
+    if (r2) {
+      double ss = 0;  // R^2 about zero (a fit through the origin), weighted
+      for (std::size_t j = 0; j < n; ++j) ss += w[j] * y[j] * y[j];
+      *r2 = ss > 0 ? 1.0 - chisq / ss : 1.0;
+    }
+  };
+  mul(xK4, a.d_fit, a.d_fit_stderr, &a.d_fit_r2);
+  mul(xk4, a.d_fit_continuum_k, a.d_fit_continuum_k_stderr, nullptr);
+  // C - C1 = A k^2 + D K^4, columns scaled by the shortest wavelength's k for conditioning
+  {
+    const double ks = a.wavenumbers_per_m.front();
+    std::unique_ptr<gsl_matrix, decltype(&gsl_matrix_free)> X(gsl_matrix_alloc(n, 2), gsl_matrix_free);
+    std::unique_ptr<gsl_vector, decltype(&gsl_vector_free)> yy(gsl_vector_alloc(n), gsl_vector_free),
+        ww(gsl_vector_alloc(n), gsl_vector_free), cc(gsl_vector_alloc(2), gsl_vector_free);
+    std::unique_ptr<gsl_matrix, decltype(&gsl_matrix_free)> cov(gsl_matrix_alloc(2, 2), gsl_matrix_free);
+    std::unique_ptr<gsl_multifit_linear_workspace, decltype(&gsl_multifit_linear_free)> ws(
+        gsl_multifit_linear_alloc(n, 2), gsl_multifit_linear_free);
+    for (std::size_t j = 0; j < n; ++j) {
+      const double q = a.wavenumbers_per_m[j] / ks, Q = a.lattice_wavenumbers_per_m[j] / ks;
+      gsl_matrix_set(X.get(), j, 0, q * q);
+      gsl_matrix_set(X.get(), j, 1, Q * Q * Q * Q);
+      gsl_vector_set(yy.get(), j, y[j]);
+      gsl_vector_set(ww.get(), j, w[j]);
+    }
+    double chisq;
+    gsl_multifit_wlinear(X.get(), ww.get(), yy.get(), cc.get(), cov.get(), &chisq, ws.get());
+    const double s2 = chisq / double(n - 2);
+    a.k2_coefficient = gsl_vector_get(cc.get(), 0) / (ks * ks);
+    a.k2_coefficient_stderr = std::sqrt(gsl_matrix_get(cov.get(), 0, 0) * s2) / (ks * ks);
+    a.d_fit_k2 = gsl_vector_get(cc.get(), 1) / std::pow(ks, 4);
+    a.d_fit_k2_stderr = std::sqrt(gsl_matrix_get(cov.get(), 1, 1) * s2) / std::pow(ks, 4);
+  }
+  a.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return a;
+}
+
+scene::json to_json(const AxialStiffness& a) {
+  std::vector<double> ratio, shell;
+  for (std::size_t j = 0; j < a.C_Pa_per_m.size(); ++j) {
+    ratio.push_back(a.C_Pa_per_m[j] / a.c1);
+    shell.push_back(a.c1 + a.d_wall * std::pow(a.lattice_wavenumbers_per_m[j], 4));
+  }
+  scene::json j = scene::json::object();
+  j["wavelengths_m"] = a.wavelengths_m;
+  j["wavenumbers_per_m"] = a.wavenumbers_per_m;
+  j["lattice_wavenumbers_per_m"] = a.lattice_wavenumbers_per_m;
+  j["C_Pa_per_m"] = a.C_Pa_per_m;
+  j["C_over_C1"] = ratio;
+  j["shell_law_C_Pa_per_m"] = shell;
+  j["load_amplitudes_Pa"] = a.load_amplitudes_Pa;
+  j["response_amplitudes_m"] = a.response_amplitudes_m;
+  j["quadrature_ratio"] = a.quadrature_ratio;
+  j["profile_residual_ratio"] = a.profile_residual_ratio;
+  j["newton_iterations"] = a.iterations;
+  j["C1_Pa_per_m"] = a.c1;
+  j["C1_load_Pa"] = a.c1_load_Pa;
+  j["C1_displacement_m"] = a.c1_displacement_m;
+  j["bending_rigidity_fit_J"] = a.d_fit;
+  j["bending_rigidity_fit_stderr_J"] = a.d_fit_stderr;
+  j["bending_rigidity_fit_r2"] = a.d_fit_r2;
+  j["bending_rigidity_wall_J"] = a.d_wall;
+  j["fit_on_k4"] = {{"bending_rigidity_J", a.d_fit_continuum_k},
+                    {"bending_rigidity_stderr_J", a.d_fit_continuum_k_stderr},
+                    {"model", "C - C1 = D k^4 (the continuum wavenumber; the lattice's fourth difference left in)"}};
+  j["bending_length_m"] = a.bending_length_m;
+  j["fit_with_k2"] = {{"k2_coefficient_N_per_m", a.k2_coefficient},
+                      {"k2_coefficient_stderr_N_per_m", a.k2_coefficient_stderr},
+                      {"bending_rigidity_J", a.d_fit_k2},
+                      {"bending_rigidity_stderr_J", a.d_fit_k2_stderr},
+                      {"model", "C - C1 = A k^2 + D K^4"}};
+  j["tube_length_m"] = a.tube_length_m;
+  j["measurement_window_m"] = a.window_m;
+  j["end_margin_m"] = a.end_margin_m;
+  j["ring_spacing_m"] = a.ring_spacing_m;
+  j["nodes_per_ring"] = a.n_theta;
+  j["rings"] = a.n_rings;
+  j["membrane_nodes"] = a.nodes;
+  j["bending_constant_N"] = a.bending_constant_N;
+  j["wall_time_s"] = a.wall_time_s;
+  j["method"] =
+      "static: inward ring pressures p0 cos(k (x - x_mid)) on a long round tube of the scene's wall and node spacing, "
+      "relaxed to equilibrium on the 3D membrane; amplitude a of the inward ring displacement by least squares over "
+      "the middle window (an integer number of wavelengths), C(k) = p0 / a; C1 from a uniform load on the same tube; "
+      "fit C - C1 = D K^4 with weights 1 / C^2, K = (2 / dx) sin(k dx / 2) the ring lattice's wavenumber "
+      "(thin-shell law D w'''' + C1 w = p, free axial ends)";
+  return j;
+}
+
+void add_axial_stiffness(scene::json& j, const AxialStiffness& a) {
+  j["axial_stiffness"] = to_json(a);
+  j["axial_bending_rigidity_J"] = a.d_fit;
 }
 
 WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,

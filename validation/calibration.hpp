@@ -77,6 +77,63 @@ std::vector<double> default_loads(const full3d::Params3d& p);
 StaticCalibration calibrate_static(const full3d::Params3d& p, const std::vector<double>& pressures,
                                    const std::function<void(std::size_t)>& on_load = {});
 
+// ---- The wall's stiffness along the axis, C(k) ----------------------------------------------
+//
+// A thin cylindrical shell under an axisymmetric radial load p(x) with free axial ends obeys
+// D w'''' + (Y / R0^2) w = p (w the inward radial displacement, D the bending rigidity, Y the
+// 2D stretching modulus, C1 = Y / R0^2): a load p0 cos(k x) gives the amplitude p0 / C(k) with
+// C(k) = C1 + D k^4. The 1D tier's local law p = C1 (R0 - R) is the k = 0 limit; its bending
+// term D d^4R/dz^4 needs the D the network actually has along the axis.
+//
+// measure_axial_stiffness: a long round tube of the scene's wall (R0, k_s, D, form of eq. 8)
+// and node spacing (the round calibration mesh's n_theta; rings at the equilateral spacing) is
+// loaded with the inward ring pressures P_k = p0 cos(k (x_k - x_mid)) (x_k the ring's reference
+// axial position, x_mid the tube's middle) and relaxed to its static state
+// (full3d::relax_under_ring_pressures). The amplitude a of the inward ring displacement
+// R0 - r_k is fitted by least squares to a cos + b sin + c over the middle window (an integer
+// number of wavelengths, away from the open ends), and C(k) = p0 / a. C1 is measured the same
+// way with a uniform load (k = 0: the mean displacement over the window). Every load is set for
+// an amplitude of 1e-3 R0 (linear range). Wavelengths: lambda_j = lambda_0 2^j, j = 0..3, with
+// lambda_0 = max(1.5 l_b, 8 dx) (l_b = (D / C1_net)^(1/4) the bending length from the scene's D
+// and the network's C1_net = 2 k_s / (sqrt 3 R0^2), dx the ring spacing); the window is
+// 2 lambda_3 long and each end margin max(10 l_b, 2 lambda_0) (an end disturbance decays as
+// exp(-x / (sqrt 2 l_b))). Fits (GSL, weights 1 / C^2): C - C1 = D_axial K^4 through the
+// origin (gsl_fit_wmul), K = (2 / dx) sin(k dx / 2) the ring lattice's wavenumber (its fourth
+// difference: D k^4 less 6-9 % at 8-10 rings per wavelength); the same on k^4, for comparison;
+// and C - C1 = A k^2 + D K^4 (gsl_multifit_wlinear) to show whether a k^2 term is needed (the
+// shell's bending coupling of the axial and hoop curvatures gives A = -2 nu_b D / R0^2).
+struct AxialStiffness {
+  std::vector<double> wavelengths_m, wavenumbers_per_m;
+  std::vector<double> lattice_wavenumbers_per_m;  ///< K = (2 / dx) sin(k dx / 2), dx the ring spacing
+  std::vector<double> load_amplitudes_Pa;      ///< p0 per wavelength
+  std::vector<double> response_amplitudes_m;   ///< a, inward
+  std::vector<double> C_Pa_per_m;              ///< p0 / a
+  std::vector<double> quadrature_ratio;        ///< |b| / a (sin component; 0 for a symmetric response)
+  std::vector<double> profile_residual_ratio;  ///< rms of the fit's residual over the window / a
+  std::vector<int> iterations;                 ///< Newton iterations per load
+  double c1 = 0;                               ///< uniform load on the long tube, Pa/m
+  double c1_load_Pa = 0, c1_displacement_m = 0;
+  double d_fit = 0, d_fit_stderr = 0, d_fit_r2 = 0;      ///< C - C1 = D K^4, J: D_axial
+  double d_fit_continuum_k = 0, d_fit_continuum_k_stderr = 0;  ///< C - C1 = D k^4, J
+  double k2_coefficient = 0, k2_coefficient_stderr = 0;  ///< A of C - C1 = A k^2 + D K^4, N/m
+  double d_fit_k2 = 0, d_fit_k2_stderr = 0;              ///< D of the same fit, J
+  double d_wall = 0;                  ///< the scene's resolved D (Params3d::bending_rigidity), J
+  double bending_length_m = 0;        ///< (D_wall / C1)^(1/4), C1 measured here
+  double tube_length_m = 0, window_m = 0, end_margin_m = 0, ring_spacing_m = 0;
+  double bending_constant_N = 0;      ///< k_b of eq. (8) on the long tube
+  int n_theta = 0, n_rings = 0, nodes = 0;
+  double wall_time_s = 0;
+};
+/// The long tube's k_b gives it the scene's resolved D (k_b = D / (D / k_b of the long mesh)),
+/// with either bending model: with FixedKb the scene's D is that of its own mesh. Throws
+/// swim::NumericalError when a load reaches no static state.
+AxialStiffness measure_axial_stiffness(const full3d::Params3d& p);
+/// calibration.json's "axial_stiffness" section.
+scene::json to_json(const AxialStiffness& a);
+/// Adds the "axial_stiffness" section and the top-level "axial_bending_rigidity_J" (the fitted
+/// D_axial: the rigidity the 1D tier's bending term reads) to calibration.json `j`.
+void add_axial_stiffness(scene::json& j, const AxialStiffness& a);
+
 /// Fluid-coupled confirmation of one static load: the scene's 3D tube, immersed in its fluid and
 /// container, under the same uniform inward pressure, stepped (forward Euler, the step set to
 /// half the explicit stability limit of the coupling, IbSolver::explicit_rate) until the middle

@@ -25,9 +25,10 @@ namespace swim::validation {
 namespace {
 
 /// Changes whenever calibration.json gains or renames keys, or a measurement in it changes
-/// method (3: the held tube on the ring forces): cached calibrations of an older format are
+/// method (3: the held tube on the ring forces; 4: the axial stiffness C(k) and
+/// axial_bending_rigidity_J): cached calibrations of an older format are
 /// then recomputed instead of read.
-constexpr int kCalibrationFormat = 3;
+constexpr int kCalibrationFormat = 4;
 
 /// The files of a cached run the report reads (the series), and those that make it the run it
 /// is (its resolved scene, its radius field): each must be listed in its summary.json.

@@ -263,8 +263,8 @@ std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, 
   for (const char* k : {"C1_Pa_per_m", "C1_stderr_Pa_per_m", "C1_spring_network_Pa_per_m", "hydraulic_offset_inner_m",
                         "hydraulic_offset_inner_uncertainty_m", "hydraulic_offset_outer_m",
                         "hydraulic_offset_outer_uncertainty_m", "hydraulic_offset_outer_from_drag_m",
-                        "hydraulic_offset_outer_from_drag_uncertainty_m", "towed_drag_coefficient_N_s_per_m", "status",
-                        "wall_time_s"})
+                        "hydraulic_offset_outer_from_drag_uncertainty_m", "towed_drag_coefficient_N_s_per_m", "axial_bending_rigidity_J",
+                        "status", "wall_time_s"})
     if (cal_j.contains(k)) cr["calibration"][k] = cal_j[k];
   return cal_file;
 }

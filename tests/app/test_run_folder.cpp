@@ -484,7 +484,7 @@ TEST(RunFolderCli, A3dRunWithoutAnEstimateStopsAtTheFrameThatPassesTheOutputLimi
 
 // swim calibrate keeps what it measured: when the hydraulic radii cannot be measured (here a
 // grid so coarse that the lumen holds no velocity sample inside R0 - 2h), calibration.json
-// holds the fitted C1 with a failed status and no offsets (exit 3), and a 1D scene that asks
+// holds the fitted C1 and the axial stiffness with a failed status and no offsets (exit 3), and a 1D scene that asks
 // for the offsets from that file is refused naming the key (exit 2).
 TEST(CalibrateCli, AFailedHydraulicMeasurementKeepsTheMeasuredStiffness) {
   const fs::path d = tmpdir("calibrate_partial");
@@ -501,6 +501,11 @@ TEST(CalibrateCli, AFailedHydraulicMeasurementKeepsTheMeasuredStiffness) {
   const json j = json::parse(text);
   EXPECT_EQ(j["status"].get<std::string>().rfind("failed: hydraulic radii", 0), 0u) << j["status"];
   EXPECT_NEAR(j["C1_Pa_per_m"].get<double>() / j["C1_spring_network_Pa_per_m"].get<double>(), 1.0, 0.02);
+  // the wall's stiffness along the axis is measured before the hydraulic radii and kept too
+  ASSERT_TRUE(j.contains("axial_bending_rigidity_J"));
+  EXPECT_GT(j["axial_bending_rigidity_J"].get<double>(), 0.0);
+  EXPECT_EQ(j["axial_bending_rigidity_J"], j["axial_stiffness"]["bending_rigidity_fit_J"]);
+  EXPECT_EQ(j["axial_stiffness"]["C_Pa_per_m"].size(), 4u);
   EXPECT_FALSE(j.contains("hydraulic_offset_inner_m"));
   const Cli r = swim_cli("run \"" + kDemo + "\" --set wall.spring_constant=null --set wall.C1=null --set wall.calibration='\"" +
                              (out / "calibration.json").string() +
@@ -590,7 +595,9 @@ TEST(CalibrateCli, ProgressLinesWithProgressNoneWithQuiet) {
                            "--set container.radius='\"0.27 um\"' --out \"";
   const Cli on = swim_cli(args + (d / "on").string() + "\" --progress", d, "", false);
   EXPECT_EQ(on.code, 3) << on.err;  // the coarse grid: C1 measured, the hydraulic radii not
-  EXPECT_NE(on.err.find("calibrate tiny_3d_cycle:   6.7%  load 1/13  ~"), std::string::npos) << on.err;
+  // 16 steps: the 13 loads, the axial stiffness, the hydraulic radii, the towed tube
+  EXPECT_NE(on.err.find("calibrate tiny_3d_cycle:   6.2%  load 1/13  ~"), std::string::npos) << on.err;
+  EXPECT_NE(on.err.find("axial stiffness  ~"), std::string::npos) << on.err;
   EXPECT_NE(on.err.find("s left\n"), std::string::npos) << on.err;
   EXPECT_NE(on.err.find("calibrate tiny_3d_cycle: done in"), std::string::npos) << on.err;
   const Cli off = swim_cli(args + (d / "off").string() + "\"", d);  // --quiet

@@ -204,6 +204,30 @@ TEST(MembranePressure, UniformContractionAndEffectiveC1) {
   EXPECT_NEAR(c1[1] / c1[0], 1.0, 0.02);  // linear regime
 }
 
+// A pressure profile along the axis (relax_under_ring_pressures) that is the same on every ring
+// is the uniform load: the same Newton path, so the same static state bit for bit. A profile of
+// the wrong length is refused.
+TEST(MembranePressure, AConstantRingProfileIsTheUniformLoad) {
+  const CylinderMesh m = make_cylinder(kR0, kL, 16, Eigen::Vector3d::Zero());
+  const MembraneParams p;
+  const double P = 3e-3;  // Pa
+  const PressureResponse u = relax_under_pressure(m, p, P);
+  const PressureResponse v = relax_under_ring_pressures(m, p, Eigen::VectorXd::Constant(m.n_rings, P));
+  EXPECT_GT(u.iterations, 0);
+  EXPECT_EQ(v.iterations, u.iterations);
+  EXPECT_EQ((v.X - u.X).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ(v.c1, u.c1);
+  EXPECT_EQ(v.max_residual_force, u.max_residual_force);
+  EXPECT_THROW(relax_under_ring_pressures(m, p, Eigen::VectorXd::Constant(m.n_rings - 1, P)), swim::InputError);
+  // a profile that varies, inward at the ends and outward in the middle: the rings follow it
+  Eigen::VectorXd prof(m.n_rings);
+  for (int k = 0; k < m.n_rings; ++k) prof[k] = P * std::cos(2.0 * M_PI * k / (m.n_rings - 1));
+  const PressureResponse w = relax_under_ring_pressures(m, p, prof);
+  EXPECT_GT(w.ring_radius[(m.n_rings - 1) / 2], kR0);
+  EXPECT_LT(w.ring_radius[0], kR0);
+  EXPECT_LT(w.ring_radius[m.n_rings - 1], kR0);
+}
+
 // The wall-wrinkle measure of a 3D run's series (run3d_measure.hpp): zero for any
 // axisymmetric shape (here rings contracted to different radii), and the RMS amplitude
 // a / sqrt(2) of an azimuthal lobe pattern r = r_k (1 + ...) + a cos(m theta) on the ring

@@ -6,6 +6,7 @@ Run by CTest (label unit) with /usr/bin/python3; exits 77 (skipped) without matp
 import csv
 import importlib.util
 import json
+import math
 import os
 import sys
 import tempfile
@@ -193,6 +194,27 @@ class CalibrationFigure(unittest.TestCase):
         self.write()
         self.mod.main(self.d)
         self.assertTrue(os.path.exists(f"{self.d}/calibration.png"))
+        self.assertFalse(os.path.exists(f"{self.d}/axial_stiffness.png"))
+
+    def test_axial_stiffness_figure(self):
+        self.write()
+        with open(f"{self.d}/calibration.json") as f:
+            c = json.load(f)
+        lam = [40e-9, 80e-9, 160e-9, 320e-9]
+        dx, D, c1 = 4e-9, 2e-24, 4e6
+        ks = [2 * math.pi / v for v in lam]
+        K = [2 / dx * math.sin(0.5 * k * dx) for k in ks]
+        C = [c1 + D * q ** 4 for q in K]
+        c["axial_stiffness"] = {
+            "wavelengths_m": lam, "wavenumbers_per_m": ks, "lattice_wavenumbers_per_m": K, "C_Pa_per_m": C,
+            "C_over_C1": [v / c1 for v in C], "C1_Pa_per_m": c1, "bending_rigidity_wall_J": D,
+            "bending_rigidity_fit_J": 0.99 * D, "bending_length_m": 26.6e-9, "ring_spacing_m": dx,
+            "membrane_nodes": 50000, "tube_length_m": 1.2e-6,
+            "fit_with_k2": {"k2_coefficient_N_per_m": -1e-10, "bending_rigidity_J": D}}
+        with open(f"{self.d}/calibration.json", "w") as f:
+            json.dump(c, f)
+        self.mod.main(self.d)
+        self.assertTrue(os.path.exists(f"{self.d}/axial_stiffness.png"))
 
     def test_failed_hydraulic_measurement_looks_failed(self):
         self.write("failed: hydraulic radii: numerical failure: slipping")
