@@ -8,6 +8,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <string>
 #include <vector>
 
@@ -237,4 +238,37 @@ TEST(AxialBending, SceneRefusesItWhereItDoesNotApply) {
   s = forced;
   s["model1d"] = {{"axial_bending", {{"source", "scene"}, {"rigidity", "1e-24 J"}}}};
   EXPECT_EQ(key_of(s), "accepted");
+}
+
+// The calibration route: model1d.axial_bending.source = "calibration" reads the rigidity that
+// swim calibrate measures on the 3D membrane (axial_bending_rigidity_J) from wall.calibration,
+// bit for bit; a calibration file without it is refused naming wall.calibration.
+TEST(AxialBending, TheCalibratedRigidityIsReadFromTheCalibrationFile) {
+  const std::string dir = ::testing::TempDir();
+  const std::string with = dir + "/cal_with_axial.json", without = dir + "/cal_without_axial.json";
+  const double D = 2.0946135e-24;
+  {
+    std::ofstream(with) << scene::json{{"C1_Pa_per_m", 4.07e6}, {"hydraulic_offset_inner_m", 1e-8},
+                                       {"hydraulic_offset_outer_m", 1e-8}, {"axial_bending_rigidity_J", D}}.dump();
+    std::ofstream(without) << scene::json{{"C1_Pa_per_m", 4.07e6}, {"hydraulic_offset_inner_m", 1e-8},
+                                          {"hydraulic_offset_outer_m", 1e-8}}.dump();
+  }
+  auto scene_for = [](const std::string& file) {
+    return scene::json{{"name", "b"},
+                       {"wall", {{"calibration", file}}},
+                       {"wave", {{"kind", "force_driven"}}},
+                       {"protocol", {{"load_factor", 1.5}}},
+                       {"model1d", {{"axial_bending", {{"source", "calibration"}}}}}};
+  };
+  scene::json resolved;
+  const Params p = read_scene(scene_for(with), resolved);
+  EXPECT_EQ(p.wall.D_axial, D);
+  EXPECT_EQ(p.wall.C1, 4.07e6);
+  try {
+    read_scene(scene_for(without), resolved);
+    ADD_FAILURE() << "a calibration file without axial_bending_rigidity_J was accepted";
+  } catch (const swim::InputError& e) {
+    EXPECT_EQ(e.key(), "wall.calibration");
+    EXPECT_NE(std::string(e.what()).find("axial_bending_rigidity_J"), std::string::npos) << e.what();
+  }
 }
