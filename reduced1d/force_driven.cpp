@@ -321,6 +321,28 @@ void EventLoop::install_laws() {
 }
 
 void EventLoop::check_end_radii(double t) const {
+  if (M_.bending) {
+    // A bending wall's ends follow the wall. Its active segment, of length l under the whole
+    // actuation q, deflects at its middle by f q / C1 with f = 1 - exp(-x) cos(x),
+    // x = l / (2 sqrt(2) l_b), l_b = (D / C1)^(1/4) (a uniform load on a length l of a beam on
+    // an elastic foundation): the static radius there must stay above the collapse radius.
+    // (Held segments are controlled to R_f, not loaded by q.)
+    const double ell_b = std::pow(M_.D_axial / M_.C1, 0.25);
+    double longest = 0;
+    for (double w : machine_.seg_weight()) longest = std::max(longest, w * M_.h);
+    const double x = longest / (2.0 * std::sqrt(2.0) * ell_b);
+    const double f = 1.0 - std::exp(-x) * std::cos(x);
+    const double q = f * P_.protocol.q;
+    const double Rs = M_.wall.law ? M_.wall.static_radius(q) : M_.R0 - q / M_.C1;
+    if (Rs < collapse_)
+      throw NumericalError(
+          "tube radius collapsed to zero: under the actuation " + fmt(P_.protocol.q) + " Pa a protocol segment of " +
+              metres(longest) + " (bending length " + metres(ell_b) + ") has the static radius " + metres(Rs) +
+              " at its middle, below the collapse radius " + metres(collapse_),
+          "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) or raise wall.C1",
+          t);
+    return;
+  }
   double lo0, loL;
   M_.end_radius_range(lo0, loL);
   if ((lo0 < collapse_ || loL < collapse_) && M_.wall.law) {

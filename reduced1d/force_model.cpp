@@ -94,7 +94,7 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
     ik = 3 + J;
     bend_c = D_axial * R0 / (h * h * h * h);
     band_mu = 2 * stride - 2;
-    band_ml = 2 * stride - 1;
+    band_ml = 2 * stride;  // and V_front's row reaches a_{N-2} through the free end's radius
   }
   const double f_s = bal.per_length ? pi * C1 * R0 * R0 * R0 / L : C1 * R0 * R0 / (2.0 * L);
   D_s = f_s * T_s;
@@ -166,6 +166,10 @@ void ForceModel::set_actuation(const ProtocolMachine& mc, const std::vector<Prot
 void ForceModel::end_radius_range(double& lo0, double& loL) const {
   lo0 = Rb0_static;
   loL = RbL_static;
+  if (bending) {  // the ends follow the wall (unpack); EventLoop::check_end_radii checks the segments
+    lo0 = loL = R0;
+    return;
+  }
   if (end0_seg) lo0 = law[0].a->rest_radius(wall, seg_law[seg_a[0]]->operator()(1e300));
   if (endL_seg) loL = law[N - 1].a->rest_radius(wall, seg_law[seg_a[N - 1]]->operator()(1e300));
 }
@@ -200,8 +204,14 @@ bool ForceModel::unpack(const double* y, ModelState& s) const {
     s.Rbar[k] = sum / seg_w[k];
     s.qs[k] = seg_law[k]->eval(s.Rbar[k], s.dqs[k]);
   }
-  s.Rb0 = end0_seg ? law[0].a->rest_radius(wall, s.qs[seg_a[0]]) : Rb0_static;
-  s.RbL = endL_seg ? law[N - 1].a->rest_radius(wall, s.qs[seg_a[N - 1]]) : RbL_static;
+  if (bending) {  // free ends of a bending wall: straight through the last two cells (no curvature)
+    s.Rb0 = 1.5 * R[0] - 0.5 * R[1];
+    s.RbL = 1.5 * R[N - 1] - 0.5 * R[N - 2];
+    if (!(s.Rb0 > 0) || !(s.RbL > 0)) ok = false;
+  } else {
+    s.Rb0 = end0_seg ? law[0].a->rest_radius(wall, s.qs[seg_a[0]]) : Rb0_static;
+    s.RbL = endL_seg ? law[N - 1].a->rest_radius(wall, s.qs[seg_a[N - 1]]) : RbL_static;
+  }
   if (wall.law) {  // d Rb / d qs = -1 / w'(Rb) (the end cell of a held segment has no own ramp)
     double d;
     wall.eval(s.Rb0, d);
@@ -675,6 +685,19 @@ void ForceModel::ida_band(const Linearisation& s, const double* y, double cj, co
   band(iVf, iVf, cj);
   band(iVf, 1 + S * (N - 1), -s.QL[N] * dRda(N - 1) / V_s);
   band(iVf, 1 + S * (N - 1) + 2, -cond[N] * P_s / V_s);
+  if (bending) {  // Q_0 and Q_N through the free ends' radii Rb = 1.5 R_end - 0.5 R_next
+    const double c = cp / h;
+    for (auto [i, w] : {std::pair{0, 1.5}, std::pair{1, -0.5}}) {
+      const double d0 = s.Qb0 * w * dRda(i);
+      band(1 + 2, 1 + S * i, -c * d0);
+      band(iVr, 1 + S * i, -d0 / V_s);
+    }
+    for (auto [i, w] : {std::pair{N - 1, 1.5}, std::pair{N - 2, -0.5}}) {
+      const double dN = s.QbL * w * dRda(i);
+      band(1 + S * (N - 1) + 2, 1 + S * i, c * dN);
+      band(iVf, 1 + S * i, -dN / V_s);
+    }
+  }
   for (int i : {iD, iX, iVrl, iVfl}) band(i, i, cj);
   if (!force_free) {  // F_X = X' - W / X_s, W = (thrust - D - c_ext X) / m_eff
     band(iX, iD, D_s / (bal.m_eff * X_s));
@@ -712,8 +735,8 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
       Ul[off + 1 + S * i + 1] = cv * u;  // F_V = [V'] + cv (C1 (R - R0) + q + T - p)
       Vt[off + 1 + S * i] = st.dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
     }
-    double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii
-    if (endL_seg && seg_a[N - 1] == k) {  // Q_N depends on RbL (linear law: R0 - qs/C1)
+    double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii (not a bending wall's)
+    if (endL_seg && seg_a[N - 1] == k && !bending) {  // Q_N depends on RbL (linear law: R0 - qs/C1)
       const double dQN = s.QbL * end_sensitivity(st, true);
       Ul[off + 1 + S * (N - 1) + 2] += cp * dQN / h;
       Ul[off + iVf] += -dQN / V_s;
@@ -722,7 +745,7 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
         else g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
       }
     }
-    if (end0_seg && seg_a[0] == k) {
+    if (end0_seg && seg_a[0] == k && !bending) {
       const double dQ0 = s.Qb0 * end_sensitivity(st, false);
       Ul[off + 1 + 2] += -cp * dQ0 / h;
       Ul[off + iVr] += -dQ0 / V_s;
@@ -765,6 +788,20 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
       vu[1 + S * i] = -(Gi[1][0] * g1a + Gi[1][1] * g2a);
       vw[1 + S * i + 2] = -(Gi[0][0] * g1p + Gi[0][1] * g2p);
       vu[1 + S * i + 2] = -(Gi[1][0] * g1p + Gi[1][1] * g2p);
+    }
+    if (bending) {  // the end points' radii follow the cells beside them
+      auto add = [&](int i, double g1, double g2) {
+        vw[1 + S * i] -= Gi[0][0] * g1 + Gi[0][1] * g2;
+        vu[1 + S * i] -= Gi[1][0] * g1 + Gi[1][1] * g2;
+      };
+      for (auto [i, w] : {std::pair{0, 1.5}, std::pair{1, -0.5}}) {
+        const double f = w * 0.5 * R0 * R0 / R[i];
+        add(i, s.g1a[0] * f, s.g2a[0] * f);
+      }
+      for (auto [i, w] : {std::pair{N - 1, 1.5}, std::pair{N - 2, -0.5}}) {
+        const double f = w * 0.5 * R0 * R0 / R[i];
+        add(i, s.g1b[N] * f, s.g2b[N] * f);
+      }
     }
     for (const auto& sx : seg_x)
       for (int row = 0; row < n; ++row) {

@@ -120,8 +120,10 @@ class StandInCalibration {
     if (fd < 0) throw OutputError("a temporary calibration file", std::strerror(errno));
     ::close(fd);
     path_ = tmpl;
+    // (the axial rigidity: the paper's wall, 1.0e-24 J, for a model that reads it)
     std::ofstream(path_) << json{{"C1_Pa_per_m", c1}, {"hydraulic_offset_inner_m", 0.0},
-                                 {"hydraulic_offset_outer_m", 0.0}, {"status", "ok"}}.dump();
+                                 {"hydraulic_offset_outer_m", 0.0}, {"axial_bending_rigidity_J", 1.009e-24},
+                                 {"status", "ok"}}.dump();
   }
   ~StandInCalibration() {
     std::error_code ec;
