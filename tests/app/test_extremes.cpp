@@ -190,8 +190,9 @@ TEST(Extremes, ForceDrivenOnTheCalibratedWallAndWithAxialBending) {
   //  - 1 Pa exceeds the law's static load at the collapse radius (0.35 Pa): the open ends
   //    collapse at t = 0 (numerical failure naming the load).
   // The wall's bending along the axis (D = 2.1e-24 J, bending length 27 nm) on the linear
-  // wall: the same collapse below R_f = 1/3 R0 at the open ends (their radius is the local
-  // law's); on the shortest tube (segments of 20 to 40 nm, shorter than the bending length)
+  // wall: at R_f = 0.1 R0 the active 75 nm segment's static radius at its middle (a beam on an
+  // elastic foundation) is below the collapse radius, and the run stops at t = 0 naming the
+  // collapse; on the shortest tube (segments of 20 to 40 nm, shorter than the bending length)
   // the active segment cannot bend down to R_f and the run stalls (numerical failure); the
   // longer tubes complete. On the buckled law the bending, 30 times stiffer than the plateau
   // at the segments' scale, holds the segment above R_f: stall.
