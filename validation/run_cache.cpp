@@ -28,7 +28,7 @@ namespace {
 /// method (3: the held tube on the ring forces; 4: the axial stiffness C(k) and
 /// axial_bending_rigidity_J): cached calibrations of an older format are
 /// then recomputed instead of read.
-constexpr int kCalibrationFormat = 4;
+constexpr int kCalibrationFormat = 5;
 
 /// The files of a cached run the report reads (the series), and those that make it the run it
 /// is (its resolved scene, its radius field): each must be listed in its summary.json.
@@ -455,9 +455,16 @@ std::string RunCache::calibration(const json& base, const std::string& grid_key,
     const StaticCalibration c = calibrate_static(p, loads, [&](std::size_t done) {
       bar.step(done, steps, "load " + std::to_string(done) + "/" + std::to_string(loads.size()));
     });
+    cal_j = to_json(c, p, resolved);
+    // the wall's stiffness along the axis, as swim calibrate (a failure keeps its reason, and
+    // the 1D models that read axial_bending_rigidity_J are then not run)
+    try {
+      add_axial_stiffness(cal_j, measure_axial_stiffness(p));
+    } catch (const NumericalError& e) {
+      cal_j["axial_stiffness"] = {{"status", std::string("failed: ") + e.what()}};
+    }
     const HydraulicRadii hr = measure_hydraulic_radii(p);
     bar.step(loads.size() + 1, steps, "hydraulic radii");
-    cal_j = to_json(c, p, resolved);
     json hj = to_json(hr);
     hj["hydraulic_wall_time_s"] = hj["wall_time_s"];
     hj.erase("wall_time_s");
