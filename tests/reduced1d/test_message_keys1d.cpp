@@ -29,6 +29,7 @@ std::set<std::string> accepted_keys() {
       {"wave.kind=sine", "protocol=null", "wave.contracted_ratio=null", "wave.contracted_radius=0.1 um"},
       {"wall.spring_constant=null", "wall.C1=4e6 Pa/m", "wall.mass_per_length=null", "wall.mass_per_area=1e-3 kg/m^2"},
       {"wall.law=linear"},
+      {"model1d.axial_bending.source=scene", "model1d.axial_bending.rigidity=1e-24 J"},
   };
   std::set<std::string> keys = swim::testing::resolved_keys(scene::json::object(), variants,
                                                             [](const scene::json& sc, scene::json& r) { reduced1d::read_scene(sc, r); });
