@@ -532,14 +532,14 @@ PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
   return run_cycle(out, cores, "paper_amplitude_0.55", {}, "paper_cycle", 60.0);
 }
 
-/// The paper's buckling wall on a fine grid: paper_aspect_L0.2 at `cells` across, seeded as
-/// the converged suite's paper_aspect_L0.2_seeded (m = 8 lobes of 1e-2 R0), into
-/// out/fine_cycle_N. Targets: 4 min at 96 cells, 12 min at 128 (none on other grids).
+/// The paper's buckling wall on a fine grid: paper_aspect_L0.2 at `cells` across, seeded with the
+/// mode its buckling estimate grows fastest (seed_mode = "auto": m = 8 lobes of 1e-2 R0, as the
+/// converged suite's paper_aspect_L0.2_seeded), into out/fine_cycle_N. Targets: 4 min at 96
+/// cells, 12 min at 128 (none on other grids).
 PaperCycle run_fine_cycle(const std::string& out, unsigned cores, int cells) {
   const double target = cells == 96 ? 240.0 : cells == 128 ? 720.0 : 0.0;
   return run_cycle(out, cores, "paper_aspect_L0.2",
-                   {"full3d.grid.cells_across=" + std::to_string(cells), "full3d.membrane.seed_mode=8",
-                    "full3d.membrane.seed_amplitude=0.01"},
+                   {"full3d.grid.cells_across=" + std::to_string(cells), "full3d.membrane.seed_mode=auto"},
                    "fine_cycle_" + std::to_string(cells), target);
 }
 
