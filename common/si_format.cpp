@@ -19,7 +19,7 @@ std::string si(double value, const std::string& unit, int digits) {
     // volumes: always µm³, the scale of the swimmers, so that two runs print comparable
     // figures ("0.00382 µm³", "0.000962 µm³"); plain decimals down to 10⁻⁶ µm³
     const std::string u = "\u00b5m\u00b3" + unit.substr(3);
-    const double x = value * 1e18;
+    const double x = value == 0.0 ? 0.0 : value * 1e18;  // (no "-0" for a negative zero)
     const double a = std::abs(x);
     if (a == 0.0 || a < 1e-6 || a >= 1e15) {
       std::snprintf(buf, sizeof buf, "%.*g %s", digits, x, u.c_str());

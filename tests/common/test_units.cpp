@@ -52,6 +52,8 @@ TEST(SiFormat, PrefixesMantissasAndVolumes) {
   EXPECT_EQ(swim::si(0.134, "s"), "134 ms");
   // volumes: one unit, µm³, for every printout (two runs' pumped volumes compare at a glance)
   EXPECT_EQ(swim::si(0.0, "m^3"), "0 \u00b5m\u00b3");
+  EXPECT_EQ(swim::si(-0.0, "m^3"), "0 \u00b5m\u00b3");  // a run stopped at t = 0: no "-0"
+  EXPECT_EQ(swim::si(-0.0, "m"), "0 m");
   EXPECT_EQ(swim::si(7.1823e-22, "m^3"), "0.000718 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(-7.1823e-22, "m^3"), "-0.000718 \u00b5m\u00b3");
   EXPECT_EQ(swim::si(3.82e-21, "m^3"), "0.00382 \u00b5m\u00b3");
