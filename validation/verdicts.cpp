@@ -58,6 +58,31 @@ Valued reference_of(const json& c, const std::string& key) {
   return v;
 }
 
+/// The relative error given to a 1D value in a trend claim: the tier's grid error at its default
+/// grid (N = 50 within 0.5 % of N = 400, docs/outer-flow-1d.md §3b).
+constexpr double kOneDGridError = 5e-3;
+
+/// The suite's default 1D model's (the first of models1d) value of `key` on case c, with the
+/// error kOneDGridError |value|.
+Valued default_model_of(const json& c, const std::string& key) {
+  Valued v;
+  const json& models = c.contains("models1d") ? c["models1d"] : json::array();
+  if (models.empty() || !models[0].is_object()) {
+    v.missing = "no 1D model";
+    return v;
+  }
+  const json& m = models[0];
+  if (m.value("status", std::string()) == "ok" && m.contains(key) && m[key].is_number()) {
+    v.value = m[key].get<double>();
+    v.error = kOneDGridError * std::abs(v.value);
+    if (std::isfinite(v.value)) return v;
+  }
+  v.value = v.error = kNaN;
+  v.missing = "the default 1D model (" + m.value("label", std::string()) + ") has no value: " +
+              m.value("status", std::string("no cycle"));
+  return v;
+}
+
 const char* kTrendRule =
     "each difference the claim rests on is compared with the combined uncertainty of its two values, "
     "|a − b| > e_a + e_b (their error bars do not overlap): reproduced when every difference exceeds it in the "
@@ -73,13 +98,18 @@ struct Point {
 
 /// The reference values of the cases of a claim, with the evidence; `missing` gets the first
 /// case without a value (or without an error bar).
+/// one_d: the suite's default 1D model's values instead of the reference's.
 std::vector<Point> points(const std::vector<const json*>& cases, const std::string& key, const char* sweep_name,
-                          json& ev, std::string& missing) {
+                          json& ev, std::string& missing, bool one_d = false) {
   std::vector<Point> p;
   for (const json* c : cases) {
-    Point q{c, reference_of(*c, key)};
+    Point q{c, one_d ? default_model_of(*c, key) : reference_of(*c, key)};
+    const json& models = c->contains("models1d") ? (*c)["models1d"] : json::array();
+    const std::string source =
+        one_d ? "1D: " + (models.empty() ? std::string() : models[0].value("label", std::string()))
+              : judged_reference_name(*c);
     json e = {{"case", (*c)["name"]}, {sweep_name, (*c)["sweep_value"]}, {"quantity", key},
-              {"value", num(q.v.value)}, {"error", num(q.v.error)}, {"reference", judged_reference_name(*c)}};
+              {"value", num(q.v.value)}, {"error", num(q.v.error)}, {"reference", source}};
     if (!q.v.missing.empty()) {
       e["note"] = q.v.missing;
       if (missing.empty()) missing = q.name() + ": " + q.v.missing;
@@ -120,7 +150,8 @@ json finding(const std::string& claim, const std::string& rule, const json& ev) 
 
 /// A claim that values[a] > values[b] for each (a, b) in `pairs`.
 json trend(const std::string& claim, const std::vector<Point>& p, const std::string& missing, const json& ev,
-           const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::string& unit) {
+           const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::string& unit,
+           const std::string& settle_suffix = kSettleSuffix) {
   json f = finding(claim, kTrendRule, ev);
   if (p.size() < 2) {
     f["reason"] = "the suite has fewer than two cases for it";
@@ -140,7 +171,7 @@ json trend(const std::string& claim, const std::vector<Point>& p, const std::str
   }
   f["comparisons"] = comps;
   f["status"] = against ? "refuted" : all ? "reproduced" : "inconclusive";
-  if (!against && !all) f["to_settle"] = join(undecided, "; ") + kSettleSuffix;
+  if (!against && !all) f["to_settle"] = join(undecided, "; ") + settle_suffix;
   return f;
 }
 
@@ -252,68 +283,79 @@ json findings(const json& cases, const json& th) {
   const std::string kd = "displacement_per_cycle_m", kv = "mean_velocity_per_cycle_m_per_s";
   const auto aspect = group("aspect"), amplitude = group("amplitude");
 
-  // distance per cycle grows with L: each L against the next
-  {
-    json ev = json::array();
-    std::string missing;
-    const auto p = points(aspect, kd, "L_um", ev, missing);
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
-    for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i + 1, i);
-    out.push_back(trend("distance per cycle grows with the swimmer length L", p, missing, ev, pairs, "m"));
-  }
-  // ... and with the amplitude: the sweep value is R_f / R0, the deformation grows as it falls
-  {
-    json ev = json::array();
-    std::string missing;
-    const auto p = points(amplitude, kd, "R_f_over_R0", ev, missing);
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
-    for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i, i + 1);
-    out.push_back(trend("distance per cycle grows with the deformation amplitude", p, missing, ev, pairs, "m"));
-  }
-  // the shortest swimmer against every other
-  {
-    json ev = json::array();
-    std::string missing;
-    const auto p = points(aspect, kv, "L_um", ev, missing);
-    std::vector<std::pair<std::size_t, std::size_t>> pairs;
-    for (std::size_t j = 1; j < p.size(); ++j) pairs.emplace_back(0, j);
-    out.push_back(trend("mean velocity per cycle is largest for the shortest swimmer", p, missing, ev, pairs, "m/s"));
-  }
-  // largest at about 50 % deformation (R_f / R0 within 0.1 of 0.5): some case there exceeds
-  // every case away from it
-  {
-    json ev = json::array();
-    std::string missing;
-    const auto p = points(amplitude, kv, "R_f_over_R0", ev, missing);
-    json f = finding("mean velocity per cycle is largest at about 50 % deformation (R_f/R0 within 0.1 of 0.5)",
-                     std::string(kTrendRule) + "; a case at about 50 % must exceed every case away from it", ev);
-    std::vector<std::size_t> at, away;
-    for (std::size_t i = 0; i < p.size(); ++i)
-      (std::abs((*p[i].c)["sweep_value"].get<double>() - 0.5) <= 0.1 ? at : away).push_back(i);
-    if (p.size() < 2) f["reason"] = "the suite has fewer than two cases for it";
-    else if (!missing.empty()) f["reason"] = missing;
-    else if (at.empty()) f["reason"] = "the sweep has no case at about 50 % deformation";
-    else if (away.empty()) f["reason"] = "the sweep has no case away from 50 % deformation";
-    else {
-      json comps = json::array();
-      std::vector<std::string> undecided;
-      std::vector<std::vector<int>> o(at.size(), std::vector<int>(away.size()));
-      for (std::size_t i = 0; i < at.size(); ++i)
-        for (std::size_t j = 0; j < away.size(); ++j) o[i][j] = exceeds(p[at[i]], p[away[j]], "m/s", comps, undecided);
-      bool reproduced = false, refuted = false;
-      for (std::size_t i = 0; i < at.size(); ++i)
-        reproduced = reproduced || std::all_of(o[i].begin(), o[i].end(), [](int x) { return x > 0; });
-      for (std::size_t j = 0; j < away.size(); ++j) {
-        bool beats_all = true;
-        for (std::size_t i = 0; i < at.size(); ++i) beats_all = beats_all && o[i][j] < 0;
-        refuted = refuted || beats_all;
-      }
-      f["comparisons"] = comps;
-      f["status"] = reproduced ? "reproduced" : refuted ? "refuted" : "inconclusive";
-      if (!reproduced && !refuted) f["to_settle"] = join(undecided, "; ") + kSettleSuffix;
+  // The paper's trends, on the reference (the converged answer) and then on the suite's default
+  // 1D model with the same rule (each 1D value carries the tier's grid error, kOneDGridError).
+  const auto trends = [&](bool one_d) {
+    const std::string on = one_d ? " (1D tier, the suite's default 1D model)" : "";
+    const std::string settle_suffix = one_d ? ": a finer 1D grid (numerics1d.cells)" : kSettleSuffix;
+    // distance per cycle grows with L: each L against the next
+    {
+      json ev = json::array();
+      std::string missing;
+      const auto p = points(aspect, kd, "L_um", ev, missing, one_d);
+      std::vector<std::pair<std::size_t, std::size_t>> pairs;
+      for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i + 1, i);
+      out.push_back(
+          trend("distance per cycle grows with the swimmer length L" + on, p, missing, ev, pairs, "m", settle_suffix));
     }
-    out.push_back(f);
-  }
+    // ... and with the amplitude: the sweep value is R_f / R0, the deformation grows as it falls
+    {
+      json ev = json::array();
+      std::string missing;
+      const auto p = points(amplitude, kd, "R_f_over_R0", ev, missing, one_d);
+      std::vector<std::pair<std::size_t, std::size_t>> pairs;
+      for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i, i + 1);
+      out.push_back(
+          trend("distance per cycle grows with the deformation amplitude" + on, p, missing, ev, pairs, "m", settle_suffix));
+    }
+    // the shortest swimmer against every other
+    {
+      json ev = json::array();
+      std::string missing;
+      const auto p = points(aspect, kv, "L_um", ev, missing, one_d);
+      std::vector<std::pair<std::size_t, std::size_t>> pairs;
+      for (std::size_t j = 1; j < p.size(); ++j) pairs.emplace_back(0, j);
+      out.push_back(
+          trend("mean velocity per cycle is largest for the shortest swimmer" + on, p, missing, ev, pairs, "m/s", settle_suffix));
+    }
+    // largest at about 50 % deformation (R_f / R0 within 0.1 of 0.5): some case there exceeds
+    // every case away from it
+    {
+      json ev = json::array();
+      std::string missing;
+      const auto p = points(amplitude, kv, "R_f_over_R0", ev, missing, one_d);
+      json f = finding("mean velocity per cycle is largest at about 50 % deformation (R_f/R0 within 0.1 of 0.5)" + on,
+                       std::string(kTrendRule) + "; a case at about 50 % must exceed every case away from it", ev);
+      std::vector<std::size_t> at, away;
+      for (std::size_t i = 0; i < p.size(); ++i)
+        (std::abs((*p[i].c)["sweep_value"].get<double>() - 0.5) <= 0.1 ? at : away).push_back(i);
+      if (p.size() < 2) f["reason"] = "the suite has fewer than two cases for it";
+      else if (!missing.empty()) f["reason"] = missing;
+      else if (at.empty()) f["reason"] = "the sweep has no case at about 50 % deformation";
+      else if (away.empty()) f["reason"] = "the sweep has no case away from 50 % deformation";
+      else {
+        json comps = json::array();
+        std::vector<std::string> undecided;
+        std::vector<std::vector<int>> o(at.size(), std::vector<int>(away.size()));
+        for (std::size_t i = 0; i < at.size(); ++i)
+          for (std::size_t j = 0; j < away.size(); ++j) o[i][j] = exceeds(p[at[i]], p[away[j]], "m/s", comps, undecided);
+        bool reproduced = false, refuted = false;
+        for (std::size_t i = 0; i < at.size(); ++i)
+          reproduced = reproduced || std::all_of(o[i].begin(), o[i].end(), [](int x) { return x > 0; });
+        for (std::size_t j = 0; j < away.size(); ++j) {
+          bool beats_all = true;
+          for (std::size_t i = 0; i < at.size(); ++i) beats_all = beats_all && o[i][j] < 0;
+          refuted = refuted || beats_all;
+        }
+        f["comparisons"] = comps;
+        f["status"] = reproduced ? "reproduced" : refuted ? "refuted" : "inconclusive";
+        if (!reproduced && !refuted) f["to_settle"] = join(undecided, "; ") + settle_suffix;
+      }
+      out.push_back(f);
+    }
+  };
+  trends(false);
+  trends(true);
   // 1D against 3D up to 50 % deformation (R_f / R0 >= 0.5), one finding per figure, judged on
   // the suite's default 1D model (the first); every model is evidence
   {

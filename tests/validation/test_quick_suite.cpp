@@ -86,8 +86,9 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
   ASSERT_TRUE(err.count("rtol = 1e-06") && err.count("rtol = 1e-08"));
   EXPECT_LT(std::abs(err["rtol = 1e-06"] - err["rtol = 1e-08"]), 1e-3);
   EXPECT_GT(c["wall_time_ratio_3d_over_1d"].get<double>(), 10.0);
-  // five claims, the 1D agreement one per figure (four rows); each with a status and its rule
-  ASSERT_EQ(r["findings"].size(), 9u);
+  // five claims, the four trends again on the 1D tier, the 1D agreement one per figure (four
+  // rows); each with a status and its rule
+  ASSERT_EQ(r["findings"].size(), 13u);
   for (const auto& f : r["findings"]) {
     EXPECT_TRUE(f["status"] == "reproduced" || f["status"] == "refuted" || f["status"] == "inconclusive" ||
                 f["status"] == "not assessed")
