@@ -20,6 +20,7 @@
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
+#include "mode_response.hpp"
 
 using namespace swim::reduced1d;
 namespace scene = swim::scene;
@@ -29,50 +30,10 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kD = 2.1184615504e-24;  // J: the round wall of the validation suite
 
-/// A long unbounded tube under a fixed sinusoidal load of grid mode m; returns the amplitude of
-/// the radius's response in that mode over the middle half of the tube, in units of q0 / C1,
-/// at time t (a multiple of the mode's relaxation time 1 / lambda), and the mode's
-/// stiffness ratio C(k) / C1 = 1 + D kd^4 / C1 and relaxation time.
-struct ModeResponse {
-  double amplitude, stiffness_ratio, relaxation_time;
-};
+using test::ModeResponse;
+
 ModeResponse mode_response(int m, double D, double t_over_relaxation) {
-  Params p;
-  p.wave = WaveKind::ForceDriven;
-  p.swimmer.outer = OuterFlow::Unbounded;
-  p.swimmer.short_wave_traction = true;
-  p.wall.D_axial = D;
-  const double R0 = p.geometry.R0, C1 = p.wall.C1, mu = p.fluid.mu;
-  const int N = 400;
-  p.geometry.L = 40 * R0;
-  p.numerics.cells = N;
-  p.numerics.rtol = 1e-8;
-  const double L = p.geometry.L, h = L / N;
-  const double k = m * kPi / L, kd = 2.0 / h * std::sin(0.5 * k * h);
-  // the discrete fourth difference of the free-ended wall: (2 - 2 cos k h)^2 / h^4 = kd^4
-  const double stiffness = C1 + D * kd * kd * kd * kd;
-  const double eta = 16.0 * mu / (R0 * R0 * R0 * kd * kd) + 4.0 * mu * kd;
-  const double t1 = eta / stiffness;
-  const double q0 = 2e-3 * C1 * R0;
-  std::vector<double> q(N), c(N);
-  for (int i = 0; i < N; ++i) {
-    c[i] = std::cos(k * (i + 0.5) * h);
-    q[i] = q0 * c[i];
-  }
-  const double t = t_over_relaxation * t1;
-  p.numerics.output_interval = t;
-  const Result r = detail::solve_fixed_actuation(p, q, t);
-  if (r.failure) ADD_FAILURE() << r.failure->what();
-  if (r.radius_times.size() != 2u) {
-    ADD_FAILURE() << "expected two samples";
-    return {0, stiffness / C1, t1};
-  }
-  double num = 0, den = 0;
-  for (int i = N / 4; i < 3 * N / 4; ++i) {
-    num += (r.radius[std::size_t(N) + i] - R0) * c[i];
-    den += c[i] * c[i];
-  }
-  return {-(num / den) / (q0 / C1), stiffness / C1, t1};
+  return test::mode_response(m, D, true, t_over_relaxation);
 }
 
 }  // namespace

@@ -14,6 +14,7 @@
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
+#include "mode_response.hpp"
 
 using namespace swim::reduced1d;
 
@@ -54,40 +55,8 @@ TEST(WallTraction, QuadratureOfAbsKIsWithinOnePercentOnEveryGridMode) {
 // relaxation is 17 times slower with it, and each model meets its own rate to 2 %.
 TEST(WallTraction, ShortWaveLoadRelaxesAtTheLinearStokesRate) {
   for (bool traction : {true, false}) {
-    Params p;
-    p.wave = WaveKind::ForceDriven;
-    p.swimmer.outer = OuterFlow::Unbounded;
-    p.swimmer.short_wave_traction = traction;
-    const double R0 = p.geometry.R0, C1 = p.wall.C1, mu = p.fluid.mu;
-    const int N = 400;
-    p.geometry.L = 40 * R0;
-    p.numerics.cells = N;
-    p.numerics.rtol = 1e-8;
-    const double L = p.geometry.L, h = L / N;
-    const int m = 51;  // k R0 = 4.006
-    const double k = m * kPi / L, kd = 2.0 / h * std::sin(0.5 * k * h);
-    const double eta = 16.0 * mu / (R0 * R0 * R0 * kd * kd) + (traction ? 4.0 * mu * kd : 0.0);
-    const double lambda = C1 / eta;
-    const double t1 = 1.0 / lambda;
-    const double q0 = 2e-3 * C1 * R0;
-    std::vector<double> q(N), c(N);
-    for (int i = 0; i < N; ++i) {
-      c[i] = std::cos(k * (i + 0.5) * h);
-      q[i] = q0 * c[i];
-    }
-    p.numerics.output_interval = t1;
-    const Result r = detail::solve_fixed_actuation(p, q, t1);
-    ASSERT_FALSE(r.failure) << r.failure->what();
-    ASSERT_EQ(r.radius_times.size(), 2u);
-    EXPECT_NEAR(r.radius_times[1], t1, 1e-9 * t1);
-    // amplitude of the mode over the middle half of the tube
-    double num = 0, den = 0;
-    for (int i = N / 4; i < 3 * N / 4; ++i) {
-      num += (r.radius[std::size_t(N) + i] - R0) * c[i];
-      den += c[i] * c[i];
-    }
-    const double amplitude = -(num / den) / (q0 / C1);
-    EXPECT_NEAR(amplitude, 1.0 - std::exp(-1.0), 0.02 * (1.0 - std::exp(-1.0))) << "traction " << traction;
+    const test::ModeResponse r = test::mode_response(51, 0.0, traction, 1.0);  // k R0 = 4.006
+    EXPECT_NEAR(r.amplitude, 1.0 - std::exp(-1.0), 0.02 * (1.0 - std::exp(-1.0))) << "traction " << traction;
   }
 }
 
