@@ -46,20 +46,8 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   // the wall's stiffness along the axis, C(k) (a long round tube of the same wall)
   // (a failure leaves the section with its reason and no axial_bending_rigidity_J: C1 and the
   // offsets are still measured)
-  validation::AxialStiffness axial;
-  std::string axial_failed;
-  try {
-    axial = validation::measure_axial_stiffness(p);
-  } catch (const NumericalError& e) {
-    axial_failed = e.what();
-  }
+  const validation::AxialStiffnessOutcome axial_outcome = validation::try_measure_axial_stiffness(p);
   progress.step(loads.size() + 1, steps, "axial stiffness");
-  const auto add_axial = [&](scene::json& js) {
-    if (axial_failed.empty())
-      validation::add_axial_stiffness(js, axial);
-    else
-      js["axial_stiffness"] = {{"status", "failed: " + axial_failed}};
-  };
   validation::HydraulicRadii hr;
   validation::TowedCalibration tow;
   try {
@@ -73,7 +61,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
     // the wall stiffness is measured: keep it, say the offsets are missing and why (exit 3)
     output::make_dir(out);
     scene::json j = validation::to_json(c, p, resolved);
-    add_axial(j);
+    j.update(axial_outcome.entries());
     j["status"] = "failed: hydraulic radii: " + std::string(e.what());
     j["wall_time_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     output::write_json(out + "/calibration.json", j);
@@ -96,7 +84,7 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   output::make_dir(out);
   scene::json j = validation::to_json(c, p, resolved);
-  add_axial(j);
+  j.update(axial_outcome.entries());
   j["status"] = "ok";
   j["wall_time_s"] = wall;
   scene::json hj = validation::to_json(hr);
@@ -137,9 +125,10 @@ int calibrate(const std::string& scene_path, const std::vector<std::string>& set
               c.fit.linear_over_all_loads ? "over every load, up to" : "up to",
               si(c.fit.linear_over_all_loads ? c.loads.back().pressure_Pa : c.fit.linear_up_to_Pa, "Pa").c_str(),
               si(stable_up_to, "Pa").c_str(), stable, c.nodes, si(wall, "s").c_str(), out.c_str());
-  if (!axial_failed.empty()) {
-    std::printf("  axial stiffness C(k): failed (%s)\n", axial_failed.c_str());
+  if (!axial_outcome.measured) {
+    std::printf("  axial stiffness C(k): failed (%s)\n", axial_outcome.failure.c_str());
   } else {
+    const validation::AxialStiffness& axial = *axial_outcome.measured;
     std::string table;
     for (std::size_t k = 0; k < axial.wavelengths_m.size(); ++k)
       table += (k ? ", " : "") + si(axial.wavelengths_m[k], "m", 3) + " " +

@@ -16,10 +16,9 @@ namespace {
 // The linear estimate of the contracted wall's buckling (buckling_estimate.hpp) for the scene:
 // per stage of the contraction, the fastest-growing lobe number in the fluid and its rate.
 scene::json buckling_estimate(const Params3d& p) {
-  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);  // the equilateral network's 2D Young's modulus
+  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);  // (reported with the estimate)
   const double N = p.protocol.q * p.R0;                   // hoop compression holding R_f
-  const auto stages = contraction_buckling(p.L, p.protocol.segments, p.protocol.first_ratio, p.protocol.R_f, N,
-                                           p.bending_rigidity, Y, p.fluid.mu);
+  const auto stages = scene_contraction_buckling(p);
   scene::json j = {{"model", "Donnell shell, segment of the loaded length between round parts (the whole tube: free "
                              "ends), at R_f, Stokes drag 4 mu k"},
                    {"hoop_compression_N_per_m", N},

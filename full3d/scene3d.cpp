@@ -311,14 +311,17 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   return p;
 }
 
+std::vector<ContractionStage> scene_contraction_buckling(const Params3d& p) {
+  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);  // the equilateral network's 2D Young's modulus
+  return contraction_buckling(p.L, p.protocol.segments, p.protocol.first_ratio, p.protocol.R_f, p.protocol.q * p.R0,
+                              p.bending_rigidity, Y, p.fluid.mu);
+}
+
 int auto_seed_mode(const Params3d& p) {
   if (p.axisymmetric_wall || p.dry || !(p.protocol.q > 0.0)) return 0;
-  const double Y = 2.0 * p.membrane.ks / std::sqrt(3.0);  // the equilateral network's 2D Young's modulus
-  const auto stages = contraction_buckling(p.L, p.protocol.segments, p.protocol.first_ratio, p.protocol.R_f,
-                                           p.protocol.q * p.R0, p.bending_rigidity, Y, p.fluid.mu);
   int mode = 0;
   double rate = 0.0;
-  for (const auto& s : stages)
+  for (const auto& s : scene_contraction_buckling(p))
     if (s.mode > 0 && s.growth_rate > rate) rate = s.growth_rate, mode = s.mode;
   return mode;
 }

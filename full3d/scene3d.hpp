@@ -16,6 +16,7 @@
 
 #include "common/scene.hpp"
 #include "common/scene_shared.hpp"
+#include "full3d/buckling_estimate.hpp"
 #include "full3d/grid.hpp"
 #include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
@@ -120,9 +121,13 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh);
 /// The reference mesh of the scene (no-leak rule with the scene's spacing factor), with the
 /// scene's seed imperfection (full3d.membrane.seed_mode, seed_amplitude) in its stress-free shape.
 CylinderMesh make_mesh(const Params3d& p);
+/// The scene's contraction stages of the linear buckling estimate (contraction_buckling): the
+/// network's 2D Young's modulus Y = 2 k_s / sqrt(3), the hoop compression q R0 that holds R_f,
+/// the scene's D and viscosity.
+std::vector<ContractionStage> scene_contraction_buckling(const Params3d& p);
 /// The lobe number seed_mode = "auto" resolves to for the scene's wall, load and protocol: of the
-/// contraction's stages (contraction_buckling), the mode of the fastest-growing one; 0 when no
-/// stage buckles, for an axisymmetric or dry wall, or without a force-driven load.
+/// contraction's stages (scene_contraction_buckling), the mode of the fastest-growing one; 0 when
+/// no stage buckles, for an axisymmetric or dry wall, or without a force-driven load.
 int auto_seed_mode(const Params3d& p);
 /// The same tube without the seed imperfection: the round tube whose law the calibration
 /// measures and on which D / k_b is measured.

@@ -166,10 +166,6 @@ void ForceModel::set_actuation(const ProtocolMachine& mc, const std::vector<Prot
 void ForceModel::end_radius_range(double& lo0, double& loL) const {
   lo0 = Rb0_static;
   loL = RbL_static;
-  if (bending) {  // the ends follow the wall (unpack); EventLoop::check_end_radii checks the segments
-    lo0 = loL = R0;
-    return;
-  }
   if (end0_seg) lo0 = law[0].a->rest_radius(wall, seg_law[seg_a[0]]->operator()(1e300));
   if (endL_seg) loL = law[N - 1].a->rest_radius(wall, seg_law[seg_a[N - 1]]->operator()(1e300));
 }

@@ -167,7 +167,8 @@ struct ForceModel {
   void set_actuation(const ProtocolMachine& mc, const std::vector<ProtocolMachine::CellLaw>& laws,
                      const std::vector<const ActuationLaw*>& seg_laws);
 
-  /// Extreme end radii the current laws can produce (for the collapse check at a switch).
+  /// Extreme end radii the current laws can produce (for the collapse check at a switch; a
+  /// bending wall's ends follow the wall, and EventLoop::check_end_radii checks its segments).
   void end_radius_range(double& lo0, double& loL) const;
 
   /// Radii (and V, p) from the scaled state; p from the tube law without inertia.

@@ -441,6 +441,25 @@ void add_axial_stiffness(scene::json& j, const AxialStiffness& a) {
   j["axial_bending_rigidity_J"] = a.d_fit;
 }
 
+AxialStiffnessOutcome try_measure_axial_stiffness(const full3d::Params3d& p) {
+  AxialStiffnessOutcome o;
+  try {
+    o.measured = measure_axial_stiffness(p);
+  } catch (const NumericalError& e) {
+    o.failure = e.what();
+  }
+  return o;
+}
+
+scene::json AxialStiffnessOutcome::entries() const {
+  scene::json j = scene::json::object();
+  if (measured)
+    add_axial_stiffness(j, *measured);
+  else
+    j["axial_stiffness"] = {{"status", "failed: " + failure}};
+  return j;
+}
+
 WetConfirmation confirm_wet(const full3d::Params3d& p, double pressure, double static_displacement_m,
                             bool axisymmetric_wall) {
   const auto t0 = std::chrono::steady_clock::now();

@@ -10,7 +10,7 @@
 #pragma once
 
 #include <functional>
-
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -133,6 +133,16 @@ scene::json to_json(const AxialStiffness& a);
 /// Adds the "axial_stiffness" section and the top-level "axial_bending_rigidity_J" (the fitted
 /// D_axial: the rigidity the 1D tier's bending term reads) to calibration.json `j`.
 void add_axial_stiffness(scene::json& j, const AxialStiffness& a);
+/// measure_axial_stiffness for a calibration, whose C1 and offsets stay measurable when it fails.
+struct AxialStiffnessOutcome {
+  std::optional<AxialStiffness> measured;
+  std::string failure;  ///< the reason when it reached no static state
+  /// calibration.json's entries: {"axial_stiffness", "axial_bending_rigidity_J"}
+  /// (add_axial_stiffness), or {"axial_stiffness": {"status": "failed: <reason>"}} without the
+  /// rigidity (the 1D models that read it are then refused). For json::update.
+  scene::json entries() const;
+};
+AxialStiffnessOutcome try_measure_axial_stiffness(const full3d::Params3d& p);
 
 /// Fluid-coupled confirmation of one static load: the scene's 3D tube, immersed in its fluid and
 /// container, under the same uniform inward pressure, stepped (forward Euler, the step set to

@@ -456,13 +456,7 @@ std::string RunCache::calibration(const json& base, const std::string& grid_key,
       bar.step(done, steps, "load " + std::to_string(done) + "/" + std::to_string(loads.size()));
     });
     cal_j = to_json(c, p, resolved);
-    // the wall's stiffness along the axis, as swim calibrate (a failure keeps its reason, and
-    // the 1D models that read axial_bending_rigidity_J are then not run)
-    try {
-      add_axial_stiffness(cal_j, measure_axial_stiffness(p));
-    } catch (const NumericalError& e) {
-      cal_j["axial_stiffness"] = {{"status", std::string("failed: ") + e.what()}};
-    }
+    cal_j.update(try_measure_axial_stiffness(p).entries());  // the wall's stiffness along the axis, as swim calibrate
     const HydraulicRadii hr = measure_hydraulic_radii(p);
     bar.step(loads.size() + 1, steps, "hydraulic radii");
     json hj = to_json(hr);
