@@ -403,6 +403,7 @@ RunAxi RunCache::run_axi(const json& sc, int progress) {
   const std::string status = summary.value("status", std::string("unknown"));
   r.ok = status == "ok";
   r.wall = summary.value("wall_time_s", 0.0);
+  r.series = series_of(rec);
   r.cyc = cycle_figures_of(rec, summary);
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number())
     r.max_displacement = summary["max_displacement_m"].get<double>();
@@ -415,6 +416,10 @@ RunAxi RunCache::run_axi(const json& sc, int progress) {
   } else {
     r.record["no_cycle_reason"] = r.cyc.absent_because;
   }
+  // as run_3d's: the first cycle of a one-cycle scene, the whole run of a multi-cycle one (the
+  // reference of the report's U(t) comparisons, drawn beside 3D's)
+  const double t_end = r.series.t.empty() ? 0.0 : r.series.t.back();
+  r.record["series"] = downsample(r.series, r.cyc.has_cycle && p.base.protocol.cycles == 1 ? r.cyc.cycle_time_s : t_end);
   return r;
 }
 

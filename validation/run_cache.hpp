@@ -57,6 +57,7 @@ struct Run3d {
 /// One axisymmetric run as the report sees it.
 struct RunAxi {
   json record;  ///< report entry
+  Series series;
   record::CycleFigures cyc;
   double h = 0, wall = 0;
   double max_displacement = std::numeric_limits<double>::quiet_NaN();  ///< m, over the run

@@ -45,11 +45,11 @@ json run_suite(const SuiteOptions& o) {
     const std::vector<Run3d> runs = resolution_study(c, cache, say, o.run_progress, cr);
     // 2. the 3D reference, extrapolated to h -> 0; the axisymmetric reference when the case has one
     cr["reference3d"] = reference_3d(runs, orders_3d(c, suite), c.paper_max);
-    axi_reference_study(c, suite, runs, cache, say, o.run_progress, cr);
+    const std::vector<RunAxi> aruns = axi_reference_study(c, suite, runs, cache, say, o.run_progress, cr);
     // 3. the 1D tier calibrated from 3D
     const std::string cal_file = calibrate_case(c, cache, say, cr, o.run_progress);
     // 4. every 1D model against the references
-    cr["models1d"] = judge_models(c, suite, cal_file, runs, cr, say);
+    cr["models1d"] = judge_models(c, suite, cal_file, runs, aruns, cr, say);
     // 5. speed against accuracy
     cr["speed_accuracy"] = speed_accuracy(c, suite, cal_file, runs, cr, cache, say, o.run_progress);
     wall_times(c, runs, cr);

@@ -94,26 +94,38 @@ json at_calibration_grid(const SuiteCase& c) {
   return s;
 }
 
-/// U(t) of a 1D run against the finest 3D run, in cycle phase and in time, with the spread of
-/// the phase correlation over the (up to) three finest grids that completed a cycle.
-json velocity_vs_finest3d(const Run1d& r, const std::vector<Run3d>& runs) {
-  const Run3d& finest = runs.back();
-  const SeriesComparison ph = compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, finest.series.t,
-                                             finest.series.u, finest.cyc.cycle_time_s, true);
-  const SeriesComparison ab = compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, finest.series.t,
-                                             finest.series.u, finest.cyc.cycle_time_s, false);
+/// The runs of a grid series (coarse to fine) as U(t) references.
+template <class Run>
+std::vector<VelocityRun> velocity_runs(const std::vector<Run>& runs) {
+  std::vector<VelocityRun> v;
+  for (const Run& r : runs) v.push_back({&r.series, r.cyc.has_cycle, r.cyc.cycle_time_s, r.h});
+  return v;
+}
+
+}  // namespace
+
+json velocity_vs_runs(const Series& s, double cycle_time_s, const std::vector<VelocityRun>& runs) {
+  // the runs that completed a cycle, coarse to fine: the finest of them is the reference
+  std::vector<const VelocityRun*> done;
+  for (const VelocityRun& r : runs)
+    if (r.has_cycle && r.cycle_time_s > 0 && r.series->t.size() > 1) done.push_back(&r);
+  if (done.empty() || s.t.size() < 2 || !(cycle_time_s > 0)) return json::object();
+  const VelocityRun& finest = *done.back();
+  const SeriesComparison ph =
+      compare_series(s.t, s.u, cycle_time_s, finest.series->t, finest.series->u, finest.cycle_time_s, true);
+  const SeriesComparison ab =
+      compare_series(s.t, s.u, cycle_time_s, finest.series->t, finest.series->u, finest.cycle_time_s, false);
   json v = {{"phase_l2_relative", ph.l2_relative},
             {"phase_correlation", ph.correlation},
             {"time_l2_relative", ab.l2_relative},
-            {"time_correlation", ab.correlation}};
+            {"time_correlation", ab.correlation},
+            {"reference_cell_size_m", finest.h}};
   // the uncertainty of the correlation: its spread against the (up to) three finest grids
   // that completed a cycle, as the spread of a reference that is not asymptotic
   std::vector<double> corr;
-  for (auto it = runs.rbegin(); it != runs.rend() && corr.size() < 3; ++it)
-    if (it->cyc.has_cycle && it->series.t.size() > 1)
-      corr.push_back(compare_series(r.series.t, r.series.u, r.cyc.cycle_time_s, it->series.t, it->series.u,
-                                    it->cyc.cycle_time_s, true)
-                         .correlation);
+  for (auto it = done.rbegin(); it != done.rend() && corr.size() < 3; ++it)
+    corr.push_back(
+        compare_series(s.t, s.u, cycle_time_s, (*it)->series->t, (*it)->series->u, (*it)->cycle_time_s, true).correlation);
   if (corr.size() >= 2) {
     const double spread = *std::max_element(corr.begin(), corr.end()) - *std::min_element(corr.begin(), corr.end());
     v["phase_correlation_grid_spread"] = spread;
@@ -121,8 +133,6 @@ json velocity_vs_finest3d(const Run1d& r, const std::vector<Run3d>& runs) {
   }
   return v;
 }
-
-}  // namespace
 
 SuiteCase open_case(const json& spec, std::size_t index, std::size_t count, const std::string& suite_dir,
                     const std::string& data_dir) {
@@ -199,9 +209,9 @@ OrderRange orders_3d(const SuiteCase& c, const json& suite) {
                                          : kImmersedBoundaryOrders;
 }
 
-void axi_reference_study(const SuiteCase& c, const json& suite, const std::vector<Run3d>& runs, RunCache& cache,
-                         const Say& say, int progress, json& cr) {
-  if (!c.spec.contains("reference")) return;
+std::vector<RunAxi> axi_reference_study(const SuiteCase& c, const json& suite, const std::vector<Run3d>& runs,
+                                        RunCache& cache, const Say& say, int progress, json& cr) {
+  if (!c.spec.contains("reference")) return {};
   const json& rs = c.spec["reference"];
   const json& rgrids = rs["grids"];
   const std::string rkey = rs.value("grid_key", std::string("axi.grid.cells_across"));
@@ -252,6 +262,13 @@ void axi_reference_study(const SuiteCase& c, const json& suite, const std::vecto
   for (const auto& r : runs)
     if (r.cyc.has_cycle) done3d.push_back(&r);
   cr["comparison_3d_vs_reference"] = compare_3d_with_reference(cr["reference3d"], cr["reference"], done3d);
+  // U(t) of the finest 3D run against the finest axi run (informative: no verdict)
+  if (!runs.empty() && runs.back().cyc.has_cycle)
+    if (json v = velocity_vs_runs(runs.back().series, runs.back().cyc.cycle_time_s, velocity_runs(aruns)); !v.empty()) {
+      v["cell_size_m"] = runs.back().h;
+      cr["velocity_3d_vs_reference"] = v;
+    }
+  return aruns;
 }
 
 std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, json& cr, int progress) {
@@ -270,7 +287,7 @@ std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, 
 }
 
 json judge_models(const SuiteCase& c, const json& suite, const std::string& cal_file, const std::vector<Run3d>& runs,
-                  const json& cr, const Say& say) {
+                  const std::vector<RunAxi>& aruns, const json& cr, const Say& say) {
   const Run3d& finest = runs.back();
   const Run3d& at_cal = runs[c.calibration_grid];
   json models_j = json::array();
@@ -298,8 +315,18 @@ json judge_models(const SuiteCase& c, const json& suite, const std::string& cal_
             relative(r.cyc.mean_velocity_per_cycle_m_per_s, at_cal.cyc.mean_velocity_per_cycle_m_per_s);
       }
       entry["relative_error_vs_calibration_grid"] = vs_cal;
+      // U(t) against the finest 3D run (informative when the case has an axi reference) and
+      // against the finest axi run; the verdict takes the axi one when the case has it
+      // (judged_velocity, verdicts.hpp)
       if (finest.cyc.has_cycle && r.series.t.size() > 1 && finest.series.t.size() > 1)
-        entry["velocity_vs_finest3d"] = velocity_vs_finest3d(r, runs);
+        entry["velocity_vs_finest3d"] = velocity_vs_runs(r.series, r.cyc.cycle_time_s, velocity_runs(runs));
+      if (cr.contains("reference")) {
+        json v = velocity_vs_runs(r.series, r.cyc.cycle_time_s, velocity_runs(aruns));
+        // no axi run completed a cycle: no verdict, rather than one taken against 3D
+        if (v.empty()) v["note"] = "no axisymmetric run completed a cycle";
+        entry["velocity_vs_reference"] = v;
+      }
+      if (!judged_velocity(entry).empty()) entry["velocity_judged_against"] = judged_velocity_name(entry);
       // pass, fail or inconclusive against the reference's error bar (verdicts.hpp)
       if (const json v = model_verdicts(entry, suite["thresholds"]); !v.empty()) entry["verdicts"] = v;
       if (at_cal.record.value("pumped_volume_m3", 0.0) != 0.0)

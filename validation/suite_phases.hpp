@@ -46,22 +46,43 @@ std::vector<Run3d> resolution_study(const SuiteCase& c, RunCache& cache, const S
 /// boundary's.
 OrderRange orders_3d(const SuiteCase& c, const json& suite);
 
+/// A run of a grid series as a reference of U(t) (a 3D or an axi run): its centre history and
+/// its first cycle.
+struct VelocityRun {
+  const Series* series = nullptr;
+  bool has_cycle = false;
+  double cycle_time_s = 0;
+  double h = 0;  ///< m, the run's cell size
+};
+
+/// U(t) of a series (cycle time cycle_time_s) against the finest of `runs` (a grid series,
+/// coarse to fine) that completed a cycle, in cycle phase and in time: phase_l2_relative,
+/// phase_correlation, time_l2_relative, time_correlation, reference_cell_size_m; and the
+/// uncertainty of the phase correlation, its spread over the (up to) three finest runs that
+/// completed a cycle (phase_correlation_grid_spread, phase_correlation_grids), when two or
+/// more did. Empty when no run completed a cycle.
+json velocity_vs_runs(const Series& s, double cycle_time_s, const std::vector<VelocityRun>& runs);
+
 /// 2b. The converged reference: the case's scene on the axi tier at each reference grid,
 /// extrapolated with the reference's order range (target: the suite's
-/// reference_target_relative), and the 3D extrapolation against it. Adds "reference" and
-/// "comparison_3d_vs_reference"; nothing for a case without a reference.
-void axi_reference_study(const SuiteCase& c, const json& suite, const std::vector<Run3d>& runs, RunCache& cache,
-                         const Say& say, int progress, json& cr);
+/// reference_target_relative), and the 3D extrapolation against it. Adds "reference",
+/// "comparison_3d_vs_reference" and "velocity_3d_vs_reference" (U(t) of the finest 3D run
+/// against the finest axi run, velocity_vs_runs); nothing for a case without a reference.
+/// Returns the axi runs, coarse to fine (none without a reference).
+std::vector<RunAxi> axi_reference_study(const SuiteCase& c, const json& suite, const std::vector<Run3d>& runs,
+                                        RunCache& cache, const Say& say, int progress, json& cr);
 
 /// 3. The calibration at the case's calibration grid. Adds "calibration"; returns the
 /// calibration file, "" when it failed.
 std::string calibrate_case(const SuiteCase& c, RunCache& cache, const Say& say, json& cr, int progress = 0);
 
 /// 4. Every 1D model of the suite, compared with the case's judged reference, with the 3D run
-/// at the calibration grid, and (U(t)) with the finest 3D run; verdicts against the
-/// thresholds. Returns the "models1d" entries.
+/// at the calibration grid, and (U(t), velocity_vs_runs) with the finest 3D run
+/// ("velocity_vs_finest3d") and, when the case has an axi reference, with the finest axi run
+/// of `aruns` ("velocity_vs_reference"); verdicts against the thresholds, U(t)'s against the
+/// axi run when there is one (judged_velocity, verdicts.hpp). Returns the "models1d" entries.
 json judge_models(const SuiteCase& c, const json& suite, const std::string& cal_file, const std::vector<Run3d>& runs,
-                  const json& cr, const Say& say);
+                  const std::vector<RunAxi>& aruns, const json& cr, const Say& say);
 
 /// 5. Speed/accuracy: the first 1D model over cell counts and integrator tolerances, 3D over
 /// the grids and the case's time-step variants (at the calibration grid), each point's error

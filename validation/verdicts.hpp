@@ -68,14 +68,24 @@ std::string judged_reference_name(const scene::json& case_report);
 /// is left out (no verdict).
 void compare_with_reference(scene::json& entry, const scene::json& case_report);
 
-/// U(t) correlation with the finest 3D run, its uncertainty (the spread of the correlation
-/// over the grids) and the smallest passing correlation: "pass" when corr - error >=
-/// threshold, "fail" when corr + error < threshold, else "inconclusive".
+/// U(t) correlation with the reference run, its uncertainty (the spread of the correlation
+/// over the reference's grids) and the smallest passing correlation: "pass" when corr - error
+/// >= threshold, "fail" when corr + error < threshold, else "inconclusive".
 std::string correlation_verdict(double corr, double error, double threshold);
 
+/// The U(t) comparison a 1D model's entry is judged by, as judged_reference() for the
+/// figures: its `velocity_vs_reference` (against the finest axisymmetric run) when the entry
+/// has it, else its `velocity_vs_finest3d`; an empty object when it has neither. An entry
+/// whose axisymmetric comparison has no correlation (no axi run completed a cycle) gets no
+/// U(t) verdict: it is never judged against 3D instead.
+const scene::json& judged_velocity(const scene::json& entry);
+
+/// "finest axisymmetric run" or "finest 3D run": which run judged_velocity() compares with.
+std::string judged_velocity_name(const scene::json& entry);
+
 /// The verdicts of one 1D model of a report from its `relative_error_vs_reference`,
-/// `reference_error_relative` (thresholds: displacement_per_cycle_relative, ...) and
-/// `velocity_vs_finest3d` (`phase_correlation`, `phase_correlation_grid_spread`;
+/// `reference_error_relative` (thresholds: displacement_per_cycle_relative, ...) and its
+/// judged_velocity() (`phase_correlation`, `phase_correlation_grid_spread`;
 /// velocity_phase_correlation): {"displacement_per_cycle": "pass", ...}. A figure whose
 /// numbers the entry lacks is left out; one whose numbers are null is "not assessed".
 scene::json model_verdicts(const scene::json& entry, const scene::json& thresholds);

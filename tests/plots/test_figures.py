@@ -297,6 +297,29 @@ class ValidationFigures(unittest.TestCase):
         styles = {(str(ln.get_color()), ln.get_linestyle()) for ln in lines}
         self.assertEqual(len(styles), 3)
 
+    def test_velocity_figure_draws_the_finest_axi_run_with_a_cycle(self):
+        # the U(t) verdict's reference: the finest axi run that completed a cycle (not the
+        # finest grid, which here did not), in both panels, named; none without a reference
+        s = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-8, 0]}
+        case = {"name": "c", "models1d": [], "runs3d": [
+            {"has_cycle": True, "series": s, "cycle_time_s": 1.0, "cell_size_m": 4e-8}],
+            "reference": {"runs": [
+                {"has_cycle": True, "series": s, "cycle_time_s": 2.0, "cell_size_m": 3e-8},
+                {"has_cycle": True, "series": s, "cycle_time_s": 2.0, "cell_size_m": 2e-8},
+                {"has_cycle": False, "series": s, "cell_size_m": 1.5e-8}]}}
+        self.mod.velocity_figure(case, f"{self.d}/v.png")
+        fig = self.closed[-1]
+        axi = [[ln for ln in ax.get_lines() if ln.get_label().startswith("axisymmetric reference")]
+               for ax in fig.axes[:2]]
+        for lines in axi:
+            self.assertEqual(len(lines), 1)
+            self.assertIn("h = 20 nm", lines[0].get_label())
+        self.assertEqual(list(axi[1][0].get_xdata()), [0, 0.25, 0.5])  # its phase on its own cycle (2 s)
+        self.assertIn("axisymmetric reference", fig._suptitle.get_text())
+        del case["reference"]
+        self.mod.velocity_figure(case, f"{self.d}/v.png")
+        self.assertFalse([ln for ln in self.closed[-1].axes[0].get_lines() if "axisymmetric" in ln.get_label()])
+
     def test_convergence_grids_apart_and_not_asymptotic_said(self):
         runs = [{"has_cycle": True, "cell_size_m": h, "displacement_per_cycle_m": d}
                 for h, d in ((4e-8, 7e-10), (3.2e-8, 2.7e-9), (2.67e-8, 3.7e-9))]

@@ -190,6 +190,41 @@ TEST(SuiteReference, OneDVerdictsAreJudgedAgainstTheAxisymmetricReference) {
   EXPECT_EQ(e0.dump().find("NaN"), std::string::npos);
 }
 
+// U(t) of a case with an axisymmetric reference is judged against its finest axisymmetric
+// run, as the figures are against the axisymmetric reference: a model whose U(t) correlates by
+// 0.9 ± 0.05 with the axi run passes (threshold 0.8) where against the finest 3D run's 0.5 ±
+// 0.05 it would fail; without the axi comparison the same entry is judged against 3D. An axi
+// comparison without a correlation (no axi run completed a cycle) gives no verdict rather than
+// the 3D one. The finding's evidence carries the same number and names the run.
+TEST(SuiteReference, OneDVelocityIsJudgedAgainstTheAxisymmetricRun) {
+  const json vs3d = {{"phase_correlation", 0.5}, {"phase_correlation_grid_spread", 0.05}};
+  const json vsaxi = {{"phase_correlation", 0.9}, {"phase_correlation_grid_spread", 0.05}};
+  json e = {{"label", "m"}, {"velocity_vs_finest3d", vs3d}, {"velocity_vs_reference", vsaxi}};
+  EXPECT_EQ(judged_velocity(e), vsaxi);
+  EXPECT_EQ(judged_velocity_name(e), "finest axisymmetric run");
+  EXPECT_EQ(model_verdicts(e, kThresholds)["velocity_phase_correlation"], "pass");
+
+  json e3 = e;
+  e3.erase("velocity_vs_reference");
+  EXPECT_EQ(judged_velocity_name(e3), "finest 3D run");
+  EXPECT_EQ(model_verdicts(e3, kThresholds)["velocity_phase_correlation"], "fail");
+
+  json e0 = e;
+  e0["velocity_vs_reference"] = {{"note", "no axisymmetric run completed a cycle"}};
+  EXPECT_FALSE(model_verdicts(e0, kThresholds).contains("velocity_phase_correlation"));
+
+  // the finding "1D agrees with 3D up to 50 % deformation: U(t) ..." on an amplitude case
+  json c = make_case("A0.82", 0.82, {10 * nm, 0.5 * nm, 1.0, 0.1}, {20 * nm, 0.1 * nm, 0.5, 0.005});
+  c["group"] = "amplitude";
+  e["verdicts"] = model_verdicts(e, kThresholds);
+  c["models1d"] = json::array({e});
+  const json f = find(findings(json::array({c}), kThresholds), "1D agrees with 3D up to 50 % deformation: U(t)");
+  EXPECT_EQ(f["status"], "reproduced") << f.dump(1);
+  ASSERT_EQ(f["evidence"].size(), 1u);
+  EXPECT_NEAR(f["evidence"][0]["correlation"].get<double>(), 0.9, 1e-12);
+  EXPECT_EQ(f["evidence"][0]["reference"], "finest axisymmetric run");
+}
+
 // The findings take the same reference: 3D says the distance falls with L (refuted), the
 // axisymmetric references say it grows (reproduced); the evidence names the reference.
 TEST(SuiteReference, FindingsAreJudgedAgainstTheAxisymmetricReference) {

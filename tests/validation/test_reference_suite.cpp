@@ -115,6 +115,22 @@ TEST(ReferenceSuite, TheAxiSeriesIsTheReferenceOfTheCase) {
   EXPECT_NEAR(m["reference_error_relative"]["displacement_per_cycle"].get<double>(),
               std::abs(ref["displacement_per_cycle_m"]["error"].get<double>() / d_ref), 1e-12);
 
+  // U(t) against the finest axi run (the verdict's reference), with its spread over the three
+  // axi grids, and against the finest 3D run beside it; the finest 3D run against the finest
+  // axi run; each axi run carries its U(t) for the figure
+  ASSERT_TRUE(m.contains("velocity_vs_reference")) << m.dump().substr(0, 1000);
+  const json& uv = m["velocity_vs_reference"];
+  EXPECT_TRUE(uv["phase_correlation"].is_number()) << uv.dump();
+  EXPECT_DOUBLE_EQ(uv["reference_cell_size_m"].get<double>(), ref["runs"][2]["cell_size_m"].get<double>());
+  EXPECT_EQ(uv["phase_correlation_grids"], 3);
+  EXPECT_TRUE(m.contains("velocity_vs_finest3d"));
+  EXPECT_EQ(m["velocity_judged_against"], "finest axisymmetric run");
+  ASSERT_TRUE(m["verdicts"].contains("velocity_phase_correlation"));
+  EXPECT_EQ(m["verdicts"]["velocity_phase_correlation"],
+            validation::correlation_verdict(uv["phase_correlation"], uv["phase_correlation_grid_spread"], 0.8));
+  EXPECT_TRUE(c["velocity_3d_vs_reference"]["phase_correlation"].is_number()) << c["velocity_3d_vs_reference"];
+  for (const auto& run : ref["runs"]) EXPECT_EQ(run["series"]["velocity_m_per_s"].size(), 401u);
+
   // 3D against the reference, figure by figure, with the agreement rule and the finest grid's error
   const json& cmp = c["comparison_3d_vs_reference"];
   for (const char* k : {"displacement_per_cycle_m", "cycle_time_s", "mean_velocity_per_cycle_m_per_s"}) {

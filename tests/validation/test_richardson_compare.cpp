@@ -11,6 +11,7 @@
 #include "validation/compare.hpp"
 #include "validation/richardson.hpp"
 #include "validation/suite.hpp"
+#include "validation/suite_phases.hpp"
 
 using namespace swim;
 using namespace swim::validation;
@@ -187,6 +188,66 @@ TEST(CompareSeries, PhaseNormalisationAndCorrelation) {
   const SeriesComparison mir = compare_series(t3, u3, 1.0, t1, u1, 1.0, true);
   EXPECT_NEAR(mir.correlation, -1.0, 1e-9);
   EXPECT_THROW(compare_series({0.0}, {1.0}, 1.0, t1, u1, 1.0, true), InputError);
+}
+
+namespace {
+/// U(t) = sin(2 pi t / T + shift) + 0.3 over one cycle of T, 1001 samples.
+Series shifted(double T, double shift) {
+  Series s;
+  for (int k = 0; k <= 1000; ++k) {
+    s.t.push_back(T * k / 1000.0);
+    s.x.push_back(0.0);
+    s.u.push_back(std::sin(2 * M_PI * k / 1000.0 + shift) + 0.3);
+  }
+  return s;
+}
+}  // namespace
+
+// A history correlates with itself exactly (correlation 1, no L2 difference); a copy shifted
+// in phase by phi correlates by cos(phi) over the cycle, below 1, and the larger the shift the
+// lower the correlation.
+TEST(CompareSeries, SelfCorrelationIsOneAndAPhaseShiftLowersIt) {
+  const Series a = shifted(1.0, 0.0);
+  const SeriesComparison self = compare_series(a.t, a.u, 1.0, a.t, a.u, 1.0, true);
+  EXPECT_NEAR(self.correlation, 1.0, 1e-12);
+  EXPECT_NEAR(self.l2_relative, 0.0, 1e-12);
+  double previous = 1.0;
+  for (double phi : {0.1, 0.3, 0.6, 1.0}) {
+    const Series b = shifted(1.0, phi);
+    const SeriesComparison c = compare_series(a.t, a.u, 1.0, b.t, b.u, 1.0, true);
+    EXPECT_NEAR(c.correlation, std::cos(phi), 1e-4) << "shift " << phi;
+    EXPECT_LT(c.correlation, previous - 1e-3) << "shift " << phi;
+    EXPECT_GT(c.l2_relative, 0.0);
+    previous = c.correlation;
+  }
+}
+
+// The U(t) comparison against a grid series (velocity_vs_runs: the 1D models against the
+// finest 3D run, and against the finest axisymmetric run) takes the finest run that completed
+// a cycle as the reference and the spread of the phase correlation over the three finest such
+// runs as its uncertainty: here runs shifted by 1.0, 0.6, 0.3 and 0.1 rad (coarse to fine),
+// then a finest run without a cycle, which is passed over.
+TEST(CompareSeries, VelocityAgainstAGridSeriesTakesItsFinestRunWithACycle) {
+  const Series one_d = shifted(1.0, 0.0);
+  const std::vector<double> shifts = {1.0, 0.6, 0.3, 0.1, 0.0};
+  std::vector<Series> series;
+  for (double phi : shifts) series.push_back(shifted(2.0, phi));  // the reference's cycle is twice as long
+  std::vector<VelocityRun> runs;
+  for (std::size_t k = 0; k < shifts.size(); ++k)
+    runs.push_back({&series[k], k + 1 < shifts.size(), 2.0, 40e-9 / double(k + 1)});
+  const json v = velocity_vs_runs(one_d, 1.0, runs);
+  ASSERT_TRUE(v.contains("phase_correlation")) << v.dump(1);
+  EXPECT_NEAR(v["phase_correlation"].get<double>(), std::cos(0.1), 1e-4);
+  EXPECT_NEAR(v["reference_cell_size_m"].get<double>(), 10e-9, 1e-18);
+  EXPECT_NEAR(v["phase_correlation_grid_spread"].get<double>(), std::cos(0.1) - std::cos(0.6), 1e-4);
+  EXPECT_EQ(v["phase_correlation_grids"], 3);
+  // against time the two cycles differ (1 s against 2 s): not the phase figure
+  EXPECT_LT(v["time_correlation"].get<double>(), v["phase_correlation"].get<double>() - 0.1);
+  // one run with a cycle: a correlation without an uncertainty; none: no comparison
+  const json single = velocity_vs_runs(one_d, 1.0, {runs[3], runs[4]});
+  EXPECT_NEAR(single["phase_correlation"].get<double>(), std::cos(0.1), 1e-4);
+  EXPECT_FALSE(single.contains("phase_correlation_grid_spread"));
+  EXPECT_TRUE(velocity_vs_runs(one_d, 1.0, {runs[4]}).empty());
 }
 
 // A malformed suite is rejected naming the key, before any run.
