@@ -120,7 +120,7 @@ void stop_workers() {}
 
 namespace {
 
-enum Tag : int { kReady = 1, kTask = 2, kResult = 3, kBeat = 4, kStop = 5 };
+enum Tag : int { kReady = 1, kTask = 2, kResult = 3, kBeat = 4, kStop = 5, kBye = 6 };
 
 void send_text(const std::string& s, int dest, int tag) {
   MPI_Send(s.data(), static_cast<int>(s.size()), MPI_CHAR, dest, tag, MPI_COMM_WORLD);
@@ -235,6 +235,10 @@ extern "C" void on_stop_signal(int s) {
 
 Session::Session(int* argc, char*** argv) {
   if (launcher_size() == 0) return;  // not started by mpirun: a single process, as always
+  // No barrier in Open MPI's MPI_Finalize: rank 0 ends the run by a stop that every live worker
+  // answers (stop_workers), and that barrier would wait for a rank that died (--enable-recovery).
+  // A value the user set is kept.
+  ::setenv("OMPI_MCA_async_mpi_finalize", "1", 0);
   int provided = 0;
   MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
   g_mpi = true;
@@ -274,7 +278,10 @@ int serve(const Work& work) {
     std::string text;
     while (receive_any(source, tag, text)) {
       busy = true;
-      if (tag == kStop) return 0;
+      if (tag == kStop) {  // the answer tells rank 0 that nothing more is in flight from here
+        send_text("", 0, kBye);
+        return 0;
+      }
       if (tag == kTask) {
         json m = json::parse(text);
         runner.push(m["task"].get<std::size_t>(), std::move(m["payload"]));
@@ -299,11 +306,37 @@ int serve(const Work& work) {
 void stop_workers() {
   if (!g_mpi || g_rank != 0 || g_stopped) return;
   g_stopped = true;
-  for (int r = 1; r < g_size; ++r) {
-    // a lost rank may be dead: send it nothing (a send to a dead peer leaves a connection
-    // attempt pending, and MPI_Finalize then waits on it for ever)
-    if (std::any_of(g_lost.begin(), g_lost.end(), [&](const LostRank& l) { return l.rank == r; })) continue;
+  // Every live worker is told to stop and answers; MPI_Finalize then needs no barrier (Session).
+  // A lost rank is sent nothing unless it speaks again (declared lost while alive, for example
+  // starved of CPU): a send to a dead peer leaves a connection attempt pending.
+  auto lost = [](int r) {
+    return std::any_of(g_lost.begin(), g_lost.end(), [&](const LostRank& l) { return l.rank == r; });
+  };
+  std::vector<int> stage(static_cast<std::size_t>(g_size), 0);  // 0 not told, 1 told, 2 answered
+  auto tell = [&](int r) {
     MPI_Send(nullptr, 0, MPI_CHAR, r, kStop, MPI_COMM_WORLD);
+    stage[static_cast<std::size_t>(r)] = 1;
+  };
+  for (int r = 1; r < g_size; ++r)
+    if (!lost(r)) tell(r);
+  // lost ranks get more than a heartbeat interval (1 s) to show they are alive; a told rank
+  // that never answers is given up after lost_after_s()
+  const auto t0 = Clock::now();
+  const double listen_s = g_lost.empty() ? 0.0 : 2.5, give_up_s = lost_after_s() + listen_s;
+  Backoff backoff;
+  for (;;) {
+    int source = 0, tag = 0;
+    std::string text;
+    while (receive_any(source, tag, text)) {  // late beats and results are dropped
+      int& st = stage[static_cast<std::size_t>(source)];
+      if (tag == kBye) st = 2;
+      else if (st == 0) tell(source);
+      backoff.reset();
+    }
+    const double waited = std::chrono::duration<double>(Clock::now() - t0).count();
+    const bool answered = std::none_of(stage.begin() + 1, stage.end(), [](int st) { return st == 1; });
+    if ((answered && waited >= listen_s) || waited > give_up_s) break;
+    std::this_thread::sleep_for(backoff.next(2000));
   }
 }
 

@@ -179,7 +179,11 @@ TEST(MpiScreen, AKilledRankIsReportedItsRunsRedoneOrTheRestartReusesTheFinishedR
   EXPECT_TRUE(aborted.err.find(",1]") != std::string::npos || aborted.err.find("rank 1") != std::string::npos)
       << aborted.err;
   EXPECT_FALSE(fs::exists(d / "restarted/confirm.json"));
-  EXPECT_FALSE(fs::exists(d / "restarted/screen.json"));
+  // screen.json is written only when the job stops while the screen's figure is drawn (on a
+  // loaded machine the kill can come that late), and then its status says it was interrupted
+  if (fs::exists(d / "restarted/screen.json"))
+    EXPECT_NE(read(d / "restarted/screen.json")["status"].get<std::string>().find("interrupted"), std::string::npos)
+        << slurp(d / "restarted/screen.json");
   // the runs that finished before the abort are reused by the restart, the others run again
   long finished = 0;
   if (fs::exists(d / "restarted/confirm-runs"))
