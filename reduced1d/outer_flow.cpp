@@ -100,6 +100,21 @@ double slender_velocity(const std::vector<double>& zc, const std::vector<double>
   return cu / c;
 }
 
+void end_junction(const EndJunction& j, double R, double Rc, double mu, double M[3][3], double& rim) {
+  const double xg = std::clamp(std::log(Rc / R - 1.0), j.xg_min, j.xg_max);
+  double v[6];
+  for (int k = 0; k < 6; ++k) v[k] = j.b[k][0] + j.b[k][1] * xg;
+  const double B[3][3] = {{v[0], 0, 0}, {v[1], v[2], 0}, {v[3], v[4], v[5]}};
+  const double S[3] = {std::pow(R, -1.5), std::pow(R, -1.5), std::sqrt(R)};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c <= r; ++c) {
+      double bb = 0;
+      for (int k = 0; k <= c; ++k) bb += B[r][k] * B[c][k];
+      M[r][c] = M[c][r] = mu * S[r] * bb * S[c];
+    }
+  rim = j.rim[0] + j.rim[1] * xg;
+}
+
 ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, double mu_, double a_in_, double a_out_,
                                double Rc_, double period, double L_)
     : np(npoints),
@@ -124,6 +139,7 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   const double Ro_max = Rc * (1.0 - 1e-3);
   R_end_[0] = Rpt[0];
   R_end_[1] = Rpt[np - 1];
+  if (junction) R_pt_.assign(Rpt, Rpt + np);
   if (derivatives)
     for (int p = 0; p < np; ++p) {
       const double Ro = Rpt[p] + a_out, Ri = Rpt[p] - a_in;
@@ -291,7 +307,43 @@ void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {
   Eigen::Vector4d b;
   A << RL, 0, 0, 1, /**/ -RA, RA, C, 1, /**/ 0, -r_free, -r_free * A_c, 1, /**/ SRA, -SRA, E - SC, 0;
   b << RLs, -RAs, 0, F_ext + SRAs;
+  double Mj[2][3][3];
+  if (junction) {
+    // At each end x_e = (q_l, q_a, U) = (Q_in0 - s_e, Q_tot - Q_in0 + s_e, U) with s_e = 0 at the
+    // rear and the whole displaced flux at the front: dD/dq_l joins the lumen row, dD/dq_a the
+    // annulus row and dD/dU the force row (each a resistance term on the rows' left side).
+    const double sN = s_cum[ni - 1];
+    double z = 0;  // cell centres (points 1 .. np - 2) from the rear end
+    double rim_rate[2] = {0, 0}, rim[2] = {0, 0};
+    for (int e = 0; e < 2; ++e) end_junction(*junction, R_end_[e], Rc, mu, Mj[e], rim[e]);
+    const double lr[2] = {junction->rim_length * R_end_[0], junction->rim_length * R_end_[1]};
+    for (int i = 0; i + 2 < np && junction->rim_length > 0; ++i) {
+      z += d[i];
+      const double Rdot_h = (s_cum[i + 1] - s_cum[i]) / (2.0 * pi * R_pt_[i + 1]);  // dR/dt times the cell length
+      rim_rate[0] += std::exp(-z / lr[0]) / lr[0] * Rdot_h;
+      rim_rate[1] += std::exp(-(L - z) / lr[1]) / lr[1] * Rdot_h;
+    }
+    const int rows[3] = {0, 1, 3};
+    for (int e = 0; e < 2; ++e) {
+      const double se = e == 0 ? 0.0 : sN;
+      const auto& M = Mj[e];
+      for (int r = 0; r < 3; ++r) {
+        A(rows[r], 0) += M[r][0] - M[r][1];
+        A(rows[r], 1) += M[r][1];
+        A(rows[r], 2) += M[r][2];
+        b(rows[r]) -= (M[r][1] - M[r][0]) * se;
+      }
+      // the rim's thrust: away from the end for a contraction next to it
+      b(3) += (e == 0 ? 1.0 : -1.0) * rim[e] * mu * R_end_[e] * rim_rate[e];
+    }
+  }
   const Eigen::Vector4d x = A.partialPivLu().solve(b);
+  mouth_[0] = mouth_[1] = 0.0;
+  if (junction)
+    for (int e = 0; e < 2; ++e) {
+      const double se = e == 0 ? 0.0 : s_cum[ni - 1];
+      mouth_[e] = Mj[e][0][0] * (x(0) - se) + Mj[e][0][1] * (x(1) - x(0) + se) + Mj[e][0][2] * x(2);
+    }
   Q_tot = x(1);
   U = x(2);
   W = Q_tot + A_c * U;
@@ -301,7 +353,7 @@ void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {
 
 void ConfinedSystem::lumen_pressure(std::vector<double>& p) const {
   p.resize(np);
-  p[0] = -0.5 * dp_tube - rl_end_[0] * Q_in[0];
+  p[0] = -0.5 * dp_tube - rl_end_[0] * Q_in[0] - mouth_[0];
   for (int j = 0; j < ni; ++j) p[j + 1] = p[j] - k[j].rl * Q_in[j];
 }
 

@@ -84,6 +84,40 @@ struct EndEffects {
 /// Pfeffer): the thin tube's end is not a hole in a wall (docs/outer-flow-1d.md §2b).
 inline constexpr EndEffects kOpenEnds{0.2, 0.25};
 
+/// The open ends as a calibrated junction (`model1d.end_effects = "junction"`,
+/// docs/outer-flow-1d.md §2c). At each end the flow around the rim, which lubrication leaves
+/// out, dissipates D = x^T M x / 2 in the end's lumen flux q_l and annulus flux q_a (swimmer
+/// frame, towards +zeta) and the tube's velocity U, x = (q_l, q_a, U): the lumen and the
+/// annulus each lose dD/dq at the end and the tube feels the force -dD/dU. M is positive
+/// semi-definite by construction, M = mu S B B^T S with S = diag(R^-3/2, R^-3/2, R^1/2) (R the
+/// end's membrane radius) and B lower triangular, its six entries linear in
+/// x_g = ln(Rc / R - 1) (clamped to the fitted range). A radial motion of the wall within a
+/// few tenths of R of an end pushes the tube by rim mu R <dR/dt>, <.> the rate weighted by
+/// exp(-d / (rim_length R)) / (rim_length R) over the distance d from the end (away from the
+/// end for a contraction). The coefficients are fitted to steady flows of the axisymmetric tier
+/// only (tools/fit_end_junction.py): towed tubes and the swimming velocity of every narrow
+/// wall band, on uniform and on partly contracted tubes (L/R0 = 3.2 and 6.4, Rc/R0 = 1.5 to 4).
+struct EndJunction {
+  double b[6][2];       ///< B's entries (B00, B10, B11, B20, B21, B22): value at x_g = 0, slope
+  double rim[2];        ///< rim thrust coefficient: value at x_g = 0, slope
+  double rim_length;    ///< decay length of the rim weight / R
+  double xg_min, xg_max;  ///< the fitted range of ln(Rc / R - 1)
+};
+inline constexpr EndJunction kCalibratedJunction{{{1.7528618, -0.3296076},
+                                                  {0.0469545, -0.0239119},
+                                                  {0.2824024, -0.1213643},
+                                                  {1.6954469, -0.3045723},
+                                                  {-2.5063304, 0.4196936},
+                                                  {-0.0048411, -0.0008607}},
+                                                 {-0.9194222, -0.5815371},
+                                                 0.15,
+                                                 -0.6931472,
+                                                 1.8362112};
+
+/// The junction's dissipation matrix M (row-major 3 x 3, units of q_l, q_a: Pa s / m^3, of U:
+/// Pa s m) and rim thrust coefficient at an end of membrane radius R in the container Rc.
+void end_junction(const EndJunction& j, double R, double Rc, double mu, double M[3][3], double& rim);
+
 /// The confined lubrication system on the point set {0, z_0, ..., z_{N-1}, L} (N + 2 points,
 /// N + 1 intervals; interval j contains face j). Two ways to close it:
 ///  - transmural(): force-driven wave, Pi = p_in - p_out known at the points (0 at both ends);
@@ -122,6 +156,7 @@ class ConfinedSystem {
   double U = 0, Q_tot = 0, dp_tube = 0;  ///< velocity, total swimmer-frame flux, pL - p0
   double W = 0;                          ///< Q_tot + U pi Rc^2: lab-frame flux through the free pipe
   EndEffects ends;                       ///< the open ends' extensions (kinematic() only)
+  const EndJunction* junction = nullptr;  ///< the calibrated end junction (kinematic() only)
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
 
  private:
@@ -129,6 +164,8 @@ class ConfinedSystem {
   std::vector<double> lambda_, last_Ro_;  // geometry() workspace and the radii of pts_
   double R_end_[2] = {0, 0};               // membrane radius at the two ends (geometry())
   double rl_end_[2] = {0, 0};              // the lumen end resistances of the last kinematic()
+  double mouth_[2] = {0, 0};               // the junction's lumen pressure drops of the last kinematic()
+  std::vector<double> R_pt_;               // the point radii of the last geometry() (with a junction)
   std::vector<int> changed_;
   bool interval_valid_ = false;  // k and w match last_Ro_ (set by a plain geometry() call)
 };

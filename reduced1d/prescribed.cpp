@@ -82,6 +82,7 @@ struct PrescribedModel {
       sys = std::make_unique<outer::ConfinedSystem>(N + 2, dpt, mu, a_in, a_out, p.container.radius_eff,
                                                     p.container.period, L);
       sys->ends = {p.swimmer.end_lumen, p.swimmer.end_annulus};
+      if (p.swimmer.end_junction) sys->junction = &outer::kCalibratedJunction;
     } else if (force_free) {
       zc.assign(zpt.begin() + 1, zpt.end() - 1);
       faces.resize(N + 1);

@@ -249,14 +249,18 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
                        "\"paper\"; the confined force-free model runs without it (at Re ~ 1e-6 the wall's inertia "
                        "is negligible: its time scale 2 pi sqrt(m / C1) is below 0.1 ms)");
     // default on for the force-free force-driven wave (docs/outer-flow-1d.md, 3b)
-    if (m.choice("end_effects", "none", {"none", "open_ends"}) == "open_ends") {
+    if (const std::string ends = m.choice("end_effects", "none", {"none", "open_ends", "junction"}); ends != "none") {
       if (p.swimmer.model != SwimmerModel::ForceFree || p.swimmer.outer != OuterFlow::Confined || forced)
-        throw InputError(m.path("end_effects"), "\"open_ends\"",
+        throw InputError(m.path("end_effects"), "\"" + ends + "\"",
                          "the open ends' flow is modelled for the confined force-free model (model1d.model = "
                          "\"force_free\", model1d.outer_flow = \"confined\") with a prescribed wave (wave.kind = "
                          "\"step\" or \"sine\"); use \"none\" here");
-      p.swimmer.end_lumen = outer::kOpenEnds.lumen;
-      p.swimmer.end_annulus = outer::kOpenEnds.annulus;
+      if (ends == "open_ends") {
+        p.swimmer.end_lumen = outer::kOpenEnds.lumen;
+        p.swimmer.end_annulus = outer::kOpenEnds.annulus;
+      } else {
+        p.swimmer.end_junction = true;
+      }
     }
     p.swimmer.short_wave_traction = m.boolean("short_wave_traction", p.swimmer.model == SwimmerModel::ForceFree && forced);
     if (p.swimmer.short_wave_traction && p.swimmer.model != SwimmerModel::ForceFree)

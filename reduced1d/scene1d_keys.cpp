@@ -15,7 +15,7 @@ const scene::json& section_keys() {
           {"external_drag", "choice:none|resistive_force"}}},
         {"wall_inertia", "boolean"},
         {"short_wave_traction", "boolean"},
-        {"end_effects", "choice:none|open_ends"},
+        {"end_effects", "choice:none|open_ends|junction"},
         {"axial_bending", {{"source", "choice:none|scene|calibration"}, {"rigidity", "quantity:J@positive"}}}}},
       {"numerics1d", {{"cells", "integer"}, {"rtol", "number"}, {"atol_scale", "number"}, {"max_steps", "integer"}}}};
   return keys;

@@ -59,6 +59,26 @@ TEST(EndEffects, CorrectionVanishesAsOneOverTheTubeLength) {
   EXPECT_LT(std::abs(prev), 0.02);
 }
 
+// The calibrated junction (§2c) is an end effect too: at the same fixed wave its relative change
+// of the displacement per transit halves with each doubling of the tube (L >= 1.6 um).
+TEST(EndEffects, JunctionCorrectionVanishesAsOneOverTheTubeLength) {
+  double prev = 0.0;
+  for (double L : {0.8, 1.6, 3.2, 6.4}) {
+    const double off = transit_displacement("sine", L, 0.4, "none");
+    const double on = transit_displacement("sine", L, 0.4, "junction");
+    const double rel = on / off - 1.0;
+    std::printf("L = %.1f um: displacement %.4e -> %.4e m with the junction, relative change %+.4f, times L/Rc %.3f\n",
+                L, off, on, rel, rel * L / 0.25);
+    EXPECT_GT(rel, 0.0) << "the junction adds the thrust lubrication misses at the ends";
+    if (prev != 0.0 && L >= 3.2) {
+      EXPECT_GT(rel / prev, 0.4) << "L = " << L;
+      EXPECT_LT(rel / prev, 0.6) << "L = " << L;
+    }
+    prev = rel;
+  }
+  EXPECT_LT(prev, 0.05);
+}
+
 // The scene key: a value outside the choice names the key and the allowed values; the ends
 // are refused with a force-driven wave and with the unbounded outer flow.
 TEST(EndEffects, SceneKeyRefusesBadValuesAndOtherModels) {
@@ -94,4 +114,15 @@ TEST(EndEffects, SceneKeyRefusesBadValuesAndOtherModels) {
   EXPECT_EQ(p.swimmer.end_lumen, kOpenEnds.lumen);
   EXPECT_EQ(p.swimmer.end_annulus, kOpenEnds.annulus);
   EXPECT_EQ(resolved["model1d"]["end_effects"], "open_ends");
+  EXPECT_FALSE(p.swimmer.end_junction);
+  // the calibrated junction: the same models only, and the choice is echoed
+  const std::string junction_forced = message(scene({{"end_effects", "junction"}}, "force_driven"));
+  EXPECT_NE(junction_forced.find("model1d.end_effects"), std::string::npos) << junction_forced;
+  EXPECT_NE(junction_forced.find("junction"), std::string::npos) << junction_forced;
+  EXPECT_NE(bad.find("junction"), std::string::npos) << bad;
+  json resolved_j;
+  const auto pj = swim::reduced1d::read_scene(scene({{"end_effects", "junction"}}, "step"), resolved_j);
+  EXPECT_TRUE(pj.swimmer.end_junction);
+  EXPECT_EQ(pj.swimmer.end_lumen, 0.0);
+  EXPECT_EQ(resolved_j["model1d"]["end_effects"], "junction");
 }

@@ -338,3 +338,115 @@ TEST(OuterFlowEnds, ReciprocalStrokeGivesNoNetDisplacement) {
   EXPECT_GT(std::abs(forward), 1e-3 * kR0);
   EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
 }
+
+// The calibrated end junction (docs/outer-flow-1d.md §2c): its dissipation matrix is positive
+// semi-definite at every end radius (so it only adds drag), and a junction whose coefficients are
+// all zero is the plain junction.
+TEST(OuterFlowJunction, DissipationIsNonNegativeAndOnlyAddsDrag) {
+  for (double rc : {1.2, 1.5, 2.0, 3.0, 4.0, 8.0, 20.0}) {
+    double M[3][3], rim;
+    end_junction(kCalibratedJunction, kR0, rc * kR0, kMu, M, rim);
+    // D = x^T M x / 2 >= 0 for random x (in units where each term is of order one)
+    std::mt19937 g(7);
+    std::normal_distribution<double> n(0.0, 1.0);
+    const double q = kR0 * kR0 * 1e-6, u = 1e-6;  // a flux and a velocity of the same flow
+    for (int k = 0; k < 200; ++k) {
+      const double x[3] = {q * n(g), q * n(g), u * n(g)};
+      double D = 0, scale = 0;
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) {
+          D += x[r] * M[r][c] * x[c];
+          scale += std::abs(x[r] * M[r][c] * x[c]);
+        }
+      EXPECT_GE(D, -1e-12 * scale) << "Rc/R " << rc;
+    }
+    EXPECT_EQ(M[0][1], M[1][0]);
+    EXPECT_EQ(M[0][2], M[2][0]);
+    EXPECT_EQ(M[1][2], M[2][1]);
+  }
+  // towed rigid tubes of three radii: the junction adds drag; the zero junction is the plain one
+  const int N = 40;
+  for (double R : {0.6 * kR0, kR0, 1.5 * kR0}) {
+    std::vector<double> Rp(N + 2, R), s(N + 1, 0.0);
+    const EndJunction zero{};
+    double U[3];
+    for (int k = 0; k < 3; ++k) {
+      ConfinedSystem sys(N + 2, intervals(N, kL), kMu, 0, 0, kRc, kP, kL);
+      if (k == 1) sys.junction = &zero;
+      if (k == 2) sys.junction = &kCalibratedJunction;
+      ASSERT_TRUE(sys.geometry(Rp.data()));
+      sys.kinematic(s.data(), 1e-15);  // towed by 1 fN
+      U[k] = sys.U;
+    }
+    EXPECT_EQ(U[1], U[0]) << "R/R0 " << R / kR0;
+    EXPECT_GT(U[0], 0.0);
+    EXPECT_LT(U[2], U[0]) << "R/R0 " << R / kR0 << ": the junction dissipates, the towed tube is slower";
+    EXPECT_GT(U[2], 0.5 * U[0]);
+  }
+}
+
+// Mirror z -> L - z with the junction: the mirrored shape and wall velocities swim the other way.
+TEST(OuterFlowJunction, MirroredProfilesSwimTheOtherWay) {
+  std::mt19937 g(17);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.5, 1.3);
+  for (int N : {8, 33}) {
+    const auto d = intervals(N, kL);
+    std::vector<double> R(N + 2);
+    for (auto& r : R) r = u(g) * kR0;
+    std::vector<double> Rm(R.rbegin(), R.rend());
+    ConfinedSystem a(N + 2, d, kMu, 0, 0, kRc, kP, kL), b(N + 2, d, kMu, 0, 0, kRc, kP, kL),
+        c(N + 2, d, kMu, 0, 0, kRc, kP, kL);
+    a.junction = b.junction = &kCalibratedJunction;
+    ASSERT_TRUE(a.geometry(R.data()));
+    ASSERT_TRUE(b.geometry(Rm.data()));
+    ASSERT_TRUE(c.geometry(R.data()));
+    std::vector<double> s(N + 1), sm(N + 1);
+    const double h = kL / N;
+    for (int j = 0; j < N; ++j) s[j + 1] = s[j] + h * 1e-15 * n(g);
+    for (int j = 0; j <= N; ++j) sm[j] = s[N] - s[N - j];
+    a.kinematic(s.data());
+    b.kinematic(sm.data());
+    c.kinematic(s.data());
+    EXPECT_GT(std::abs(a.U), 0.0);
+    EXPECT_NEAR(b.U, -a.U, 1e-11 * std::abs(a.U));
+    EXPECT_GT(std::abs(c.U - a.U), 1e-3 * std::abs(a.U)) << "the junction changes the answer";
+  }
+}
+
+// Scallop theorem with the junction: a reciprocal stroke near the rear end (forward in 0.1 s,
+// back in 0.3 s) returns the tube to its start; U stays linear in the wall velocity at a given
+// shape, the rim's thrust included.
+TEST(OuterFlowJunction, ReciprocalStrokeGivesNoNetDisplacement) {
+  const int N = 60;
+  const double h = kL / N, a = 0.35 * kR0;
+  ConfinedSystem sys(N + 2, intervals(N, kL), kMu, 0, 0, kRc, kP, kL);
+  sys.junction = &kCalibratedJunction;
+  std::vector<double> zpt(N + 2), R(N + 2), s(N + 1);
+  zpt[0] = 0, zpt[N + 1] = kL;
+  for (int i = 0; i < N; ++i) zpt[i + 1] = (i + 0.5) * h;
+  auto shape = [&](double z) { return std::exp(-std::pow((z - 0.1 * kL) / (0.15 * kL), 2)); };
+  auto velocity = [&](double amp, double rate) {
+    for (int k = 0; k < N + 2; ++k) R[k] = kR0 - a * amp * shape(zpt[k]);
+    double cum = 0;
+    for (int i = 0; i < N; ++i) {
+      s[i] = cum;
+      cum += h * 2 * pi * R[i + 1] * (-a * rate * shape(zpt[i + 1]));
+    }
+    s[N] = cum;
+    if (!sys.geometry(R.data())) ADD_FAILURE();
+    sys.kinematic(s.data());
+    return sys.U;
+  };
+  const double T1 = 0.1, T2 = 0.3;
+  const double forward = swim::test::gauss_legendre10([&](double t) {
+    const double x = pi * t / (2 * T1);
+    return velocity(std::sin(x) * std::sin(x), 2 * std::sin(x) * std::cos(x) * pi / (2 * T1));
+  }, 0.0, T1, 20);
+  const double back = swim::test::gauss_legendre10([&](double t) {
+    const double x = pi * (t - T1) / (2 * T2);
+    return velocity(std::cos(x) * std::cos(x), -2 * std::sin(x) * std::cos(x) * pi / (2 * T2));
+  }, T1, T1 + T2, 20);
+  EXPECT_GT(std::abs(forward), 1e-3 * kR0);
+  EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
+}

@@ -1,0 +1,167 @@
+#!/usr/bin/env python3
+"""Fit the 1D tier's end junction (reduced1d/outer_flow.hpp kCalibratedJunction,
+docs/outer-flow-1d.md §2c) to the steady flows of the axisymmetric tier.
+
+The data are what swim_junction_kernels writes (data/calibration/junction_kernels.txt): for each
+tube shape, the towed tube's drag and lumen flux and the swimming velocity that the radial
+velocity of each wall ring alone gives. The model is the 1D tier's confined lubrication system
+(ConfinedSystem::kinematic, restated here in numpy) with, at each end, the dissipation
+D = x^T M x / 2 in x = (lumen flux, annulus flux, tube velocity), M = mu S B B^T S,
+S = diag(R^-3/2, R^-3/2, R^1/2), B lower triangular with entries linear in ln(Rc/R - 1), and the
+rim's thrust rim mu R <dR/dt>. Fitted by least squares (scipy) to, for every shape, the velocity
+of narrow wall bands (0.5 R0 wide, every 0.25 R0 along the tube, each relative to the largest of
+that shape) and the towed drag and lumen flux (relative, weight 3). Needs python3-scipy.
+
+    tools/fit_end_junction.py [data/calibration/junction_kernels.txt]
+
+Prints each shape's residuals before (plain junction) and after the fit, and the C++ initializer.
+"""
+import sys
+
+import numpy as np
+from scipy.optimize import least_squares
+
+R0 = 0.125e-6
+RIM_LENGTH = 0.15  # the rim weight's decay length / R (not fitted)
+
+
+def annulus(Ro, Rc, mu):
+    lam = np.log(Rc / Ro)
+    D2 = Rc**2 - Ro**2
+    G = np.pi / (8 * mu) * (Rc**4 - Ro**4 - D2**2 / lam)
+    S = 0.5 * np.pi * D2 / lam
+    rho = 1 / G
+    return rho, (np.pi * Rc**2 - S) * rho, S, 2 * np.pi * mu / lam
+
+
+class Tube:
+    """The confined lubrication system on N cells (as ConfinedSystem, a_in = a_out = 0)."""
+
+    def __init__(self, L, Rc, P, shape, mu, N=200):
+        self.L, self.Rc, self.mu, self.h = L, Rc, mu, L / N
+        zp = np.concatenate([[0], (np.arange(N) + 0.5) * self.h, [L]])
+        self.zc = zp[1:-1]
+        d = np.diff(zp)
+        R = shape(zp)
+        self.R = R
+        rho, kap, S, e = annulus(R, Rc, mu)
+        a, b = R[:-1], R[1:]
+        self.rl = (8 * mu / np.pi) * d / 3 * (a * a + a * b + b * b) / (a**3 * b**3)
+        self.ra = 0.5 * d * (rho[:-1] + rho[1:])
+        self.c = 0.5 * d * (kap[:-1] + kap[1:])
+        self.S = 0.5 * (S[:-1] + S[1:])
+        self.e = 0.5 * d * (e[:-1] + e[1:])
+        self.rfree = (P - L) * 8 * mu / (np.pi * Rc**4)
+        self.Ac = np.pi * Rc**2
+        self.M = [np.zeros((3, 3)), np.zeros((3, 3))]
+        self.rim = [0.0, 0.0]
+
+    def solve(self, Rdot, F_ext=0.0):
+        s = np.concatenate([[0], np.cumsum(self.h * 2 * np.pi * self.R[1:-1] * Rdot)])
+        RL, RLs = self.rl.sum(), (self.rl * s).sum()
+        RA, RAs, C = self.ra.sum(), (self.ra * s).sum(), self.c.sum()
+        SRA, SRAs = (self.S * self.ra).sum(), (self.S * self.ra * s).sum()
+        SC, E = (self.S * self.c).sum(), self.e.sum()
+        A = np.array([[RL, 0, 0, 1], [-RA, RA, C, 1], [0, -self.rfree, -self.rfree * self.Ac, 1], [SRA, -SRA, E - SC, 0]])
+        b = np.array([RLs, -RAs, 0, F_ext + SRAs])
+        T = np.array([[1, 0, 0], [-1, 1, 0], [0, 0, 1.0]])
+        rows = [0, 1, 3]
+        for k, t in ((0, np.zeros(3)), (1, np.array([-s[-1], s[-1], 0]))):
+            A[np.ix_(rows, [0, 1, 2])] += self.M[k] @ T
+            b[rows] -= self.M[k] @ t
+            Re = self.R[0] if k == 0 else self.R[-1]
+            dist = self.zc if k == 0 else self.L - self.zc
+            w = np.exp(-dist / (RIM_LENGTH * Re)) / (RIM_LENGTH * Re) * self.h
+            b[3] += (1 if k == 0 else -1) * self.rim[k] * self.mu * Re * (w * Rdot).sum()
+        return np.linalg.solve(A, b)  # lumen flux at the rear, total flux, U, pressure rise
+
+    def tow(self):
+        x = self.solve(np.zeros_like(self.zc), 1.0)
+        return 1 / x[2], x[0] / x[2]
+
+
+def junction(p, R, Rc, mu):
+    xg = np.log(Rc / R - 1)
+    v = [p[2 * i] + p[2 * i + 1] * xg for i in range(6)]
+    B = np.array([[v[0], 0, 0], [v[1], v[2], 0], [v[3], v[4], v[5]]])
+    S = np.array([R**-1.5, R**-1.5, R**0.5])
+    return mu * (S[:, None] * (B @ B.T) * S[None, :]), p[12] + p[13] * xg
+
+
+def load(fn):
+    cases, cur, tq = [], None, None
+    for line in open(fn):
+        if line.startswith("# towed"):
+            tq = float(line.split()[6])
+        elif line.startswith("# L/R0"):
+            t = line.split()
+            cur = dict(L=float(t[2]) * R0, Rc=float(t[4]) * R0, cells=int(t[8]), drag=float(t[12]), mu=float(t[14]), zf=float(t[16]),
+                       rf=float(t[18]), tq=tq, rings=[])
+            cases.append(cur)
+        elif cur is not None and line.strip() and not line.startswith("#"):
+            cur["rings"].append([float(x) for x in line.split()[:4]])
+    return cases
+
+
+def shape_of(c):
+    L, zf, rf = c["L"], c["zf"], c["rf"]
+    if zf < 0:
+        return lambda z: R0 + 0 * z
+    w = L / 8
+
+    def f(z):
+        x = (z - zf * L) / w
+        return np.where(x <= -0.5, rf * R0, np.where(x >= 0.5, R0, rf * R0 + (1 - rf) * R0 * 0.5 * (1 + np.sin(np.pi * x))))
+    return f
+
+
+def main():
+    fn = sys.argv[1] if len(sys.argv) > 1 else "data/calibration/junction_kernels.txt"
+    data = []
+    for c in load(fn):
+        h = c["Rc"] / c["cells"]
+        P = round(5 * c["L"] / h) * h
+        r = np.array(c["rings"])
+        z, U_ring = r[:, 1] * R0, r[:, 3] / 1e-6
+        tube = Tube(c["L"], c["Rc"], P, shape_of(c), c["mu"])
+        bands = []
+        for zc in np.arange(0.25 * R0, c["L"] - 0.25 * R0 + 1e-12, 0.25 * R0):
+            def band(zz, zc=zc):
+                x = (zz - zc) / (0.5 * R0)
+                return np.where(abs(x) < 0.5, np.cos(np.pi * x) ** 2, 0.0)
+            bands.append(band(tube.zc))
+            c.setdefault("U", []).append(np.sum(U_ring * band(z)))
+        c["U"] = np.array(c["U"])
+        data.append((c, tube, bands))
+
+    def residuals(p, report=False):
+        out = []
+        for c, tube, bands in data:
+            for k in (0, 1):
+                tube.M[k], tube.rim[k] = junction(p, tube.R[0] if k == 0 else tube.R[-1], c["Rc"], c["mu"])
+            U = np.array([tube.solve(b)[2] for b in bands])
+            scale = np.abs(c["U"]).max()
+            out.extend((U - c["U"]) / scale)
+            drag, flux = tube.tow()
+            out += [3 * (drag / c["drag"] - 1), 3 * (flux / c["tq"] - 1)]
+            if report:
+                e = (U - c["U"]) / scale
+                print(f"  L/R0 {c['L'] / R0:5.2f} Rc/R0 {c['Rc'] / R0:4.2f} zf {c['zf']:5.2f} rf {c['rf']:.2f}: bands rms "
+                      f"{np.sqrt(np.mean(e**2)):.3f} max {np.abs(e).max():.3f}; drag {drag / c['drag'] - 1:+.3f}, "
+                      f"lumen flux {flux / c['tq'] - 1:+.3f}")
+        return np.array(out)
+
+    print("plain junction:")
+    residuals(np.zeros(14), True)
+    start = np.array([1, 0, 0.1, 0, 0.1, 0, 0.5, 0, -0.3, 0, 0.5, 0, 0, 0.0])
+    fit = least_squares(residuals, start)
+    print(f"fitted ({len(fit.fun)} residuals, cost {fit.cost:.4f}):")
+    residuals(fit.x, True)
+    p = fit.x
+    xg = [np.log(c["Rc"] / r - 1) for c, tube, _ in data for r in (tube.R[0], tube.R[-1])]
+    entries = ",\n    ".join(f"{{{p[2 * i]:.7f}, {p[2 * i + 1]:.7f}}}" for i in range(6))
+    print("\ninline constexpr EndJunction kCalibratedJunction{{" + entries + "},\n    " +
+          f"{{{p[12]:.7f}, {p[13]:.7f}}}, {RIM_LENGTH}, {min(xg):.7f}, {max(xg):.7f}}};")
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,113 @@
+// The steady flows the 1D tier's end junction is fitted to (docs/outer-flow-1d.md §2c): on the
+// axisymmetric tier (fitted method), a straight or partly contracted tube in the periodic
+// container, (1) towed rigidly: its drag and the lumen flux relative to it; (2) the swimming
+// velocity that a radial velocity of each wall ring alone gives, ring by ring (U is linear in the
+// wall's velocity at a given shape, so these responses are the whole steady kernel). A tool, not
+// part of the product: tools/fit_end_junction.py reads what it writes.
+//
+//   swim_junction_kernels [--cells 16] CASE ... > kernels.txt
+//   CASE = L/R0,Rc/R0[,zf[,rf]]: tube length and container radius in R0 = 0.125 um; zf < 0 (the
+//          default) a uniform tube of radius R0, else the tube contracted to rf R0 (default 0.55)
+//          over [0, zf L] with a front L/8 wide (a half sine) that rises to R0 beyond it.
+//
+// Output per case: a header line "# L/R0 .. Rc/R0 .. Rt/R0 1.00 cells .. nodes .. drag .. mu ..
+// zf .. rf ..", a line "# towed lumen flux per U .. m^2", then per ring "k z/R0 dz/R0 U" (U in m/s
+// for dR/dt = 1 um/s at ring k alone; dz the ring's share of the wall).
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "axi/prescribed_axi.hpp"
+#include "axi/scene_axi.hpp"
+#include "axi/wall_axi.hpp"
+#include "common/scene.hpp"
+
+namespace {
+
+using swim::scene::json;
+
+constexpr double kR0 = 0.125e-6, kRate = 1e-6;
+
+std::string um(double v) {
+  char b[40];
+  std::snprintf(b, sizeof b, "%.12g um", v * 1e6);
+  return b;
+}
+
+void measure(double l, double rc, double zf, double rf, int cells) {
+  const double L = l * kR0, Rc = rc * kR0, h = Rc / cells;
+  const double P = std::round(5 * L / h) * h;
+  const json sc = {{"name", "junction_kernel"},
+                   {"swimmer", {{"radius", um(kR0)}, {"length", um(L)}}},
+                   {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(P)}}},
+                   {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
+                   {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
+                   {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", cells}}}}}};
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
+  auto shape = [&](double z) {
+    if (zf < 0) return kR0;
+    const double x = (z - zf * L) / (L / 8);
+    if (x <= -0.5) return rf * kR0;
+    if (x >= 0.5) return kR0;
+    return rf * kR0 + (1 - rf) * kR0 * 0.5 * (1 + std::sin(M_PI * x));
+  };
+  int ring = -1;  // the ring that moves; -1: none (the towed tube)
+  swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& R, Eigen::VectorXd& Rt) {
+    R.resize(Eigen::Index(z.size()));
+    for (std::size_t k = 0; k < z.size(); ++k) R[Eigen::Index(k)] = shape(z[k]);
+    Rt = Eigen::VectorXd::Zero(Eigen::Index(z.size()));
+    if (ring >= 0) Rt[ring] = kRate;
+  };
+  swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), p.base.fluid.mu, wall.reference_positions(), kin,
+                                  p.x_start());
+  const std::vector<double>& z = sw.z();
+  const int n = int(z.size());
+  const swim::axi::PrescribedState tow = sw.evaluate(0.0);
+  std::printf("# towed lumen flux per U %.9e m^2\n", tow.towed_lumen_flux);
+  std::printf("# L/R0 %.4f Rc/R0 %.4f Rt/R0 1.00 cells %d nodes %d drag %.9e mu %.6e zf %.4f rf %.4f\n", l, rc, cells, n,
+              tow.drag, p.base.fluid.mu, zf, rf);
+  for (ring = 0; ring < n; ++ring) {
+    const double dz = 0.5 * ((ring + 1 < n ? z[ring + 1] : z[ring]) - (ring > 0 ? z[ring - 1] : z[ring]));
+    std::printf("%d %.9e %.9e %.9e\n", ring, z[ring] / kR0, dz / kR0, sw.evaluate(0.0).velocity);
+  }
+  std::fflush(stdout);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  int cells = 16;
+  std::vector<std::string> cases;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--cells" && i + 1 < argc) cells = std::atoi(argv[++i]);
+    else cases.push_back(a);
+  }
+  if (cases.empty() || cells < 4) {
+    std::fprintf(stderr, "usage: swim_junction_kernels [--cells N >= 4] L/R0,Rc/R0[,zf[,rf]] ...\n");
+    return 2;
+  }
+  try {
+    for (const std::string& c : cases) {
+      double l = 0, rc = 0, zf = -1, rf = 0.55;
+      if (std::sscanf(c.c_str(), "%lf,%lf,%lf,%lf", &l, &rc, &zf, &rf) < 2 || !(l > 0) || !(rc > 1) ||
+          !(rf > 0 && rf < 1) || zf >= 1) {
+        std::fprintf(stderr, "swim_junction_kernels: case \"%s\": expected L/R0 > 0, Rc/R0 > 1, zf < 1, 0 < rf < 1\n",
+                     c.c_str());
+        return 2;
+      }
+      measure(l, rc, zf, rf, cells);
+    }
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "swim_junction_kernels: %s\n", e.what());
+    return 3;
+  }
+  return 0;
+}
