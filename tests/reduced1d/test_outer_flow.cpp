@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 #include <random>
 #include <vector>
 
@@ -271,9 +272,13 @@ TEST(OuterFlowEnds, TowedTubeIsTheClosedFormOfTheExtendedChannels) {
   EXPECT_LT(d1, 1.2 * d0);
 }
 
-// Mirror z -> L - z with the ends on: the mirrored shape and wall velocities swim the other way.
-TEST(OuterFlowEnds, MirroredProfilesSwimTheOtherWay) {
-  std::mt19937 g(13);
+namespace {
+
+/// Mirror z -> L - z on random shapes and wall velocities (N = 8 and 33 cells): the mirrored
+/// problem swims the other way, and the end model `configure` sets changes the answer.
+void expect_mirrored_profiles_swim_the_other_way(unsigned seed, double a_in, double a_out,
+                                                 const std::function<void(ConfinedSystem&)>& configure) {
+  std::mt19937 g(seed);
   std::normal_distribution<double> n(0.0, 1.0);
   std::uniform_real_distribution<double> u(0.5, 1.3);
   for (int N : {8, 33}) {
@@ -281,38 +286,37 @@ TEST(OuterFlowEnds, MirroredProfilesSwimTheOtherWay) {
     std::vector<double> R(N + 2);
     for (auto& r : R) r = u(g) * kR0;
     std::vector<double> Rm(R.rbegin(), R.rend());
-    ConfinedSystem a(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL), b(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
-    a.ends = b.ends = kOpenEnds;
+    ConfinedSystem a(N + 2, d, kMu, a_in, a_out, kRc, kP, kL), b(N + 2, d, kMu, a_in, a_out, kRc, kP, kL),
+        c(N + 2, d, kMu, a_in, a_out, kRc, kP, kL);
+    configure(a);
+    configure(b);
     ASSERT_TRUE(a.geometry(R.data()));
     ASSERT_TRUE(b.geometry(Rm.data()));
+    ASSERT_TRUE(c.geometry(R.data()));
     std::vector<double> s(N + 1), sm(N + 1);
     const double h = kL / N;
     for (int j = 0; j < N; ++j) s[j + 1] = s[j] + h * 1e-15 * n(g);
     for (int j = 0; j <= N; ++j) sm[j] = s[N] - s[N - j];
     a.kinematic(s.data());
     b.kinematic(sm.data());
+    c.kinematic(s.data());  // the plain junction
     EXPECT_GT(std::abs(a.U), 0.0);
     EXPECT_NEAR(b.U, -a.U, 1e-11 * std::abs(a.U));
-    // and the ends change the answer (asymmetric end radii)
-    ConfinedSystem c(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
-    ASSERT_TRUE(c.geometry(R.data()));
-    c.kinematic(s.data());
-    EXPECT_GT(std::abs(c.U - a.U), 1e-6 * std::abs(a.U));
+    EXPECT_GT(std::abs(c.U - a.U), 1e-6 * std::abs(a.U)) << "the end model changes the answer";
   }
 }
 
-// Scallop theorem with the ends on: a reciprocal stroke (an asymmetric contraction near the
-// rear, forward in 0.1 s and back in 0.3 s) returns the tube to its start; U is still linear in
-// the wall velocity at a given shape.
-TEST(OuterFlowEnds, ReciprocalStrokeGivesNoNetDisplacement) {
+/// A reciprocal stroke (an asymmetric contraction that reaches the rear end, so the end radius
+/// changes: forward in 0.1 s and back in 0.3 s) returns the tube to its start with the end
+/// model `configure` sets: U stays linear in the wall velocity at a given shape.
+void expect_reciprocal_stroke_returns(const std::function<void(ConfinedSystem&)>& configure) {
   const int N = 60;
   const double h = kL / N, a = 0.35 * kR0;
   ConfinedSystem sys(N + 2, intervals(N, kL), kMu, 0, 0, kRc, kP, kL);
-  sys.ends = kOpenEnds;
+  configure(sys);
   std::vector<double> zpt(N + 2), R(N + 2), s(N + 1);
   zpt[0] = 0, zpt[N + 1] = kL;
   for (int i = 0; i < N; ++i) zpt[i + 1] = (i + 0.5) * h;
-  // the contraction reaches the rear end, so the end radius changes during the stroke
   auto shape = [&](double z) { return std::exp(-std::pow((z - 0.1 * kL) / (0.15 * kL), 2)); };
   auto velocity = [&](double amp, double rate) {
     for (int k = 0; k < N + 2; ++k) R[k] = kR0 - a * amp * shape(zpt[k]);
@@ -337,6 +341,18 @@ TEST(OuterFlowEnds, ReciprocalStrokeGivesNoNetDisplacement) {
   }, T1, T1 + T2, 20);
   EXPECT_GT(std::abs(forward), 1e-3 * kR0);
   EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
+}
+
+}  // namespace
+
+// Mirror z -> L - z with the ends on: the mirrored shape and wall velocities swim the other way.
+TEST(OuterFlowEnds, MirroredProfilesSwimTheOtherWay) {
+  expect_mirrored_profiles_swim_the_other_way(13, 1e-9, 2e-9, [](ConfinedSystem& s) { s.ends = kOpenEnds; });
+}
+
+// Scallop theorem with the ends on.
+TEST(OuterFlowEnds, ReciprocalStrokeGivesNoNetDisplacement) {
+  expect_reciprocal_stroke_returns([](ConfinedSystem& s) { s.ends = kOpenEnds; });
 }
 
 // The calibrated end junction (docs/outer-flow-1d.md §2c): its dissipation matrix is positive
@@ -385,68 +401,12 @@ TEST(OuterFlowJunction, DissipationIsNonNegativeAndOnlyAddsDrag) {
   }
 }
 
-// Mirror z -> L - z with the junction: the mirrored shape and wall velocities swim the other way.
+// Mirror z -> L - z with the junction (the rim's thrust included).
 TEST(OuterFlowJunction, MirroredProfilesSwimTheOtherWay) {
-  std::mt19937 g(17);
-  std::normal_distribution<double> n(0.0, 1.0);
-  std::uniform_real_distribution<double> u(0.5, 1.3);
-  for (int N : {8, 33}) {
-    const auto d = intervals(N, kL);
-    std::vector<double> R(N + 2);
-    for (auto& r : R) r = u(g) * kR0;
-    std::vector<double> Rm(R.rbegin(), R.rend());
-    ConfinedSystem a(N + 2, d, kMu, 0, 0, kRc, kP, kL), b(N + 2, d, kMu, 0, 0, kRc, kP, kL),
-        c(N + 2, d, kMu, 0, 0, kRc, kP, kL);
-    a.junction = b.junction = &kCalibratedJunction;
-    ASSERT_TRUE(a.geometry(R.data()));
-    ASSERT_TRUE(b.geometry(Rm.data()));
-    ASSERT_TRUE(c.geometry(R.data()));
-    std::vector<double> s(N + 1), sm(N + 1);
-    const double h = kL / N;
-    for (int j = 0; j < N; ++j) s[j + 1] = s[j] + h * 1e-15 * n(g);
-    for (int j = 0; j <= N; ++j) sm[j] = s[N] - s[N - j];
-    a.kinematic(s.data());
-    b.kinematic(sm.data());
-    c.kinematic(s.data());
-    EXPECT_GT(std::abs(a.U), 0.0);
-    EXPECT_NEAR(b.U, -a.U, 1e-11 * std::abs(a.U));
-    EXPECT_GT(std::abs(c.U - a.U), 1e-3 * std::abs(a.U)) << "the junction changes the answer";
-  }
+  expect_mirrored_profiles_swim_the_other_way(17, 0.0, 0.0, [](ConfinedSystem& s) { s.junction = &kCalibratedJunction; });
 }
 
-// Scallop theorem with the junction: a reciprocal stroke near the rear end (forward in 0.1 s,
-// back in 0.3 s) returns the tube to its start; U stays linear in the wall velocity at a given
-// shape, the rim's thrust included.
+// Scallop theorem with the junction, the rim's thrust included.
 TEST(OuterFlowJunction, ReciprocalStrokeGivesNoNetDisplacement) {
-  const int N = 60;
-  const double h = kL / N, a = 0.35 * kR0;
-  ConfinedSystem sys(N + 2, intervals(N, kL), kMu, 0, 0, kRc, kP, kL);
-  sys.junction = &kCalibratedJunction;
-  std::vector<double> zpt(N + 2), R(N + 2), s(N + 1);
-  zpt[0] = 0, zpt[N + 1] = kL;
-  for (int i = 0; i < N; ++i) zpt[i + 1] = (i + 0.5) * h;
-  auto shape = [&](double z) { return std::exp(-std::pow((z - 0.1 * kL) / (0.15 * kL), 2)); };
-  auto velocity = [&](double amp, double rate) {
-    for (int k = 0; k < N + 2; ++k) R[k] = kR0 - a * amp * shape(zpt[k]);
-    double cum = 0;
-    for (int i = 0; i < N; ++i) {
-      s[i] = cum;
-      cum += h * 2 * pi * R[i + 1] * (-a * rate * shape(zpt[i + 1]));
-    }
-    s[N] = cum;
-    if (!sys.geometry(R.data())) ADD_FAILURE();
-    sys.kinematic(s.data());
-    return sys.U;
-  };
-  const double T1 = 0.1, T2 = 0.3;
-  const double forward = swim::test::gauss_legendre10([&](double t) {
-    const double x = pi * t / (2 * T1);
-    return velocity(std::sin(x) * std::sin(x), 2 * std::sin(x) * std::cos(x) * pi / (2 * T1));
-  }, 0.0, T1, 20);
-  const double back = swim::test::gauss_legendre10([&](double t) {
-    const double x = pi * (t - T1) / (2 * T2);
-    return velocity(std::cos(x) * std::cos(x), -2 * std::sin(x) * std::cos(x) * pi / (2 * T2));
-  }, T1, T1 + T2, 20);
-  EXPECT_GT(std::abs(forward), 1e-3 * kR0);
-  EXPECT_NEAR(forward + back, 0.0, 1e-10 * std::abs(forward));
+  expect_reciprocal_stroke_returns([](ConfinedSystem& s) { s.junction = &kCalibratedJunction; });
 }
