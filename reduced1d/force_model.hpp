@@ -15,7 +15,8 @@
 // as extra differential states.
 // Force-free model (default): p_i is the transmural pressure Pi_i = p_in - p_out. Confined:
 // the lumen fluxes come from the lumen/annulus/free-pipe system of outer_flow.hpp, which also
-// gives U and Q_tot (global couplings: two more rank-1 terms in the Newton matrix).
+// gives U and Q_tot (global couplings: two more rank-1 terms in the Newton matrix; four with the
+// calibrated end junction, whose closure adds the end points' transmural pressures).
 // Unbounded: p_out = 0, the lumen fluxes are local as above and U is the slender-body
 // average of the induced axial flow (it does not feed back into the radii).
 // State scaling: A/(pi R0^2), V/(R0/T_s), p/(C1 R0), D/D_s, X/X_s, V/(pi R0^2 L).
