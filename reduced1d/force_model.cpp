@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <stdexcept>
 #include <string>
 
 #include "reduced1d/v4.hpp"
@@ -59,7 +60,9 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
       J(int(tq.s.size())),
       D_axial(P.wall.D_axial),
       bending(P.wall.D_axial > 0),
-      dae(P.wall.inertia || J > 0 || bending),
+      junction(P.swimmer.model == SwimmerModel::ForceFree && P.swimmer.outer == OuterFlow::Confined &&
+               P.swimmer.end_junction),
+      dae(P.wall.inertia || J > 0 || bending || junction),
       velocity_quadrature(step_velocity && force_free && !confined),
       stride(dae ? 3 + J + (bending ? 1 : 0) : 1),
       Rb0_static(R0),
@@ -133,6 +136,10 @@ ModelState ForceModel::make_state() const {
     s.Pipt.assign(N + 2, 0.0);
     if (confined) {
       s.sys = std::make_unique<outer::ConfinedSystem>(N + 2, d, mu, a_in, a_out, Rc_eff, period, L);
+      if (junction) {
+        s.sys->junction = &outer::kCalibratedJunction;
+        s.Vpt.assign(N + 2, 0.0);
+      }
     } else {
       s.sigma.assign(N, 0.0);
       s.rho.assign(N, R0);
@@ -251,7 +258,12 @@ void ForceModel::fluxes(ModelState& s, bool derivatives, bool want_velocity) con
       s.U = std::nan("");
       return;
     }
-    sys.transmural(s.Pipt.data());
+    if (junction) {
+      for (int i = 0; i < N; ++i) s.Vpt[i + 1] = s.V[i];
+      sys.transmural(s.Pipt.data(), 0.0, s.Vpt.data());
+    } else {
+      sys.transmural(s.Pipt.data());
+    }
     for (int j = 0; j <= N; ++j) {
       Q[j] = sys.Q_in[j];
       r[j] = sys.k[j].rl;
@@ -387,6 +399,7 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
     s.g1a.assign(N + 1, 0.0), s.g1b.assign(N + 1, 0.0), s.g1pi.assign(N + 1, 0.0);
     s.g2a.assign(N + 1, 0.0), s.g2b.assign(N + 1, 0.0), s.g2pi.assign(N + 1, 0.0);
     const double Qt = sys.Q_tot, Uv = sys.U;
+    double Qab[2][2] = {{0, 0}, {0, 0}};  // the end intervals' dQ / d(R_a, R_b) (the junction)
     for (int j = 0; j <= N; ++j) {
       const double a = Rp(j), b = Rp(j + 1), d = (j == 0 || j == N) ? 0.5 * h : h;
       const double dpi = sys.dPi[j];
@@ -405,6 +418,8 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
       double Qa, Qb;
       partial(da, rla, Qa, s.g1a[j], s.g2a[j]);
       partial(db, rlb, Qb, s.g1b[j], s.g2b[j]);
+      if (j == 0) Qab[0][0] = Qa, Qab[0][1] = Qb;
+      if (j == N) Qab[1][0] = Qa, Qab[1][1] = Qb;
       s.g1pi[j] = -k.rl * w;        // d t1 / d dPi
       s.g2pi[j] = -k.S * k.ra * w;  // d t2 / d dPi
       // dQ/d Pi_j = +w, dQ/d Pi_{j+1} = -w
@@ -413,6 +428,35 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
     }
     s.Qb0 = s.QL[0];
     s.QbL = s.QR[N];
+    if (junction) {
+      // The end rows through the end fluxes Q_0, Q_N (at fixed W, U, Pi_0, Pi_L) and the end
+      // radii (the dissipation matrices and the rims' thrust); g1 and g2 gain the same.
+      const auto& jc = sys.jc;
+      s.g3a.assign(N + 1, 0.0), s.g3b.assign(N + 1, 0.0), s.g3pi.assign(N + 1, 0.0);
+      s.g4a.assign(N + 1, 0.0), s.g4b.assign(N + 1, 0.0), s.g4pi.assign(N + 1, 0.0);
+      for (int e = 0; e < 2; ++e) {
+        const int j = e == 0 ? 0 : N;
+        const auto &Me = jc.M[e], &dMe = jc.dM[e];
+        const double m0 = Me[0][0] - Me[0][1], m1 = Me[1][0] - Me[1][1], m2 = Me[2][0] - Me[2][1];
+        double dx[3];  // (dM_e x_e)_r
+        for (int r = 0; r < 3; ++r) dx[r] = dMe[r][0] * jc.x[e][0] + dMe[r][1] * jc.x[e][1] + dMe[r][2] * jc.x[e][2];
+        const double wq = -sys.w[j];  // dQ_j / d dPi_j
+        std::vector<double>& gea = e == 0 ? s.g3a : s.g4a;
+        std::vector<double>& geb = e == 0 ? s.g3b : s.g4b;
+        std::vector<double>& gepi = e == 0 ? s.g3pi : s.g4pi;
+        const double sg = e == 0 ? 1.0 : -1.0;  // g3 = Pi_0 + (Mx)_0 - (Mx)_1, g4 = Pi_L - (Mx)_0 + (Mx)_1
+        s.g1a[j] += m0 * Qab[e][0], s.g1b[j] += m0 * Qab[e][1], s.g1pi[j] += m0 * wq;
+        s.g2a[j] += m2 * Qab[e][0], s.g2b[j] += m2 * Qab[e][1], s.g2pi[j] += m2 * wq;
+        gea[j] = sg * (m0 - m1) * Qab[e][0], geb[j] = sg * (m0 - m1) * Qab[e][1], gepi[j] = sg * (m0 - m1) * wq;
+        // the end radius: point 0 (left of interval 0) or N + 1 (right of interval N)
+        std::vector<double>& g1e = e == 0 ? s.g1a : s.g1b;
+        std::vector<double>& g2e = e == 0 ? s.g2a : s.g2b;
+        std::vector<double>& gee = e == 0 ? s.g3a : s.g4b;
+        g1e[j] += dx[0];
+        g2e[j] += dx[2] - jc.dthrust[e];
+        gee[j] += sg * (dx[0] - dx[1]);
+      }
+    }
     return;
   }
   for (int j = 0; j <= N; ++j) {
@@ -436,6 +480,14 @@ Linearisation ForceModel::linearise(const double* y, ModelState& st, bool with_p
     const double det = G[0][0] * G[1][1] - G[0][1] * G[1][0];
     lin.Gi[0][0] = G[1][1] / det, lin.Gi[0][1] = -G[0][1] / det, lin.Gi[1][0] = -G[1][0] / det,
     lin.Gi[1][1] = G[0][0] / det;
+    if (junction) {
+      Eigen::Matrix4d A;
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) A(r, c) = st.sys->jc.G[r][c];
+      const Eigen::Matrix4d Ai = A.inverse();
+      for (int r = 0; r < 4; ++r)
+        for (int c = 0; c < 4; ++c) lin.Gi4[r][c] = Ai(r, c);
+    }
   }
   return lin;
 }
@@ -447,6 +499,11 @@ struct SegChain {
   double xw, xu;
   std::size_t off;
 };
+/// The same for the junction's closure z = (W, U, Pi_0, Pi_L): dz/dqs_k.
+struct JunctionChain {
+  double x[4];
+  std::size_t off;
+};
 }  // namespace
 
 template <class Band>
@@ -456,6 +513,7 @@ int ForceModel::jacobian(const Linearisation& s, const Band& band, std::vector<d
   const std::vector<double>& R = st.R;
   const std::vector<double>& cond = st.cond;
   const double c = 1.0 / (h * pi * R0 * R0);
+  if (junction) throw std::logic_error("the calibrated junction runs on the IDA path (ForceModel::dae)");
   for (int i = 0; i < N; ++i) {
     const double dRda = 0.5 * R0 * R0 / R[i];
     // f_i = c (Q_i - Q_{i+1}): Q_i depends on R_{i-1}, R_i; Q_{i+1} on R_i, R_{i+1}
@@ -715,6 +773,7 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
   const int S = stride;
   const auto& Gi = s.Gi;
   std::vector<SegChain> seg_x;
+  std::vector<JunctionChain> seg_j;
   int rank = 0;
   Ul.clear();
   Vt.clear();
@@ -750,11 +809,78 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
         else g1 -= s.g1a[0] / C1, g2 -= s.g2a[0] / C1;
       }
     }
-    if (confined && (g1 != 0.0 || g2 != 0.0))
+    if (junction) {  // the end rows through the end radii too
+      double g[4] = {g1, g2, 0.0, 0.0};
+      if (endL_seg && seg_a[N - 1] == k && !bending) g[3] += s.g4b[N] * end_sensitivity(st, true);
+      if (end0_seg && seg_a[0] == k && !bending) g[2] += s.g3a[0] * end_sensitivity(st, false);
+      if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0 || g[3] != 0.0) {
+        JunctionChain jx{{}, off};
+        for (int c = 0; c < 4; ++c)
+          for (int l = 0; l < 4; ++l) jx.x[c] -= s.Gi4[c][l] * g[l];
+        seg_j.push_back(jx);
+      }
+    } else if (confined && (g1 != 0.0 || g2 != 0.0)) {
       seg_x.push_back({-(Gi[0][0] * g1 + Gi[0][1] * g2), -(Gi[1][0] * g1 + Gi[1][1] * g2), off});
+    }
     ++rank;
   }
-  if (confined) {
+  if (confined && junction) {
+    // Four rank-1 terms dF/dz_m (dz_m/dy)^T for z = (W, U, Pi_0, Pi_L) of the junction's
+    // closure (outer::ConfinedSystem::transmural): Q_in,j = alpha_j W + beta_j U - w_j dPi_j,
+    // dPi_0 = Pi_1 - Pi_0, dPi_N = Pi_L - Pi_N; dz/dy = -G^{-1} dg/dy.
+    const outer::ConfinedSystem& sys = *st.sys;
+    const std::size_t off = Ul.size();
+    Ul.resize(off + 4 * std::size_t(n), 0.0);
+    Vt.resize(off + 4 * std::size_t(n), 0.0);
+    double* f[4] = {Ul.data() + off, Ul.data() + off + n, Ul.data() + off + 2 * n, Ul.data() + off + 3 * n};
+    auto al = [&](int j) { return sys.k[j].ra * sys.w[j]; };
+    auto be = [&](int j) { return (sys.k[j].c - sys.A_c * sys.k[j].ra) * sys.w[j]; };
+    for (int i = 0; i < N; ++i) {
+      f[0][1 + S * i + 2] = cp * (al(i + 1) - al(i)) / h;
+      f[1][1 + S * i + 2] = cp * (be(i + 1) - be(i)) / h;
+    }
+    f[0][iVr] = -al(0) / V_s, f[1][iVr] = -be(0) / V_s;
+    f[0][iVf] = -al(N) / V_s, f[1][iVf] = -be(N) / V_s;
+    f[1][iX] = -1.0 / X_s;
+    f[0][iVrl] = -al(0) / V_s, f[1][iVrl] = -(be(0) + pi * st.Rb0 * st.Rb0) / V_s;
+    f[0][iVfl] = -al(N) / V_s, f[1][iVfl] = -(be(N) + pi * st.RbL * st.RbL) / V_s;
+    // dQ_0 / dPi_0 = w_0, dQ_N / dPi_L = -w_N
+    const double w0 = sys.w[0], wN = sys.w[N];
+    f[2][1 + 2] = -cp * w0 / h;
+    f[2][iVr] = -w0 / V_s, f[2][iVrl] = -w0 / V_s;
+    f[3][1 + S * (N - 1) + 2] = -cp * wN / h;
+    f[3][iVf] = wN / V_s, f[3][iVfl] = wN / V_s;
+    // dg/dy, dense per row g_l
+    std::vector<double> dg(4 * std::size_t(n), 0.0);
+    const std::vector<double>* ga[4] = {&s.g1a, &s.g2a, &s.g3a, &s.g4a};
+    const std::vector<double>* gb[4] = {&s.g1b, &s.g2b, &s.g3b, &s.g4b};
+    const std::vector<double>* gp[4] = {&s.g1pi, &s.g2pi, &s.g3pi, &s.g4pi};
+    for (int l = 0; l < 4; ++l) {
+      double* d = dg.data() + l * std::size_t(n);
+      const auto &A = *ga[l], &B = *gb[l], &P = *gp[l];
+      for (int i = 0; i < N; ++i) {  // point i + 1 = cell i: right end of interval i, left of i + 1
+        d[1 + S * i] = (B[i] + A[i + 1]) * 0.5 * R0 * R0 / R[i];
+        d[1 + S * i + 2] = (P[i] - P[i + 1]) * P_s;
+      }
+      if (bending) {  // the end points' radii follow the cells beside them
+        for (auto [i, w] : {std::pair{0, 1.5}, std::pair{1, -0.5}}) d[1 + S * i] += A[0] * w * 0.5 * R0 * R0 / R[i];
+        for (auto [i, w] : {std::pair{N - 1, 1.5}, std::pair{N - 2, -0.5}})
+          d[1 + S * i] += B[N] * w * 0.5 * R0 * R0 / R[i];
+      }
+    }
+    for (int i = 0; i < N; ++i) dg[n + 1 + S * i + 1] = -sys.jc.dthrust_dV[i + 1] * Vel_s;  // g2 = ... - thrust
+    for (int iz = 0; iz < 4; ++iz) {
+      double* v = Vt.data() + off + iz * std::size_t(n);
+      for (int l = 0; l < 4; ++l) {
+        const double c = s.Gi4[iz][l];
+        const double* d = dg.data() + l * std::size_t(n);
+        for (int row = 0; row < n; ++row) v[row] -= c * d[row];
+      }
+      for (const auto& sx : seg_j)
+        for (int row = 0; row < n; ++row) v[row] += sx.x[iz] * Vt[sx.off + row];
+    }
+    rank += 4;
+  } else if (confined) {
     const outer::ConfinedSystem& sys = *st.sys;
     // Q_in,j = alpha_j W + beta_j U - gamma_j (outer::ConfinedSystem::transmural)
     const std::size_t off = Ul.size();

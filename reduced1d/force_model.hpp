@@ -15,7 +15,8 @@
 // as extra differential states.
 // Force-free model (default): p_i is the transmural pressure Pi_i = p_in - p_out. Confined:
 // the lumen fluxes come from the lumen/annulus/free-pipe system of outer_flow.hpp, which also
-// gives U and Q_tot (global couplings: two more rank-1 terms in the Newton matrix).
+// gives U and Q_tot (global couplings: two more rank-1 terms in the Newton matrix; four with the
+// calibrated end junction, whose closure adds the end points' transmural pressures).
 // Unbounded: p_out = 0, the lumen fluxes are local as above and U is the slender-body
 // average of the induced axial flow (it does not feed back into the radii).
 // State scaling: A/(pi R0^2), V/(R0/T_s), p/(C1 R0), D/D_s, X/X_s, V/(pi R0^2 L).
@@ -66,6 +67,7 @@ struct ModelState {
   // outer-flow workspace
   std::unique_ptr<outer::ConfinedSystem> sys;  ///< confined outer flow (its last geometry is cached)
   std::vector<double> Rpt, Pipt, sigma, rho, u_ind, pl;
+  std::vector<double> Vpt;  ///< the wall velocity at the points (the calibrated junction's rim)
 };
 
 /// Flux sensitivities at one state: dQ_j/dR_{j-1} (QL[j]) and dQ_j/dR_j (QR[j]), through the
@@ -81,6 +83,10 @@ struct Linearisation {
   double Qb0 = 0, QbL = 0;
   std::vector<double> g1a, g1b, g1pi, g2a, g2b, g2pi;  // confined only
   double Gi[2][2] = {{0, 0}, {0, 0}};                  // confined only
+  // the calibrated junction: the end rows g3 (rear), g4 (front) per interval (nonzero on the
+  // end intervals), and the inverse of the 4 x 4 in (W, U, Pi_0, Pi_L)
+  std::vector<double> g3a, g3b, g3pi, g4a, g4b, g4pi;
+  double Gi4[4][4] = {};
 };
 
 /// Where a Jacobian's band entries go: band(i, j, v) for the entry (i, j). The Jacobians are
@@ -126,7 +132,11 @@ struct ForceModel {
   // sum_i (D/2) (R0 kappa_i / h^2)^2 2 pi R0 h (free ends: no moment, no shear).
   double D_axial;
   bool bending;
-  bool dae;            // IDA path: wall inertia, short-wave traction or axial bending
+  // The calibrated end junction (P.swimmer.end_junction, confined): the end points' transmural
+  // pressures are closure unknowns and the rims' thrust follows the wall velocities, so it
+  // runs on the IDA path (V an unknown) even without the traction.
+  bool junction;
+  bool dae;            // IDA path: wall inertia, short-wave traction, axial bending or the junction
   // Unbounded: U does not feed back into the radii. With velocity_quadrature the right-hand
   // side leaves it out (X and the U parts of the lab-frame volumes are then integrated along
   // the accepted steps by the event loop) and fluxes() computes it only when asked to.

@@ -115,6 +115,27 @@ void end_junction(const EndJunction& j, double R, double Rc, double mu, double M
   rim = j.rim[0] + j.rim[1] * xg;
 }
 
+void end_junction_d(const EndJunction& j, double R, double Rc, double mu, double M[3][3], double& rim,
+                    double dM[3][3], double& drim) {
+  end_junction(j, R, Rc, mu, M, rim);
+  const double xr = std::log(Rc / R - 1.0);
+  const double xg = std::clamp(xr, j.xg_min, j.xg_max);
+  const double dxg = (xr > j.xg_min && xr < j.xg_max) ? -Rc / (R * (Rc - R)) : 0.0;
+  double v[6], dv[6];
+  for (int k = 0; k < 6; ++k) v[k] = j.b[k][0] + j.b[k][1] * xg, dv[k] = j.b[k][1] * dxg;
+  const double B[3][3] = {{v[0], 0, 0}, {v[1], v[2], 0}, {v[3], v[4], v[5]}};
+  const double dB[3][3] = {{dv[0], 0, 0}, {dv[1], dv[2], 0}, {dv[3], dv[4], dv[5]}};
+  const double S[3] = {std::pow(R, -1.5), std::pow(R, -1.5), std::sqrt(R)};
+  const double dS[3] = {-1.5 * S[0] / R, -1.5 * S[1] / R, 0.5 * S[2] / R};
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c <= r; ++c) {
+      double bb = 0, dbb = 0;
+      for (int k = 0; k <= c; ++k) bb += B[r][k] * B[c][k], dbb += dB[r][k] * B[c][k] + B[r][k] * dB[c][k];
+      dM[r][c] = dM[c][r] = mu * ((dS[r] * S[c] + S[r] * dS[c]) * bb + S[r] * S[c] * dbb);
+    }
+  drim = j.rim[1] * dxg;
+}
+
 ConfinedSystem::ConfinedSystem(int npoints, const std::vector<double>& dd, double mu_, double a_in_, double a_out_,
                                double Rc_, double period, double L_)
     : np(npoints),
@@ -234,7 +255,11 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
   return true;
 }
 
-void ConfinedSystem::transmural(const double* Pi, double F_ext) {
+void ConfinedSystem::transmural(const double* Pi, double F_ext, const double* Rdot) {
+  if (junction) {
+    transmural_junction(Pi, F_ext, Rdot);
+    return;
+  }
   // Unknowns W = Q_tot + U A_c (the lab-frame flux through the free pipe) and U; in these the
   // 2 x 2 is well conditioned (Q_tot itself is close to -U A_c).
   //   Q_in,j = alpha_j W + beta_j U - gamma_j,  alpha = ra / (rl + ra),
@@ -265,6 +290,127 @@ void ConfinedSystem::transmural(const double* Pi, double F_ext) {
     Q_in[j] = (c.ra * W + (c.c - A_c * c.ra) * U - dPi[j]) * w[j];
     dp_tube -= c.rl * Q_in[j];
   }
+}
+
+void ConfinedSystem::transmural_junction(const double* Pi, double F_ext, const double* Rdot) {
+  // Unknowns z = (W, U, Pi_0, Pi_L); Q_in,j = alpha_j W + beta_j U - w_j dPi_j with
+  // dPi_0 = Pi_1 - Pi_0 and dPi_N = Pi_L - Pi_N. At each end x_e = (Q_in,e, Q_tot - Q_in,e, U)
+  // (e = 0: the rear face, N: the front face) and the junction's pressure p_J,e joins the
+  // lumen at p_J0 - (M_r x_r)_0 and the annulus at p_J0 - (M_r x_r)_1 (the rear), at
+  // p_JL + (M_f x_f)_0 and p_JL + (M_f x_f)_1 (the front). The four rows:
+  //   g1 = sum rl Q_in + r_free W + (M_r x_r)_0 + (M_f x_f)_0                       (periodicity)
+  //   g2 = sum (-S rl Q_in - S dPi + e U) + (M_r x_r)_2 + (M_f x_f)_2 - F_ext - thrust  (force)
+  //   g3 = Pi_0 + (M_r x_r)_0 - (M_r x_r)_1,   g4 = Pi_L - (M_f x_f)_0 + (M_f x_f)_1
+  // all affine in z: G z = -g(0).
+  JunctionClosure& J = jc;
+  const int f = ni - 1;
+  // The junction at the end radius held to the fitted range Rc / R = 1 + exp(x_g): a force-driven
+  // wave's quasi-static end radius leaves it (a held end segment pinches its end to 0.1 R0 and
+  // below), where the fit's R^-3 scale would close the wide annulus's mouth.
+  double Rj[2], in[2];
+  for (int e = 0; e < 2; ++e) {
+    const double lo = Rc / (1.0 + std::exp(junction->xg_max)), hi = Rc / (1.0 + std::exp(junction->xg_min));
+    Rj[e] = std::clamp(R_end_[e], lo, hi);
+    in[e] = (R_end_[e] > lo && R_end_[e] < hi) ? 1.0 : 0.0;
+    end_junction_d(*junction, Rj[e], Rc, mu, J.M[e], J.rim[e], J.dM[e], J.drim[e]);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) J.dM[e][r][c] *= in[e];
+    J.drim[e] *= in[e];
+  }
+  // the rims' thrust: (+ at the rear, - at the front) rim mu R sum_i wt(z_i) Rdot_i h_i
+  J.dthrust_dV.assign(np, 0.0);
+  J.thrust = 0.0;
+  J.dthrust[0] = J.dthrust[1] = 0.0;
+  if (junction->rim_length > 0 && Rdot) {
+    double z = 0;
+    for (int i = 0; i + 2 < np; ++i) {
+      z += d[i];
+      // the cell's length: the end intervals are half cells (the solver's point set)
+      const double hc = (i == 0 ? d[0] : 0.5 * d[i]) + (i + 2 == ni ? d[ni - 1] : 0.5 * d[i + 1]);
+      for (int e = 0; e < 2; ++e) {
+        const double R = Rj[e], lr = junction->rim_length * R, dist = e == 0 ? z : L - z;
+        const double wt = std::exp(-dist / lr) / lr, dwt = wt * (dist / (lr * R) - 1.0 / R);
+        const double sg = e == 0 ? 1.0 : -1.0, c = sg * mu * hc;
+        J.thrust += c * J.rim[e] * R * wt * Rdot[i + 1];
+        J.dthrust_dV[i + 1] += c * J.rim[e] * R * wt;
+        J.dthrust[e] += in[e] * c * (J.drim[e] * R * wt + J.rim[e] * wt + J.rim[e] * R * dwt) * Rdot[i + 1];
+      }
+    }
+  }
+  // interval sums with Pi_0 = Pi_L = 0 (z = 0)
+  double m11 = r_free, m12 = 0, b1 = 0, m21 = 0, m22 = 0, b2 = 0;
+  for (int j = 0; j < ni; ++j) {
+    const auto& c = k[j];
+    const double wj = w[j];
+    const double alpha = c.ra * wj, beta = (c.c - A_c * c.ra) * wj;
+    const double dpi = (j == 0 ? Pi[1] : (j == f ? -Pi[j] : Pi[j + 1] - Pi[j]));
+    m11 += c.rl * alpha;
+    m12 += c.rl * beta;
+    b1 += c.rl * dpi * wj;
+    m21 -= c.S * c.rl * alpha;
+    m22 += c.e - c.S * c.rl * beta;
+    b2 += c.S * alpha * dpi;
+  }
+  const double dpi0 = Pi[1], dpiN = -Pi[f];
+  const double Q0z = -w[0] * dpi0, QNz = -w[f] * dpiN;  // the end fluxes at z = 0
+  // g(0) and G without the ends' dissipation
+  double g0[4] = {-b1, -b2 - F_ext - J.thrust, 0.0, 0.0};
+  double G[4][4] = {{m11, m12, k[0].rl * w[0], -k[f].rl * w[f]},
+                    {m21, m22, k[0].S * k[0].ra * w[0], -k[f].S * k[f].ra * w[f]},
+                    {0, 0, 1, 0},
+                    {0, 0, 0, 1}};
+  // the ends: d(M x_e)_r / dz = (M_r0 - M_r1) n_e + M_r1 (1, -A_c, 0, 0) + M_r2 (0, 1, 0, 0)
+  const double ne[2][4] = {{k[0].ra * w[0], (k[0].c - A_c * k[0].ra) * w[0], w[0], 0.0},
+                           {k[f].ra * w[f], (k[f].c - A_c * k[f].ra) * w[f], 0.0, -w[f]}};
+  const double Qez[2] = {Q0z, QNz};
+  // row weights of (M x_e)_0, _1, _2 in g1 .. g4
+  const double wr[2][4][3] = {{{1, 0, 0}, {0, 0, 1}, {1, -1, 0}, {0, 0, 0}}, {{1, 0, 0}, {0, 0, 1}, {0, 0, 0}, {-1, 1, 0}}};
+  for (int e = 0; e < 2; ++e) {
+    const auto& Me = J.M[e];
+    for (int r = 0; r < 3; ++r) {
+      double dz[4];
+      for (int m = 0; m < 4; ++m) dz[m] = (Me[r][0] - Me[r][1]) * ne[e][m];
+      dz[0] += Me[r][1];
+      dz[1] += -A_c * Me[r][1] + Me[r][2];
+      const double v0 = (Me[r][0] - Me[r][1]) * Qez[e];
+      for (int row = 0; row < 4; ++row) {
+        const double c = wr[e][row][r];
+        if (c == 0.0) continue;
+        g0[row] += c * v0;
+        for (int m = 0; m < 4; ++m) G[row][m] += c * dz[m];
+      }
+    }
+  }
+  Eigen::Matrix4d A;
+  Eigen::Vector4d b;
+  for (int r = 0; r < 4; ++r) {
+    for (int m = 0; m < 4; ++m) A(r, m) = J.G[r][m] = G[r][m];
+    b(r) = -g0[r];
+  }
+  const Eigen::Vector4d x = A.partialPivLu().solve(b);
+  W = x(0);
+  U = x(1);
+  J.Pi0 = x(2);
+  J.PiL = x(3);
+  Q_tot = W - A_c * U;
+  M[0][0] = m11, M[0][1] = m12, M[1][0] = m21, M[1][1] = m22;  // the plain 2 x 2 (drag_coefficient)
+  dp_tube = 0;
+  for (int j = 0; j < ni; ++j) {
+    const auto& c = k[j];
+    const double Pa = j == 0 ? J.Pi0 : Pi[j], Pb = j == f ? J.PiL : Pi[j + 1];
+    dPi[j] = Pb - Pa;
+    Q_in[j] = (c.ra * W + (c.c - A_c * c.ra) * U - dPi[j]) * w[j];
+    dp_tube -= c.rl * Q_in[j];
+  }
+  for (int e = 0; e < 2; ++e) {
+    const double q = e == 0 ? Q_in[0] : Q_in[f];
+    J.x[e][0] = q, J.x[e][1] = Q_tot - q, J.x[e][2] = U;
+    const auto& Me = J.M[e];
+    mouth_[e] = Me[0][0] * J.x[e][0] + Me[0][1] * J.x[e][1] + Me[0][2] * J.x[e][2];
+  }
+  // junction pressure rise p_JL - p_J0: the lumen's drop and both mouths
+  dp_tube -= mouth_[0] + mouth_[1];
+  rl_end_[0] = rl_end_[1] = 0.0;
 }
 
 void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {

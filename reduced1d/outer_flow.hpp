@@ -117,11 +117,30 @@ inline constexpr EndJunction kCalibratedJunction{{{1.7528618, -0.3296076},
 /// The junction's dissipation matrix M (row-major 3 x 3, units of q_l, q_a: Pa s / m^3, of U:
 /// Pa s m) and rim thrust coefficient at an end of membrane radius R in the container Rc.
 void end_junction(const EndJunction& j, double R, double Rc, double mu, double M[3][3], double& rim);
+/// The same with the derivatives dM/dR and d rim/dR (zero where x_g is clamped).
+void end_junction_d(const EndJunction& j, double R, double Rc, double mu, double M[3][3], double& rim,
+                    double dM[3][3], double& drim);
+
+/// The calibrated junction in the force-driven closure (ConfinedSystem::transmural with a
+/// junction, docs/outer-flow-1d.md §2c): the unknowns z = (W, U, Pi_0, Pi_L), the transmural
+/// pressures at the end points no longer zero, and what the Newton matrix needs of them.
+struct JunctionClosure {
+  double G[4][4] = {};       ///< d g / d z of the four rows (periodicity, force, rear, front)
+  double M[2][3][3] = {};    ///< the ends' dissipation matrices (rear, front)
+  double dM[2][3][3] = {};   ///< their derivatives with respect to the end radius
+  double rim[2] = {}, drim[2] = {};  ///< rim coefficients and d/dR
+  double x[2][3] = {};       ///< the ends' (q_l, q_a, U)
+  double Pi0 = 0, PiL = 0;   ///< the end points' transmural pressures
+  double thrust = 0;         ///< the rims' thrust on the tube (the force row's right side)
+  double dthrust[2] = {};    ///< its derivative with respect to each end radius
+  std::vector<double> dthrust_dV;  ///< d thrust / d Rdot at the points (0 at the ends)
+};
 
 /// The confined lubrication system on the point set {0, z_0, ..., z_{N-1}, L} (N + 2 points,
 /// N + 1 intervals; interval j contains face j). Two ways to close it:
 ///  - transmural(): force-driven wave, Pi = p_in - p_out known at the points (0 at both ends);
-///    unknowns Q_tot and U (2 x 2);
+///    unknowns Q_tot and U (2 x 2); with the junction Pi at the two end points joins them
+///    (4 x 4 in W, U, Pi_0, Pi_L; JunctionClosure);
 ///  - kinematic(): prescribed wave, lumen flux known up to its value at the rear,
 ///    Q_in,j = Q_in,0 - s_j; unknowns Q_in,0, Q_tot, U and the pressure rise pL - p0 (4 x 4).
 /// After either, Q_in (per face), the pressures and the force split are available.
@@ -134,7 +153,9 @@ class ConfinedSystem {
   /// container or the lumen closes: then nothing else is valid).
   /// `derivatives`: also the d/dR_o of the point functions (for the Newton matrix).
   bool geometry(const double* Rpt, bool derivatives = false);
-  void transmural(const double* Pi, double F_ext = 0.0);
+  /// With `junction` (set before the call) the end points' Pi are unknowns (their given values
+  /// are ignored) and `Rdot`, the wall's radial velocity at the points, drives the rim thrust.
+  void transmural(const double* Pi, double F_ext = 0.0, const double* Rdot = nullptr);
   /// d/dR_o of the point functions at point p (valid after geometry()).
   const AnnulusPoint<double>& point_derivative(int p) const { return dpts_[p]; }
   /// With `ends` (set before the call) the two ends' extensions join the sums.
@@ -156,7 +177,8 @@ class ConfinedSystem {
   double U = 0, Q_tot = 0, dp_tube = 0;  ///< velocity, total swimmer-frame flux, pL - p0
   double W = 0;                          ///< Q_tot + U pi Rc^2: lab-frame flux through the free pipe
   EndEffects ends;                       ///< the open ends' extensions (kinematic() only)
-  const EndJunction* junction = nullptr;  ///< the calibrated end junction (kinematic() only)
+  const EndJunction* junction = nullptr;  ///< the calibrated end junction
+  JunctionClosure jc;                     ///< transmural() with a junction: its closure
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
 
  private:
@@ -164,7 +186,8 @@ class ConfinedSystem {
   std::vector<double> lambda_, last_Ro_;  // geometry() workspace and the radii of pts_
   double R_end_[2] = {0, 0};               // membrane radius at the two ends (geometry())
   double rl_end_[2] = {0, 0};              // the lumen end resistances of the last kinematic()
-  double mouth_[2] = {0, 0};               // the junction's lumen pressure drops of the last kinematic()
+  double mouth_[2] = {0, 0};               // the junction's lumen pressure drops of the last closure
+  void transmural_junction(const double* Pi, double F_ext, const double* Rdot);
   std::vector<double> R_pt_;               // the point radii of the last geometry() (with a junction)
   std::vector<int> changed_;
   bool interval_valid_ = false;  // k and w match last_Ro_ (set by a plain geometry() call)

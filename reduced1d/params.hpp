@@ -143,7 +143,8 @@ struct Swimmer {
   /// a rigid extension of the lumen by end_lumen R_i and of the annulus by end_annulus (Rc - R_o)
   /// (docs/outer-flow-1d.md §2b). 0: the plain lubrication junction.
   double end_lumen = 0.0, end_annulus = 0.0;
-  /// The open ends as the calibrated junction (outer::kCalibratedJunction; prescribed waves)
+  /// The open ends as the calibrated junction (outer::kCalibratedJunction; prescribed and
+  /// force-driven waves, docs/outer-flow-1d.md §2c)
   bool end_junction = false;
   /// Short-wave wall traction (force-driven wave only): the viscous normal stress 2 mu |k| Rdot
   /// that each fluid (lumen, outside) exerts on a wall moving at axial wavenumbers the

@@ -250,11 +250,14 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
                        "is negligible: its time scale 2 pi sqrt(m / C1) is below 0.1 ms)");
     // default on for the force-free force-driven wave (docs/outer-flow-1d.md, 3b)
     if (const std::string ends = m.choice("end_effects", "none", {"none", "open_ends", "junction"}); ends != "none") {
-      if (p.swimmer.model != SwimmerModel::ForceFree || p.swimmer.outer != OuterFlow::Confined || forced)
+      if (p.swimmer.model != SwimmerModel::ForceFree || p.swimmer.outer != OuterFlow::Confined)
         throw InputError(m.path("end_effects"), "\"" + ends + "\"",
                          "the open ends' flow is modelled for the confined force-free model (model1d.model = "
-                         "\"force_free\", model1d.outer_flow = \"confined\") with a prescribed wave (wave.kind = "
-                         "\"step\" or \"sine\"); use \"none\" here");
+                         "\"force_free\", model1d.outer_flow = \"confined\"); use \"none\" here");
+      if (forced && ends != "junction")
+        throw InputError(m.path("end_effects"), "\"" + ends + "\"",
+                         "with wave.kind = \"force_driven\" the open ends are modelled by the calibrated junction; "
+                         "use \"junction\" or \"none\" here");
       if (ends == "open_ends") {
         p.swimmer.end_lumen = outer::kOpenEnds.lumen;
         p.swimmer.end_annulus = outer::kOpenEnds.annulus;

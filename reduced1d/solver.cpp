@@ -58,6 +58,13 @@ void validate(const Params& p) {
   if (p.wall.inertia && p.swimmer.model == SwimmerModel::ForceFree && p.swimmer.outer == OuterFlow::Confined)
     throw InputError("model1d.wall_inertia", "true", "not available with the confined force-free model");
   require(p.swimmer.a_out >= 0, "model1d.hydraulic_offsets.outer", p.swimmer.a_out, "must be >= 0");
+  if ((p.swimmer.end_junction || p.swimmer.end_lumen > 0 || p.swimmer.end_annulus > 0) &&
+      (p.swimmer.model != SwimmerModel::ForceFree || p.swimmer.outer != OuterFlow::Confined))
+    throw InputError("model1d.end_effects", p.swimmer.end_junction ? "\"junction\"" : "\"open_ends\"",
+                     "the open ends' flow is modelled for the confined force-free model");
+  if (p.wave == WaveKind::ForceDriven && (p.swimmer.end_lumen > 0 || p.swimmer.end_annulus > 0))
+    throw InputError("model1d.end_effects", "\"open_ends\"",
+                     "with wave.kind = \"force_driven\" the open ends are modelled by the calibrated junction");
   switch (p.wave) {
     case WaveKind::Step:
       require(p.step.R_min > 0, "wave.contracted_radius", p.step.R_min, "must be positive");

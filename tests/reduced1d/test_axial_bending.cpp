@@ -140,6 +140,27 @@ TEST(AxialBending, AnalyticJacobianMatchesFiniteDifferences) {
     }
 }
 
+// The same with the calibrated end junction (confined): the end radii follow the cells beside
+// them, and the junction's dissipation matrices and rim thrust follow the end radii.
+TEST(AxialBending, AnalyticJacobianMatchesFiniteDifferencesWithTheJunction) {
+  for (bool traction : {true, false}) {
+    Params p;
+    p.wave = WaveKind::ForceDriven;
+    p.swimmer.short_wave_traction = traction;
+    p.swimmer.end_junction = true;
+    p.wall.D_axial = kD;
+    p.numerics.cells = 37;
+    const int n = p.protocol.segments;
+    for (auto [phase, active] : {std::pair{0, 2}, std::pair{1, 0}})
+      for (unsigned seed : {1u, 2u}) {
+        const auto c = test::check_jacobian(p, phase, active, seed);
+        EXPECT_LT(c.max_rel_error, 1e-6) << "traction=" << traction << " phase=" << phase;
+        const int held = phase == 0 ? n - 1 - active : 0;
+        EXPECT_EQ(c.rank, held + 4);
+      }
+  }
+}
+
 // The paper's short tube (`paper_aspect_L0.2`, its own protocol, load and 1D model): a
 // vanishing rigidity gives the local law's cycle within 5e-3 (measured 2.2e-3 in both the
 // displacement and the cycle time: a bending wall's open ends follow the wall, straight through

@@ -3,7 +3,9 @@
 // and the exact Newton matrix of the confined model.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -157,6 +159,33 @@ TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
           EXPECT_EQ(c.rank, held + (outer == OuterFlow::Confined ? 2 : 0));
         }
     }
+}
+
+// The same with the calibrated end junction (model1d.end_effects = "junction", IDA path with or
+// without the traction): the closure's unknowns are (W, U, Pi_0, Pi_L), four rank-1 terms whose
+// dependence on the state runs through the end cells' radii and pressures, the end radii (held
+// end segments) and the wall velocities near the ends (the rims' thrust).
+TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferencesWithTheJunction) {
+  double worst = 0;
+  for (bool traction : {false, true})
+    for (int N : {37, 60}) {
+      Params p = force_free_cycle(N);
+      p.swimmer.short_wave_traction = traction;
+      p.swimmer.end_junction = true;
+      p.swimmer.a_in = 2e-9;
+      p.swimmer.a_out = 3e-9;
+      const int n = p.protocol.segments;
+      for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
+        for (unsigned seed : {1u, 2u}) {
+          const auto c = test::check_jacobian(p, phase, active, seed);
+          EXPECT_LT(c.max_rel_error, 1e-6)
+              << "traction=" << traction << " N=" << N << " phase=" << phase << " active=" << active;
+          const int held = phase == 0 ? n - 1 - active : 0;
+          EXPECT_EQ(c.rank, held + 4);
+          worst = std::max(worst, c.max_rel_error);
+        }
+    }
+  std::printf("largest relative entry error with the junction: %.2e\n", worst);
 }
 
 // Prescribed waves of the force-free model integrate X and the end volumes by quadrature on

@@ -5,6 +5,7 @@
 // against the closed form of the extended channels, mirror symmetry and the scallop theorem.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <random>
@@ -409,4 +410,91 @@ TEST(OuterFlowJunction, MirroredProfilesSwimTheOtherWay) {
 // Scallop theorem with the junction, the rim's thrust included.
 TEST(OuterFlowJunction, ReciprocalStrokeGivesNoNetDisplacement) {
   expect_reciprocal_stroke_returns([](ConfinedSystem& s) { s.junction = &kCalibratedJunction; });
+}
+
+// The force-driven closure with the junction (transmural, unknowns W, U, Pi_0, Pi_L) is the
+// kinematic one's physics: the transmural pressures that the kinematic closure's solution
+// implies at the cells (Pi_0 = (M_r x_r)_1 - (M_r x_r)_0 at the rear, then per interval
+// dPi = -rl Q_in + ra Q_out + c U), with the same wall velocities, give back its U, fluxes,
+// end transmural pressures and lumen pressures.
+TEST(OuterFlowJunction, TransmuralClosureReproducesTheKinematicOne) {
+  std::mt19937 g(23);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.5, 1.3);
+  for (int N : {8, 33}) {
+    const auto d = intervals(N, kL);
+    const double h = kL / N;
+    std::vector<double> R(N + 2);
+    for (auto& r : R) r = u(g) * kR0;
+    ConfinedSystem a(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL), b(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
+    a.junction = b.junction = &kCalibratedJunction;
+    ASSERT_TRUE(a.geometry(R.data()));
+    ASSERT_TRUE(b.geometry(R.data()));
+    std::vector<double> s(N + 1), Rdot(N + 2, 0.0);
+    for (int j = 0; j < N; ++j) s[j + 1] = s[j] + h * 1e-15 * n(g);
+    for (int i = 0; i < N; ++i) Rdot[i + 1] = (s[i + 1] - s[i]) / (2 * pi * R[i + 1] * h);
+    const double F = 1e-16 * n(g);
+    a.kinematic(s.data(), F);
+    double M[3][3], rim;
+    end_junction(kCalibratedJunction, R[0], kRc, kMu, M, rim);
+    const double x[3] = {a.Q_in[0], a.Q_tot - a.Q_in[0], a.U};
+    std::vector<double> Pi(N + 2);
+    Pi[0] = 0;
+    for (int c = 0; c < 3; ++c) Pi[0] += (M[1][c] - M[0][c]) * x[c];
+    for (int j = 0; j <= N; ++j) {
+      const auto& k = a.k[j];
+      Pi[j + 1] = Pi[j] - k.rl * a.Q_in[j] + k.ra * (a.Q_tot - a.Q_in[j]) + k.c * a.U;
+    }
+    std::vector<double> Pg = Pi;
+    Pg.front() = Pg.back() = 1e300;  // the end values are unknowns of the closure, not read
+    b.transmural(Pg.data(), F, Rdot.data());
+    EXPECT_GT(std::abs(a.U), 0.0);
+    EXPECT_NEAR(b.U, a.U, 1e-9 * std::abs(a.U)) << N;
+    EXPECT_NEAR(b.Q_tot, a.Q_tot, 1e-9 * std::abs(a.Q_tot)) << N;
+    double scale = 0;
+    for (double v : Pi) scale = std::max(scale, std::abs(v));
+    EXPECT_NEAR(b.jc.Pi0, Pi.front(), 1e-9 * scale) << N;
+    EXPECT_NEAR(b.jc.PiL, Pi.back(), 1e-9 * scale) << N;
+    EXPECT_GT(std::abs(Pi.front()), 1e-3 * scale) << "the end transmural pressure is not zero";
+    for (int j = 0; j <= N; ++j) EXPECT_NEAR(b.Q_in[j], a.Q_in[j], 1e-9 * std::abs(a.Q_tot) + 1e-9 * std::abs(a.Q_in[j])) << j;
+    std::vector<double> pa, pb;
+    a.lumen_pressure(pa);
+    b.lumen_pressure(pb);
+    double ps = 0;
+    for (double v : pa) ps = std::max(ps, std::abs(v));
+    for (int k = 0; k < N + 2; ++k) EXPECT_NEAR(pb[k], pa[k], 1e-9 * ps) << k;
+  }
+}
+
+// Mirror z -> L - z of the force-driven closure with the junction: mirrored radii, transmural
+// pressures and wall velocities swim the other way, the two end transmural pressures exchanged;
+// and the junction changes the answer of the plain closure.
+TEST(OuterFlowJunction, TransmuralMirroredProfilesSwimTheOtherWay) {
+  std::mt19937 g(29);
+  std::normal_distribution<double> n(0.0, 1.0);
+  std::uniform_real_distribution<double> u(0.5, 1.3);
+  for (int N : {8, 33}) {
+    const auto d = intervals(N, kL);
+    std::vector<double> R(N + 2), Pi(N + 2), Rdot(N + 2);
+    for (auto& r : R) r = u(g) * kR0;
+    for (auto& v : Pi) v = n(g);
+    for (auto& v : Rdot) v = 1e-6 * n(g);
+    Pi.front() = Pi.back() = 0.0;
+    std::vector<double> Rm(R.rbegin(), R.rend()), Pim(Pi.rbegin(), Pi.rend()), Rdm(Rdot.rbegin(), Rdot.rend());
+    ConfinedSystem a(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL), b(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL),
+        c(N + 2, d, kMu, 1e-9, 2e-9, kRc, kP, kL);
+    a.junction = b.junction = &kCalibratedJunction;
+    ASSERT_TRUE(a.geometry(R.data()));
+    ASSERT_TRUE(b.geometry(Rm.data()));
+    ASSERT_TRUE(c.geometry(R.data()));
+    a.transmural(Pi.data(), 0.0, Rdot.data());
+    b.transmural(Pim.data(), 0.0, Rdm.data());
+    c.transmural(Pi.data());
+    EXPECT_GT(std::abs(a.U), 0.0);
+    EXPECT_NEAR(b.U, -a.U, 1e-11 * std::abs(a.U));
+    EXPECT_NEAR(b.Q_tot, -a.Q_tot, 1e-10 * std::abs(a.Q_tot));
+    EXPECT_NEAR(b.jc.Pi0, a.jc.PiL, 1e-10 * (std::abs(a.jc.Pi0) + std::abs(a.jc.PiL)));
+    EXPECT_NEAR(b.jc.PiL, a.jc.Pi0, 1e-10 * (std::abs(a.jc.Pi0) + std::abs(a.jc.PiL)));
+    EXPECT_GT(std::abs(c.U - a.U), 1e-3 * std::abs(a.U)) << "the junction changes the answer";
+  }
 }
