@@ -472,12 +472,12 @@ void ConfinedSystem::kinematic(const double* s_cum, double F_ext) {
     const int rows[3] = {0, 1, 3};
     for (int e = 0; e < 2; ++e) {
       const double se = e == 0 ? 0.0 : sN;
-      const auto& M = Mj[e];
+      const auto& Me = Mj[e];
       for (int r = 0; r < 3; ++r) {
-        A(rows[r], 0) += M[r][0] - M[r][1];
-        A(rows[r], 1) += M[r][1];
-        A(rows[r], 2) += M[r][2];
-        b(rows[r]) -= (M[r][1] - M[r][0]) * se;
+        A(rows[r], 0) += Me[r][0] - Me[r][1];
+        A(rows[r], 1) += Me[r][1];
+        A(rows[r], 2) += Me[r][2];
+        b(rows[r]) -= (Me[r][1] - Me[r][0]) * se;
       }
       // the rim's thrust: away from the end for a contraction next to it
       b(3) += (e == 0 ? 1.0 : -1.0) * rim[e] * mu * R_end_[e] * rim_rate[e];
