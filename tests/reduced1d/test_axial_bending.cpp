@@ -119,46 +119,31 @@ TEST(AxialBending, WallRowIsTheGradientOfTheBendingEnergy) {
 
 // The Newton matrix with the curvature unknowns (band part and the low-rank segment and closure
 // terms) against central differences of the residual, confined and unbounded, with and
-// without the short-wave traction (without it the bending alone takes the IDA path).
+// without the short-wave traction (without it the bending alone takes the IDA path), and with
+// the calibrated end junction (confined): the end radii follow the cells beside them, and the
+// junction's dissipation matrices and rim thrust follow the end radii.
 TEST(AxialBending, AnalyticJacobianMatchesFiniteDifferences) {
+  for (bool junction : {false, true})
   for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
     for (bool traction : {true, false}) {
+      if (junction && outer != OuterFlow::Confined) continue;  // the junction belongs to the confined closure
       Params p;
       p.wave = WaveKind::ForceDriven;
       p.swimmer.outer = outer;
       p.swimmer.short_wave_traction = traction;
+      p.swimmer.end_junction = junction;
       p.wall.D_axial = kD;
       p.numerics.cells = 37;
       const int n = p.protocol.segments;
+      const int closure = outer == OuterFlow::Confined ? (junction ? 4 : 2) : 0;
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
           const auto c = test::check_jacobian(p, phase, active, seed);
-          EXPECT_LT(c.max_rel_error, 1e-6) << "traction=" << traction << " phase=" << phase;
+          EXPECT_LT(c.max_rel_error, 1e-6) << "junction=" << junction << " traction=" << traction << " phase=" << phase;
           const int held = phase == 0 ? n - 1 - active : 0;
-          EXPECT_EQ(c.rank, held + (outer == OuterFlow::Confined ? 2 : 0));
+          EXPECT_EQ(c.rank, held + closure);
         }
     }
-}
-
-// The same with the calibrated end junction (confined): the end radii follow the cells beside
-// them, and the junction's dissipation matrices and rim thrust follow the end radii.
-TEST(AxialBending, AnalyticJacobianMatchesFiniteDifferencesWithTheJunction) {
-  for (bool traction : {true, false}) {
-    Params p;
-    p.wave = WaveKind::ForceDriven;
-    p.swimmer.short_wave_traction = traction;
-    p.swimmer.end_junction = true;
-    p.wall.D_axial = kD;
-    p.numerics.cells = 37;
-    const int n = p.protocol.segments;
-    for (auto [phase, active] : {std::pair{0, 2}, std::pair{1, 0}})
-      for (unsigned seed : {1u, 2u}) {
-        const auto c = test::check_jacobian(p, phase, active, seed);
-        EXPECT_LT(c.max_rel_error, 1e-6) << "traction=" << traction << " phase=" << phase;
-        const int held = phase == 0 ? n - 1 - active : 0;
-        EXPECT_EQ(c.rank, held + 4);
-      }
-  }
 }
 
 // The paper's short tube (`paper_aspect_L0.2`, its own protocol, load and 1D model): a
