@@ -223,7 +223,11 @@ def velocity_figure(case, path):
     fig.suptitle(title)
     handles, labels = ax[0].get_legend_handles_labels()
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize="small", frameon=False)
-    fig.tight_layout(rect=(0, 0.14, 1, 1))
+    # room below the panels for the legend's rows (about 0.18 inch each) and a gap above them
+    rows = math.ceil(len(labels) / 3)
+    below = 0.18 * rows + 0.12
+    fig.set_size_inches(12, 4.0 + below)
+    fig.tight_layout(rect=(0, below / (4.0 + below), 1, 1))
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
@@ -406,9 +410,14 @@ def pareto_figure(report, path):
                                          fontsize=7, xytext=(4, -10) if below else (-4, 4),
                                          textcoords="offset points", ha="left" if below else "right"))
     ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)")
-    sub = f"{len(cases)} cases, one line per case and axis" if many else "error against the extrapolated 3D reference"
-    fig.suptitle(f"Speed against accuracy: {report['suite']} suite\n({sub}; error against the 3D reference)"
-                 if many else f"Speed against accuracy: {report['suite']} suite\n({sub})")
+    # each case's error is taken against its judged reference: the axisymmetric one where the
+    # case has it, else the 3D extrapolation
+    axi = [bool(c.get("reference")) for c in cases]
+    against = ("error against the converged axisymmetric reference" if all(axi)
+               else "error against the extrapolated 3D reference" if not any(axi)
+               else "error against the axisymmetric reference where a case has one, else the 3D extrapolation")
+    sub = f"{len(cases)} cases, one line per case and axis\n{against}" if many else against
+    fig.suptitle(f"Speed against accuracy: {report['suite']} suite\n{sub}")
     legend_right(ax)
     fig.tight_layout()  # the final axes size, so that the labels are placed where they are drawn
     declutter(fig, texts)
