@@ -33,6 +33,16 @@ void single_threaded_blas() {
   (void)done;
 }
 
+}  // namespace
+
+std::string blas_provider() {
+  using Config = char* (*)();
+  if (auto f = reinterpret_cast<Config>(dlsym(RTLD_DEFAULT, "openblas_get_config")))
+    if (const char* c = f()) return std::string(c).rfind("OpenBLAS", 0) == 0 ? std::string(c) : "OpenBLAS " + std::string(c);
+  return "not OpenBLAS (the reference BLAS or another provider)";
+}
+
+namespace {
 
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 constexpr int kLoc = 21;  // 9 nodes x 2 velocity components + 3 pressure coefficients

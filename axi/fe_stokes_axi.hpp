@@ -101,11 +101,18 @@
 #include <cstddef>
 #include <functional>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "axi/fitted_mesh.hpp"
 
 namespace swim::axi {
+
+/// The BLAS that UMFPACK's dense kernels run in, as the run's statistics report it: OpenBLAS's
+/// own configuration string when it is the provider (looked up at run time), otherwise
+/// "not OpenBLAS (the reference BLAS or another provider)". The fitted method's factorisations
+/// take about 1.5 times the CPU time on Debian's reference BLAS (docs/performance.md).
+std::string blas_provider();
 
 class FittedStokes {
  public:

@@ -684,7 +684,11 @@ class Runner {
                   {"protocol_switches", protocol_.state().switches},
                   {"wall_time_s", wall},
                   {"wall_time_split_s", split_json()}};
-    if (fitted_) rec_.stats["fitted_unknowns"] = flow_->unknowns(), rec_.stats["fitted_nonzeros"] = flow_->nonzeros();
+    if (fitted_) {
+      rec_.stats["fitted_unknowns"] = flow_->unknowns();
+      rec_.stats["fitted_nonzeros"] = flow_->nonzeros();
+      rec_.stats["blas"] = blas_provider();
+    }
   }
 
   json split_json() const {

@@ -9,6 +9,7 @@
 #include <memory>
 #include <optional>
 
+#include "axi/fe_stokes_axi.hpp"
 #include "axi/prescribed_axi.hpp"
 #include "axi/run_axi.hpp"
 #include "axi/run_folder_axi.hpp"
@@ -154,6 +155,7 @@ class PrescribedRunner {
                   {"stokes_solves", tm.solves},
                   {"fitted_unknowns", swimmer_->stokes().unknowns()},
                   {"fitted_nonzeros", swimmer_->stokes().nonzeros()},
+                  {"blas", blas_provider()},
                   {"quadrature_tolerance_m", tol_X_},
                   {"wall_time_s", wall},
                   {"wall_time_split_s",

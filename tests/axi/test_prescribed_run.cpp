@@ -3,6 +3,8 @@
 // a step and a sine wave against the 1D tier's force-free lubrication model on the same scene.
 #include <gtest/gtest.h>
 
+#include <dlfcn.h>
+
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -79,6 +81,12 @@ Pair run_both(const json& sc, const std::string& tag) {
   std::printf("  %ld prescribed solves, %ld quadrature pieces, %s\n", out.record.stats["prescribed_solves"].get<long>(),
               out.record.stats["quadrature_pieces"].get<long>(), out.record.stats["wall_time_split_s"].dump().c_str());
   EXPECT_LT(std::abs(dv - inflow), tol_v);
+  // the statistics name the BLAS that ran UMFPACK's kernels: OpenBLAS exactly when its symbols
+  // are in the process
+  const std::string blas = out.record.stats.value("blas", std::string());
+  const bool openblas = dlsym(RTLD_DEFAULT, "openblas_get_config") != nullptr;
+  EXPECT_EQ(blas.rfind("OpenBLAS", 0) == 0, openblas) << blas;
+  EXPECT_EQ(blas.rfind("not OpenBLAS", 0) == 0, !openblas) << blas;
   EXPECT_EQ(out.summary["model"], "axisymmetric_fitted_finite_elements");
   EXPECT_NEAR(out.summary["t_end_s"].get<double>(), p.base.wave.transit(p.base.L), 1e-12);
   return r;
