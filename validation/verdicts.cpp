@@ -302,36 +302,36 @@ json findings(const json& cases, const json& th) {
   const auto trends = [&](bool one_d) {
     const std::string on = one_d ? " (1D tier, the suite's default 1D model)" : "";
     const std::string settle_suffix = one_d ? ": a finer 1D grid (numerics1d.cells)" : kSettleSuffix;
+    // a trend claimed pairwise, "the value at i exceeds the value at j" for each pair (i, j)
+    // the rule gives on the sweep's n points
+    using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
+    const auto pairwise = [&](const std::string& claim, const auto& sweep, const std::string& key, const char* axis,
+                              const char* unit, const auto& pairs_of) {
+      json ev = json::array();
+      std::string missing;
+      const auto p = points(sweep, key, axis, ev, missing, one_d);
+      out.push_back(trend(claim + on, p, missing, ev, pairs_of(p.size()), unit, settle_suffix));
+    };
     // distance per cycle grows with L: each L against the next
-    {
-      json ev = json::array();
-      std::string missing;
-      const auto p = points(aspect, kd, "L_um", ev, missing, one_d);
-      std::vector<std::pair<std::size_t, std::size_t>> pairs;
-      for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i + 1, i);
-      out.push_back(
-          trend("distance per cycle grows with the swimmer length L" + on, p, missing, ev, pairs, "m", settle_suffix));
-    }
+    pairwise("distance per cycle grows with the swimmer length L", aspect, kd, "L_um", "m", [](std::size_t n) {
+      Pairs q;
+      for (std::size_t i = 0; i + 1 < n; ++i) q.emplace_back(i + 1, i);
+      return q;
+    });
     // ... and with the amplitude: the sweep value is R_f / R0, the deformation grows as it falls
-    {
-      json ev = json::array();
-      std::string missing;
-      const auto p = points(amplitude, kd, "R_f_over_R0", ev, missing, one_d);
-      std::vector<std::pair<std::size_t, std::size_t>> pairs;
-      for (std::size_t i = 0; i + 1 < p.size(); ++i) pairs.emplace_back(i, i + 1);
-      out.push_back(
-          trend("distance per cycle grows with the deformation amplitude" + on, p, missing, ev, pairs, "m", settle_suffix));
-    }
+    pairwise("distance per cycle grows with the deformation amplitude", amplitude, kd, "R_f_over_R0", "m",
+             [](std::size_t n) {
+               Pairs q;
+               for (std::size_t i = 0; i + 1 < n; ++i) q.emplace_back(i, i + 1);
+               return q;
+             });
     // the shortest swimmer against every other
-    {
-      json ev = json::array();
-      std::string missing;
-      const auto p = points(aspect, kv, "L_um", ev, missing, one_d);
-      std::vector<std::pair<std::size_t, std::size_t>> pairs;
-      for (std::size_t j = 1; j < p.size(); ++j) pairs.emplace_back(0, j);
-      out.push_back(
-          trend("mean velocity per cycle is largest for the shortest swimmer" + on, p, missing, ev, pairs, "m/s", settle_suffix));
-    }
+    pairwise("mean velocity per cycle is largest for the shortest swimmer", aspect, kv, "L_um", "m/s",
+             [](std::size_t n) {
+               Pairs q;
+               for (std::size_t j = 1; j < n; ++j) q.emplace_back(0, j);
+               return q;
+             });
     // largest at about 50 % deformation (R_f / R0 within 0.1 of 0.5): some case there exceeds
     // every case away from it
     {
