@@ -16,68 +16,6 @@ namespace swim::reduced1d {
 double RecordedRadius::min_radius() const { return *std::min_element(R.begin(), R.end()); }
 double RecordedRadius::max_radius() const { return *std::max_element(R.begin(), R.end()); }
 
-void RecordedRadius::locate(double time, std::size_t& k, double& theta) const {
-  const double T = period();
-  double tt = time - t.front();
-  if (tt > T) {  // a longer run repeats the record
-    tt = std::fmod(tt, T);
-    if (tt == 0.0) tt = T;  // the end of a repetition is the end of the record
-  }
-  if (tt < 0) tt = 0;
-  tt += t.front();
-  const std::size_t n = t.size();
-  // the interval with t[k] <= tt < t[k + 1]; the last time belongs to the last interval
-  k = std::size_t(std::upper_bound(t.begin(), t.end(), tt) - t.begin());
-  k = k == 0 ? 0 : k - 1;
-  if (k > n - 2) k = n - 2;
-  theta = (tt - t[k]) / (t[k + 1] - t[k]);
-}
-
-namespace {
-/// The bracketing rings and the weight of the upper one at zq (linear extrapolation from the
-/// end rings outside their span).
-inline void z_weights(const std::vector<double>& z, double zq, std::size_t& j, double& w) {
-  const std::size_t m = z.size();
-  j = std::size_t(std::upper_bound(z.begin(), z.end(), zq) - z.begin());
-  j = j == 0 ? 0 : j - 1;
-  if (j > m - 2) j = m - 2;
-  w = (zq - z[j]) / (z[j + 1] - z[j]);
-}
-}  // namespace
-
-void RecordedRadius::eval(double zq, double time, double& Rq, double& Rt) const {
-  std::size_t k, j;
-  double th, w;
-  locate(time, k, th);
-  z_weights(z, zq, j, w);
-  const std::size_t m = z.size();
-  const double dt = t[k + 1] - t[k];
-  const double* a = R.data() + k * m;
-  const double* b = a + m;
-  const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
-  Rq = (1 - w) * ra + w * rb;
-  Rt = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
-}
-
-void RecordedRadius::eval_uniform(double z0, double dz, int n, double time, double* Rq, double* Rt) const {
-  std::size_t k;
-  double th;
-  locate(time, k, th);
-  const std::size_t m = z.size();
-  const double dt = t[k + 1] - t[k];
-  const double* a = R.data() + k * m;
-  const double* b = a + m;
-  std::size_t j = 0;
-  for (int i = 0; i < n; ++i) {
-    const double zq = z0 + i * dz;
-    while (j + 2 < m && z[j + 1] <= zq) ++j;  // points increase: walk the rings once
-    const double w = (zq - z[j]) / (z[j + 1] - z[j]);
-    const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
-    Rq[i] = (1 - w) * ra + w * rb;
-    Rt[i] = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
-  }
-}
-
 namespace {
 
 bool parse_number(std::string_view s, double& v) {

@@ -13,6 +13,8 @@
 // time.duration repeats it.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 #include <memory>
 #include <string>
@@ -36,6 +38,63 @@ struct RecordedRadius {
   /// R and dR/dt at the n points zq[i] = z0 + i dz at one time.
   void eval_uniform(double z0, double dz, int n, double time, double* Rq, double* Rt) const;
 };
+
+// The evaluation is header-only, as the rest of disc::PrescribedShape (reduced1d/discretisation.hpp,
+// which the axisymmetric tier's prescribed waves include without the 1D library).
+
+inline void RecordedRadius::locate(double time, std::size_t& k, double& theta) const {
+  const double T = period();
+  double tt = time - t.front();
+  if (tt > T) {  // a longer run repeats the record
+    tt = std::fmod(tt, T);
+    if (tt == 0.0) tt = T;  // the end of a repetition is the end of the record
+  }
+  if (tt < 0) tt = 0;
+  tt += t.front();
+  const std::size_t n = t.size();
+  // the interval with t[k] <= tt < t[k + 1]; the last time belongs to the last interval
+  k = std::size_t(std::upper_bound(t.begin(), t.end(), tt) - t.begin());
+  k = k == 0 ? 0 : k - 1;
+  if (k > n - 2) k = n - 2;
+  theta = (tt - t[k]) / (t[k + 1] - t[k]);
+}
+
+inline void RecordedRadius::eval(double zq, double time, double& Rq, double& Rt) const {
+  std::size_t k;
+  double th;
+  locate(time, k, th);
+  // the bracketing rings and the upper one's weight (linear continuation outside their span)
+  const std::size_t m = z.size();
+  std::size_t j = std::size_t(std::upper_bound(z.begin(), z.end(), zq) - z.begin());
+  j = j == 0 ? 0 : j - 1;
+  if (j > m - 2) j = m - 2;
+  const double w = (zq - z[j]) / (z[j + 1] - z[j]);
+  const double dt = t[k + 1] - t[k];
+  const double* a = R.data() + k * m;
+  const double* b = a + m;
+  const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
+  Rq = (1 - w) * ra + w * rb;
+  Rt = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
+}
+
+inline void RecordedRadius::eval_uniform(double z0, double dz, int n, double time, double* Rq, double* Rt) const {
+  std::size_t k;
+  double th;
+  locate(time, k, th);
+  const std::size_t m = z.size();
+  const double dt = t[k + 1] - t[k];
+  const double* a = R.data() + k * m;
+  const double* b = a + m;
+  std::size_t j = 0;
+  for (int i = 0; i < n; ++i) {
+    const double zq = z0 + i * dz;
+    while (j + 2 < m && z[j + 1] <= zq) ++j;  // the points increase: walk the rings once
+    const double w = (zq - z[j]) / (z[j + 1] - z[j]);
+    const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
+    Rq[i] = (1 - w) * ra + w * rb;
+    Rt[i] = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
+  }
+}
 
 /// Reads and checks a radius.csv for a tube of length L [m] (InputError naming `key`, the path
 /// and what is allowed, for a missing or unreadable file, a header other than
