@@ -103,7 +103,24 @@ double read_contracted_radius(Reader& w, double R0) {
 WaveSpec read_wave(Reader& top, double R0, double L) {
   WaveSpec s;
   Reader w = top.child("wave");
-  s.kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven"});
+  s.kind = w.choice("kind", "force_driven", {"step", "sine", "force_driven", "recorded"});
+  if (s.kind == "recorded") {
+    // the record sets the radius: a contracted radius, speed, width or wavelength has no meaning
+    for (const char* k : {"contracted_ratio", "contracted_radius", "speed", "width", "wavelength"})
+      if (w.has(k))
+        throw InputError(w.path(k), show(w.given(k)),
+                         "is not used with wave.kind = \"recorded\" (the radius comes from wave.radius_file)");
+    if (!w.has("radius_file"))
+      throw InputError(w.path("radius_file"), "(missing)",
+                       "wave.kind = \"recorded\" needs wave.radius_file: the path of a radius.csv (t_s, z_m, "
+                       "radius_m) written by swim run");
+    s.radius_file = w.text("radius_file", "");
+    w.finish();
+    return s;
+  }
+  if (w.has("radius_file"))
+    throw InputError(w.path("radius_file"), show(w.given("radius_file")),
+                     "is only used with wave.kind = \"recorded\"");
   s.R_f = read_contracted_radius(w, R0);
   if (s.kind == "step") {
     s.speed = w.quantity("speed", "m/s", "10 um/s", Range::positive());
@@ -156,6 +173,7 @@ ProtocolSpec read_protocol_section(Reader& top, double R0, double L, double R_f,
 double WaveSpec::transit(double L) const {
   if (kind == "step") return L / speed;
   if (kind == "sine") return wavelength / speed;
+  if (kind == "recorded") return period;
   return 0.0;
 }
 

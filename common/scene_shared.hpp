@@ -61,15 +61,19 @@ struct WallSpec {
 double c1_from_spring_constant(double k_s, double R0);
 
 /// The wave section (docs/scenes.md "wave.*"): its kind, the contracted radius and the
-/// prescribed waves' kinematics (reduced1d/params.hpp StepWave, SineWave).
+/// prescribed waves' kinematics (reduced1d/params.hpp StepWave, SineWave; a recorded wave's
+/// file, which the 1D tier reads: reduced1d/recorded_wave.hpp).
 struct WaveSpec {
-  std::string kind;         ///< "step", "sine" or "force_driven"
+  std::string kind;         ///< "step", "sine", "force_driven" or "recorded"
   double R_f = 0;           ///< contracted radius [m]: the step's R_min, the sine's R0 - amplitude
   double speed = 0;         ///< step, sine: wave speed s > 0, the wave travels towards -z [m/s]
   double width = 0;         ///< step: smoothing width w [m]
   double wavelength = 0;    ///< sine: lambda [m]
+  std::string radius_file;  ///< recorded: the radius.csv to replay (read by the 1D tier)
+  double period = 0;        ///< recorded: the record's span [s], set by the tier that reads the file
   bool prescribed() const { return kind != "force_driven"; }
-  /// The default end time of a prescribed wave: L/s (step), lambda/s (sine); 0 (force_driven).
+  /// The default end time of a prescribed wave: L/s (step), lambda/s (sine), the record's span
+  /// (recorded, once the tier has read it); 0 (force_driven).
   double transit(double L) const;
 };
 

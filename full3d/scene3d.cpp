@@ -97,6 +97,10 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   p.container_radius = s.container.radius;
   p.period = s.container.period;
   p.wave = s.wave;
+  if (p.wave.kind == "recorded")
+    throw InputError("wave.kind", "\"recorded\"",
+                     "a recorded wave (wave.radius_file) is replayed by the 1D tier only: run --tier 1d; the 3D tier "
+                     "runs \"force_driven\", the axisymmetric tier \"force_driven\", \"step\" and \"sine\"");
   if (p.wave.prescribed() && !prescribed_waves)
     throw InputError("wave.kind", "\"" + p.wave.kind + "\"",
                      "the 3D tier drives the wall by forces only (prescribed kinematics are not implemented): "

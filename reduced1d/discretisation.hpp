@@ -9,10 +9,12 @@
 #pragma once
 
 #include <cmath>
+#include <memory>
 #include <numbers>
 #include <vector>
 
 #include "reduced1d/params.hpp"
+#include "reduced1d/recorded_wave.hpp"
 
 namespace swim::reduced1d::disc {
 
@@ -96,13 +98,16 @@ struct PrescribedShape {
   double R0 = 0, L = 0;
   double Rmin = 0, s = 0, w = 0;    // step
   double a = 0, lambda = 0;         // sine (s shared)
+  std::shared_ptr<const RecordedRadius> rec;  // recorded
 
   static PrescribedShape from(const Params& p) {
     PrescribedShape sh;
     sh.kind = p.wave;
     sh.R0 = p.geometry.R0;
     sh.L = p.geometry.L;
-    if (p.wave == WaveKind::Step) {
+    if (p.wave == WaveKind::Recorded) {
+      sh.rec = p.recorded;
+    } else if (p.wave == WaveKind::Step) {
       sh.Rmin = p.step.R_min;
       sh.s = p.step.speed;
       sh.w = p.step.width;
@@ -115,7 +120,9 @@ struct PrescribedShape {
   }
   /// R and dR/dt at (z, t).
   void eval(double z, double t, double& R, double& Rt) const {
-    if (kind == WaveKind::Step) {
+    if (kind == WaveKind::Recorded) {
+      rec->eval(z, t, R, Rt);
+    } else if (kind == WaveKind::Step) {
       const double x = (L - s * t - z) / w;
       // tanh(x) rounds to +-1 in double precision for |x| > 19.1; skip the libm call there.
       const double th = x > 19.5 ? 1.0 : (x < -19.5 ? -1.0 : std::tanh(x));
@@ -136,6 +143,10 @@ struct PrescribedShape {
   /// values agree with eval() to a few ulps of R0). Saturated points (|x| > 19.5) take
   /// exactly eval()'s values.
   void eval_uniform(double z0, double dz, int n, double t, double* R, double* Rt) const {
+    if (kind == WaveKind::Recorded) {
+      rec->eval_uniform(z0, dz, n, t, R, Rt);
+      return;
+    }
     if (kind != WaveKind::Step) {
       for (int k = 0; k < n; ++k) eval(z0 + k * dz, t, R[k], Rt[k]);
       return;

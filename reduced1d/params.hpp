@@ -32,13 +32,15 @@
 
 namespace swim::reduced1d {
 
-class TubeLaw;  // reduced1d/tube_law.hpp
+class TubeLaw;          // reduced1d/tube_law.hpp
+struct RecordedRadius;  // reduced1d/recorded_wave.hpp
 
 /// How the radius wave R(z,t) is produced.
 enum class WaveKind {
   Step,         ///< prescribed smoothed step (eq. 53) travelling in -z at speed s
   Sine,         ///< prescribed contraction sinusoid travelling in -z
   ForceDriven,  ///< radius evolves under the actuation protocol of Section 3 mapped to 1D
+  Recorded,     ///< prescribed R(z,t) replayed from a recorded radius.csv (wave.radius_file)
 };
 
 /// Which swimmer model defines the velocity.
@@ -175,6 +177,8 @@ struct Params {
   WaveKind wave = WaveKind::Step;
   StepWave step;
   SineWave sine;
+  /// wave.kind = "recorded": the record (its span is the period); nullptr otherwise
+  std::shared_ptr<const RecordedRadius> recorded;
   Protocol protocol;
   Swimmer swimmer;
   Container container;

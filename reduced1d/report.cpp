@@ -5,6 +5,7 @@
 
 #include "common/output.hpp"
 #include "common/run_figures.hpp"
+#include "reduced1d/recorded_wave.hpp"
 
 namespace swim::reduced1d {
 
@@ -77,9 +78,10 @@ json write_run(const std::string& dir, const Params& p, const json& resolved, Re
                  {"mass_per_area_kg_per_m2", p.wall.m},
                  {"mass_per_length_kg_per_m", p.wall.m * 2.0 * M_PI * p.geometry.R0},
                  {"aspect_ratio_R0_over_L", p.geometry.R0 / p.geometry.L},
-                 {"contracted_ratio", (p.wave == WaveKind::Sine   ? p.geometry.R0 - p.sine.amplitude
-                                       : p.wave == WaveKind::Step ? p.step.R_min
-                                                                  : p.protocol.R_f) /
+                 {"contracted_ratio", (p.wave == WaveKind::Sine       ? p.geometry.R0 - p.sine.amplitude
+                                       : p.wave == WaveKind::Step     ? p.step.R_min
+                                       : p.wave == WaveKind::Recorded ? p.recorded->min_radius()
+                                                                      : p.protocol.R_f) /
                                           p.geometry.R0},
                  {"actuation_pressure_Pa", p.wave == WaveKind::ForceDriven ? p.protocol.q : 0.0},
                  {"container_radius_1d_m", p.container.radius_eff},

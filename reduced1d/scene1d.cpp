@@ -12,6 +12,7 @@
 #include "common/scene_shared.hpp"
 #include "common/units.hpp"
 #include "reduced1d/outer_flow.hpp"
+#include "reduced1d/recorded_wave.hpp"
 #include "reduced1d/tube_law.hpp"
 
 namespace swim::reduced1d {
@@ -170,11 +171,20 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
   }
   const std::string& calibration = s.wall.calibration;
 
-  const double R_f = s.wave.R_f;
+  double R_f = s.wave.R_f;
   {
-    const scene::WaveSpec& w = s.wave;
-    p.wave = w.kind == "step" ? WaveKind::Step : w.kind == "sine" ? WaveKind::Sine : WaveKind::ForceDriven;
-    if (p.wave == WaveKind::Step) {
+    scene::WaveSpec& w = s.wave;
+    p.wave = w.kind == "step"       ? WaveKind::Step
+             : w.kind == "sine"     ? WaveKind::Sine
+             : w.kind == "recorded" ? WaveKind::Recorded
+                                    : WaveKind::ForceDriven;
+    if (p.wave == WaveKind::Recorded) {
+      // the record is read (and checked) with the scene, before anything is written; its span
+      // is the period, its smallest radius stands for the contracted radius
+      p.recorded = read_radius_file("wave.radius_file", w.radius_file, scene_dir, L);
+      w.period = p.recorded->period();
+      R_f = std::min(p.recorded->min_radius(), R0);
+    } else if (p.wave == WaveKind::Step) {
       p.step.R_min = R_f;
       p.step.speed = w.speed;
       p.step.width = w.width;

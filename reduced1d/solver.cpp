@@ -9,6 +9,7 @@
 #include "reduced1d/internal.hpp"
 #include "reduced1d/outer_flow.hpp"
 #include "reduced1d/protocol.hpp"
+#include "reduced1d/recorded_wave.hpp"
 #include "reduced1d/tube_law.hpp"
 #include "common/errors.hpp"
 
@@ -76,6 +77,12 @@ void validate(const Params& p) {
               "must be in [0, R0)");
       require(p.sine.wavelength > 0, "wave.wavelength", p.sine.wavelength, "must be positive");
       require(p.sine.speed > 0, "wave.speed", p.sine.speed, "must be positive");
+      break;
+    case WaveKind::Recorded:
+      if (!p.recorded || p.recorded->t.size() < 2 || p.recorded->z.size() < 2 || !(p.recorded->period() > 0))
+        throw InputError("wave.radius_file", "a record", "must hold at least 2 times and 2 rings");
+      require(p.recorded->min_radius() > 0, "wave.radius_file", p.recorded->min_radius(),
+              "the recorded radius must be positive");
       break;
     case WaveKind::ForceDriven: {
       const auto& q = p.protocol;
@@ -150,6 +157,8 @@ double end_time(const Params& p) {
       return p.geometry.L / p.step.speed;
     case WaveKind::Sine:
       return p.sine.wavelength / p.sine.speed;
+    case WaveKind::Recorded:
+      return p.recorded ? p.recorded->period() : 0.0;
     case WaveKind::ForceDriven:
     default: {
       // Upper bound for a run of protocol.cycles cycles (docs/reduced1d.md, "End time"):

@@ -34,6 +34,7 @@ std::set<std::string> accepted_keys() {
   std::set<std::string> keys = swim::testing::resolved_keys(scene::json::object(), variants,
                                                             [](const scene::json& sc, scene::json& r) { reduced1d::read_scene(sc, r); });
   keys.insert("wall.calibration");  // needs a file to resolve; read by the same wall reader
+  keys.insert("wave.radius_file");  // needs a record to resolve (wave.kind = recorded)
   return keys;
 }
 
