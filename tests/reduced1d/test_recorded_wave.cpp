@@ -4,6 +4,7 @@
 // swims back by the same distance and a reciprocal record does not swim (scallop theorem), and
 // bad files are refused naming the key.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <cmath>
@@ -50,8 +51,11 @@ json recorded_scene(const std::string& ends, const std::string& file) {
   return sc;
 }
 
+/// A folder of the running test's own (CTest runs the tests of this file in parallel, and two of
+/// them record the same sine run).
 fs::path scratch() {
-  const fs::path d = fs::temp_directory_path() / "swim_recorded_wave_test";
+  const std::string test = ::testing::UnitTest::GetInstance()->current_test_info()->name();
+  const fs::path d = fs::temp_directory_path() / ("swim_recorded_wave_test_" + test + "_" + std::to_string(::getpid()));
   fs::create_directories(d);
   return d;
 }
