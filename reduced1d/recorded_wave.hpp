@@ -37,6 +37,16 @@ struct RecordedRadius {
   void eval(double zq, double time, double& Rq, double& Rt) const;
   /// R and dR/dt at the n points zq[i] = z0 + i dz at one time.
   void eval_uniform(double z0, double dz, int n, double time, double* Rq, double* Rt) const;
+
+ private:
+  /// R and dR/dt between rings j and j + 1 (weight w of the upper one) in the record's interval
+  /// from the rows a to b (weight th of b, length dt).
+  static void blend(const double* a, const double* b, std::size_t j, double w, double th, double dt, double& Rq,
+                    double& Rt) {
+    const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
+    Rq = (1 - w) * ra + w * rb;
+    Rt = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
+  }
 };
 
 // The evaluation is header-only, as the rest of disc::PrescribedShape (reduced1d/discretisation.hpp,
@@ -71,10 +81,7 @@ inline void RecordedRadius::eval(double zq, double time, double& Rq, double& Rt)
   const double w = (zq - z[j]) / (z[j + 1] - z[j]);
   const double dt = t[k + 1] - t[k];
   const double* a = R.data() + k * m;
-  const double* b = a + m;
-  const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
-  Rq = (1 - w) * ra + w * rb;
-  Rt = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
+  blend(a, a + m, j, w, th, dt, Rq, Rt);
 }
 
 inline void RecordedRadius::eval_uniform(double z0, double dz, int n, double time, double* Rq, double* Rt) const {
@@ -89,10 +96,7 @@ inline void RecordedRadius::eval_uniform(double z0, double dz, int n, double tim
   for (int i = 0; i < n; ++i) {
     const double zq = z0 + i * dz;
     while (j + 2 < m && z[j + 1] <= zq) ++j;  // the points increase: walk the rings once
-    const double w = (zq - z[j]) / (z[j + 1] - z[j]);
-    const double ra = (1 - th) * a[j] + th * b[j], rb = (1 - th) * a[j + 1] + th * b[j + 1];
-    Rq[i] = (1 - w) * ra + w * rb;
-    Rt[i] = ((1 - w) * (b[j] - a[j]) + w * (b[j + 1] - a[j + 1])) / dt;
+    blend(a, b, j, (zq - z[j]) / (z[j + 1] - z[j]), th, dt, Rq[i], Rt[i]);
   }
 }
 
