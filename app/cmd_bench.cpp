@@ -689,7 +689,8 @@ void print_axi_cycle(const AxiCycle& c) {
               r.failed ? "FAILED" : "cycle ended", r.steps, c.stokes_solves, c.factorisations, c.gmres_iterations,
               c.wall_s, c.cpu_s, c.cpu_s / c.factor_cpu_s, c.factor_cpu_s, 100 * c.fact_s / c.wall_s,
               100 * c.solves_s / c.wall_s, r.failed ? ("  " + r.message).c_str() : "");
-  std::printf("  BLAS: %s\n", axi::blas_provider().c_str());
+  std::printf("  preconditioner: %s; BLAS (UMFPACK's): %s\n",
+              c.run.record.stats.value("preconditioner", std::string("?")).c_str(), axi::blas_provider().c_str());
 }
 
 scene::json axi_cycle_json(const AxiCycle& c) {
@@ -700,6 +701,8 @@ scene::json axi_cycle_json(const AxiCycle& c) {
           {"gmres_iterations", c.gmres_iterations}, {"wall_time_s", c.wall_s}, {"cpu_time_s", c.cpu_s},
           {"one_factorisation_cpu_s", c.factor_cpu_s}, {"cpu_over_factorisation", c.cpu_s / c.factor_cpu_s},
           {"wall_time_split_s", c.split}, {"blas", axi::blas_provider()},
+          {"preconditioner", c.run.record.stats.value("preconditioner", scene::json())},
+          {"ldlt_fallbacks", c.run.record.stats.value("ldlt_fallbacks", scene::json())},
           {"displacement_per_cycle_m", sm.value("displacement_per_cycle_m", scene::json())},
           {"cycle_times_s", sm.value("cycle_times_s", scene::json::array())}, {"failed", c.run.failed}};
 }

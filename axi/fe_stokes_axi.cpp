@@ -252,6 +252,11 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
   }
 
   lu_ = new_lu();
+  ldlt_ = new_ldlt();
+  preg_.resize(n_, n_);
+  preg_.reserve(Eigen::VectorXi::Constant(n_, 1));
+  for (int i = n_vel_; i < n_; ++i) preg_.insert(i, i) = -1.0;
+  preg_.makeCompressed();
   rhs_.setZero(n_);
   sol_.setZero(n_);
 }
@@ -395,15 +400,51 @@ std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, in
   return lu;
 }
 
+std::unique_ptr<FittedStokes::Ldlt> FittedStokes::new_ldlt() {
+  auto f = std::make_unique<Ldlt>();
+  f->cholmod().print = 0;  // failures are reported through info(), not printed
+  return f;
+}
+
+std::string FittedStokes::preconditioner() const { return use_ldlt_ ? "LDL^T (CHOLMOD)" : "LU (UMFPACK)"; }
+
 void FittedStokes::forget_factorisation() {
   analysed_ = lu_valid_ = lu_current_ = false;
   last_iters_ = 0;
   lu_ = new_lu();
+  ldlt_ = new_ldlt();
+  ldlt_analysed_ = pc_ldlt_ = false;
+  use_ldlt_ = true;
+  for (Eigen::VectorXd& g : guess_) g.resize(0);
 }
 
-void FittedStokes::numeric_factor() {
+bool FittedStokes::ldlt_factor() {
   const auto t0 = Clock::now();
-  lu_valid_ = lu_current_ = false;
+  lu_valid_ = lu_current_ = pc_ldlt_ = false;
+  double d = 0.0;
+  for (int c = 0; c < n_vel_; ++c) d = std::max(d, std::abs(A_.coeff(c, c)));
+  areg_ = A_ + (kLdltRegularisation * d) * preg_;
+  if (!ldlt_analysed_) {
+    ldlt_->analyzePattern(areg_);
+    ldlt_analysed_ = ldlt_->info() == Eigen::Success;
+  }
+  if (ldlt_analysed_) ldlt_->factorize(areg_);
+  timing_.factor += seconds_since(t0);
+  if (!ldlt_analysed_ || ldlt_->info() != Eigen::Success || !(d > 0.0) || !std::isfinite(d)) {
+    use_ldlt_ = false;
+    ++ldlt_fallbacks_;
+    return false;
+  }
+  ++timing_.factorisations;
+  lu_valid_ = lu_current_ = pc_ldlt_ = true;
+  last_iters_ = 0;
+  return true;
+}
+
+void FittedStokes::numeric_factor(bool ldlt) {
+  if (ldlt && use_ldlt_ && ldlt_factor()) return;
+  const auto t0 = Clock::now();
+  lu_valid_ = lu_current_ = pc_ldlt_ = false;
   if (!analysed_) {
     lu_->analyzePattern(A_);
     if (lu_->info() != Eigen::Success)
@@ -439,11 +480,11 @@ void FittedStokes::factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<d
   assemble(K, scale);
   timing_.assemble += seconds_since(t0);
   // The iteration-count trigger is checked at the next solve (see the header comment).
-  if (!reuse_ || !lu_valid_ || force) numeric_factor();
+  if (!reuse_ || !lu_valid_ || force) numeric_factor(reuse_);
   factored_ = true;
 }
 
-bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& relres) {
+bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& relres, const Eigen::VectorXd* x0) {
   const int m = std::min(20, std::max(1, max_iterations));  // restart length
   iters = 0;
   sol_.setZero(n_);
@@ -452,17 +493,32 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
     relres = 0.0;
     return true;
   }
+  Eigen::VectorXd r = rhs_;
+  double res = 1.0;  // true relative residual of sol_
+  if (x0 && x0->size() == n_) {
+    // the best multiple alpha x0 (one product): b - alpha A x0 orthogonal to A x0
+    const Eigen::VectorXd ax = A_ * *x0;
+    const double axn2 = ax.squaredNorm();
+    if (axn2 > 0.0 && std::isfinite(axn2)) {
+      const double alpha = ax.dot(rhs_) / axn2;
+      const Eigen::VectorXd r0 = rhs_ - alpha * ax;
+      const double res0 = r0.norm() / bnorm;
+      if (std::isfinite(res0) && res0 < 1.0) {
+        sol_ = alpha * *x0;
+        r = r0;
+        res = res0;
+      }
+    }
+  }
   if (kv_.rows() != n_ || kv_.cols() != m + 1) kv_.resize(n_, m + 1);
   if (kz_.rows() != n_ || kz_.cols() != m) kz_.resize(n_, m);
   lu_->umfpackControl()(UMFPACK_IRSTEP) = 0;  // preconditioner solves: no refinement (see header)
   Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m + 1, m);
   Eigen::VectorXd cs(m), sn(m), g(m + 1), v(n_), z(n_), w(n_);
-  Eigen::VectorXd r = rhs_;
-  double res = 1.0;  // true relative residual of sol_ (x = 0)
   Eigen::VectorXd best = sol_;
   double best_res = res;
-  bool ok = false;
-  for (;;) {
+  bool ok = res <= tol_;
+  while (!ok) {
     const double beta = res * bnorm;
     kv_.col(0) = r / beta;
     g.setZero();
@@ -471,7 +527,10 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
     int k = 0;
     while (k < m && iters < max_iterations) {
       v = kv_.col(k);
-      z = lu_->solve(v);
+      if (pc_ldlt_)
+        z = ldlt_->solve(v);
+      else
+        z = lu_->solve(v);
       kz_.col(k) = z;
       w.noalias() = A_ * z;
       // modified Gram-Schmidt, twice
@@ -524,8 +583,12 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
 }
 
 void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
-                         const std::function<Eigen::Vector2d(double x, double r)>* body) {
+                         const std::function<Eigen::Vector2d(double x, double r)>* body, int guess) {
   if (!factored_) throw std::logic_error("FittedStokes::solve before a successful factor()");
+  if (guess < -1 || guess >= kGuessSlots)
+    throw std::invalid_argument("FittedStokes::solve: warm-start slot " + std::to_string(guess) + " not in [-1, " +
+                                std::to_string(kGuessSlots - 1) + "]");
+  const Eigen::VectorXd* x0 = guess >= 0 ? &guess_[std::size_t(guess)] : nullptr;
   const int nm = mesh_.membrane_nodes();
   if (F.cols() != nm)
     throw std::invalid_argument("FittedStokes::solve: F has " + std::to_string(F.cols()) + " columns, expected " +
@@ -563,19 +626,28 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
     last_res_ = -1.0;
   } else {
     // The previous solve needed too many iterations: factor the current system first.
-    if (!lu_current_ && last_iters_ > refactor_after_) numeric_factor();
+    if (!lu_current_ && last_iters_ > refactor_after_) numeric_factor(true);
     int it = 0;
     double res = 0.0;
     bool fresh = lu_current_;
-    bool ok = gmres(fresh ? 40 : 20, fresh, it, res);
+    bool ok = gmres(fresh ? 40 : 20, fresh, it, res, x0);
     timing_.krylov_iterations += it;
     if (!ok && !fresh) {  // the old factorisation is no longer good enough: refactor, solve again
-      numeric_factor();
+      numeric_factor(true);
       int it2 = 0;
-      ok = gmres(40, true, it2, res);
+      ok = gmres(40, true, it2, res, x0);
       timing_.krylov_iterations += it2;
       it = it2;
       fresh = true;
+    }
+    if (!ok && pc_ldlt_) {  // a fresh LDL^T that does not converge: UMFPACK's LU from now on
+      use_ldlt_ = false;
+      ++ldlt_fallbacks_;
+      numeric_factor(false);
+      int it3 = 0;
+      ok = gmres(40, true, it3, res, x0);
+      timing_.krylov_iterations += it3;
+      it = it3;
     }
     if (!ok)
       throw NumericalError("the fitted Stokes solve did not converge (relative residual " + significant(res) +
@@ -585,6 +657,7 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
     if (!fresh) ++timing_.reused;
     last_iters_ = it;
     last_res_ = res;
+    if (guess >= 0) guess_[std::size_t(guess)] = sol_;
   }
   if (!sol_.allFinite())
     throw NumericalError("the fitted Stokes solve returned a non-finite velocity",
@@ -670,7 +743,7 @@ FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen:
       throw NumericalError("a wall unknown of the fitted Stokes system has no positive diagonal",
                            "check the wall's shape; change axi.grid");
   timing_.assemble += seconds_since(t0);
-  numeric_factor();
+  numeric_factor(false);
   lu_current_ = false;  // A_ is not the traction system any more
   lu_valid_ = false;
   const auto t1 = Clock::now();

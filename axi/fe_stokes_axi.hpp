@@ -70,9 +70,9 @@
 // reuse on, factor() always assembles the CURRENT system A(X) + scale G K G^T but factors it only
 // when needed; solve() then solves the current system by right-preconditioned restarted GMRES
 // (Givens rotations, modified Gram-Schmidt with one re-orthogonalisation), the preconditioner
-// being the stored LU of an earlier system. Right preconditioning: the minimised residual is the
-// TRUE residual b - A x, so the stopping test is on what is asked for; after each cycle the true
-// residual is recomputed (one product) and the solve only returns when
+// being the stored factorisation of an earlier system. Right preconditioning: the minimised
+// residual is the TRUE residual b - A x, so the stopping test is on what is asked for; after each
+// cycle the true residual is recomputed (one product) and the solve only returns when
 //   ||b - A x||_2 <= reuse_tolerance ||b||_2   (2-norm of the scaled system, default 1e-12),
 // or, with a factorisation of the current system, when GMRES stagnates (the best that
 // factorisation gives; the best iterate by true residual is returned). A numeric factorisation
@@ -81,10 +81,29 @@
 // `refactor_after` iterations (checked at the next solve, so that a system solved twice, as the
 // Rosenbrock stages are, is refactored before its second solve), or when GMRES with the old
 // factorisation does not converge within the cycle (the current system is then factored and
-// solved again: an unconverged answer is never returned). Preconditioner solves run UMFPACK
-// without iterative refinement (UMFPACK_IRSTEP = 0): its refinement would use the CURRENT values
-// of the matrix it refers to with the factors of an older one. With reuse off every factor()
-// factors and solve() is the direct solve with one refinement step (the original behaviour).
+// solved again: an unconverged answer is never returned). A solve may name a warm-start slot
+// (solve's `guess`): GMRES then starts from the best multiple of that slot's last solution.
+//
+// The preconditioner (reuse on) is a sparse LDL^T (CHOLMOD, simplicial, its fill-reducing
+// ordering) of the system regularised on its pressure diagonal,
+//   [A  B^T; B  -eps d I],   d = the largest |diagonal entry| of the velocity block, eps = 1e-12.
+// The saddle-point system (symmetric: the viscous form, the divergence and the wall's stiffness
+// term are) has zero pressure diagonals, so an unpivoted LDL^T of it breaks down; regularised it
+// is quasi-definite when the velocity block is positive definite, and a quasi-definite matrix has
+// an LDL^T in any symmetric ordering (Vanderbei 1995), so the ordering is chosen for fill alone.
+// Measured on paper_amplitude_0.82's system at 16 and 32 cells across (10 439 and 33 047
+// unknowns): 1.0 and 1.7 million entries in L against 2.6 and 10.1 million in UMFPACK's
+// threshold-pivoted L + U, one application 0.8-1.9 and 6-7 ms against 9 and 35 ms, a numeric
+// factorisation 0.03-0.07 and 0.42 s against 0.15 and 0.83 s; one application of the fresh
+// factorisation leaves a relative residual of about 5e-6 (eps = 1e-10: 1e-4; eps = 1e-14: 5e-4,
+// round-off), a second 1e-10. When the LDL^T fails (a zero pivot, or GMRES on a fresh LDL^T does
+// not converge: a velocity block that the wall's stiffness term makes indefinite) the solver
+// falls back to UMFPACK's LU for the rest of the run, until forget_factorisation
+// (ldlt_fallbacks() counts). Preconditioner solves run UMFPACK without iterative refinement
+// (UMFPACK_IRSTEP = 0): its refinement would use the CURRENT values of the matrix it refers to
+// with the factors of an older one. With reuse off every factor() factors by UMFPACK and solve()
+// is the direct solve with one refinement step (the original behaviour); so is the prescribed
+// wall's constrained (unsymmetric) system.
 // Measured on a driver run (16 k unknowns): a factorisation costs ~15 GMRES iterations; a reused
 // LU needs 6-9 iterations one step later (the stage system also changes with gamma dt; a scale
 // ratio 1.5 adds ~5 iterations), growing to 12-15 after ~5 steps; refactor_after = 8 was faster
@@ -95,6 +114,7 @@
 
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
+#include <Eigen/CholmodSupport>
 #include <Eigen/UmfPackSupport>
 
 #include <array>
@@ -145,11 +165,18 @@ class FittedStokes {
   /// Throws std::invalid_argument for refactor_after < 0 or a tolerance not in (0, 1).
   void set_reuse(bool on, int refactor_after = kRefactorAfter, double tolerance = kReuseTolerance);
   bool reuse() const { return reuse_; }
-  /// Drops the factorisation and the symbolic analysis: the next factor() starts as a new
-  /// solver's first does. A run checkpoints after calling it, so that a run resumed from the
+  /// Drops the factorisation, the symbolic analysis and the warm-start solutions: the next
+  /// factor() and solve() start as a new solver's first do. A run checkpoints after calling it, so that a run resumed from the
   /// checkpoint (new solvers) repeats the uninterrupted one bit for bit.
   void forget_factorisation();
   static constexpr int kRefactorAfter = 8;
+  /// Regularisation of the pressure diagonal in the LDL^T preconditioner (see the header comment).
+  static constexpr double kLdltRegularisation = 1e-12;
+  /// Times the LDL^T preconditioner failed and the solver fell back to UMFPACK's LU (since the
+  /// solver's construction; not restored on resume).
+  long ldlt_fallbacks() const { return ldlt_fallbacks_; }
+  /// "LDL^T (CHOLMOD)" or "LU (UMFPACK)": the factorisation the next reused solve preconditions with.
+  std::string preconditioner() const;
   static constexpr double kReuseTolerance = 1e-12;
   /// GMRES iterations (preconditioner applications) and relative true residual ||b - A x|| / ||b||
   /// of the last solve (0 and not computed, -1, with reuse off).
@@ -160,8 +187,14 @@ class FittedStokes {
   /// whole ring, N) at the membrane vertices, and optionally a body force density (f_x, f_r),
   /// N/m^3; returns the membrane vertices' velocities U (3 x n, rows 0/1 axial/radial, row 2 = 0).
   /// May be called several times per factorisation. Keeps the full solution for the queries.
+  /// `guess` (0 to kGuessSlots - 1; -1 = none) names a warm-start slot: with reuse on, GMRES
+  /// starts from the last solution solved in that slot, scaled to the best multiple for the
+  /// current system (alpha = argmin ||b - alpha A x_prev||), or from zero when that leaves a
+  /// larger residual than ||b||. A caller that solves the same kind of system on a slowly moving
+  /// mesh (a time stepper's stages) gives each kind its own slot.
   void solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
-             const std::function<Eigen::Vector2d(double x, double r)>* body = nullptr);
+             const std::function<Eigen::Vector2d(double x, double r)>* body = nullptr, int guess = -1);
+  static constexpr int kGuessSlots = 2;
 
   /// Prescribed wall motion with a free axial translation: the force-free swimmer of a
   /// prescribed wave (docs/axi.md "Prescribed waves"). On the mesh fitted to the rings X, the
@@ -237,11 +270,15 @@ class FittedStokes {
   double eval_pressure(int e, double x, double r) const;
   int find_position(int row, int col) const;  ///< value index of (row, col) in A_, or -1
   void transfer_weights();                    ///< gw_ from the fitted mesh (consistent coupling)
-  void numeric_factor();                      ///< factors A_ (symbolic analysis on the first call)
-  /// Right-preconditioned GMRES on A_ x = rhs_ from x = 0 into sol_; returns true when converged
-  /// to tol_; iters and the true relative residual out. fresh: the LU is of A_ itself (then
-  /// stagnation ends the solve with the best iterate).
-  bool gmres(int max_iterations, bool fresh, int& iters, double& relres);
+  /// Factors A_ (symbolic analysis on the first call): the regularised LDL^T when `ldlt` and it
+  /// has not failed, else UMFPACK's LU.
+  void numeric_factor(bool ldlt);
+  bool ldlt_factor();  ///< the regularised LDL^T of A_; false (and no factorisation) when it fails
+  /// Right-preconditioned GMRES on A_ x = rhs_ into sol_, from x0 scaled to its best multiple (or
+  /// from zero: x0 null or empty, or no better than zero); returns true when converged to tol_;
+  /// iters and the true relative residual out. fresh: the LU is of A_ itself (then stagnation
+  /// ends the solve with the best iterate).
+  bool gmres(int max_iterations, bool fresh, int& iters, double& relres, const Eigen::VectorXd* x0 = nullptr);
   void pressure_gauge();  ///< p_mean_ of the current sol_
 
   FittedMesh mesh_;
@@ -258,16 +295,26 @@ class FittedStokes {
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> A_;
   std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> lu_;
   static std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> new_lu();
+  using Ldlt = Eigen::CholmodSimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>;
+  static std::unique_ptr<Ldlt> new_ldlt();
+  std::unique_ptr<Ldlt> ldlt_;
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> areg_;  ///< A_ with the pressure diagonal regularised
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> preg_;  ///< -1 on the pressure diagonal
+  bool ldlt_analysed_ = false;
+  bool use_ldlt_ = true;   ///< false after an LDL^T failure (UMFPACK until forget_factorisation)
+  bool pc_ldlt_ = false;   ///< the stored factorisation (lu_valid_) is ldlt_'s, else lu_'s
+  long ldlt_fallbacks_ = 0;
   bool analysed_ = false, factored_ = false, solved_ = false;
   bool reuse_ = true;
   int refactor_after_ = kRefactorAfter;
   double tol_ = kReuseTolerance;
-  bool lu_valid_ = false;    ///< lu_ holds a numeric factorisation (of some earlier or the current A_)
+  bool lu_valid_ = false;    ///< a numeric factorisation is stored (of some earlier or the current A_)
   bool lu_current_ = false;  ///< ... of the current A_
   int last_iters_ = 0;
   double last_res_ = -1.0;
   Eigen::MatrixXd kv_, kz_;  ///< GMRES work: Krylov basis and preconditioned basis
   Eigen::VectorXd rhs_, sol_;
+  std::array<Eigen::VectorXd, kGuessSlots> guess_;  ///< warm-start solutions per slot (empty = none)
   double p_mean_ = 0.0;  ///< volume mean of the raw pressure (subtracted in queries)
   Timing timing_;
 };

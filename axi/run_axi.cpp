@@ -425,12 +425,12 @@ class Runner {
       try {
         const int last = n - 1;
         stage_->factor(X_, &K, gamma * dt_);
-        stage_->solve(F0, k1_);
+        stage_->solve(F0, k1_, nullptr, 0);
         const double a_rear = stage_->end_disc_flux(0, k1_(0, 0)), a_front = stage_->end_disc_flux(1, k1_(0, last));
         X1_ = X_ + dt_ * k1_;
         const Eigen::Matrix3Xd F1 = total_force(X1_);
         flow_->factor(X1_);
-        flow_->solve(F1, U1_);
+        flow_->solve(F1, U1_, nullptr, 0);
         const double b_rear = flow_->end_disc_flux(0, U1_(0, 0)), b_front = flow_->end_disc_flux(1, U1_(0, last));
         solves_ += 2;
         Eigen::Matrix3Xd g = U1_ - 2.0 * k1_;
@@ -439,7 +439,7 @@ class Runner {
         const Eigen::VectorXd Kg = K * gv;
         Eigen::Matrix3Xd KgF = Eigen::Matrix3Xd::Zero(3, n);
         for (int k = 0; k < n; ++k) KgF(0, k) = Kg(2 * k), KgF(1, k) = Kg(2 * k + 1);
-        stage_->solve(KgF, k2_);
+        stage_->solve(KgF, k2_, nullptr, 1);
         ++solves_;
         const double c_rear = stage_->end_disc_flux(0, k2_(0, 0)), c_front = stage_->end_disc_flux(1, k2_(0, last));
         k2_ = g - (gamma * dt_) * k2_;
@@ -688,6 +688,12 @@ class Runner {
       rec_.stats["fitted_unknowns"] = flow_->unknowns();
       rec_.stats["fitted_nonzeros"] = flow_->nonzeros();
       rec_.stats["blas"] = blas_provider();
+      // the factorisation that preconditions the steps' GMRES (docs/axi.md, "Linear solves"),
+      // and how often it fell back to UMFPACK's LU since the run (or its resumption) started
+      rec_.stats["preconditioner"] = stage_->ldlt_fallbacks() + flow_->ldlt_fallbacks() == 0
+                                         ? "LDL^T of the regularised system (CHOLMOD)"
+                                         : "LDL^T of the regularised system (CHOLMOD), then LU (UMFPACK) after a failure";
+      rec_.stats["ldlt_fallbacks"] = stage_->ldlt_fallbacks() + flow_->ldlt_fallbacks();
     }
   }
 
