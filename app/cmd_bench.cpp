@@ -702,7 +702,7 @@ scene::json axi_cycle_json(const AxiCycle& c) {
           {"one_factorisation_cpu_s", c.factor_cpu_s}, {"cpu_over_factorisation", c.cpu_s / c.factor_cpu_s},
           {"wall_time_split_s", c.split}, {"blas", axi::blas_provider()},
           {"preconditioner", c.run.record.stats.value("preconditioner", scene::json())},
-          {"ldlt_fallbacks", c.run.record.stats.value("ldlt_fallbacks", scene::json())},
+          {"factorisation_fallbacks", c.run.record.stats.value("factorisation_fallbacks", scene::json())},
           {"displacement_per_cycle_m", sm.value("displacement_per_cycle_m", scene::json())},
           {"cycle_times_s", sm.value("cycle_times_s", scene::json::array())}, {"failed", c.run.failed}};
 }

@@ -1,6 +1,7 @@
 #include "axi/fe_stokes_axi.hpp"
 
 #include <dlfcn.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <chrono>
@@ -32,6 +33,22 @@ void single_threaded_blas() {
   }();
   (void)done;
 }
+
+/// CHOLMOD's supernodal factorisation runs OpenMP loops with the process's default thread count.
+/// On these fronts a second thread mostly spins: one cycle of paper_amplitude_0.82 at 16 cells
+/// took 54 s of CPU for 33 s of wall time with two threads, 34 s for 35 s with one. The product
+/// runs one solve per core, so the CHOLMOD calls run on one thread (the caller's setting is put
+/// back afterwards: the 3D tier's own parallel regions name their thread count anyway).
+class OneOpenMpThread {
+ public:
+  OneOpenMpThread() : saved_(omp_get_max_threads()) { omp_set_num_threads(1); }
+  ~OneOpenMpThread() { omp_set_num_threads(saved_); }
+  OneOpenMpThread(const OneOpenMpThread&) = delete;
+  OneOpenMpThread& operator=(const OneOpenMpThread&) = delete;
+
+ private:
+  int saved_;
+};
 
 }  // namespace
 
@@ -252,13 +269,49 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
   }
 
   lu_ = new_lu();
-  ldlt_ = new_ldlt();
-  preg_.resize(n_, n_);
-  preg_.reserve(Eigen::VectorXi::Constant(n_, 1));
-  for (int i = n_vel_; i < n_; ++i) preg_.insert(i, i) = -1.0;
-  preg_.makeCompressed();
+  chol_ = new_cholesky();
+  build_schur_pattern();
   rhs_.setZero(n_);
   sol_.setZero(n_);
+}
+
+void FittedStokes::build_schur_pattern() {
+  // S's pattern is A_'s velocity block: the penalty B^T B / e couples the velocities of one
+  // element (a pressure unknown's column holds its element's velocity rows), which A_ couples.
+  const int* outer = A_.outerIndexPtr();
+  const int* inner = A_.innerIndexPtr();
+  schur_src_.clear();
+  std::vector<int> souter(n_vel_ + 1, 0), sinner;
+  for (int c = 0; c < n_vel_; ++c) {
+    for (int q = outer[c]; q < outer[c + 1]; ++q)
+      if (inner[q] < n_vel_) {
+        sinner.push_back(inner[q]);
+        schur_src_.push_back(q);
+      }
+    souter[c + 1] = int(sinner.size());
+  }
+  schur_.resize(n_vel_, n_vel_);
+  schur_.resizeNonZeros(Eigen::Index(sinner.size()));
+  std::copy(souter.begin(), souter.end(), schur_.outerIndexPtr());
+  std::copy(sinner.begin(), sinner.end(), schur_.innerIndexPtr());
+  std::fill(schur_.valuePtr(), schur_.valuePtr() + sinner.size(), 0.0);
+  auto position = [&](int row, int col) {
+    const int* b = sinner.data() + souter[col];
+    const int* e = sinner.data() + souter[col + 1];
+    const int* it = std::lower_bound(b, e, row);
+    if (it == e || *it != row)
+      throw std::logic_error("FittedStokes: a pressure unknown couples velocities its element does not");
+    return int(it - sinner.data());
+  };
+  pen_pos_.clear();
+  for (int c = n_vel_; c < n_; ++c)
+    for (int a = outer[c]; a < outer[c + 1]; ++a)
+      for (int b = outer[c]; b < outer[c + 1]; ++b) {
+        if (inner[a] >= n_vel_ || inner[b] >= n_vel_)
+          throw std::logic_error("FittedStokes: pressure unknowns coupled to each other");
+        pen_pos_.push_back(position(inner[a], inner[b]));
+      }
+  bval_.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
 }
 
 FittedStokes::~FittedStokes() = default;
@@ -400,51 +453,95 @@ std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, in
   return lu;
 }
 
-std::unique_ptr<FittedStokes::Ldlt> FittedStokes::new_ldlt() {
-  auto f = std::make_unique<Ldlt>();
+std::unique_ptr<FittedStokes::Cholesky> FittedStokes::new_cholesky() {
+  auto f = std::make_unique<Cholesky>();
   f->cholmod().print = 0;  // failures are reported through info(), not printed
   return f;
 }
 
-std::string FittedStokes::preconditioner() const { return use_ldlt_ ? "LDL^T (CHOLMOD)" : "LU (UMFPACK)"; }
+std::string FittedStokes::preconditioner() const { return use_chol_ ? "Cholesky (CHOLMOD)" : "LU (UMFPACK)"; }
 
 void FittedStokes::forget_factorisation() {
   analysed_ = lu_valid_ = lu_current_ = false;
   last_iters_ = 0;
   lu_ = new_lu();
-  ldlt_ = new_ldlt();
-  ldlt_analysed_ = pc_ldlt_ = false;
-  use_ldlt_ = true;
+  chol_ = new_cholesky();
+  chol_analysed_ = pc_chol_ = false;
+  use_chol_ = true;
   for (Eigen::VectorXd& g : guess_) g.resize(0);
 }
 
-bool FittedStokes::ldlt_factor() {
+bool FittedStokes::cholesky_factor() {
   const auto t0 = Clock::now();
-  lu_valid_ = lu_current_ = pc_ldlt_ = false;
+  lu_valid_ = lu_current_ = pc_chol_ = false;
   double d = 0.0;
   for (int c = 0; c < n_vel_; ++c) d = std::max(d, std::abs(A_.coeff(c, c)));
-  areg_ = A_ + (kLdltRegularisation * d) * preg_;
-  if (!ldlt_analysed_) {
-    ldlt_->analyzePattern(areg_);
-    ldlt_analysed_ = ldlt_->info() == Eigen::Success;
+  bool ok = d > 0.0 && std::isfinite(d);
+  if (ok) {
+    // S = A_vv + B^T B / e on its fixed pattern; the factored B kept for the applications
+    pen_ = kPressureRegularisation * d;
+    const double inv = 1.0 / pen_;
+    const double* av = A_.valuePtr();
+    const int* outer = A_.outerIndexPtr();
+    double* sv = schur_.valuePtr();
+    for (std::size_t k = 0; k < schur_src_.size(); ++k) sv[k] = av[schur_src_[k]];
+    std::size_t k = 0;
+    for (int c = n_vel_; c < n_; ++c)
+      for (int a = outer[c]; a < outer[c + 1]; ++a) {
+        const double va = av[a] * inv;
+        for (int b = outer[c]; b < outer[c + 1]; ++b) sv[pen_pos_[k++]] += va * av[b];
+      }
+    std::copy(av + outer[n_vel_], av + outer[n_], bval_.begin());
+    const OneOpenMpThread one;
+    if (!chol_analysed_) {
+      chol_->analyzePattern(schur_);
+      chol_analysed_ = chol_->info() == Eigen::Success;
+    }
+    ok = chol_analysed_;
+    if (ok) {
+      chol_->factorize(schur_);
+      ok = chol_->info() == Eigen::Success;
+    }
   }
-  if (ldlt_analysed_) ldlt_->factorize(areg_);
   timing_.factor += seconds_since(t0);
-  if (!ldlt_analysed_ || ldlt_->info() != Eigen::Success || !(d > 0.0) || !std::isfinite(d)) {
-    use_ldlt_ = false;
-    ++ldlt_fallbacks_;
+  if (!ok) {
+    use_chol_ = false;
+    ++fallbacks_;
     return false;
   }
   ++timing_.factorisations;
-  lu_valid_ = lu_current_ = pc_ldlt_ = true;
+  lu_valid_ = lu_current_ = pc_chol_ = true;
   last_iters_ = 0;
   return true;
 }
 
-void FittedStokes::numeric_factor(bool ldlt) {
-  if (ldlt && use_ldlt_ && ldlt_factor()) return;
+Eigen::VectorXd FittedStokes::cholesky_apply(const Eigen::VectorXd& v) const {
+  // the factored system's B: A_'s pressure columns (its pattern) with the values kept in bval_
+  const int* outer = A_.outerIndexPtr();
+  const int* inner = A_.innerIndexPtr();
+  const int q0 = outer[n_vel_];
+  Eigen::VectorXd f = v.head(n_vel_);
+  for (int c = n_vel_; c < n_; ++c) {
+    const double gc = v[c] / pen_;
+    for (int q = outer[c]; q < outer[c + 1]; ++q) f[inner[q]] += bval_[std::size_t(q - q0)] * gc;
+  }
+  Eigen::VectorXd z(n_);
+  {
+    const OneOpenMpThread one;
+    z.head(n_vel_) = chol_->solve(f);
+  }
+  for (int c = n_vel_; c < n_; ++c) {
+    double bu = 0.0;
+    for (int q = outer[c]; q < outer[c + 1]; ++q) bu += bval_[std::size_t(q - q0)] * z[inner[q]];
+    z[c] = (bu - v[c]) / pen_;
+  }
+  return z;
+}
+
+void FittedStokes::numeric_factor(bool regularised) {
+  if (regularised && use_chol_ && cholesky_factor()) return;
   const auto t0 = Clock::now();
-  lu_valid_ = lu_current_ = pc_ldlt_ = false;
+  lu_valid_ = lu_current_ = pc_chol_ = false;
   if (!analysed_) {
     lu_->analyzePattern(A_);
     if (lu_->info() != Eigen::Success)
@@ -527,8 +624,8 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
     int k = 0;
     while (k < m && iters < max_iterations) {
       v = kv_.col(k);
-      if (pc_ldlt_)
-        z = ldlt_->solve(v);
+      if (pc_chol_)
+        z = cholesky_apply(v);
       else
         z = lu_->solve(v);
       kz_.col(k) = z;
@@ -640,9 +737,9 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
       it = it2;
       fresh = true;
     }
-    if (!ok && pc_ldlt_) {  // a fresh LDL^T that does not converge: UMFPACK's LU from now on
-      use_ldlt_ = false;
-      ++ldlt_fallbacks_;
+    if (!ok && pc_chol_) {  // a fresh Cholesky that does not converge: UMFPACK's LU from now on
+      use_chol_ = false;
+      ++fallbacks_;
       numeric_factor(false);
       int it3 = 0;
       ok = gmres(40, true, it3, res, x0);

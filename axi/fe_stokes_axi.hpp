@@ -84,26 +84,31 @@
 // solved again: an unconverged answer is never returned). A solve may name a warm-start slot
 // (solve's `guess`): GMRES then starts from the best multiple of that slot's last solution.
 //
-// The preconditioner (reuse on) is a sparse LDL^T (CHOLMOD, simplicial, its fill-reducing
-// ordering) of the system regularised on its pressure diagonal,
-//   [A  B^T; B  -eps d I],   d = the largest |diagonal entry| of the velocity block, eps = 1e-12.
+// The preconditioner (reuse on) is the factorisation of the system regularised on its pressure
+// diagonal,
+//   [A  B^T; B  -e I],   e = eps d,   d = the largest diagonal entry of the velocity block,
+//   eps = 1e-12 (kPressureRegularisation).
 // The saddle-point system (symmetric: the viscous form, the divergence and the wall's stiffness
-// term are) has zero pressure diagonals, so an unpivoted LDL^T of it breaks down; regularised it
-// is quasi-definite when the velocity block is positive definite, and a quasi-definite matrix has
-// an LDL^T in any symmetric ordering (Vanderbei 1995), so the ordering is chosen for fill alone.
-// Measured on paper_amplitude_0.82's system at 16 and 32 cells across (10 439 and 33 047
-// unknowns): 1.0 and 1.7 million entries in L against 2.6 and 10.1 million in UMFPACK's
-// threshold-pivoted L + U, one application 0.8-1.9 and 6-7 ms against 9 and 35 ms, a numeric
-// factorisation 0.03-0.07 and 0.42 s against 0.15 and 0.83 s; one application of the fresh
-// factorisation leaves a relative residual of about 5e-6 (eps = 1e-10: 1e-4; eps = 1e-14: 5e-4,
-// round-off), a second 1e-10. When the LDL^T fails (a zero pivot, or GMRES on a fresh LDL^T does
-// not converge: a velocity block that the wall's stiffness term makes indefinite) the solver
-// falls back to UMFPACK's LU for the rest of the run, until forget_factorisation
-// (ldlt_fallbacks() counts). Preconditioner solves run UMFPACK without iterative refinement
-// (UMFPACK_IRSTEP = 0): its refinement would use the CURRENT values of the matrix it refers to
-// with the factors of an older one. With reuse off every factor() factors by UMFPACK and solve()
-// is the direct solve with one refinement step (the original behaviour); so is the prescribed
-// wall's constrained (unsymmetric) system.
+// term are; Cholesky reads the lower triangle) has zero pressure diagonals, so an unpivoted
+// symmetric factorisation of it breaks down; regularised, the pressure (whose block is now
+// diagonal) is eliminated exactly: p = (B u - g) / e and
+//   S u = f + B^T g / e,   S = A + B^T B / e,
+// S symmetric positive definite when A is, with A's own sparsity (the discontinuous pressure
+// couples only one element's velocities, which A couples already). S is factored by CHOLMOD's
+// supernodal Cholesky (its fill-reducing ordering, BLAS-3 kernels). As a preconditioner it is
+// nearly exact: one application leaves a relative residual of about 5e-6 (eps = 1e-10: 2e-5;
+// 1e-8: 3e-3), a second 1e-10. Measured on paper_amplitude_0.82's system at 32 cells across
+// (33 047 unknowns, one core): a numeric factorisation 0.09 s (+0.05 s to form S) and one
+// application 6-7 ms, against 0.83 s and 35 ms for UMFPACK's threshold-pivoted LU of the
+// unregularised system (10.1 million entries in L + U) and 0.42 s and 6-7 ms for a simplicial
+// LDL^T of the regularised one (1.7 million entries in L). When the Cholesky fails (S not
+// positive definite: a velocity block made indefinite by the wall's stiffness term) or GMRES on
+// a fresh one does not converge, the solver falls back to UMFPACK's LU until
+// forget_factorisation (factorisation_fallbacks() counts). Preconditioner solves run UMFPACK
+// without iterative refinement (UMFPACK_IRSTEP = 0): its refinement would use the CURRENT values
+// of the matrix it refers to with the factors of an older one. With reuse off every factor()
+// factors by UMFPACK and solve() is the direct solve with one refinement step (the original
+// behaviour); so is the prescribed wall's constrained (unsymmetric) system.
 // Measured on a driver run (16 k unknowns): a factorisation costs ~15 GMRES iterations; a reused
 // LU needs 6-9 iterations one step later (the stage system also changes with gamma dt; a scale
 // ratio 1.5 adds ~5 iterations), growing to 12-15 after ~5 steps; refactor_after = 8 was faster
@@ -170,12 +175,12 @@ class FittedStokes {
   /// checkpoint (new solvers) repeats the uninterrupted one bit for bit.
   void forget_factorisation();
   static constexpr int kRefactorAfter = 8;
-  /// Regularisation of the pressure diagonal in the LDL^T preconditioner (see the header comment).
-  static constexpr double kLdltRegularisation = 1e-12;
-  /// Times the LDL^T preconditioner failed and the solver fell back to UMFPACK's LU (since the
-  /// solver's construction; not restored on resume).
-  long ldlt_fallbacks() const { return ldlt_fallbacks_; }
-  /// "LDL^T (CHOLMOD)" or "LU (UMFPACK)": the factorisation the next reused solve preconditions with.
+  /// Regularisation of the pressure diagonal in the preconditioner (see the header comment).
+  static constexpr double kPressureRegularisation = 1e-12;
+  /// Times the regularised system's Cholesky failed and the solver fell back to UMFPACK's LU
+  /// (since the solver's construction; not restored on resume).
+  long factorisation_fallbacks() const { return fallbacks_; }
+  /// "Cholesky (CHOLMOD)" or "LU (UMFPACK)": what the next reused solve preconditions with.
   std::string preconditioner() const;
   static constexpr double kReuseTolerance = 1e-12;
   /// GMRES iterations (preconditioner applications) and relative true residual ||b - A x|| / ||b||
@@ -270,10 +275,11 @@ class FittedStokes {
   double eval_pressure(int e, double x, double r) const;
   int find_position(int row, int col) const;  ///< value index of (row, col) in A_, or -1
   void transfer_weights();                    ///< gw_ from the fitted mesh (consistent coupling)
-  /// Factors A_ (symbolic analysis on the first call): the regularised LDL^T when `ldlt` and it
-  /// has not failed, else UMFPACK's LU.
-  void numeric_factor(bool ldlt);
-  bool ldlt_factor();  ///< the regularised LDL^T of A_; false (and no factorisation) when it fails
+  /// Factors A_ (symbolic analysis on the first call): the regularised system's Cholesky when
+  /// `regularised` and it has not failed, else UMFPACK's LU.
+  void numeric_factor(bool regularised);
+  bool cholesky_factor();  ///< the regularised system's Cholesky; false (no factorisation) when it fails
+  Eigen::VectorXd cholesky_apply(const Eigen::VectorXd& v) const;  ///< its solve
   /// Right-preconditioned GMRES on A_ x = rhs_ into sol_, from x0 scaled to its best multiple (or
   /// from zero: x0 null or empty, or no better than zero); returns true when converged to tol_;
   /// iters and the true relative residual out. fresh: the LU is of A_ itself (then stagnation
@@ -295,15 +301,20 @@ class FittedStokes {
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> A_;
   std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> lu_;
   static std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> new_lu();
-  using Ldlt = Eigen::CholmodSimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>;
-  static std::unique_ptr<Ldlt> new_ldlt();
-  std::unique_ptr<Ldlt> ldlt_;
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> areg_;  ///< A_ with the pressure diagonal regularised
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> preg_;  ///< -1 on the pressure diagonal
-  bool ldlt_analysed_ = false;
-  bool use_ldlt_ = true;   ///< false after an LDL^T failure (UMFPACK until forget_factorisation)
-  bool pc_ldlt_ = false;   ///< the stored factorisation (lu_valid_) is ldlt_'s, else lu_'s
-  long ldlt_fallbacks_ = 0;
+  using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>;
+  static std::unique_ptr<Cholesky> new_cholesky();
+  std::unique_ptr<Cholesky> chol_;
+  /// S = A + B^T B / e on the velocity unknowns (pattern fixed: A_'s velocity block)
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_;
+  std::vector<int> schur_src_;  ///< per entry of S: its entry in A_
+  std::vector<int> pen_pos_;    ///< per pair of entries of each pressure column of A_: its entry in S
+  std::vector<double> bval_;    ///< A_'s pressure columns (B^T) at the stored factorisation
+  void build_schur_pattern();   ///< schur_'s pattern, schur_src_, pen_pos_ (constructor)
+  double pen_ = 0.0;                                         ///< e = eps d of the stored Cholesky
+  bool chol_analysed_ = false;
+  bool use_chol_ = true;  ///< false after a Cholesky failure (UMFPACK until forget_factorisation)
+  bool pc_chol_ = false;  ///< the stored factorisation (lu_valid_) is chol_'s, else lu_'s
+  long fallbacks_ = 0;
   bool analysed_ = false, factored_ = false, solved_ = false;
   bool reuse_ = true;
   int refactor_after_ = kRefactorAfter;

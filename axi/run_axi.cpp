@@ -690,10 +690,11 @@ class Runner {
       rec_.stats["blas"] = blas_provider();
       // the factorisation that preconditions the steps' GMRES (docs/axi.md, "Linear solves"),
       // and how often it fell back to UMFPACK's LU since the run (or its resumption) started
-      rec_.stats["preconditioner"] = stage_->ldlt_fallbacks() + flow_->ldlt_fallbacks() == 0
-                                         ? "LDL^T of the regularised system (CHOLMOD)"
-                                         : "LDL^T of the regularised system (CHOLMOD), then LU (UMFPACK) after a failure";
-      rec_.stats["ldlt_fallbacks"] = stage_->ldlt_fallbacks() + flow_->ldlt_fallbacks();
+      const long fallbacks = stage_->factorisation_fallbacks() + flow_->factorisation_fallbacks();
+      rec_.stats["preconditioner"] =
+          fallbacks == 0 ? "Cholesky of the regularised system (CHOLMOD)"
+                         : "Cholesky of the regularised system (CHOLMOD), then LU (UMFPACK) after a failure";
+      rec_.stats["factorisation_fallbacks"] = fallbacks;
     }
   }
 

@@ -804,7 +804,7 @@ TEST(FittedStokes, ReuseCountersBehave) {
   EXPECT_EQ(a.timing().factorisations, 1);
   a.solve(F, Ua);
   EXPECT_EQ(a.timing().reused, 0);
-  EXPECT_LE(a.last_iterations(), 3);  // its own system's LDL^T: 5e-6, 1e-10, then 1e-12 reached
+  EXPECT_LE(a.last_iterations(), 3);  // its own system's Cholesky: 5e-6, 1e-10, then 1e-12
   EXPECT_GE(a.last_iterations(), 1);
   b.factor(X);
   b.solve(F, Ub);
@@ -861,13 +861,14 @@ TEST(FittedStokes, ReuseCountersBehave) {
   EXPECT_THROW(a.set_reuse(true, 8, 0.0), std::invalid_argument);
 }
 
-// The reused solves are preconditioned by an LDL^T of the system regularised on its pressure
-// diagonal (eps = 1e-12 of the velocity block's largest diagonal): an approximate factorisation,
+// The reused solves are preconditioned by the Cholesky of the system regularised on its pressure
+// diagonal (eps = 1e-12 of the velocity block's largest diagonal), the pressure eliminated: an
+// approximate factorisation,
 // so GMRES must still return the exact system's answer. Expected: with and without the stiffness
 // term, U equal to UMFPACK's direct solve to 1e-10, the residual at the tolerance, no more than
 // 3 iterations on the fresh factorisation (one application leaves about 1e-5, two about 1e-10),
-// and the LDL^T in use (no fallback to the LU).
-TEST(FittedStokes, TheRegularisedLdltPreconditionerSolvesTheExactSystem) {
+// and the Cholesky in use (no fallback to the LU).
+TEST(FittedStokes, TheRegularisedCholeskyPreconditionerSolvesTheExactSystem) {
   std::mt19937 rng(14);
   const Eigen::SparseMatrix<double> K = random_stiffness(kRn, 1e-7, rng);
   const Eigen::Matrix3Xd X = tube(kRn, 0.2, 0.3e-6, kL, 0.2), F = random_forces(kRn, rng);
@@ -886,9 +887,9 @@ TEST(FittedStokes, TheRegularisedLdltPreconditionerSolvesTheExactSystem) {
     EXPECT_GE(s.last_iterations(), 1);
     EXPECT_LE(s.last_iterations(), 3);
   }
-  EXPECT_EQ(s.preconditioner(), "LDL^T (CHOLMOD)");
-  EXPECT_EQ(s.ldlt_fallbacks(), 0);
-  EXPECT_EQ(fresh.ldlt_fallbacks(), 0);
+  EXPECT_EQ(s.preconditioner(), "Cholesky (CHOLMOD)");
+  EXPECT_EQ(s.factorisation_fallbacks(), 0);
+  EXPECT_EQ(fresh.factorisation_fallbacks(), 0);
 }
 
 // A warm start (solve's `guess` slot) begins GMRES at the best multiple of the slot's last
