@@ -459,6 +459,11 @@ std::unique_ptr<FittedStokes::Cholesky> FittedStokes::new_cholesky() {
   return f;
 }
 
+void FittedStokes::give_up_cholesky() {
+  use_chol_ = false;
+  ++fallbacks_;
+}
+
 std::string FittedStokes::preconditioner() const { return use_chol_ ? "Cholesky (CHOLMOD)" : "LU (UMFPACK)"; }
 
 void FittedStokes::forget_factorisation() {
@@ -505,8 +510,7 @@ bool FittedStokes::cholesky_factor() {
   }
   timing_.factor += seconds_since(t0);
   if (!ok) {
-    use_chol_ = false;
-    ++fallbacks_;
+    give_up_cholesky();
     return false;
   }
   ++timing_.factorisations;
@@ -738,8 +742,7 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
       fresh = true;
     }
     if (!ok && pc_chol_) {  // a fresh Cholesky that does not converge: UMFPACK's LU from now on
-      use_chol_ = false;
-      ++fallbacks_;
+      give_up_cholesky();
       numeric_factor(false);
       int it3 = 0;
       ok = gmres(40, true, it3, res, x0);

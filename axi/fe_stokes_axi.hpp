@@ -278,6 +278,7 @@ class FittedStokes {
   /// Factors A_ (symbolic analysis on the first call): the regularised system's Cholesky when
   /// `regularised` and it has not failed, else UMFPACK's LU.
   void numeric_factor(bool regularised);
+  void give_up_cholesky();  ///< UMFPACK's LU until forget_factorisation; counts the fallback
   bool cholesky_factor();  ///< the regularised system's Cholesky; false (no factorisation) when it fails
   Eigen::VectorXd cholesky_apply(const Eigen::VectorXd& v) const;  ///< its solve
   /// Right-preconditioned GMRES on A_ x = rhs_ into sol_, from x0 scaled to its best multiple (or
