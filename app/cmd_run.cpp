@@ -329,10 +329,18 @@ int run(const RunOptions& o) {
   scene::json sc = scene::load_file(o.scene);
   for (const auto& s : o.sets) scene::apply_override(sc, s);
   if (o.threads > 0) {
-    if (o.tier != "3d")
+    if (o.tier == "axi") {
+      if (o.threads > 2)
+        throw InputError("--threads", std::to_string(o.threads),
+                         "1 or 2 with --tier axi (axi.threads: the second thread factors the systems the first solves)");
+      scene::apply_override(sc, "axi.threads=" + std::to_string(o.threads));
+    } else if (o.tier != "3d") {
       throw InputError("--threads", std::to_string(o.threads),
-                       "only the 3D tier runs on several threads (full3d.threads); add --tier 3d or leave --threads out");
-    scene::apply_override(sc, "full3d.threads=" + std::to_string(o.threads));
+                       "only the 3D and axisymmetric tiers run on several threads (full3d.threads, axi.threads); add "
+                       "--tier 3d or --tier axi, or leave --threads out");
+    } else {
+      scene::apply_override(sc, "full3d.threads=" + std::to_string(o.threads));
+    }
   }
   if (o.tier == "3d") return run3d(o, sc);
   if (o.tier == "axi") return run_axi(o, sc);

@@ -34,20 +34,29 @@ void single_threaded_blas() {
   (void)done;
 }
 
-/// CHOLMOD's supernodal factorisation runs OpenMP loops with the process's default thread count.
-/// On these fronts a second thread mostly spins: one cycle of paper_amplitude_0.82 at 16 cells
-/// took 54 s of CPU for 33 s of wall time with two threads, 34 s for 35 s with one. The product
-/// runs one solve per core, so the CHOLMOD calls run on one thread (the caller's setting is put
-/// back afterwards: the 3D tier's own parallel regions name their thread count anyway).
+/// CHOLMOD's supernodal factorisation runs OpenMP loops that name their own thread count (4, a
+/// constant of Debian's build, CHOLMOD_OMP_NUM_THREADS), which omp_set_num_threads does not
+/// override. On these fronts the extra threads mostly spin and wake: one cycle of
+/// paper_amplitude_0.82 at 16 cells took 54 s of CPU for 33 s of wall time with them, 34 s for
+/// 35 s without; and every new thread that calls CHOLMOD starts a pool of its own. The product
+/// runs one solve per core, so the CHOLMOD calls run with no active parallel level
+/// (max-active-levels 0: every region a team of the calling thread alone); the caller's settings
+/// are put back afterwards. Per thread: a background factorisation sets its own.
 class OneOpenMpThread {
  public:
-  OneOpenMpThread() : saved_(omp_get_max_threads()) { omp_set_num_threads(1); }
-  ~OneOpenMpThread() { omp_set_num_threads(saved_); }
+  OneOpenMpThread() : threads_(omp_get_max_threads()), levels_(omp_get_max_active_levels()) {
+    omp_set_num_threads(1);
+    omp_set_max_active_levels(0);
+  }
+  ~OneOpenMpThread() {
+    omp_set_max_active_levels(levels_);
+    omp_set_num_threads(threads_);
+  }
   OneOpenMpThread(const OneOpenMpThread&) = delete;
   OneOpenMpThread& operator=(const OneOpenMpThread&) = delete;
 
  private:
-  int saved_;
+  int threads_, levels_;
 };
 
 }  // namespace
@@ -268,8 +277,16 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
         if (L[i] >= 0 && L[j] >= 0 && (i < 18 || j < 18)) P[i * kLoc + j] = find_position(L[i], L[j]);
   }
 
+  // the row-major copy's pattern and, per entry, its entry in A_
+  rows_ = A_;
+  row_src_.resize(std::size_t(rows_.nonZeros()));
+  for (int r = 0; r < n_; ++r)
+    for (int q = rows_.outerIndexPtr()[r]; q < rows_.outerIndexPtr()[r + 1]; ++q)
+      row_src_[std::size_t(q)] = find_position(r, rows_.innerIndexPtr()[q]);
+
   lu_ = new_lu();
-  chol_ = new_cholesky();
+  chol_.factor = new_cholesky();
+  spare_.factor = new_cholesky();
   build_schur_pattern();
   rhs_.setZero(n_);
   sol_.setZero(n_);
@@ -311,10 +328,13 @@ void FittedStokes::build_schur_pattern() {
           throw std::logic_error("FittedStokes: pressure unknowns coupled to each other");
         pen_pos_.push_back(position(inner[a], inner[b]));
       }
-  bval_.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
+  chol_.bval.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
+  spare_.bval = chol_.bval;
 }
 
-FittedStokes::~FittedStokes() = default;
+FittedStokes::~FittedStokes() {
+  if (worker_.joinable()) worker_.join();
+}
 
 int FittedStokes::find_position(int row, int col) const {
   const int* inner = A_.innerIndexPtr();
@@ -439,6 +459,7 @@ void FittedStokes::set_reuse(bool on, int refactor_after, double tolerance) {
   if (refactor_after < 0) throw std::invalid_argument("FittedStokes::set_reuse: refactor_after must be >= 0");
   if (!(tolerance > 0.0 && tolerance < 1.0))
     throw std::invalid_argument("FittedStokes::set_reuse: tolerance must be in (0, 1)");
+  if (!on) join_background(true);
   reuse_ = on;
   refactor_after_ = refactor_after;
   tol_ = tolerance;
@@ -466,48 +487,58 @@ void FittedStokes::give_up_cholesky() {
 
 std::string FittedStokes::preconditioner() const { return use_chol_ ? "Cholesky (CHOLMOD)" : "LU (UMFPACK)"; }
 
+void FittedStokes::set_background_factorisation(bool on) {
+  if (!on) join_background(true);
+  background_ = on;
+}
+
 void FittedStokes::forget_factorisation() {
+  join_background(false);
   analysed_ = lu_valid_ = lu_current_ = false;
   last_iters_ = 0;
   lu_ = new_lu();
-  chol_ = new_cholesky();
-  chol_analysed_ = pc_chol_ = false;
+  for (CholeskySlot* c : {&chol_, &spare_}) {
+    c->factor = new_cholesky();
+    c->analysed = false;
+  }
+  pc_chol_ = false;
   use_chol_ = true;
   for (Eigen::VectorXd& g : guess_) g.resize(0);
 }
 
-bool FittedStokes::cholesky_factor() {
-  const auto t0 = Clock::now();
-  lu_valid_ = lu_current_ = pc_chol_ = false;
+bool FittedStokes::factor_into(CholeskySlot& slot) const {
   double d = 0.0;
   for (int c = 0; c < n_vel_; ++c) d = std::max(d, std::abs(A_.coeff(c, c)));
-  bool ok = d > 0.0 && std::isfinite(d);
-  if (ok) {
-    // S = A_vv + B^T B / e on its fixed pattern; the factored B kept for the applications
-    pen_ = kPressureRegularisation * d;
-    const double inv = 1.0 / pen_;
-    const double* av = A_.valuePtr();
-    const int* outer = A_.outerIndexPtr();
-    double* sv = schur_.valuePtr();
-    for (std::size_t k = 0; k < schur_src_.size(); ++k) sv[k] = av[schur_src_[k]];
-    std::size_t k = 0;
-    for (int c = n_vel_; c < n_; ++c)
-      for (int a = outer[c]; a < outer[c + 1]; ++a) {
-        const double va = av[a] * inv;
-        for (int b = outer[c]; b < outer[c + 1]; ++b) sv[pen_pos_[k++]] += va * av[b];
-      }
-    std::copy(av + outer[n_vel_], av + outer[n_], bval_.begin());
-    const OneOpenMpThread one;
-    if (!chol_analysed_) {
-      chol_->analyzePattern(schur_);
-      chol_analysed_ = chol_->info() == Eigen::Success;
+  if (!(d > 0.0 && std::isfinite(d))) return false;
+  // S = A_vv + B^T B / e on its fixed pattern; the factored B kept for the applications
+  slot.pen = kPressureRegularisation * d;
+  const double inv = 1.0 / slot.pen;
+  const double* av = A_.valuePtr();
+  const int* outer = A_.outerIndexPtr();
+  double* sv = schur_.valuePtr();
+  for (std::size_t k = 0; k < schur_src_.size(); ++k) sv[k] = av[schur_src_[k]];
+  std::size_t k = 0;
+  for (int c = n_vel_; c < n_; ++c)
+    for (int a = outer[c]; a < outer[c + 1]; ++a) {
+      const double va = av[a] * inv;
+      for (int b = outer[c]; b < outer[c + 1]; ++b) sv[pen_pos_[k++]] += va * av[b];
     }
-    ok = chol_analysed_;
-    if (ok) {
-      chol_->factorize(schur_);
-      ok = chol_->info() == Eigen::Success;
-    }
+  std::copy(av + outer[n_vel_], av + outer[n_], slot.bval.begin());
+  const OneOpenMpThread one;  // per thread: the worker's own setting
+  if (!slot.analysed) {
+    slot.factor->analyzePattern(schur_);
+    slot.analysed = slot.factor->info() == Eigen::Success;
+    if (!slot.analysed) return false;
   }
+  slot.factor->factorize(schur_);
+  return slot.factor->info() == Eigen::Success;
+}
+
+bool FittedStokes::cholesky_factor() {
+  join_background(false);  // a pending one would be of this system too: factored here instead
+  const auto t0 = Clock::now();
+  lu_valid_ = lu_current_ = pc_chol_ = false;
+  const bool ok = factor_into(chol_);
   timing_.factor += seconds_since(t0);
   if (!ok) {
     give_up_cholesky();
@@ -519,31 +550,74 @@ bool FittedStokes::cholesky_factor() {
   return true;
 }
 
+void FittedStokes::launch_background() {
+  worker_ok_ = false;
+  worker_seconds_ = 0.0;
+  worker_ = std::thread([this] {
+    const auto t0 = Clock::now();
+    bool ok = false;
+    try {
+      ok = factor_into(spare_);
+    } catch (...) {  // out of memory in CHOLMOD or Eigen: reported as a failed factorisation
+      ok = false;
+    }
+    worker_ok_ = ok;
+    worker_seconds_ = seconds_since(t0);
+  });
+}
+
+bool FittedStokes::join_background(bool install) {
+  if (!worker_.joinable()) return false;
+  const auto t0 = Clock::now();
+  worker_.join();
+  timing_.factor += seconds_since(t0);
+  timing_.factor_background += worker_seconds_;
+  ++timing_.factorisations;
+  if (!install) return false;
+  if (!worker_ok_) {  // S not positive definite: UMFPACK's LU from the next factorisation on
+    give_up_cholesky();
+    lu_valid_ = lu_current_ = pc_chol_ = false;
+    return false;
+  }
+  std::swap(chol_, spare_);
+  lu_valid_ = lu_current_ = pc_chol_ = true;  // of the current A_ until the next assembly
+  last_iters_ = 0;
+  return true;
+}
+
+void FittedStokes::refactor_now() {
+  if (worker_.joinable() && join_background(true)) return;
+  numeric_factor(true);
+}
+
 Eigen::VectorXd FittedStokes::cholesky_apply(const Eigen::VectorXd& v) const {
   // the factored system's B: A_'s pressure columns (its pattern) with the values kept in bval_
   const int* outer = A_.outerIndexPtr();
   const int* inner = A_.innerIndexPtr();
   const int q0 = outer[n_vel_];
+  const double pen = chol_.pen;
+  const std::vector<double>& bval = chol_.bval;
   Eigen::VectorXd f = v.head(n_vel_);
   for (int c = n_vel_; c < n_; ++c) {
-    const double gc = v[c] / pen_;
-    for (int q = outer[c]; q < outer[c + 1]; ++q) f[inner[q]] += bval_[std::size_t(q - q0)] * gc;
+    const double gc = v[c] / pen;
+    for (int q = outer[c]; q < outer[c + 1]; ++q) f[inner[q]] += bval[std::size_t(q - q0)] * gc;
   }
   Eigen::VectorXd z(n_);
   {
     const OneOpenMpThread one;
-    z.head(n_vel_) = chol_->solve(f);
+    z.head(n_vel_) = chol_.factor->solve(f);
   }
   for (int c = n_vel_; c < n_; ++c) {
     double bu = 0.0;
-    for (int q = outer[c]; q < outer[c + 1]; ++q) bu += bval_[std::size_t(q - q0)] * z[inner[q]];
-    z[c] = (bu - v[c]) / pen_;
+    for (int q = outer[c]; q < outer[c + 1]; ++q) bu += bval[std::size_t(q - q0)] * z[inner[q]];
+    z[c] = (bu - v[c]) / pen;
   }
   return z;
 }
 
 void FittedStokes::numeric_factor(bool regularised) {
   if (regularised && use_chol_ && cholesky_factor()) return;
+  join_background(false);
   const auto t0 = Clock::now();
   lu_valid_ = lu_current_ = pc_chol_ = false;
   if (!analysed_) {
@@ -577,12 +651,41 @@ void FittedStokes::factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<d
   auto t0 = Clock::now();
   mesh_.fit(X);
   transfer_weights();
+  // the previous system's background factorisation: the preconditioner from now on
+  if (worker_.joinable()) {
+    const auto tj = Clock::now();
+    join_background(true);
+    t0 += Clock::now() - tj;  // accounted as factorisation
+  }
   lu_current_ = false;  // A_ changes now (the stored LU, if any, stays valid as a preconditioner)
   assemble(K, scale);
+  {
+    const double* av = A_.valuePtr();
+    double* rv = rows_.valuePtr();
+    for (std::size_t k = 0; k < row_src_.size(); ++k) rv[k] = av[row_src_[k]];
+  }
   timing_.assemble += seconds_since(t0);
+  solves_on_system_ = 0;
   // The iteration-count trigger is checked at the next solve (see the header comment).
-  if (!reuse_ || !lu_valid_ || force) numeric_factor(reuse_);
+  if (!reuse_ || !lu_valid_ || force)
+    numeric_factor(reuse_);
+  else if (background_ && pc_chol_ && use_chol_)
+    launch_background();
   factored_ = true;
+}
+
+void FittedStokes::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  // one thread, row by row (a background factorisation may be using the other core)
+  const int* outer = rows_.outerIndexPtr();
+  const int* inner = rows_.innerIndexPtr();
+  const double* val = rows_.valuePtr();
+  const double* xv = x.data();
+  y.resize(n_);
+  for (int i = 0; i < n_; ++i) {
+    double s = 0.0;
+    for (int q = outer[i]; q < outer[i + 1]; ++q) s += val[q] * xv[inner[q]];
+    y[i] = s;
+  }
 }
 
 bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& relres, const Eigen::VectorXd* x0) {
@@ -598,7 +701,8 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
   double res = 1.0;  // true relative residual of sol_
   if (x0 && x0->size() == n_) {
     // the best multiple alpha x0 (one product): b - alpha A x0 orthogonal to A x0
-    const Eigen::VectorXd ax = A_ * *x0;
+    Eigen::VectorXd ax(n_);
+    multiply(*x0, ax);
     const double axn2 = ax.squaredNorm();
     if (axn2 > 0.0 && std::isfinite(axn2)) {
       const double alpha = ax.dot(rhs_) / axn2;
@@ -633,7 +737,7 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
       else
         z = lu_->solve(v);
       kz_.col(k) = z;
-      w.noalias() = A_ * z;
+      multiply(z, w);
       // modified Gram-Schmidt, twice
       for (int pass = 0; pass < 2; ++pass)
         for (int i = 0; i <= k; ++i) {
@@ -665,7 +769,8 @@ bool FittedStokes::gmres(int max_iterations, bool fresh, int& iters, double& rel
         H.topLeftCorner(k, k).triangularView<Eigen::Upper>().solve(g.head(k));
     sol_.noalias() += kz_.leftCols(k) * y;
     r = rhs_;
-    r.noalias() -= A_ * sol_;
+    multiply(sol_, w);
+    r -= w;
     const double prev = res;
     res = r.norm() / bnorm;
     if (!std::isfinite(res)) break;
@@ -726,15 +831,18 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
     last_iters_ = 0;
     last_res_ = -1.0;
   } else {
-    // The previous solve needed too many iterations: factor the current system first.
-    if (!lu_current_ && last_iters_ > refactor_after_) numeric_factor(true);
+    // This system's second solve uses its own background factorisation; the previous solve
+    // needed too many iterations: factor the current system first.
+    if (++solves_on_system_ > 1 && worker_.joinable()) join_background(true);
+    if (!lu_current_ && last_iters_ > refactor_after_) refactor_now();
+    if (!lu_valid_) numeric_factor(true);  // a background Cholesky failed: the LU now
     int it = 0;
     double res = 0.0;
     bool fresh = lu_current_;
     bool ok = gmres(fresh ? 40 : 20, fresh, it, res, x0);
     timing_.krylov_iterations += it;
     if (!ok && !fresh) {  // the old factorisation is no longer good enough: refactor, solve again
-      numeric_factor(true);
+      refactor_now();
       int it2 = 0;
       ok = gmres(40, true, it2, res, x0);
       timing_.krylov_iterations += it2;
@@ -798,6 +906,7 @@ FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen:
   if (V.cols() != nm || !V.topRows(2).allFinite())
     throw std::invalid_argument("FittedStokes::prescribed_wall_velocity: V must be 3 x " + std::to_string(nm) +
                                 " and finite");
+  join_background(false);  // its worker reads A_, which is about to change
   factored_ = solved_ = false;
   lu_valid_ = lu_current_ = false;  // the stored LU will be of the constrained system
   auto t0 = Clock::now();

@@ -109,6 +109,30 @@
 // of the matrix it refers to with the factors of an older one. With reuse off every factor()
 // factors by UMFPACK and solve() is the direct solve with one refinement step (the original
 // behaviour); so is the prescribed wall's constrained (unsymmetric) system.
+// GMRES's products with A_ run on a row-major copy (refreshed after each assembly through a
+// fixed permutation of A_'s values): it gathers along rows instead of scattering updates down
+// columns, the same sums in the same order, so the products are unchanged.
+//
+// Factorisation in the background (set_background_factorisation; off by default, on in the
+// time stepper). With the Cholesky in use, a factor() that keeps an earlier factorisation starts
+// the Cholesky of the system it assembled on a worker thread (it forms S from A_, which nothing
+// writes until the worker is joined, into a second Cholesky object with its own B and e); the
+// solves go on with the earlier factorisation. The worker's factorisation is installed
+//   - at this system's second solve (the Rosenbrock stages' correction: then solved on the
+//     system's own Cholesky),
+//   - when a solve needs the current system's factorisation (the refactor_after trigger, a GMRES
+//     cycle that does not converge), instead of factoring again,
+//   - at the next factor(), before it assembles: the preconditioner of the next system.
+// Every point of installation is fixed by the sequence of calls, never by the worker's timing,
+// so a run is repeated bit for bit. A failed background Cholesky falls back to UMFPACK's LU as a
+// synchronous one does; forget_factorisation and a prescribed wall discard a pending one. On a
+// 2-core machine the factorisations then run beside the solves: one cycle of the round
+// paper_aspect_L0.2 at half ring spacing took 38 s of wall time at 16 cells and 195 s at 32 cells
+// across, against 62 s and 352 s factoring in turn before the CHOLMOD threads were confined
+// (docs/performance.md).
+// Timing::factor counts the caller's time in factorisations and in waiting for a worker,
+// Timing::factor_background the workers' own.
+//
 // Measured on a driver run (16 k unknowns): a factorisation costs ~15 GMRES iterations; a reused
 // LU needs 6-9 iterations one step later (the stage system also changes with gamma dt; a scale
 // ratio 1.5 adds ~5 iterations), growing to 12-15 after ~5 steps; refactor_after = 8 was faster
@@ -127,6 +151,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "axi/fitted_mesh.hpp"
@@ -182,6 +207,14 @@ class FittedStokes {
   long factorisation_fallbacks() const { return fallbacks_; }
   /// "Cholesky (CHOLMOD)" or "LU (UMFPACK)": what the next reused solve preconditions with.
   std::string preconditioner() const;
+  /// Background factorisation (default off; see the header comment "Factorisation in the
+  /// background"): with reuse on and the Cholesky in use, every factor() that keeps an earlier
+  /// factorisation starts the current system's Cholesky on a worker thread; it becomes the
+  /// preconditioner at this system's second solve, at a solve that needs it (an unconverged
+  /// GMRES cycle, the refactor_after trigger) and at the next factor(). Off: the worker (if any)
+  /// is joined and its factorisation kept.
+  void set_background_factorisation(bool on);
+  bool background_factorisation() const { return background_; }
   static constexpr double kReuseTolerance = 1e-12;
   /// GMRES iterations (preconditioner applications) and relative true residual ||b - A x|| / ||b||
   /// of the last solve (0 and not computed, -1, with reuse off).
@@ -247,8 +280,10 @@ class FittedStokes {
   std::size_t nonzeros() const { return std::size_t(A_.nonZeros()); }
 
   struct Timing {
-    double assemble = 0, factor = 0, solve = 0;
-    long factorisations = 0, solves = 0;
+    /// factor: seconds the caller's thread spent factoring or waiting for a background
+    /// factorisation; factor_background: seconds the worker threads spent factoring.
+    double assemble = 0, factor = 0, solve = 0, factor_background = 0;
+    long factorisations = 0, solves = 0;  ///< factorisations: all numeric ones (background too)
     long krylov_iterations = 0;  ///< GMRES iterations over all solves (reuse on)
     long reused = 0;             ///< solves done with the factorisation of an earlier system
   };
@@ -281,6 +316,25 @@ class FittedStokes {
   void give_up_cholesky();  ///< UMFPACK's LU until forget_factorisation; counts the fallback
   bool cholesky_factor();  ///< the regularised system's Cholesky; false (no factorisation) when it fails
   Eigen::VectorXd cholesky_apply(const Eigen::VectorXd& v) const;  ///< its solve
+  using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>;
+  /// A Cholesky of S with what applying it needs: the factored system's B (A_'s pressure
+  /// columns' values) and e.
+  struct CholeskySlot {
+    std::unique_ptr<Cholesky> factor;
+    bool analysed = false;
+    std::vector<double> bval;
+    double pen = 0.0;
+  };
+  /// Forms S from the current A_ into schur_ and factors it into `slot` (its symbolic analysis
+  /// on its first use); false when S is not positive definite. Reads A_, writes schur_ and slot
+  /// only (safe on a worker thread while the caller's thread reads A_).
+  bool factor_into(CholeskySlot& slot) const;
+  void launch_background();  ///< spare_ <- the current A_'s Cholesky, on a worker thread
+  /// Waits for the worker; `install`: its Cholesky becomes the preconditioner (of the current
+  /// A_ when joined before the next assembly), a failed one gives the Cholesky up. Returns true
+  /// when a factorisation was installed.
+  bool join_background(bool install);
+  void refactor_now();  ///< the current A_'s factorisation: the background one if pending, else now
   /// Right-preconditioned GMRES on A_ x = rhs_ into sol_, from x0 scaled to its best multiple (or
   /// from zero: x0 null or empty, or no better than zero); returns true when converged to tol_;
   /// iters and the true relative residual out. fresh: the LU is of A_ itself (then stagnation
@@ -300,19 +354,27 @@ class FittedStokes {
   std::vector<std::array<int, 5>> gnode_;
   std::vector<std::array<double, 5>> gw_;
   Eigen::SparseMatrix<double, Eigen::ColMajor, int> A_;
+  /// A_ stored by rows, for GMRES's products (a row-major product gathers: about 3 times faster
+  /// than the column-major one's scattered updates); refreshed after each assembly by the
+  /// permutation row_src_ (per entry of rows_: its entry in A_).
+  Eigen::SparseMatrix<double, Eigen::RowMajor, int> rows_;
+  std::vector<int> row_src_;
+  void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const;  ///< y = A_ x (by rows_)
   std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> lu_;
   static std::unique_ptr<Eigen::UmfPackLU<Eigen::SparseMatrix<double, Eigen::ColMajor, int>>> new_lu();
-  using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>;
   static std::unique_ptr<Cholesky> new_cholesky();
-  std::unique_ptr<Cholesky> chol_;
+  CholeskySlot chol_;   ///< the stored (applied) Cholesky
+  CholeskySlot spare_;  ///< the one a worker factors into (swapped with chol_ when installed)
   /// S = A + B^T B / e on the velocity unknowns (pattern fixed: A_'s velocity block)
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_;
+  mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_;
   std::vector<int> schur_src_;  ///< per entry of S: its entry in A_
   std::vector<int> pen_pos_;    ///< per pair of entries of each pressure column of A_: its entry in S
-  std::vector<double> bval_;    ///< A_'s pressure columns (B^T) at the stored factorisation
   void build_schur_pattern();   ///< schur_'s pattern, schur_src_, pen_pos_ (constructor)
-  double pen_ = 0.0;                                         ///< e = eps d of the stored Cholesky
-  bool chol_analysed_ = false;
+  bool background_ = false;
+  std::thread worker_;          ///< joinable while a background factorisation is pending
+  bool worker_ok_ = false;      ///< set by the worker: its Cholesky succeeded
+  double worker_seconds_ = 0.0; ///< set by the worker: its time
+  int solves_on_system_ = 0;    ///< solves since the last factor() (the current A_)
   bool use_chol_ = true;  ///< false after a Cholesky failure (UMFPACK until forget_factorisation)
   bool pc_chol_ = false;  ///< the stored factorisation (lu_valid_) is chol_'s, else lu_'s
   long fallbacks_ = 0;

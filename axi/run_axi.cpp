@@ -82,6 +82,8 @@ class Runner {
       // with 114 factorisations instead of 431 (docs/performance.md, "Axisymmetric tier").
       stage_->set_reuse(true, FittedStokes::kRefactorAfter, kStepSolveTolerance);
       flow_->set_reuse(true, FittedStokes::kRefactorAfter, kStepSolveTolerance);
+      stage_->set_background_factorisation(p_.threads > 1);
+      flow_->set_background_factorisation(p_.threads > 1);
     } else {
       stokes_ = std::make_unique<AxiStokes>(grid_, b_.fluid.mu);
     }
@@ -191,13 +193,14 @@ class Runner {
   /// The fitted solvers' statistics so far, as numbers (they continue in a resumed run).
   static std::vector<double> timing_record(const FittedStokes::Timing& t) {
     return {t.assemble, t.factor, t.solve, double(t.factorisations), double(t.solves), double(t.krylov_iterations),
-            double(t.reused)};
+            double(t.reused), t.factor_background};
   }
   static FittedStokes::Timing timing_of(const std::vector<double>& v) {
     FittedStokes::Timing t;
     t.assemble = v.at(0), t.factor = v.at(1), t.solve = v.at(2);
     t.factorisations = long(v.at(3)), t.solves = long(v.at(4)), t.krylov_iterations = long(v.at(5)),
     t.reused = long(v.at(6));
+    t.factor_background = v.at(7);
     return t;
   }
 
@@ -707,6 +710,7 @@ class Runner {
             {"wall_stiffness", split_stiffness_},
             {"assembly", a.assemble + b.assemble},
             {"factorisation", a.factor + b.factor},
+            {"factorisation_in_background", a.factor_background + b.factor_background},
             {"solves", a.solve + b.solve},
             {"factorisations", a.factorisations + b.factorisations},
             {"solves_on_an_earlier_factorisation", a.reused + b.reused},
@@ -787,8 +791,8 @@ full3d::CheckpointReader Runner::open_checkpoint(const ParamsAxi& p, const json&
   expect_size("U", 3 * rings, "wall rings");
   expect_size("energy", 2, "wall energies");
   if (p.method == AxiMethod::Fitted) {
-    expect_size("stage_timing", 7, "solver statistics");
-    expect_size("flow_timing", 7, "solver statistics");
+    expect_size("stage_timing", 8, "solver statistics");
+    expect_size("flow_timing", 8, "solver statistics");
   }
   expect_size(full3d::kOutputMarks, 6, "output streams (size and checksum of series.csv.part and radius.csv.part)");
   const std::vector<double> X = r.get_vector("X");

@@ -37,7 +37,8 @@ const json& section_keys() {
                               {"dt_min", "quantity:s@positive"},
                               {"event_dt", "quantity:s@positive"},
                               {"time_limit", "quantity:s@positive"},
-                              {"checkpoint_interval", "quantity:s@positive"}}}};
+                              {"checkpoint_interval", "quantity:s@positive"},
+                              {"threads", "integer@[1,2]"}}}};
   return keys;
 }
 
@@ -151,6 +152,9 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   // simulated time between checkpoints (a schedule in simulated time keeps a resumed run
   // identical to an uninterrupted one); the 3D tier's default
   p.checkpoint_interval = a.quantity("checkpoint_interval", "s", fmt(10.0 * b.output_interval, "s"), Range::positive());
+  // fitted: 2 factors each step's systems on a second thread while the first solves (docs/axi.md
+  // "Linear solves"); not part of the physics (the solves stop at the same residual either way)
+  p.threads = int(a.integer("threads", 2, 1, 2));
   a.finish();
 
   // 4. Consistency.

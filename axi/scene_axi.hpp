@@ -59,6 +59,7 @@ struct ParamsAxi {
   double dt_max = 8e-3, dt_min = 1e-8, event_dt = 1e-4;  ///< s
   double time_limit = 2.0;     ///< s; run cap when the duration is auto
   double checkpoint_interval = 0.0;  ///< s of simulated time between checkpoints (protocol-driven runs)
+  int threads = 2;             ///< fitted: 2 = factorisations on a second thread (axi.threads)
 
   const std::string& name() const { return base.name; }
   const char* method_name() const { return method == AxiMethod::Fitted ? "fitted" : "immersed_boundary"; }

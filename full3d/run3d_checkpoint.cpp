@@ -30,6 +30,7 @@ std::string resume_key(const scene::json& resolved) {
   }
   if (r.contains("axi") && r["axi"].is_object()) {
     r["axi"].erase("checkpoint_interval");
+    r["axi"].erase("threads");
     r["axi"].erase("time_limit");
   }
   return r.dump();

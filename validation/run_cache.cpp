@@ -66,7 +66,10 @@ json physics_of(json resolved) {
     resolved["full3d"].erase("checkpoint_interval");
     resolved["full3d"].erase("threads");
   }
-  if (resolved.contains("axi") && resolved["axi"].is_object()) resolved["axi"].erase("checkpoint_interval");
+  if (resolved.contains("axi") && resolved["axi"].is_object()) {
+    resolved["axi"].erase("checkpoint_interval");
+    resolved["axi"].erase("threads");
+  }
   return resolved;
 }
 
@@ -373,7 +376,10 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   return r;
 }
 
-RunAxi RunCache::run_axi(const json& sc, int progress) {
+RunAxi RunCache::run_axi(const json& scene, int progress) {
+  // the cache's threads, as the 3D runs' (the second factors the systems; 1 in an MPI rank)
+  json sc = scene;
+  set_key(sc, "axi.threads", std::min(threads_, 2));
   json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
   const std::string key = run_key_axi(resolved);

@@ -947,6 +947,88 @@ TEST(FittedStokes, AWarmStartBeginsAtTheSlotsLastSolution) {
   EXPECT_THROW(s.solve(F, U, nullptr, -2), std::invalid_argument);
 }
 
+// Background factorisation (the stepper's setting): each factor() after the first starts the
+// current system's Cholesky on a worker thread and solves with the earlier one; the system's
+// second solve uses its own. Expected: every answer equal to UMFPACK's direct solve to 1e-10;
+// the first solve of each moved system on the earlier factorisation (reused), the second on its
+// own, so one factorisation per factor(); a twin solver gives bit-identical answers and
+// iteration counts (the preconditioner's choice never depends on the worker's timing); the
+// worker's time is counted apart; forget_factorisation, a prescribed wall, switching the
+// background off and the destructor each meet a pending worker without harm.
+TEST(FittedStokes, BackgroundFactorisationIsDeterministicAndSolvesTheCurrentSystem) {
+  std::mt19937 rng(16);
+  const Eigen::SparseMatrix<double> K = random_stiffness(kRn, 1e-7, rng);
+  const Eigen::Matrix3Xd X = tube(kRn, 0.2, 0.3e-6, kL, 0.2), F = random_forces(kRn, rng);
+  FittedStokes a(reuse_params(), kMu, kRn), twin(reuse_params(), kMu, kRn), fresh(reuse_params(), kMu, kRn);
+  for (FittedStokes* s : {&a, &twin}) {
+    s->set_reuse(true, 19);  // no iteration-count refactorisation: the counts below are the rule's
+    s->set_background_factorisation(true);
+    EXPECT_TRUE(s->background_factorisation());
+  }
+  fresh.set_reuse(false);
+  Eigen::Matrix3Xd U1, U2, T1, T2, Uf;
+  const int steps = 4;
+  for (int step = 0; step <= steps; ++step) {
+    const Eigen::Matrix3Xd Y = moved(X, 0.01 * step);
+    a.factor(Y, &K, 1e-3);
+    a.solve(F, U1, nullptr, 0);
+    const int first = a.last_iterations();
+    a.solve(2.0 * F, U2, nullptr, 1);
+    const int second = a.last_iterations();
+    twin.factor(Y, &K, 1e-3);
+    twin.solve(F, T1, nullptr, 0);
+    EXPECT_EQ(twin.last_iterations(), first);
+    twin.solve(2.0 * F, T2, nullptr, 1);
+    EXPECT_EQ(twin.last_iterations(), second);
+    EXPECT_EQ(U1, T1) << "step " << step;
+    EXPECT_EQ(U2, T2) << "step " << step;
+    fresh.factor(Y, &K, 1e-3);
+    fresh.solve(F, Uf);
+    EXPECT_LT(rel_diff(U1, Uf), 1e-10) << "step " << step;
+    EXPECT_LT(rel_diff(U2, 2.0 * Uf), 1e-10) << "step " << step;
+    EXPECT_LE(second, 3) << "step " << step;  // its own system's Cholesky
+    std::printf("  step %d: %d iterations on the earlier factorisation, %d on its own\n", step, first, second);
+  }
+  EXPECT_EQ(a.timing().factorisations, 1 + steps);  // the first synchronously, then one per factor()
+  EXPECT_EQ(a.timing().reused, steps);
+  EXPECT_EQ(a.timing().solves, 2 * (steps + 1));
+  EXPECT_GT(a.timing().factor_background, 0.0);
+  EXPECT_EQ(a.preconditioner(), "Cholesky (CHOLMOD)");
+  EXPECT_EQ(a.factorisation_fallbacks(), 0);
+
+  // A pending worker met by forget_factorisation: the next factor() factors synchronously.
+  a.factor(moved(X, 0.05), &K, 1e-3);
+  a.forget_factorisation();
+  const long f0 = a.timing().factorisations;
+  a.factor(X, &K, 1e-3);
+  EXPECT_EQ(a.timing().factorisations, f0 + 1);
+  a.solve(F, U1, nullptr, 0);
+  EXPECT_EQ(a.timing().reused, steps);  // the fresh factorisation's solve
+  // ... by a prescribed wall (which reassembles A_): its answer equals a fresh solver's.
+  a.factor(moved(X, 0.01), &K, 1e-3);
+  const Eigen::Matrix3Xd V = Eigen::Matrix3Xd::Zero(3, kRn);
+  const FittedStokes::PrescribedWall w = a.prescribed_wall_velocity(X, V);
+  const FittedStokes::PrescribedWall wf = fresh.prescribed_wall_velocity(X, V);
+  EXPECT_NEAR(w.drag, wf.drag, 1e-12 * std::abs(wf.drag));
+  // ... by switching the background off: joined and kept as the preconditioner, answers right.
+  a.factor(moved(X, 0.02), &K, 1e-3);
+  a.set_background_factorisation(false);
+  EXPECT_FALSE(a.background_factorisation());
+  a.solve(F, U1);
+  fresh.factor(moved(X, 0.02), &K, 1e-3);
+  fresh.solve(F, Uf);
+  EXPECT_LT(rel_diff(U1, Uf), 1e-10);
+  EXPECT_LE(a.last_iterations(), 3);  // the joined factorisation is this system's
+  // ... by the destructor.
+  {
+    FittedStokes d(reuse_params(), kMu, kRn);
+    d.set_background_factorisation(true);
+    d.factor(X, &K, 1e-3);
+    d.solve(F, U1);
+    d.factor(moved(X, 0.01), &K, 1e-3);
+  }
+}
+
 // ---------------------------------------------------------------------------------------------
 // 7. Refusals
 
