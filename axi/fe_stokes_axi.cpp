@@ -36,9 +36,9 @@ void single_threaded_blas() {
 
 /// CHOLMOD's supernodal factorisation runs OpenMP loops that name their own thread count (4, a
 /// constant of Debian's build, CHOLMOD_OMP_NUM_THREADS), which omp_set_num_threads does not
-/// override. On these fronts the extra threads mostly spin and wake: one cycle of
-/// paper_amplitude_0.82 at 16 cells took 54 s of CPU for 33 s of wall time with them, 34 s for
-/// 35 s without; and every new thread that calls CHOLMOD starts a pool of its own. The product
+/// override. On these fronts the extra threads mostly spin and wake, and every new thread that
+/// calls CHOLMOD starts a pool of its own: one cycle of paper_amplitude_0.82 took 30 s with them
+/// and 21 s without at 16 cells, 141 s and 97 s at 32 (docs/performance.md). The product
 /// runs one solve per core, so the CHOLMOD calls run with no active parallel level
 /// (max-active-levels 0: every region a team of the calling thread alone); the caller's settings
 /// are put back afterwards. Per thread: a background factorisation sets its own.
