@@ -38,6 +38,10 @@ void RootFunctions::eval(const double* y, double* g) {
   if (machine->root_count() < 2) return;
   if (machine->phase() == 0) {
     g[1] = (machine->segment_mean(machine->active(), Rbuf.data()) - Rf) / M->R0;
+  } else if (shape_end) {
+    double worst = 0;
+    for (int i = 0; i < N; ++i) worst = std::max(worst, std::abs(Rbuf[i] - R0));
+    g[1] = worst / delta - 1.0;
   } else {
     double E = M->wall_energy(Rbuf.data());
     if (M->inertia) {
@@ -60,6 +64,11 @@ Problem::Problem(const Params& P, std::vector<double> fixed_q, bool step_velocit
   roots.collapse_level = collapse_radius(P);
   roots.Rf = P.protocol.R_f;
   roots.energy_level = P.protocol.energy_tol * reference_energy(P);
+  roots.R0 = P.geometry.R0;
+  roots.delta = P.protocol.delta;
+  roots.shape_end = P.protocol.recovery_end == RecoveryEnd::Shape;
+  if (P.protocol.recovery_end == RecoveryEnd::DeadBand)
+    roots.energy_level = std::max(roots.energy_level, dead_band_energy(P));
 }
 
 // ---------------------------------------------------------------------------------------

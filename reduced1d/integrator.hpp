@@ -27,6 +27,11 @@ struct RootFunctions {
   const ProtocolMachine* machine = nullptr;
   std::vector<double> Rbuf;
   double collapse_level = 0, Rf = 0, energy_level = 1;
+  /// The recovery's end (model1d.recovery_end): with Shape the root is max_i |R_i - R0| / delta - 1
+  /// (every cell within delta of R0), otherwise E / energy_level - 1 (energy_level taken from the
+  /// rule: energy_tol E_ref, or max of that and E_delta for DeadBand).
+  bool shape_end = false;
+  double R0 = 0, delta = 0;
 
   void eval(const double* y, double* g);
 };

@@ -122,6 +122,12 @@ struct SineWave {
   double speed = 1.0e-5;               ///< s > 0 [m/s]
 };
 
+/// How the recovery of a force-driven cycle ends (model1d.recovery_end; the 3D and axisymmetric
+/// tiers' full3d.recovery_end has the same values): Energy, the paper's rule, E < energy_tol E_ref;
+/// DeadBand, E < max(energy_tol E_ref, E_delta) with E_delta the wall energy of the tube uniformly
+/// at R0 - delta; Shape, every cell's radius within delta of R0.
+enum class RecoveryEnd { Energy, DeadBand, Shape };
+
 /// Force-driven protocol of Section 3 mapped to 1D (source-equations.md §7).
 /// Segment k = 0..n-1 covers [z_k, z_{k+1}); the rightmost segment (k = n-1) is the first one
 /// driven and the shortest: its length is first_ratio times the length of each other segment.
@@ -133,6 +139,7 @@ struct Protocol {
   double delta = 0.02 * 0.125e-6;  ///< radius tolerance delta [m]
   double energy_tol = 1e-3;        ///< recovery ends when E < energy_tol * E_ref,
                                    ///< E_ref = elastic energy of the tube uniformly at R_f
+  RecoveryEnd recovery_end = RecoveryEnd::Energy;  ///< the rule that ends the recovery
   int cycles = 1;                  ///< number of contraction+recovery cycles (>= 1)
 };
 

@@ -14,6 +14,12 @@ double reference_energy(const Params& p) {
   return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
 }
 
+double dead_band_energy(const Params& p) {
+  const double R0 = p.geometry.R0, d = p.protocol.delta;
+  if (p.wall.law) return p.wall.law->energy(R0 - d) * 2.0 * std::numbers::pi * R0 * p.geometry.L;
+  return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
+}
+
 namespace {
 /// Radius where w(R) + q(R) + extra = 0 for a continuous, strictly increasing wall load w with
 /// the inverse `static_radius` (w(static_radius(load)) = -load) and the actuation law q

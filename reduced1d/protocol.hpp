@@ -173,6 +173,11 @@ class ProtocolMachine {
 /// (with a calibrated law, int_{R0}^{R_f} w dR 2 pi R0 L).
 double reference_energy(const Params& p);
 
+/// E_delta: the elastic energy of the tube uniformly at R0 - delta, the floor of the recovery's
+/// end energy with model1d.recovery_end = "dead_band" (the wall stores it with every cell inside
+/// the protocol's tolerance band, where the recovery law applies no load).
+double dead_band_energy(const Params& p);
+
 /// The wall law of the parameters (linear when p.wall.law is null).
 inline WallLaw wall_law(const Params& p) { return {p.geometry.R0, p.wall.C1, p.wall.law.get()}; }
 

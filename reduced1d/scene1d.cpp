@@ -286,6 +286,15 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     if (p.wall.inertia && !forced)
       throw InputError(m.path("wall_inertia"), "true", "wall inertia only applies to wave.kind = \"force_driven\" "
                                                        "(a prescribed wave fixes R(z,t))");
+    if (m.has("recovery_end")) {  // (not echoed when absent: the paper's energy rule)
+      const std::string e = m.choice("recovery_end", "energy", {"energy", "dead_band", "shape"});
+      if (!forced)
+        throw InputError(m.path("recovery_end"), "\"" + e + "\"",
+                         "the recovery's end belongs to the force-driven protocol (wave.kind = \"force_driven\"); a "
+                         "prescribed wave has no recovery phase");
+      p.protocol.recovery_end =
+          e == "shape" ? RecoveryEnd::Shape : e == "dead_band" ? RecoveryEnd::DeadBand : RecoveryEnd::Energy;
+    }
     if (m.has("axial_bending")) {  // (not echoed when absent: scenes without it resolve as before)
       Reader ab = m.child("axial_bending");
       const std::string src = ab.choice("source", "none", {"none", "scene", "calibration"});

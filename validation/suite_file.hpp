@@ -52,9 +52,16 @@ std::vector<json> selected_cases(const json& suite, const std::vector<std::strin
 /// set, the grid.
 json reference_scene(const json& base, const json& ref, const json& grid);
 
+/// The 3D tier's full3d.recovery_end when a scene does not set it (full3d/scene3d.cpp; a test
+/// checks the two agree).
+inline constexpr const char* kRecoveryEndDefault3d = "dead_band";
+
 /// A 1D model's scene as the suite runs it: the case's scene `s` with the model's `set` and, for
 /// a calibrated model (`"calibrated": true`), the calibration file `cal` in place of the scene's
-/// own wall stiffness (its `wall.spring_constant` or `wall.C1`).
+/// own wall stiffness (its `wall.spring_constant` or `wall.C1`). A force-driven model whose set
+/// does not name model1d.recovery_end ends its recovery by the case's full3d.recovery_end (its
+/// reference's rule; kRecoveryEndDefault3d when the case does not set it), so that the tiers'
+/// cycle times are measured to the same end.
 json model_scene(json s, const json& model, const std::string& cal);
 
 }  // namespace swim::validation

@@ -2,6 +2,7 @@
 // conservation with and without wall inertia, and robustness at extreme parameters.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <utility>
@@ -186,4 +187,45 @@ TEST(Reduced1dForceDriven, ExtremeParametersGiveTheirStatedOutcome) {
       EXPECT_EQ(r.failure->time(), 0.0) << c.name;
     }
   }
+}
+
+// The recovery's end (model1d.recovery_end). At R_f = 0.82 R0 the tube uniformly at R0 - delta
+// stores E_delta = (delta / (R0 - R_f))^2 E_ref = 1.2e-2 E_ref, twelve times the paper's end level
+// 1e-3 E_ref. "energy" (the paper's rule) ends at 1e-3 E_ref; "dead_band" at E_delta; "shape"
+// when the last cell comes within delta of R0. The two later rules end the recovery earlier; the
+// contraction, and with it nearly all of the displacement, is the same under all three.
+TEST(Reduced1dForceDriven, RecoveryEndsByTheChosenRule) {
+  Params p = force_driven(50, SwimmerModel::ForceFree);
+  p.protocol.R_f = 0.82 * p.geometry.R0;
+  const double E_ref = detail::reference_energy(p), d = p.protocol.delta, R0 = p.geometry.R0;
+  const double E_delta = detail::dead_band_energy(p);
+  EXPECT_NEAR(E_delta / E_ref, std::pow(d / (R0 - p.protocol.R_f), 2), 1e-12);
+  Result r[3];
+  const RecoveryEnd rules[3] = {RecoveryEnd::Energy, RecoveryEnd::DeadBand, RecoveryEnd::Shape};
+  for (int k = 0; k < 3; ++k) {
+    Params q = p;
+    q.protocol.recovery_end = rules[k];
+    r[k] = solve(q);
+    ASSERT_FALSE(r[k].failure) << r[k].failure->what();
+    ASSERT_EQ(r[k].cycle_end.size(), 1u) << k;
+    EXPECT_EQ(r[k].switches, p.protocol.segments + 1) << k;
+  }
+  const Sample& e = r[0].series.back();
+  const Sample& b = r[1].series.back();
+  const Sample& s = r[2].series.back();
+  EXPECT_NEAR(e.energy / (p.protocol.energy_tol * E_ref), 1.0, 1e-3);
+  EXPECT_NEAR(b.energy / E_delta, 1.0, 1e-3);
+  // every cell within delta of R0, the farthest at delta (a located root); the sample's radii
+  // include the end points, which follow the end cells
+  const double worst = std::max(R0 - s.R_min, s.R_max - R0);
+  EXPECT_NEAR(worst / d, 1.0, 0.05);
+  EXPECT_LT(s.energy, E_delta * 1.05);
+  EXPECT_LT(r[1].cycle_end[0], 0.85 * r[0].cycle_end[0]);
+  EXPECT_LT(r[2].cycle_end[0], 0.85 * r[0].cycle_end[0]);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(r[k].segment_reached, r[0].segment_reached) << k;
+    EXPECT_NEAR(r[k].series.back().X / e.X, 1.0, 0.01) << k;
+  }
+  std::printf("R_f = 0.82 R0: cycle %.4f s (energy), %.4f s (dead_band), %.4f s (shape); X %.4g / %.4g / %.4g m\n",
+              r[0].cycle_end[0], r[1].cycle_end[0], r[2].cycle_end[0], e.X, b.X, s.X);
 }

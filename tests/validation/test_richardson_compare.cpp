@@ -12,6 +12,10 @@
 #include "validation/richardson.hpp"
 #include "validation/suite.hpp"
 #include "validation/suite_phases.hpp"
+#include "validation/suite_file.hpp"
+#include "full3d/scene3d.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "common/scene.hpp"
 
 using namespace swim;
 using namespace swim::validation;
@@ -299,6 +303,36 @@ TEST(SuiteFile, ACalibratedModelsSceneReplacesTheScenesOwnStiffness) {
     plain["calibrated"] = false;
     EXPECT_EQ(model_scene(s, plain, "/tmp/cal.json")["wall"], s["wall"]) << key;
   }
+}
+
+// A force-driven 1D model ends its recovery by its reference's rule: the case's
+// full3d.recovery_end, else the 3D tier's default (the same value the 3D tier resolves); a model
+// that names its own rule keeps it; a prescribed wave has no recovery and gets none. The scenes
+// so made are accepted by the 1D tier.
+TEST(SuiteFile, AForceDrivenModelEndsItsRecoveryByTheReferencesRule) {
+  using scene::json;
+  const json base = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");
+  {
+    json resolved;
+    (void)full3d::read_scene3d(base, resolved);
+    EXPECT_EQ(resolved["full3d"]["recovery_end"], kRecoveryEndDefault3d);
+  }
+  const json plain = {{"label", "m"}};
+  EXPECT_EQ(model_scene(base, plain, "")["model1d"]["recovery_end"], kRecoveryEndDefault3d);
+  json shape = base;
+  set_key(shape, "full3d.recovery_end", "shape");
+  const json m = model_scene(shape, plain, "");
+  EXPECT_EQ(m["model1d"]["recovery_end"], "shape");
+  json resolved;
+  EXPECT_EQ(reduced1d::read_scene(m, resolved, SWIM_SOURCE_DIR "/data/scenes").protocol.recovery_end,
+            reduced1d::RecoveryEnd::Shape);
+  const json own = {{"label", "m"}, {"set", {{"model1d.recovery_end", "energy"}}}};
+  EXPECT_EQ(model_scene(shape, own, "")["model1d"]["recovery_end"], "energy");
+  json sine = base;
+  sine["wave"] = {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", "0.4 um"}};
+  sine.erase("protocol");
+  const json ms = model_scene(sine, plain, "");
+  EXPECT_FALSE(ms.contains("model1d") && ms["model1d"].contains("recovery_end"));
 }
 
 // The shipped suites are well formed.
