@@ -63,12 +63,10 @@ Problem::Problem(const Params& P, std::vector<double> fixed_q, bool step_velocit
   roots.Rbuf.assign(M.N, 0.0);
   roots.collapse_level = collapse_radius(P);
   roots.Rf = P.protocol.R_f;
-  roots.energy_level = P.protocol.energy_tol * reference_energy(P);
+  roots.energy_level = recovery_end_energy(P);
   roots.R0 = P.geometry.R0;
   roots.delta = P.protocol.delta;
   roots.shape_end = P.protocol.recovery_end == RecoveryEnd::Shape;
-  if (P.protocol.recovery_end == RecoveryEnd::DeadBand)
-    roots.energy_level = std::max(roots.energy_level, dead_band_energy(P));
 }
 
 // ---------------------------------------------------------------------------------------

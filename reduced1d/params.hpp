@@ -127,6 +127,10 @@ struct SineWave {
 /// DeadBand, E < max(energy_tol E_ref, E_delta) with E_delta the wall energy of the tube uniformly
 /// at R0 - delta; Shape, every cell's radius within delta of R0.
 enum class RecoveryEnd { Energy, DeadBand, Shape };
+/// The scene's name of a rule ("energy", "dead_band", "shape").
+inline const char* recovery_end_name(RecoveryEnd e) {
+  return e == RecoveryEnd::Shape ? "shape" : e == RecoveryEnd::DeadBand ? "dead_band" : "energy";
+}
 
 /// Force-driven protocol of Section 3 mapped to 1D (source-equations.md §7).
 /// Segment k = 0..n-1 covers [z_k, z_{k+1}); the rightmost segment (k = n-1) is the first one

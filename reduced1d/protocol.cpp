@@ -8,16 +8,22 @@
 
 namespace swim::reduced1d::detail {
 
-double reference_energy(const Params& p) {
-  const double R0 = p.geometry.R0, d = R0 - p.protocol.R_f;
-  if (p.wall.law) return p.wall.law->energy(p.protocol.R_f) * 2.0 * std::numbers::pi * R0 * p.geometry.L;
-  return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
+namespace {
+/// Elastic energy of the tube uniformly at radius R.
+double uniform_energy(const Params& p, double R) {
+  const double R0 = p.geometry.R0, d = R0 - R;
+  const double area = 2.0 * std::numbers::pi * R0 * p.geometry.L;
+  return (p.wall.law ? p.wall.law->energy(R) : 0.5 * p.wall.C1 * d * d) * area;
 }
+}  // namespace
 
-double dead_band_energy(const Params& p) {
-  const double R0 = p.geometry.R0, d = p.protocol.delta;
-  if (p.wall.law) return p.wall.law->energy(R0 - d) * 2.0 * std::numbers::pi * R0 * p.geometry.L;
-  return 0.5 * p.wall.C1 * d * d * 2.0 * std::numbers::pi * R0 * p.geometry.L;
+double reference_energy(const Params& p) { return uniform_energy(p, p.protocol.R_f); }
+
+double dead_band_energy(const Params& p) { return uniform_energy(p, p.geometry.R0 - p.protocol.delta); }
+
+double recovery_end_energy(const Params& p) {
+  const double level = p.protocol.energy_tol * reference_energy(p);
+  return p.protocol.recovery_end == RecoveryEnd::DeadBand ? std::max(level, dead_band_energy(p)) : level;
 }
 
 namespace {

@@ -178,6 +178,10 @@ double reference_energy(const Params& p);
 /// the protocol's tolerance band, where the recovery law applies no load).
 double dead_band_energy(const Params& p);
 
+/// The energy the recovery ends below: energy_tol E_ref, or with model1d.recovery_end =
+/// "dead_band" the larger of that and E_delta (not used with "shape").
+double recovery_end_energy(const Params& p);
+
 /// The wall law of the parameters (linear when p.wall.law is null).
 inline WallLaw wall_law(const Params& p) { return {p.geometry.R0, p.wall.C1, p.wall.law.get()}; }
 

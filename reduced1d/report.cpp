@@ -89,13 +89,9 @@ json write_run(const std::string& dir, const Params& p, const json& resolved, Re
                  {"hydraulic_offset_inner_m", p.swimmer.a_in},
                  {"hydraulic_offset_outer_m", p.swimmer.a_out}};
   if (p.wave == WaveKind::ForceDriven) {
-    const RecoveryEnd e = p.protocol.recovery_end;
-    rec.derived["recovery_end"] = e == RecoveryEnd::Shape ? "shape" : e == RecoveryEnd::DeadBand ? "dead_band" : "energy";
-    if (e != RecoveryEnd::Shape) {
-      const double level = p.protocol.energy_tol * detail::reference_energy(p);
-      rec.derived["recovery_end_energy_J"] =
-          e == RecoveryEnd::DeadBand ? std::max(level, detail::dead_band_energy(p)) : level;
-    }
+    rec.derived["recovery_end"] = recovery_end_name(p.protocol.recovery_end);
+    if (p.protocol.recovery_end != RecoveryEnd::Shape)
+      rec.derived["recovery_end_energy_J"] = detail::recovery_end_energy(p);
   }
   rec.wall_time_s = wall_time_s;
   return record::write_run(dir, rec, resolved);

@@ -292,8 +292,8 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
         throw InputError(m.path("recovery_end"), "\"" + e + "\"",
                          "the recovery's end belongs to the force-driven protocol (wave.kind = \"force_driven\"); a "
                          "prescribed wave has no recovery phase");
-      p.protocol.recovery_end =
-          e == "shape" ? RecoveryEnd::Shape : e == "dead_band" ? RecoveryEnd::DeadBand : RecoveryEnd::Energy;
+      for (RecoveryEnd r : {RecoveryEnd::Energy, RecoveryEnd::DeadBand, RecoveryEnd::Shape})
+        if (e == recovery_end_name(r)) p.protocol.recovery_end = r;
     }
     if (m.has("axial_bending")) {  // (not echoed when absent: scenes without it resolve as before)
       Reader ab = m.child("axial_bending");

@@ -46,26 +46,25 @@ void check(double k, double R, double Rc, double mu) {
                                 ", mu = " + std::to_string(mu));
 }
 
+/// sigma_rr at the wall of the combination of two basis columns with u_r = 1, u_z = 0 there.
+double two_column_stress(const Column& a, const Column& b) {
+  Eigen::Matrix2d M;
+  M << a.ur, b.ur, a.uz, b.uz;
+  const Eigen::Vector2d c = M.partialPivLu().solve(Eigen::Vector2d(1.0, 0.0));
+  return c[0] * a.srr + c[1] * b.srr;
+}
+
 }  // namespace
 
 WallModeResistance stokes_wall_mode_resistance(double k, double R, double Rc, double mu) {
   check(k, R, Rc, mu);
   gsl_error_handler_t* old = gsl_set_error_handler_off();
   WallModeResistance z;
-  {
-    // Lumen: u_r(R) = 1, u_z(R) = 0.
-    const Column a = column(1, k, R, R, mu), b = column(2, k, R, R, mu);
-    Eigen::Matrix2d M;
-    M << a.ur, b.ur, a.uz, b.uz;
-    const Eigen::Vector2d c = M.partialPivLu().solve(Eigen::Vector2d(1.0, 0.0));
-    z.lumen = c[0] * a.srr + c[1] * b.srr;  // sigma_rr on the lumen side; the force on the wall is -sigma_rr
-  }
+  // Lumen: u_r(R) = 1, u_z(R) = 0; sigma_rr on the lumen side (the force on the wall is -sigma_rr).
+  z.lumen = two_column_stress(column(1, k, R, R, mu), column(2, k, R, R, mu));
   if (std::isinf(Rc)) {
-    const Column a = column(3, k, R, R, mu), b = column(4, k, R, R, mu);
-    Eigen::Matrix2d M;
-    M << a.ur, b.ur, a.uz, b.uz;
-    const Eigen::Vector2d c = M.partialPivLu().solve(Eigen::Vector2d(1.0, 0.0));
-    z.annulus = -(c[0] * a.srr + c[1] * b.srr);  // the outer fluid pulls the wall with +sigma_rr
+    // the outer fluid pulls the wall with +sigma_rr
+    z.annulus = -two_column_stress(column(3, k, R, R, mu), column(4, k, R, R, mu));
   } else {
     // Annulus: u_r(R) = 1, u_z(R) = 0, u(Rc) = 0. I-type columns scaled at Rc, K-type at R.
     Column col[4], colc[4];
