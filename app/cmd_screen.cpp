@@ -129,6 +129,7 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
     const long rank = static_cast<long>(std::find(ranked.begin(), ranked.end(), i) - ranked.begin()) + 1;
     cands.push_back({i, describe(sw, i), c < chosen.size() - chosen.size() / 2 ? "best" : "spread", rank, sw.design(i),
                      results[i].metrics});
+    design::match_recovery_end(cands.back(), sw.base_dir);  // the 1D cycle ends as the 3D run's
   }
   std::printf("confirming %zu of %zu designs in 3D (%zu best, %zu spread over the rest)%s\n", cands.size(),
               ranked.size(), cands.size() - cands.size() / 2, cands.size() / 2,

@@ -12,7 +12,9 @@
 #include "common/strict_json.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
+#include "reduced1d/scene1d.hpp"
 #include "reduced1d/screen.hpp"
+#include "validation/suite_file.hpp"
 #include "validation/error_estimate.hpp"
 
 namespace swim::design {
@@ -215,6 +217,31 @@ json figures_1d(const reduced1d::Metrics& m, const std::string& metric) {
           {"mean_velocity_m_per_s", m.mean_velocity_m_per_s}};
 }
 
+void match_recovery_end(Candidate& c, const std::string& scene_dir) {
+  json resolved;
+  const reduced1d::Params p = reduced1d::read_scene(c.scene, resolved, scene_dir);
+  if (p.wave != reduced1d::WaveKind::ForceDriven) return;
+  const json& m = c.scene.contains("model1d") ? c.scene["model1d"] : json();
+  if (m.is_object() && m.contains("recovery_end")) {
+    c.recovery_end_1d = reduced1d::recovery_end_name(p.protocol.recovery_end);
+    return;
+  }
+  const std::string rule = validation::recovery_end_3d(c.scene);
+  c.recovery_end_1d = rule;
+  if (rule == reduced1d::recovery_end_name(p.protocol.recovery_end)) return;
+  json s = c.scene;
+  if (!s.contains("model1d") || !s["model1d"].is_object()) s["model1d"] = json::object();
+  s["model1d"]["recovery_end"] = rule;
+  json r2;
+  const reduced1d::DesignOutcome o = reduced1d::run_design(reduced1d::read_scene(s, r2, scene_dir));
+  if (!o.ok)
+    throw NumericalError("design " + std::to_string(c.design) + " in 1D with the 3D run's recovery end (" + rule +
+                             "): " + o.message,
+                         "state model1d.recovery_end in the design scene to keep the sweep's rule");
+  c.metrics_sweep = c.metrics;
+  c.metrics = o.metrics;
+}
+
 json figures_3d(const json& s, const std::string& metric) {
   // a run that did not finish has only partial figures (its mean velocity up to the failure):
   // none of them is the design's
@@ -325,6 +352,8 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
               {"wall_time_3d_s", r.summary.value("wall_time_s", 0.0)},
               {"cell_size_3d_m", r.cell_size_m},
               {"figures_1d", f1},
+              {"recovery_end_1d", c.recovery_end_1d.empty() ? json(nullptr) : json(c.recovery_end_1d)},
+              {"figures_1d_sweep", c.metrics_sweep ? figures_1d(*c.metrics_sweep, o.metric) : json(nullptr)},
               {"figures_3d", f3},
               {"error_bar_3d", bar},
               {"error_bar_3d_absent_because", bar_absent},
@@ -459,6 +488,20 @@ std::string confirm_markdown(const json& r, const std::string& title) {
          fig(f3["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " + d["status_3d"].get<std::string>() + " |\n";
   }
   s += "\nΔ = (3D − 1D) / |3D|. Ranks: 1 = best by the metric; equal values share their mean rank.\n";
+  // the recovery end of the 1D figures, and the sweep's own figures where it changed them
+  std::string rules, changed;
+  for (const auto& d : r["designs"]) {
+    if (!d.contains("recovery_end_1d") || !d["recovery_end_1d"].is_string()) continue;
+    const std::string rule = d["recovery_end_1d"].get<std::string>();
+    if (rules.find("`" + rule + "`") == std::string::npos) rules += (rules.empty() ? "" : ", ") + ("`" + rule + "`");
+    if (d["figures_1d_sweep"].is_object())
+      changed += (changed.empty() ? "" : "; ") + std::string("design ") + std::to_string(d["design"].get<int>()) + ": " +
+                 fig(d["figures_1d_sweep"][m], m) + ", cycle " + fig(d["figures_1d_sweep"]["cycle_time_s"], "cycle_time_s");
+  }
+  if (!rules.empty())
+    s += "\nThe 1D cycles end by the recovery rule of their 3D runs (" + rules +
+         ", model1d.recovery_end), so that both tiers' cycle times measure the same cycle." +
+         (changed.empty() ? std::string() : " The sweep's own figures (its rule) were: " + changed + ".") + "\n";
   return s;
 }
 

@@ -13,6 +13,7 @@
 #pragma once
 
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -103,8 +104,23 @@ struct Candidate {
   std::string selected_as;  ///< "best", "spread" or "optimum"
   long rank_in_sweep = 0;   ///< 1 = best of the whole sweep by its metric
   json scene;               ///< the design's scene (1D; the section's grid is applied here)
-  reduced1d::Metrics metrics;
+  reduced1d::Metrics metrics;  ///< its 1D figures (after match_recovery_end: with the 3D run's rule)
+  /// match_recovery_end: the rule that ends the 1D cycle ("" when not matched: a prescribed
+  /// wave, or the sweep's figures kept), and the sweep's own figures when the rule changed them
+  std::string recovery_end_1d;
+  std::optional<reduced1d::Metrics> metrics_sweep;
 };
+
+/// A force-driven design's 1D cycle ends as its 3D run's does: when the design's scene states
+/// no model1d.recovery_end, its 1D figures are computed again with the 3D run's rule (the
+/// scene's full3d.recovery_end, else the 3D tier's default dead_band) and become c.metrics, the
+/// sweep's own (the 1D default, the paper's energy rule) are kept in c.metrics_sweep; a design
+/// that states a rule, or whose rule is the 3D run's already, keeps its figures. The cycle time
+/// and the mean velocity per cycle of the two tiers then measure the same cycle (the energy
+/// rule waits until the wall has relaxed far below the geometric band). A prescribed wave is
+/// left as it is. `scene_dir` resolves the scene's relative files (wall.calibration). Throws
+/// NumericalError when the 1D run with the 3D rule fails.
+void match_recovery_end(Candidate& c, const std::string& scene_dir);
 
 struct ConfirmOptions {
   std::string metric;  ///< must be in metrics_in_3d()

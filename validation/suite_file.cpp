@@ -206,6 +206,13 @@ json reference_scene(const json& base, const json& ref, const json& grid) {
   return s;
 }
 
+std::string recovery_end_3d(const json& s) {
+  if (s.contains("full3d") && s["full3d"].is_object() && s["full3d"].contains("recovery_end") &&
+      s["full3d"]["recovery_end"].is_string())
+    return s["full3d"]["recovery_end"].get<std::string>();
+  return kRecoveryEndDefault3d;
+}
+
 json model_scene(json s, const json& model, const std::string& cal) {
   apply_sets(s, model.value("set", json()));
   // A force-driven cycle ends by the reference's rule: the case's full3d.recovery_end, which the
@@ -214,13 +221,7 @@ json model_scene(json s, const json& model, const std::string& cal) {
   const json wave = s.value("wave", json::object());
   const bool forced = !wave.is_object() || wave.value("kind", std::string("force_driven")) == "force_driven";
   const bool own = s.contains("model1d") && s["model1d"].is_object() && s["model1d"].contains("recovery_end");
-  if (forced && !own) {
-    std::string rule = kRecoveryEndDefault3d;
-    if (s.contains("full3d") && s["full3d"].is_object() && s["full3d"].contains("recovery_end") &&
-        s["full3d"]["recovery_end"].is_string())
-      rule = s["full3d"]["recovery_end"].get<std::string>();
-    set_key(s, "model1d.recovery_end", rule);
-  }
+  if (forced && !own) set_key(s, "model1d.recovery_end", recovery_end_3d(s));
   if (model.value("calibrated", false)) {
     if (s.contains("wall") && s["wall"].is_object()) {
       s["wall"].erase("spring_constant");

@@ -56,6 +56,10 @@ json reference_scene(const json& base, const json& ref, const json& grid);
 /// checks the two agree).
 inline constexpr const char* kRecoveryEndDefault3d = "dead_band";
 
+/// The rule that ends a scene's 3D (and axisymmetric) recovery: its full3d.recovery_end, else
+/// kRecoveryEndDefault3d.
+std::string recovery_end_3d(const json& scene);
+
 /// A 1D model's scene as the suite runs it: the case's scene `s` with the model's `set` and, for
 /// a calibrated model (`"calibrated": true`), the calibration file `cal` in place of the scene's
 /// own wall stiffness (its `wall.spring_constant` or `wall.C1`). A force-driven model whose set
