@@ -16,6 +16,49 @@
 
 namespace swim::full3d {
 
+ChebyshevStages chebyshev_stages(int s, double damping) {
+  if (s < 1) throw InputError("Chebyshev stages", std::to_string(s), "at least 1");
+  ChebyshevStages c;
+  c.s = s;
+  c.mu.assign(s + 1, 0.0);
+  c.nu.assign(s + 1, 0.0);
+  c.mut.assign(s + 1, 0.0);
+  c.c.assign(s + 1, 0.0);
+  if (s == 1) {  // forward Euler
+    c.mut[1] = c.c[1] = 1.0;
+    return c;
+  }
+  const double w0 = 1.0 + damping / double(s) / double(s);
+  // T_j(w0) and T_j'(w0) by the three-term recurrence
+  std::vector<double> T(s + 1), dT(s + 1);
+  T[0] = 1.0, dT[0] = 0.0;
+  T[1] = w0, dT[1] = 1.0;
+  for (int j = 2; j <= s; ++j) {
+    T[j] = 2.0 * w0 * T[j - 1] - T[j - 2];
+    dT[j] = 2.0 * T[j - 1] + 2.0 * w0 * dT[j - 1] - dT[j - 2];
+  }
+  const double w1 = T[s] / dT[s];
+  c.w0 = w0;
+  c.w1 = w1;
+  std::vector<double> b(s + 1);
+  for (int j = 0; j <= s; ++j) b[j] = 1.0 / T[j];
+  c.mut[1] = w1 * b[1];
+  for (int j = 2; j <= s; ++j) {
+    c.mu[j] = 2.0 * w0 * b[j] / b[j - 1];
+    c.nu[j] = -b[j] / b[j - 2];
+    c.mut[j] = 2.0 * w1 * b[j] / b[j - 1];
+  }
+  for (int j = 1; j <= s; ++j) c.c[j] = w1 * dT[j] / T[j];  // Y_j = y + c_j dt f + O(dt^2)
+  return c;
+}
+
+int chebyshev_stages_for(double dt, double lambda, double fraction, int max_stages) {
+  if (!(lambda > 0.0)) return 1;
+  for (int s = 1; s < max_stages; ++s)
+    if (fraction * chebyshev_stages(s).stability_interval() >= dt * lambda) return s;
+  return max_stages;
+}
+
 namespace {
 }  // namespace
 
@@ -101,7 +144,7 @@ namespace {
 double inertia_step(const IbOptions& o, double dt) { return o.inertia_step > 0.0 ? o.inertia_step : dt; }
 }  // namespace
 
-IbStepStats IbSolver::step(IbState& s, double dt) {
+IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
   if (!(dt > 0.0) || !std::isfinite(dt)) throw InputError(opt_.dt_key, significant(dt, 4), "a positive time step in s");
   IbStepStats st;
   using clock = std::chrono::steady_clock;
@@ -123,7 +166,40 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
   Eigen::Matrix3Xd F = fluid_force(s.X, s.t, accel);
   guard_finite(F, "membrane force", s.t);
   lap(st.time_forces);
-  if (opt_.scheme == IbScheme::ForwardEuler) {
+  const bool chebyshev = opt_.scheme == IbScheme::Chebyshev && stages > 1;
+  if (chebyshev) {
+    // Y_j = mu_j Y_{j-1} + nu_j Y_{j-2} + mut_j dt U(Y_{j-1}); every stage's fluid solve
+    // starts from the step's u^n (the inertia term's old velocity)
+    const ChebyshevStages c = chebyshev_stages(stages);
+    auto velocity = [&](const Eigen::Matrix3Xd& Y, const Eigen::Matrix3Xd& FY) {
+      spread(grid_, Y, FY, f, opt_.threads);
+      lap(st.time_spread);
+      const StokesStats ss = stokes_.step(s.u, u, f, tau);
+      lap(st.time_fluid);
+      st.stokes_iterations += ss.iterations;
+      st.max_divergence = ss.max_divergence;
+      Eigen::Matrix3Xd UY;
+      interpolate(grid_, u, Y, UY, opt_.threads);
+      if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, Y, UY);
+      lap(st.time_interp);
+      guard_finite(UY, "node velocity", s.t);
+      return UY;
+    };
+    Eigen::Matrix3Xd Y2 = s.X;
+    Eigen::Matrix3Xd Y1 = s.X + (c.mut[1] * dt) * velocity(s.X, F);
+    for (int j = 2; j <= stages; ++j) {
+      F = fluid_force(Y1, s.t + c.c[j - 1] * dt, accel);
+      guard_finite(F, "membrane force", s.t);
+      lap(st.time_forces);
+      Eigen::Matrix3Xd Yj = c.mu[j] * Y1 + c.nu[j] * Y2 + (c.mut[j] * dt) * velocity(Y1, F);
+      guard_finite(Yj, "node position", s.t);
+      Y2 = std::move(Y1);
+      Y1 = std::move(Yj);
+    }
+    st.fluid_solves = stages;
+    U = (Y1 - s.X) / dt;
+    Xnew = std::move(Y1);
+  } else if (opt_.scheme != IbScheme::Midpoint) {
     spread(grid_, s.X, F, f, opt_.threads);
     lap(st.time_spread);
     const StokesStats ss = stokes_.step(s.u, u, f, tau);
@@ -134,6 +210,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, s.X, U);
     lap(st.time_interp);
     Xnew = s.X + dt * U;
+    st.fluid_solves = 1;
   } else {
     spread(grid_, s.X, F, f, opt_.threads);
     lap(st.time_spread);
@@ -160,6 +237,7 @@ IbStepStats IbSolver::step(IbState& s, double dt) {
     lap(st.time_interp);
     Xnew = s.X + dt * U;
     st.max_velocity_change = (U - U0).colwise().norm().maxCoeff();
+    st.fluid_solves = 2;
   }
   guard_finite(U, "node velocity", s.t);
   guard_finite(Xnew, "node position", s.t);

@@ -22,6 +22,7 @@
 #include <Eigen/Core>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "full3d/grid.hpp"
 #include "full3d/membrane.hpp"
@@ -29,7 +30,30 @@
 
 namespace swim::full3d {
 
-enum class IbScheme { ForwardEuler, Midpoint };
+/// The node update: the paper's forward Euler (eq. 21), the midpoint predictor-corrector, or
+/// the first-order damped Runge-Kutta-Chebyshev method, which takes a step of s stages (s
+/// velocity evaluations) and is stable for dt lambda <= beta_s ~ 1.93 s^2 instead of 2
+/// (ChebyshevStages; docs/full3d.md, "Chebyshev stages").
+enum class IbScheme { ForwardEuler, Midpoint, Chebyshev };
+
+/// The coefficients of the first-order damped Runge-Kutta-Chebyshev method with s stages
+/// (Verwer, Hundsdorfer and Sommeijer 1990; Verwer 1996) for y' = f(y):
+///   Y_0 = y_n,  Y_1 = Y_0 + mut[1] dt f(Y_0),
+///   Y_j = mu[j] Y_{j-1} + nu[j] Y_{j-2} + mut[j] dt f(Y_{j-1})  (j = 2..s),  y_{n+1} = Y_s,
+/// with w0 = 1 + damping / s^2, w1 = T_s(w0) / T_s'(w0), b_j = 1 / T_j(w0). Its stability
+/// polynomial is T_s(w0 + w1 z) / T_s(w0): |R| <= 1 on the real interval [-beta, 0] with
+/// beta = (1 + w0) / w1 ~ (2 - 4 damping / 3) s^2, and |R| <= 1 / T_s(w0) < 1 inside it.
+/// Stage j sits at time c[j] dt (c[s] = 1). s = 1 is forward Euler.
+struct ChebyshevStages {
+  int s = 1;
+  double w0 = 1.0, w1 = 1.0;
+  std::vector<double> mu, nu, mut, c;  ///< index j = 0..s (entries 0, and 1 of mu, nu, unused)
+  double stability_interval() const { return (1.0 + w0) / w1; }
+};
+ChebyshevStages chebyshev_stages(int s, double damping = 0.05);
+/// The fewest stages s <= max_stages with fraction * beta_s >= dt lambda (1 when lambda <= 0);
+/// max_stages when none suffices.
+int chebyshev_stages_for(double dt, double lambda, double fraction, int max_stages);
 
 struct IbOptions {
   IbScheme scheme = IbScheme::ForwardEuler;
@@ -78,6 +102,7 @@ struct IbStepStats {
   /// forward-Euler error estimate: dt times this is twice its local error)
   double max_velocity_change = 0.0;
   bool rejected = false;        ///< IbOptions::reject_on_cfl: CFL above max_cfl, state unchanged
+  int fluid_solves = 0;         ///< Stokes solves of the step (its velocity evaluations)
   // wall time of the parts of this step, s (for swim bench)
   double time_forces = 0.0;     ///< membrane + actuation forces
   double time_spread = 0.0;     ///< spreading (eq. 19)
@@ -99,7 +124,10 @@ class IbSolver {
   void set_external_force(ExternalForceFn f) { external_ = std::move(f); }
 
   /// Advances s by dt. Throws swim::NumericalError (state left at the last good step).
-  IbStepStats step(IbState& s, double dt);
+  /// `stages`: the number of Chebyshev stages (IbScheme::Chebyshev only; 1 is the forward
+  /// Euler step). The state's V is then the step's mean node velocity (X^{n+1} - X^n) / dt
+  /// and u the fluid velocity of the last stage.
+  IbStepStats step(IbState& s, double dt, int stages = 1);
 
   /// Largest decay rate lambda_max (1/s) of the linearised explicit coupling at s.X: the
   /// dominant eigenvalue of X' = U(F(X)) linearised, i.e. of v -> -I S J v with J = dF/dX

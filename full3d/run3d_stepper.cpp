@@ -78,6 +78,12 @@ bool Stepper::due(long every, double interval) const {
   return run_.adaptive ? crossed(t_prev_, s_.t, interval) : n_ % every == 0;
 }
 
+int Stepper::stages(double dt) const {
+  const Params3d& p = run_.p;
+  if (p.scheme != IbScheme::Chebyshev) return 1;
+  return chebyshev_stages_for(dt, lambda_, p.adaptive.stability_fraction, p.adaptive.max_stages);
+}
+
 /// dt snapped down to the ladder dt_max 2^(-k/4), k >= 0.
 double Stepper::ladder(double dt) const {
   const double top = run_.p.adaptive.dt_max;
@@ -98,7 +104,7 @@ IbStepStats Stepper::step() {
   if (run_.adaptive && p.duration > 0) dt = std::min(dt, p.duration - s_.t);  // land on the end
   IbStepStats st;
   for (;;) {
-    st = ib_->step(s_, dt);
+    st = ib_->step(s_, dt, stages(dt));
     if (!st.rejected) break;
     // CFL above the guard: retry from the same state with a step at the CFL target
     ++rejected_;
@@ -115,6 +121,8 @@ IbStepStats Stepper::step() {
   dt_used_max_ = std::max(dt_used_max_, dt);
   last_speed_ = st.max_node_speed;
   last_dv_ = st.max_velocity_change;
+  fluid_solves_ += st.fluid_solves;
+  stages_max_used_ = std::max(stages_max_used_, st.fluid_solves);
   return st;
 }
 
@@ -130,7 +138,7 @@ void Stepper::finish_step(double e) {
 void Stepper::next_step(int switches) {
   const AdaptiveStep& a = run_.p.adaptive;
   const double h = run_.p.h;
-  double dt = std::min(a.dt_max, 2.0 * dt_last_);  // growth at most 2x per step
+  double dt = a.dt_max;
   const char* bound = "growth";
   auto limit = [&](double v, const char* why) {
     if (v < dt) {
@@ -162,7 +170,6 @@ void Stepper::next_step(int switches) {
     lambda_max_seen_ = std::max(lambda_max_seen_, lambda_);
     ++estimates_;
   }
-  if (lambda_ > 0.0) limit(a.stability_fraction * 2.0 / lambda_, "stability");
   // protocol events: the step after an event restarts at event_dt; approaching the next
   // contraction event, the step is cut to land just past it (event times resolved to event_dt)
   const auto& ps = protocol_.state();
@@ -177,6 +184,24 @@ void Stepper::next_step(int switches) {
       if (t_event < dt) limit(std::max(a.event_dt, 1.02 * t_event), "event");
     }
   }
+  // the stability limit: forward Euler and the midpoint rule hold dt lambda within
+  // fraction * 2; Chebyshev stages take the stage count s that advances furthest per fluid
+  // solve, min(dt, fraction beta_s / lambda) / s (the fewest on a tie), judged on the bounds
+  // other than the growth, which then ramps the step towards it (the step itself takes the
+  // fewest stages that hold it, stages())
+  if (lambda_ > 0.0) {
+    double beta = 2.0;
+    if (run_.p.scheme == IbScheme::Chebyshev) {
+      double best = 0.0;
+      for (int st = 1; st <= a.max_stages; ++st) {
+        const double b = chebyshev_stages(st).stability_interval();
+        const double per_solve = std::min(dt, a.stability_fraction * b / lambda_) / st;
+        if (per_solve > best * (1.0 + 1e-12)) best = per_solve, beta = b;
+      }
+    }
+    limit(a.stability_fraction * beta / lambda_, "stability");
+  }
+  limit(2.0 * dt_last_, "growth");  // at most 2x per step
   r_active_prev_ = switches > 0 ? std::numeric_limits<double>::quiet_NaN() : r_active;
   after_event_ = switches > 0;
   if (dt < a.dt_min)
@@ -212,6 +237,11 @@ scene::json Stepper::time_step_summary() const {
           {"explicit_rate_max_per_s", lambda_max_seen_},
           {"explicit_limit_s", lambda_max_seen_ > 0 ? 2.0 / lambda_max_seen_ : 0.0},
           {"stability_estimates", estimates_},
+          {"scheme", run_.p.scheme == IbScheme::Chebyshev ? "chebyshev"
+                     : run_.p.scheme == IbScheme::Midpoint ? "midpoint"
+                                                           : "forward_euler"},
+          {"fluid_solves_this_process", fluid_solves_},
+          {"stages_max_used", stages_max_used_},
           {"steps_by_bound", bounds}};
 }
 

@@ -78,6 +78,9 @@ class Stepper {
   template <class Self, class F>
   static void records(Self& self, F&& f);
   double ladder(double dt) const;
+  /// The stages of a step of dt: the fewest whose Chebyshev interval holds dt lambda_
+  /// (full3d.scheme = chebyshev), 1 for the other schemes.
+  int stages(double dt) const;
   void next_step(int switches);
 
   const RunSetup& run_;
@@ -93,6 +96,8 @@ class Stepper {
   double lambda_ = 0.0, lambda_max_seen_ = 0.0;  ///< explicit-coupling rate estimates, 1/s
   long lambda_step_ = -1, estimates_ = 0, rejected_ = 0;
   double stability_seconds_ = 0.0;
+  long fluid_solves_ = 0;     ///< Stokes solves of the steps in this process (not across a resume)
+  int stages_max_used_ = 0;
   bool after_event_ = true;
   double r_active_prev_;
   std::map<std::string, long> bound_count_ = {{"growth", 0}, {"cfl", 0}, {"accuracy", 0}, {"stability", 0}, {"event", 0}};

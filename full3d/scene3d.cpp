@@ -142,6 +142,9 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
       g.finish();
     }
     p.dt = f.quantity("dt", "s", "1 ms", Range::positive());
+    // full3d.scheme is read below (its place in the resolved scene); the adaptive section
+    // reads the Chebyshev stage bound only for that scheme
+    const bool chebyshev = f.has("scheme") && f.given("scheme") == "chebyshev";
     {
       Reader a = f.child("adaptive");
       AdaptiveStep& q = p.adaptive;
@@ -152,14 +155,22 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
       q.dt_min = a.quantity("dt_min", "s", "1 us", Range::positive());
       q.event_dt = a.quantity("event_dt", "s", "0.25 ms", Range::positive());
       q.stability_fraction = a.number("stability_fraction", 0.5, Range::open(0.0, 1.0));
+      if (chebyshev)
+        q.max_stages = int(a.integer("max_stages", 8, 1, 32));
+      else if (a.has("max_stages"))
+        throw InputError(a.path("max_stages"), scene::show(a.given("max_stages")), "only with full3d.scheme = chebyshev (the stages of its steps)");
       if (!(q.dt_min <= q.event_dt && q.event_dt <= q.dt_max))
         throw InputError(a.path("event_dt"), fmt(q.event_dt, "s"),
                          "must lie between full3d.adaptive.dt_min = " + fmt(q.dt_min, "s") +
                              " and full3d.adaptive.dt_max = " + fmt(q.dt_max, "s"));
       a.finish();
     }
-    p.scheme = f.choice("scheme", "forward_euler", {"forward_euler", "midpoint"}) == "midpoint" ? IbScheme::Midpoint
-                                                                                               : IbScheme::ForwardEuler;
+    {
+      const std::string scheme = f.choice("scheme", "forward_euler", {"forward_euler", "midpoint", "chebyshev"});
+      p.scheme = scheme == "midpoint"    ? IbScheme::Midpoint
+                 : scheme == "chebyshev" ? IbScheme::Chebyshev
+                                         : IbScheme::ForwardEuler;
+    }
     {
       Reader m = f.child("membrane");
       p.bending_model = m.choice("bending_model", "rigidity", {"rigidity", "fixed_kb"}) == "fixed_kb"
@@ -263,6 +274,17 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   if (p.dry && p.adaptive.enabled)
     throw InputError("full3d.adaptive.enabled", "true",
                      "the adaptive step controls the fluid-coupled run; the dry swimmer uses the fixed full3d.dt");
+  if (p.scheme == IbScheme::Chebyshev) {
+    // the stage count follows the adaptive step's estimate of the coupling's stiffest rate
+    if (!p.adaptive.enabled)
+      throw InputError("full3d.scheme", "chebyshev",
+                       "the Chebyshev stages are chosen by the adaptive step (full3d.adaptive.enabled = true); "
+                       "with a fixed full3d.dt use forward_euler or midpoint");
+    if (p.wall_inertia)
+      throw InputError("full3d.scheme", "chebyshev",
+                       "not with full3d.wall_inertia = true (the lagged node inertia has its own explicit limit); "
+                       "use forward_euler or midpoint");
+  }
   if (p.dry && !(p.mass_per_area > 0))
     throw InputError("wall.mass_per_area", "", "the dry swimmer needs a positive wall mass");
   if (!(R0 + 2.0 * p.h < p.container_radius))

@@ -37,7 +37,8 @@ struct AdaptiveStep {
   double dt_min = 1e-6;             ///< s; a smaller step ends the run (exit 3)
   double dt_max = 16e-3;            ///< s
   double event_dt = 0.25e-3;        ///< s; first step and the step after each protocol event
-  double stability_fraction = 0.5;  ///< dt <= fraction * 2 / lambda_max
+  double stability_fraction = 0.5;  ///< dt <= fraction * 2 / lambda_max (Chebyshev: fraction * beta_s / lambda_max)
+  int max_stages = 8;               ///< full3d.scheme = chebyshev: the most stages of a step
 };
 
 struct Params3d {

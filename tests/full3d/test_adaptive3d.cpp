@@ -113,4 +113,97 @@ TEST(Adaptive3d, SceneKeysAreValidated) {
   EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.adaptive.cfl=0.6"}), InputError);  // above max_cfl
   EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.dry=true"}), InputError);
   EXPECT_THROW(cycle({"full3d.adaptive.stride=2"}), InputError);  // unknown key
+  // Chebyshev stages: chosen by the adaptive step, not with the lagged node inertia, and the
+  // stage bound only with that scheme
+  EXPECT_THROW(cycle({"full3d.scheme=\"chebyshev\""}), InputError);
+  EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.scheme=\"chebyshev\"", "full3d.wall_inertia=true"}),
+               InputError);
+  EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.adaptive.max_stages=4"}), InputError);
+  EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.scheme=\"chebyshev\"", "full3d.adaptive.max_stages=0"}),
+               InputError);
+  EXPECT_NO_THROW(
+      cycle({"full3d.adaptive.enabled=true", "full3d.scheme=\"chebyshev\"", "full3d.adaptive.max_stages=4"}));
+}
+
+// Chebyshev stages (full3d.scheme = chebyshev, docs/full3d.md "Chebyshev stages") on the tiny
+// cycle at h = 20 nm with a loose tolerance, where forward Euler spends most steps on its
+// stability bound: the stages take fewer fluid solves for the same accuracy. Measured: 177
+// against 225 solves; displacement 4.536 against 4.540 nm (forward Euler at the default
+// tolerance: 4.609 nm), cycle 0.691 against 0.689 s (0.708 s).
+TEST(Adaptive3d, ChebyshevStagesTakeFewerFluidSolvesWhereStabilityBinds) {
+  const std::vector<std::string> fine = {"full3d.adaptive.enabled=true", "full3d.grid.cell_size=\"0.02 um\""};
+  auto with = [&](std::vector<std::string> more) {
+    more.insert(more.begin(), fine.begin(), fine.end());
+    return cycle(more);
+  };
+  struct Result {
+    double d, t;
+    long solves;
+    int stages;
+    long stability;
+  };
+  auto run = [&](const Scene& s, const std::string& name) {
+    const std::string dir = fresh_dir(name);
+    const RunOutcome r = run3d(s.p, s.resolved, dir, quiet());
+    EXPECT_FALSE(r.failed) << r.message;
+    std::ifstream in(fs::path(dir) / "solver_stats.json");
+    const scene::json ts = scene::json::parse(in)["time_step"];
+    return Result{r.summary["displacement_m"].get<double>(), r.summary["cycle_times_s"][0].get<double>(),
+                  ts["fluid_solves_this_process"].get<long>(), ts["stages_max_used"].get<int>(),
+                  ts["steps_by_bound"]["stability"].get<long>()};
+  };
+  const Result ref = run(with({}), "cheb_reference");
+  const Result fe = run(with({"full3d.adaptive.tolerance=0.02"}), "cheb_fe");
+  const Result ch = run(with({"full3d.adaptive.tolerance=0.02", "full3d.scheme=\"chebyshev\""}), "cheb");
+  std::printf("tolerance 1e-3, forward Euler: %.5g m, %.5g s, %ld solves\n", ref.d, ref.t, ref.solves);
+  std::printf("tolerance 2e-2, forward Euler: %.5g m, %.5g s, %ld solves (%ld stability-bound steps)\n", fe.d, fe.t,
+              fe.solves, fe.stability);
+  std::printf("tolerance 2e-2, Chebyshev: %.5g m, %.5g s, %ld solves, up to %d stages\n", ch.d, ch.t, ch.solves,
+              ch.stages);
+  EXPECT_GT(fe.stability, fe.solves / 3) << "the case must be stability-bound for forward Euler";
+  EXPECT_EQ(fe.stages, 1);
+  EXPECT_GE(ch.stages, 2);
+  EXPECT_LT(ch.solves, 0.85 * fe.solves);
+  // the same accuracy: within the loose tolerance's own error of the tight run
+  EXPECT_NEAR(ch.d, ref.d, 0.03 * ref.d);
+  EXPECT_NEAR(ch.t, ref.t, 0.04 * ref.t);
+  EXPECT_LT(std::abs(ch.d - fe.d), 0.01 * fe.d);
+}
+
+// With at most one stage the Chebyshev run is the forward-Euler run, to the bit.
+TEST(Adaptive3d, OneChebyshevStageIsForwardEuler) {
+  const std::vector<std::string> base = {"full3d.adaptive.enabled=true", "full3d.grid.cell_size=\"0.02 um\"",
+                                         "time.duration=\"40 ms\""};
+  std::vector<std::string> ch = base;
+  ch.push_back("full3d.scheme=\"chebyshev\"");
+  ch.push_back("full3d.adaptive.max_stages=1");
+  const Scene a = cycle(base), b = cycle(ch);
+  const RunOutcome ra = run3d(a.p, a.resolved, fresh_dir("one_stage_fe"), quiet());
+  const RunOutcome rb = run3d(b.p, b.resolved, fresh_dir("one_stage_cheb"), quiet());
+  ASSERT_FALSE(ra.failed) << ra.message;
+  ASSERT_FALSE(rb.failed) << rb.message;
+  EXPECT_EQ(ra.steps, rb.steps);
+  EXPECT_EQ(ra.summary["displacement_m"].get<double>(), rb.summary["displacement_m"].get<double>());
+}
+
+// A Chebyshev run killed and resumed: the stage counts follow from the checkpointed step and
+// rate estimate, so the resumed run repeats the uninterrupted one to the last bit.
+TEST(Adaptive3d, ChebyshevResumeEqualsUninterruptedRun) {
+  const Scene s = cycle({"full3d.adaptive.enabled=true", "full3d.grid.cell_size=\"0.02 um\"",
+                         "full3d.adaptive.tolerance=0.02", "full3d.scheme=\"chebyshev\"", "time.duration=\"0.3 s\"",
+                         "full3d.checkpoint_interval=\"20 ms\""});
+  const std::string a = fresh_dir("cheb_resume_a"), b = fresh_dir("cheb_resume_b");
+  const RunOutcome ra = run3d(s.p, s.resolved, a, quiet());
+  ASSERT_FALSE(ra.failed) << ra.message;
+  std::ifstream in(fs::path(a) / "solver_stats.json");
+  ASSERT_GE(scene::json::parse(in)["time_step"]["stages_max_used"].get<int>(), 2) << "the run must use the stages";
+  RunControl stop = quiet();
+  stop.stop_after_steps = ra.steps / 2;
+  ASSERT_TRUE(run3d(s.p, s.resolved, b, stop).interrupted);
+  RunControl res = quiet();
+  res.resume = true;
+  const RunOutcome rc = run3d(s.p, s.resolved, b, res);
+  ASSERT_FALSE(rc.failed) << rc.message;
+  EXPECT_EQ(rc.steps, ra.steps);
+  EXPECT_EQ(rc.summary["displacement_m"].get<double>(), ra.summary["displacement_m"].get<double>());
 }

@@ -132,3 +132,101 @@ TEST(IbSolver, WallEnergyBetweenStepsChangesNothingAndIsTheMembraneEnergy) {
     EXPECT_LT(e_last, e_first) << "the perturbed tube relaxes";
   }
 }
+
+namespace {
+// R(z) of the Chebyshev stages on y' = lambda y, z = dt lambda, by the stages' own recurrence
+double chebyshev_amplification(const ChebyshevStages& c, double z) {
+  double y2 = 1.0, y1 = 1.0 + c.mut[1] * z;
+  for (int j = 2; j <= c.s; ++j) {
+    const double yj = c.mu[j] * y1 + c.nu[j] * y2 + c.mut[j] * z * y1;
+    y2 = y1;
+    y1 = yj;
+  }
+  return y1;
+}
+}  // namespace
+
+TEST(ChebyshevStages, FirstOrderAndStableOnTheirRealInterval) {
+  for (int s = 1; s <= 12; ++s) {
+    const ChebyshevStages c = chebyshev_stages(s);
+    const double beta = c.stability_interval();
+    // consistency and first order: R(z) = 1 + z + O(z^2); the last stage sits at t + dt
+    const double z = 1e-5;
+    EXPECT_NEAR(chebyshev_amplification(c, 0.0), 1.0, 1e-14) << s;
+    EXPECT_NEAR((chebyshev_amplification(c, z) - chebyshev_amplification(c, -z)) / (2 * z), 1.0, 1e-8) << s;
+    EXPECT_NEAR(c.c[s], 1.0, 1e-12) << s;
+    if (s == 1) {
+      EXPECT_EQ(beta, 2.0);  // forward Euler
+    } else {
+      // the damped interval (2 - 4 eps / 3) s^2 with eps = 0.05, to its O(1/s^2) term
+      EXPECT_GT(beta, 1.90 * s * s) << s;
+      EXPECT_LT(beta, 2.0 * s * s) << s;
+    }
+    // stable on [-beta, 0], damped inside, unstable just beyond
+    double worst = 0.0;
+    for (int k = 0; k <= 4000; ++k) worst = std::max(worst, std::abs(chebyshev_amplification(c, -beta * k / 4000.0)));
+    EXPECT_LE(worst, 1.0 + 1e-12) << s;
+    EXPECT_GT(std::abs(chebyshev_amplification(c, -1.05 * beta)), 1.0) << s;
+    // the stage count for a step: the fewest stages whose (fraction of the) interval holds dt lambda
+    EXPECT_EQ(chebyshev_stages_for(0.5 * beta * 0.999, 1.0, 0.5, 32), s) << s;
+  }
+  EXPECT_EQ(chebyshev_stages_for(1.0, 0.0, 0.5, 8), 1);     // no estimate yet: forward Euler
+  EXPECT_EQ(chebyshev_stages_for(1e6, 1.0, 0.5, 8), 8);     // capped
+}
+
+TEST(IbSolver, ChebyshevStagesAreStableBeyondTheForwardEulerLimitAndFirstOrder) {
+  const Problem p;
+  IbSolver probe = make_solver(p, IbScheme::ForwardEuler);
+  const IbState st0 = perturbed_state(p, probe);
+  const double lambda = probe.explicit_rate(st0, 1e-4, 30);
+  ASSERT_GT(lambda, 0.0);
+  // the elliptic mode relaxes at about 25 /s, the stiffest mode at lambda: a horizon of many
+  // forward-Euler limits, 4 steps of dt lambda > 4
+  const double T = 0.16;
+  const Eigen::Matrix3Xd ref = run(p, IbScheme::Midpoint, T, 512);
+  const double moved = (ref - st0.X).cwiseAbs().maxCoeff();
+  const int n = 4;
+  const double dt = T / n;
+  std::printf("explicit rate %.4g /s, dt lambda = %.3g\n", lambda, dt * lambda);
+  ASSERT_GT(dt * lambda, 4.0) << "the test needs a step beyond forward Euler's limit";
+  const int s = chebyshev_stages_for(dt, lambda, 0.5, 32);
+  ASSERT_GT(s, 2);
+  auto error_with_stages = [&](int steps, int stages) {
+    IbSolver solver = make_solver(p, IbScheme::Chebyshev);
+    IbState st = perturbed_state(p, solver);
+    int solves = 0;
+    for (int k = 0; k < steps; ++k) solves += solver.step(st, T / steps, stages).fluid_solves;
+    EXPECT_EQ(solves, steps * stages);
+    return (st.X - ref).cwiseAbs().maxCoeff();
+  };
+  // forward Euler at that step: the stiffest modes grow until a guard stops it
+  {
+    IbSolver fe = make_solver(p, IbScheme::ForwardEuler);
+    IbState st = perturbed_state(p, fe);
+    bool failed = false;
+    double err = 0.0;
+    try {
+      for (int k = 0; k < n; ++k) fe.step(st, dt);
+      err = (st.X - ref).cwiseAbs().maxCoeff();
+    } catch (const swim::NumericalError&) {
+      failed = true;
+    }
+    EXPECT_TRUE(failed || err > moved) << "forward Euler beyond its limit: error " << err << " m";
+  }
+  // the stages at the same step stay bounded; with the stages held, the error falls at
+  // order 1 as dt does
+  const double e[4] = {error_with_stages(n, s), error_with_stages(2 * n, s), error_with_stages(4 * n, s),
+                       error_with_stages(8 * n, s)};
+  std::printf("Chebyshev, %d stages: errors %.3e %.3e %.3e %.3e m (moved %.3e m), orders %.2f %.2f %.2f\n", s, e[0],
+              e[1], e[2], e[3], moved, std::log2(e[0] / e[1]), std::log2(e[1] / e[2]), std::log2(e[2] / e[3]));
+  EXPECT_LT(e[0], moved);
+  EXPECT_GT(std::log2(e[2] / e[3]), 0.8);
+  EXPECT_LT(std::log2(e[2] / e[3]), 1.3);
+  // one stage is the forward Euler step, to the bit
+  IbSolver a = make_solver(p, IbScheme::Chebyshev), b = make_solver(p, IbScheme::ForwardEuler);
+  IbState sa = perturbed_state(p, a), sb = perturbed_state(p, b);
+  a.step(sa, 1e-5, 1);
+  b.step(sb, 1e-5);
+  EXPECT_EQ(sa.X, sb.X);
+  EXPECT_EQ(sa.V, sb.V);
+}

@@ -94,6 +94,11 @@ TEST(SwimRun3d, BadInputExits2AndWritesNothing) {
   EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wave.kind='\"step\"' --set protocol=null"), 2);
   EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set wall.C1='\"4e6 Pa/m\"' --set wall.spring_constant=null"), 2);
   EXPECT_EQ(swim_cli("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set container.radius='\"0.15 um\"'"), 2);
+  // Chebyshev stages without the adaptive step that chooses them: the message names the key
+  const auto [code, msg] = swim_err("run " + kScene + " --tier 3d --quiet --out \"" + d + "\" --set full3d.scheme='\"chebyshev\"'");
+  EXPECT_EQ(code, 2);
+  EXPECT_NE(msg.find("'full3d.scheme'"), std::string::npos) << msg;
+  EXPECT_NE(msg.find("full3d.adaptive.enabled"), std::string::npos) << msg;
   EXPECT_FALSE(fs::exists(d));
 }
 
