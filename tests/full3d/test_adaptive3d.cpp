@@ -30,6 +30,16 @@ std::string fresh_dir(const std::string& name) { return run3d_test::fresh_dir("o
 
 RunControl quiet() { return run3d_test::quiet_control(); }
 
+// The run of s in dir stopped after `steps` steps and resumed to its end.
+RunOutcome stopped_and_resumed(const Scene& s, const std::string& dir, long steps) {
+  RunControl stop = quiet();
+  stop.stop_after_steps = steps;
+  EXPECT_TRUE(run3d(s.p, s.resolved, dir, stop).interrupted);
+  RunControl res = quiet();
+  res.resume = true;
+  return run3d(s.p, s.resolved, dir, res);
+}
+
 }  // namespace
 
 // One whole cycle (contraction wave, recovery, dead-band end) with the midpoint scheme: the
@@ -83,12 +93,7 @@ TEST(Adaptive3d, ResumeEqualsUninterruptedRun) {
   const std::string a = fresh_dir("resume_a"), b = fresh_dir("resume_b");
   const RunOutcome ra = run3d(s.p, s.resolved, a, quiet());
   ASSERT_FALSE(ra.failed) << ra.message;
-  RunControl stop = quiet();
-  stop.stop_after_steps = ra.steps / 2;
-  ASSERT_TRUE(run3d(s.p, s.resolved, b, stop).interrupted);
-  RunControl res = quiet();
-  res.resume = true;
-  const RunOutcome rc = run3d(s.p, s.resolved, b, res);
+  const RunOutcome rc = stopped_and_resumed(s, b, ra.steps / 2);
   ASSERT_FALSE(rc.failed) << rc.message;
   EXPECT_EQ(rc.steps, ra.steps);
   EXPECT_EQ(rc.summary["t_end_s"].get<double>(), ra.summary["t_end_s"].get<double>());
@@ -197,12 +202,7 @@ TEST(Adaptive3d, ChebyshevResumeEqualsUninterruptedRun) {
   ASSERT_FALSE(ra.failed) << ra.message;
   std::ifstream in(fs::path(a) / "solver_stats.json");
   ASSERT_GE(scene::json::parse(in)["time_step"]["stages_max_used"].get<int>(), 2) << "the run must use the stages";
-  RunControl stop = quiet();
-  stop.stop_after_steps = ra.steps / 2;
-  ASSERT_TRUE(run3d(s.p, s.resolved, b, stop).interrupted);
-  RunControl res = quiet();
-  res.resume = true;
-  const RunOutcome rc = run3d(s.p, s.resolved, b, res);
+  const RunOutcome rc = stopped_and_resumed(s, b, ra.steps / 2);
   ASSERT_FALSE(rc.failed) << rc.message;
   EXPECT_EQ(rc.steps, ra.steps);
   EXPECT_EQ(rc.summary["displacement_m"].get<double>(), ra.summary["displacement_m"].get<double>());
