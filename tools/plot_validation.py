@@ -458,7 +458,7 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title, logx=Fa
             continue
         ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
     ax.set(xlabel=xlabel, ylabel=ylabel)
-    fig.suptitle(title)
+    fig.suptitle(f"{report['suite']} suite: {title}")
     if logx:
         ax.set_xscale("log")
         ax.set_xticks(x)
