@@ -48,7 +48,8 @@ def wrinkle(run):
         return "—"
     if run.get("max_wrinkle_over_h", 1.0) < 1e-6:
         return "round"
-    return si(run["max_wrinkle_m"], "m")
+    mode = run.get("max_wrinkle_mode")
+    return si(run["max_wrinkle_m"], "m") + (f" (m = {mode})" if mode else "")
 
 
 def evidence_value(key, v):
@@ -674,10 +675,16 @@ def markdown(report, figs):
                        f"{si(r['wall_time_s'], 's')}{' (cached)' if r['cached'] else ''} |")
         wr = [r for r in c["runs3d"] if r.get("max_wrinkle_over_h", 0) > 0.5]
         if wr:
-            out += ["", "Wall wrinkle: the largest RMS departure of the 3D wall from axisymmetry. On "
-                    f"{len(wr)} of {len(c['runs3d'])} grids it exceeds h/2 (up to "
+            seeds = {r.get("seed_mode", 0) for r in wr}
+            modes = {r.get("max_wrinkle_mode") for r in wr}
+            seeded = len(seeds) == 1 and 0 not in seeds and modes == seeds
+            pattern = (f"the m = {seeds.pop()} lobes seeded in its stress-free shape, on every grid (the seed chooses "
+                       "them: docs/full3d.md, \"Ring buckling and the seed imperfection\")" if seeded
+                       else "lobes whose pattern follows the grid")
+            out += ["", "Wall wrinkle: the largest RMS departure of the 3D wall from axisymmetry (m: its lobe number). "
+                    f"On {len(wr)} of {len(c['runs3d'])} grids it exceeds h/2 (up to "
                     f"{max(r['max_wrinkle_over_h'] for r in wr):.1f} h): the hoop-compressed wall buckled into "
-                    "lobes whose pattern follows the grid, and the 1D tier, which assumes a round tube, "
+                    f"{pattern}, and the 1D tier, which assumes a round tube, "
                     "cannot represent them (docs/full3d.md, \"Wall wrinkling\")."]
         ref = c["reference3d"]
         rng = ref.get("order_range")

@@ -364,8 +364,12 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   r.record["pumped_volume_m3"] = summary.value("pumped_volume_m3", 0.0);
   // the wall's largest departure from axisymmetry (runs written before the wrinkle measure
   // existed have none)
-  for (const char* k : {"max_wrinkle_m", "max_wrinkle_over_h"})
+  for (const char* k : {"max_wrinkle_m", "max_wrinkle_over_h", "max_wrinkle_mode"})
     if (summary.contains(k) && summary[k].is_number()) r.record[k] = summary[k];
+  // the lobes seeded in the wall's stress-free shape (0: none)
+  if (summary.contains("derived") && summary["derived"].is_object() && summary["derived"].contains("seed_mode") &&
+      summary["derived"]["seed_mode"].is_number())
+    r.record["seed_mode"] = summary["derived"]["seed_mode"];
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number()) {
     r.max_displacement = summary["max_displacement_m"].get<double>();
     r.record["max_displacement_m"] = r.max_displacement;
