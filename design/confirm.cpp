@@ -218,25 +218,17 @@ json figures_1d(const reduced1d::Metrics& m, const std::string& metric) {
 }
 
 void match_recovery_end(Candidate& c, const std::string& scene_dir) {
+  const json s = validation::with_recovery_end_3d(c.scene);
   json resolved;
-  const reduced1d::Params p = reduced1d::read_scene(c.scene, resolved, scene_dir);
+  const reduced1d::Params p = reduced1d::read_scene(s, resolved, scene_dir);
   if (p.wave != reduced1d::WaveKind::ForceDriven) return;
-  const json& m = c.scene.contains("model1d") ? c.scene["model1d"] : json();
-  if (m.is_object() && m.contains("recovery_end")) {
-    c.recovery_end_1d = reduced1d::recovery_end_name(p.protocol.recovery_end);
-    return;
-  }
-  const std::string rule = validation::recovery_end_3d(c.scene);
-  c.recovery_end_1d = rule;
-  if (rule == reduced1d::recovery_end_name(p.protocol.recovery_end)) return;
-  json s = c.scene;
-  if (!s.contains("model1d") || !s["model1d"].is_object()) s["model1d"] = json::object();
-  s["model1d"]["recovery_end"] = rule;
-  json r2;
-  const reduced1d::DesignOutcome o = reduced1d::run_design(reduced1d::read_scene(s, r2, scene_dir));
+  c.recovery_end_1d = reduced1d::recovery_end_name(p.protocol.recovery_end);
+  // the design states its own rule, or the 3D rule is the sweep's (the 1D default) already
+  if (s == c.scene || p.protocol.recovery_end == reduced1d::RecoveryEnd::Energy) return;
+  const reduced1d::DesignOutcome o = reduced1d::run_design(p);
   if (!o.ok)
-    throw NumericalError("design " + std::to_string(c.design) + " in 1D with the 3D run's recovery end (" + rule +
-                             "): " + o.message,
+    throw NumericalError("design " + std::to_string(c.design) + " in 1D with the 3D run's recovery end (" +
+                             c.recovery_end_1d + "): " + o.message,
                          "state model1d.recovery_end in the design scene to keep the sweep's rule");
   c.metrics_sweep = c.metrics;
   c.metrics = o.metrics;

@@ -166,78 +166,52 @@ IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
   Eigen::Matrix3Xd F = fluid_force(s.X, s.t, accel);
   guard_finite(F, "membrane force", s.t);
   lap(st.time_forces);
-  const bool chebyshev = opt_.scheme == IbScheme::Chebyshev && stages > 1;
-  if (chebyshev) {
+  // one velocity evaluation: the force FY at the nodes Y spread, the Stokes step of tau from
+  // the step's u^n into `into`, and the node velocities interpolated from it
+  auto velocity = [&](const Eigen::Matrix3Xd& Y, const Eigen::Matrix3Xd& FY, VectorField& into, double tau_s) {
+    spread(grid_, Y, FY, f, opt_.threads);
+    lap(st.time_spread);
+    const StokesStats ss = stokes_.step(s.u, into, f, tau_s);
+    lap(st.time_fluid);
+    st.stokes_iterations += ss.iterations;
+    st.max_divergence = ss.max_divergence;
+    ++st.fluid_solves;
+    Eigen::Matrix3Xd UY;
+    interpolate(grid_, into, Y, UY, opt_.threads);
+    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, Y, UY);
+    lap(st.time_interp);
+    guard_finite(UY, "node velocity", s.t);
+    return UY;
+  };
+  if (opt_.scheme == IbScheme::Chebyshev && stages > 1) {
     // Y_j = mu_j Y_{j-1} + nu_j Y_{j-2} + mut_j dt U(Y_{j-1}); every stage's fluid solve
     // starts from the step's u^n (the inertia term's old velocity)
     const ChebyshevStages c = chebyshev_stages(stages);
-    auto velocity = [&](const Eigen::Matrix3Xd& Y, const Eigen::Matrix3Xd& FY) {
-      spread(grid_, Y, FY, f, opt_.threads);
-      lap(st.time_spread);
-      const StokesStats ss = stokes_.step(s.u, u, f, tau);
-      lap(st.time_fluid);
-      st.stokes_iterations += ss.iterations;
-      st.max_divergence = ss.max_divergence;
-      Eigen::Matrix3Xd UY;
-      interpolate(grid_, u, Y, UY, opt_.threads);
-      if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, Y, UY);
-      lap(st.time_interp);
-      guard_finite(UY, "node velocity", s.t);
-      return UY;
-    };
     Eigen::Matrix3Xd Y2 = s.X;
-    Eigen::Matrix3Xd Y1 = s.X + (c.mut[1] * dt) * velocity(s.X, F);
+    Eigen::Matrix3Xd Y1 = s.X + (c.mut[1] * dt) * velocity(s.X, F, u, tau);
     for (int j = 2; j <= stages; ++j) {
       F = fluid_force(Y1, s.t + c.c[j - 1] * dt, accel);
       guard_finite(F, "membrane force", s.t);
       lap(st.time_forces);
-      Eigen::Matrix3Xd Yj = c.mu[j] * Y1 + c.nu[j] * Y2 + (c.mut[j] * dt) * velocity(Y1, F);
+      Eigen::Matrix3Xd Yj = c.mu[j] * Y1 + c.nu[j] * Y2 + (c.mut[j] * dt) * velocity(Y1, F, u, tau);
       guard_finite(Yj, "node position", s.t);
       Y2 = std::move(Y1);
       Y1 = std::move(Yj);
     }
-    st.fluid_solves = stages;
     U = (Y1 - s.X) / dt;
     Xnew = std::move(Y1);
   } else if (opt_.scheme != IbScheme::Midpoint) {
-    spread(grid_, s.X, F, f, opt_.threads);
-    lap(st.time_spread);
-    const StokesStats ss = stokes_.step(s.u, u, f, tau);
-    lap(st.time_fluid);
-    st.stokes_iterations = ss.iterations;
-    st.max_divergence = ss.max_divergence;
-    interpolate(grid_, u, s.X, U, opt_.threads);
-    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, s.X, U);
-    lap(st.time_interp);
+    U = velocity(s.X, F, u, tau);
     Xnew = s.X + dt * U;
-    st.fluid_solves = 1;
   } else {
-    spread(grid_, s.X, F, f, opt_.threads);
-    lap(st.time_spread);
-    VectorField& uh = work_uh_;
-    const StokesStats s1 = stokes_.step(s.u, uh, f, tau_half);
-    lap(st.time_fluid);
-    interpolate(grid_, uh, s.X, U, opt_.threads);
-    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, s.X, U);
-    lap(st.time_interp);
-    guard_finite(U, "node velocity", s.t);
-    const Eigen::Matrix3Xd U0 = U;
-    const Eigen::Matrix3Xd Xh = s.X + 0.5 * dt * U;
+    const Eigen::Matrix3Xd U0 = velocity(s.X, F, work_uh_, tau_half);
+    const Eigen::Matrix3Xd Xh = s.X + 0.5 * dt * U0;
     F = fluid_force(Xh, s.t + 0.5 * dt, accel);
     guard_finite(F, "membrane force", s.t);
     lap(st.time_forces);
-    spread(grid_, Xh, F, f, opt_.threads);
-    lap(st.time_spread);
-    const StokesStats s2 = stokes_.step(s.u, u, f, tau);
-    lap(st.time_fluid);
-    st.stokes_iterations = s1.iterations + s2.iterations;
-    st.max_divergence = s2.max_divergence;
-    interpolate(grid_, u, Xh, U, opt_.threads);
-    if (opt_.axisymmetric_wall) project_axisymmetric(mesh_, Xh, U);
-    lap(st.time_interp);
+    U = velocity(Xh, F, u, tau);
     Xnew = s.X + dt * U;
     st.max_velocity_change = (U - U0).colwise().norm().maxCoeff();
-    st.fluid_solves = 2;
   }
   guard_finite(U, "node velocity", s.t);
   guard_finite(Xnew, "node position", s.t);

@@ -213,15 +213,20 @@ std::string recovery_end_3d(const json& s) {
   return kRecoveryEndDefault3d;
 }
 
+json with_recovery_end_3d(json s) {
+  const json wave = s.value("wave", json::object());
+  const bool forced = !wave.is_object() || wave.value("kind", std::string("force_driven")) == "force_driven";
+  const bool own = s.contains("model1d") && s["model1d"].is_object() && s["model1d"].contains("recovery_end");
+  if (forced && !own) set_key(s, "model1d.recovery_end", recovery_end_3d(s));
+  return s;
+}
+
 json model_scene(json s, const json& model, const std::string& cal) {
   apply_sets(s, model.value("set", json()));
   // A force-driven cycle ends by the reference's rule: the case's full3d.recovery_end, which the
   // 3D and axisymmetric runs read (the 3D tier's default when the case does not set it), unless
   // the model states its own.
-  const json wave = s.value("wave", json::object());
-  const bool forced = !wave.is_object() || wave.value("kind", std::string("force_driven")) == "force_driven";
-  const bool own = s.contains("model1d") && s["model1d"].is_object() && s["model1d"].contains("recovery_end");
-  if (forced && !own) set_key(s, "model1d.recovery_end", recovery_end_3d(s));
+  s = with_recovery_end_3d(std::move(s));
   if (model.value("calibrated", false)) {
     if (s.contains("wall") && s["wall"].is_object()) {
       s["wall"].erase("spring_constant");

@@ -60,6 +60,11 @@ inline constexpr const char* kRecoveryEndDefault3d = "dead_band";
 /// kRecoveryEndDefault3d.
 std::string recovery_end_3d(const json& scene);
 
+/// A force-driven scene whose model1d section names no recovery_end, with model1d.recovery_end
+/// set to recovery_end_3d(s): its 1D cycle then ends as its 3D and axisymmetric runs' do. Any
+/// other scene unchanged.
+json with_recovery_end_3d(json s);
+
 /// A 1D model's scene as the suite runs it: the case's scene `s` with the model's `set` and, for
 /// a calibrated model (`"calibrated": true`), the calibration file `cal` in place of the scene's
 /// own wall stiffness (its `wall.spring_constant` or `wall.C1`). A force-driven model whose set
