@@ -12,10 +12,20 @@ rim's thrust rim mu R <dR/dt>. Fitted by least squares (scipy) to, for every sha
 of narrow wall bands (0.5 R0 wide, every 0.25 R0 along the tube, each relative to the largest of
 that shape) and the towed drag and lumen flux (relative, weight 3). Needs python3-scipy.
 
-    tools/fit_end_junction.py [data/calibration/junction_kernels.txt]
+    tools/fit_end_junction.py [--no-fit] [--expansion data/calibration/junction_expansion.txt]
+                              [data/calibration/junction_kernels.txt ...]
 
-Prints each shape's residuals before (plain junction) and after the fit, and the C++ initializer.
+With --expansion, the residuals also hold, for each uniform tube there (swim_junction_kernels
+--expansion), the relative error of the wall's resistance to a uniform expansion: the lumen's and
+annulus's lubrication dissipation plus both ends' x^T M x, x = pi R w L (1, -1, 0), against the
+axisymmetric tier's (weight 3, as the towed drag).
+
+Prints each shape's residuals with the plain junction, with the shipped coefficients
+(reduced1d/outer_flow.hpp) and after the fit, and the C++ initializer.
 """
+import argparse
+import os
+import re
 import sys
 
 import numpy as np
@@ -39,6 +49,7 @@ class Tube:
 
     def __init__(self, L, Rc, P, shape, mu, N=200):
         self.L, self.Rc, self.mu, self.h = L, Rc, mu, L / N
+
         zp = np.concatenate([[0], (np.arange(N) + 0.5) * self.h, [L]])
         self.zc = zp[1:-1]
         d = np.diff(zp)
@@ -47,6 +58,7 @@ class Tube:
         rho, kap, S, e = annulus(R, Rc, mu)
         a, b = R[:-1], R[1:]
         self.rl = (8 * mu / np.pi) * d / 3 * (a * a + a * b + b * b) / (a**3 * b**3)
+
         self.ra = 0.5 * d * (rho[:-1] + rho[1:])
         self.c = 0.5 * d * (kap[:-1] + kap[1:])
         self.S = 0.5 * (S[:-1] + S[1:])
@@ -115,10 +127,44 @@ def shape_of(c):
     return f
 
 
+def load_expansion(fn):
+    """swim_junction_kernels --expansion lines: (L, Rc, R, mu, Z)"""
+    out = []
+    for line in open(fn):
+        t = line.split()
+        if line.startswith("# expansion"):
+            out.append((float(t[3]) * R0, float(t[5]) * R0, float(t[7]) * R0, float(t[11]), float(t[13])))
+    return out
+
+
+def expansion_z(p, L, Rc, R, mu):
+    """The 1D tier's resistance to a uniform expansion: lubrication lumen and annulus, both ends' junction"""
+    d = Rc * Rc - R * R
+    G = Rc**4 - R**4 - d * d / np.log(Rc / R)
+    z = (8 * np.pi / 3) * mu * R * R * L**3 * (1 / R**4 + 1 / G)
+    M, _ = junction(p, R, Rc, mu)
+    x = np.array([np.pi * R * L, -np.pi * R * L, 0.0])
+    return z + 2 * x @ M @ x
+
+
+def shipped():
+    """kCalibratedJunction's 14 coefficients as reduced1d/outer_flow.hpp holds them"""
+    src = open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "reduced1d", "outer_flow.hpp")).read()
+    body = src[src.index("kCalibratedJunction{"):]
+    nums = [float(v) for v in re.findall(r"-?\d+\.\d+(?:e-?\d+)?", body)[:17]]
+    return np.array(nums[:14])
+
+
 def main():
-    fn = sys.argv[1] if len(sys.argv) > 1 else "data/calibration/junction_kernels.txt"
+    ap = argparse.ArgumentParser()
+    ap.add_argument("kernels", nargs="*", default=["data/calibration/junction_kernels.txt"])
+    ap.add_argument("--expansion", default=None)
+    ap.add_argument("--no-fit", action="store_true", help="only the plain and the shipped junction's residuals")
+
+    a = ap.parse_args()
     data = []
-    for c in load(fn):
+    expansions = load_expansion(a.expansion) if a.expansion else []
+    for c in [c for fn in a.kernels for c in load(fn)]:
         h = c["Rc"] / c["cells"]
         P = round(5 * c["L"] / h) * h
         r = np.array(c["rings"])
@@ -149,10 +195,20 @@ def main():
                 print(f"  L/R0 {c['L'] / R0:5.2f} Rc/R0 {c['Rc'] / R0:4.2f} zf {c['zf']:5.2f} rf {c['rf']:.2f}: bands rms "
                       f"{np.sqrt(np.mean(e**2)):.3f} max {np.abs(e).max():.3f}; drag {drag / c['drag'] - 1:+.3f}, "
                       f"lumen flux {flux / c['tq'] - 1:+.3f}")
+        for L, Rc, R, mu, Z in expansions:
+            r = expansion_z(p, L, Rc, R, mu) / Z - 1
+            out.append(3 * r)
+            if report:
+                print(f"  uniform expansion L/R0 {L / R0:5.2f} Rc/R0 {Rc / R0:4.2f} R/R0 {R / R0:.2f}: resistance {r:+.3f}")
         return np.array(out)
 
     print("plain junction:")
     residuals(np.zeros(14), True)
+    print("shipped junction:")
+    r = residuals(shipped(), True)
+    print(f"  cost {0.5 * np.sum(r**2):.4f}")
+    if a.no_fit:
+        return
     start = np.array([1, 0, 0.1, 0, 0.1, 0, 0.5, 0, -0.3, 0, 0.5, 0, 0, 0.0])
     fit = least_squares(residuals, start)
     print(f"fitted ({len(fit.fun)} residuals, cost {fit.cost:.4f}):")

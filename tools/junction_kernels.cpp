@@ -13,6 +13,13 @@
 // Output per case: a header line "# L/R0 .. Rc/R0 .. Rt/R0 1.00 cells .. nodes .. drag .. mu ..
 // zf .. rf ..", a line "# towed lumen flux per U .. m^2", then per ring "k z/R0 dz/R0 U" (U in m/s
 // for dR/dt = 1 um/s at ring k alone; dz the ring's share of the wall).
+//
+//   swim_junction_kernels --expansion [--cells 16] L/R0,Rc/R0,R/R0 ... > expansion.txt
+//
+// The uniform expansion: a straight tube of radius R whose every ring moves outwards at the same
+// rate w (fore-aft symmetric: it does not swim). One line per case, "# expansion L/R0 .. Rc/R0 ..
+// R/R0 .. cells .. mu .. Z .. N s/m", Z = the viscous dissipation / w^2, the wall's resistance to
+// that motion.
 #include <Eigen/Dense>
 
 #include <cmath>
@@ -80,22 +87,59 @@ void measure(double l, double rc, double zf, double rf, int cells) {
   std::fflush(stdout);
 }
 
+void expansion(double l, double rc, double r, int cells) {
+  const double L = l * kR0, Rc = rc * kR0, h = Rc / cells, R = r * kR0;
+  const double P = std::round(5 * L / h) * h;
+  const json sc = {{"name", "junction_expansion"},
+                   {"swimmer", {{"radius", um(kR0)}, {"length", um(L)}}},
+                   {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(P)}}},
+                   {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
+                   {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
+                   {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", cells}}}}}};
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
+  swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& Rv, Eigen::VectorXd& Rt) {
+    Rv = Eigen::VectorXd::Constant(Eigen::Index(z.size()), R);
+    Rt = Eigen::VectorXd::Constant(Eigen::Index(z.size()), kRate);
+  };
+  swim::axi::PrescribedSwimmer sw(swim::axi::fitted_mesh_params(p), p.base.fluid.mu, wall.reference_positions(), kin,
+                                  p.x_start());
+  sw.evaluate(0.0);
+  std::printf("# expansion L/R0 %.4f Rc/R0 %.4f R/R0 %.4f cells %d mu %.6e Z %.9e N s/m\n", l, rc, r, cells,
+              p.base.fluid.mu, sw.stokes().dissipation() / (kRate * kRate));
+  std::fflush(stdout);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   int cells = 16;
+  bool expand = false;
   std::vector<std::string> cases;
   for (int i = 1; i < argc; ++i) {
     const std::string a = argv[i];
     if (a == "--cells" && i + 1 < argc) cells = std::atoi(argv[++i]);
+    else if (a == "--expansion") expand = true;
     else cases.push_back(a);
   }
   if (cases.empty() || cells < 4) {
-    std::fprintf(stderr, "usage: swim_junction_kernels [--cells N >= 4] L/R0,Rc/R0[,zf[,rf]] ...\n");
+    std::fprintf(stderr, "usage: swim_junction_kernels [--cells N >= 4] L/R0,Rc/R0[,zf[,rf]] ...\n"
+                         "       swim_junction_kernels --expansion [--cells N >= 4] L/R0,Rc/R0,R/R0 ...\n");
     return 2;
   }
   try {
     for (const std::string& c : cases) {
+      if (expand) {
+        double l = 0, rc = 0, r = 0;
+        if (std::sscanf(c.c_str(), "%lf,%lf,%lf", &l, &rc, &r) != 3 || !(l > 0) || !(rc > 1) || !(r > 0 && r < rc)) {
+          std::fprintf(stderr, "swim_junction_kernels: case \"%s\": expected L/R0 > 0, Rc/R0 > 1, 0 < R/R0 < Rc/R0\n",
+                       c.c_str());
+          return 2;
+        }
+        expansion(l, rc, r, cells);
+        continue;
+      }
       double l = 0, rc = 0, zf = -1, rf = 0.55;
       if (std::sscanf(c.c_str(), "%lf,%lf,%lf,%lf", &l, &rc, &zf, &rf) < 2 || !(l > 0) || !(rc > 1) ||
           !(rf > 0 && rf < 1) || zf >= 1) {
