@@ -107,7 +107,7 @@ def load(fn):
             tq = float(line.split()[6])
         elif line.startswith("# L/R0"):
             t = line.split()
-            cur = dict(L=float(t[2]) * R0, Rc=float(t[4]) * R0, cells=int(t[8]), drag=float(t[12]), mu=float(t[14]), zf=float(t[16]),
+            cur = dict(L=float(t[2]) * R0, Rc=float(t[4]) * R0, rt=float(t[6]), cells=int(t[8]), drag=float(t[12]), mu=float(t[14]), zf=float(t[16]),
                        rf=float(t[18]), tq=tq, rings=[])
             cases.append(cur)
         elif cur is not None and line.strip() and not line.startswith("#"):
@@ -116,14 +116,15 @@ def load(fn):
 
 
 def shape_of(c):
-    L, zf, rf = c["L"], c["zf"], c["rf"]
+    L, zf, rf, rt = c["L"], c["zf"], c["rf"], c["rt"]
     if zf < 0:
-        return lambda z: R0 + 0 * z
+        return lambda z: rt * R0 + 0 * z
     w = L / 8
 
     def f(z):
         x = (z - zf * L) / w
-        return np.where(x <= -0.5, rf * R0, np.where(x >= 0.5, R0, rf * R0 + (1 - rf) * R0 * 0.5 * (1 + np.sin(np.pi * x))))
+        return np.where(x <= -0.5, rf * R0,
+                        np.where(x >= 0.5, rt * R0, rf * R0 + (rt - rf) * R0 * 0.5 * (1 + np.sin(np.pi * x))))
     return f
 
 
@@ -160,6 +161,8 @@ def main():
     ap.add_argument("kernels", nargs="*", default=["data/calibration/junction_kernels.txt"])
     ap.add_argument("--expansion", default=None)
     ap.add_argument("--no-fit", action="store_true", help="only the plain and the shipped junction's residuals")
+    ap.add_argument("--rim-bands", action="store_true",
+                    help="two more bands per shape, centred on the rims (the half of a band inside the tube)")
 
     a = ap.parse_args()
     data = []
@@ -171,7 +174,10 @@ def main():
         z, U_ring = r[:, 1] * R0, r[:, 3] / 1e-6
         tube = Tube(c["L"], c["Rc"], P, shape_of(c), c["mu"])
         bands = []
-        for zc in np.arange(0.25 * R0, c["L"] - 0.25 * R0 + 1e-12, 0.25 * R0):
+        centres = np.arange(0.25 * R0, c["L"] - 0.25 * R0 + 1e-12, 0.25 * R0)
+        if a.rim_bands:
+            centres = np.concatenate([[0.0], centres, [c["L"]]])
+        for zc in centres:
             def band(zz, zc=zc):
                 x = (zz - zc) / (0.5 * R0)
                 return np.where(abs(x) < 0.5, np.cos(np.pi * x) ** 2, 0.0)
@@ -192,7 +198,7 @@ def main():
             out += [3 * (drag / c["drag"] - 1), 3 * (flux / c["tq"] - 1)]
             if report:
                 e = (U - c["U"]) / scale
-                print(f"  L/R0 {c['L'] / R0:5.2f} Rc/R0 {c['Rc'] / R0:4.2f} zf {c['zf']:5.2f} rf {c['rf']:.2f}: bands rms "
+                print(f"  L/R0 {c['L'] / R0:5.2f} Rc/R0 {c['Rc'] / R0:4.2f} zf {c['zf']:5.2f} rf {c['rf']:.2f} rt {c['rt']:.2f}: bands rms "
                       f"{np.sqrt(np.mean(e**2)):.3f} max {np.abs(e).max():.3f}; drag {drag / c['drag'] - 1:+.3f}, "
                       f"lumen flux {flux / c['tq'] - 1:+.3f}")
         for L, Rc, R, mu, Z in expansions:

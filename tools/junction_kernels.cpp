@@ -6,9 +6,10 @@
 // part of the product: tools/fit_end_junction.py reads what it writes.
 //
 //   swim_junction_kernels [--cells 16] CASE ... > kernels.txt
-//   CASE = L/R0,Rc/R0[,zf[,rf]]: tube length and container radius in R0 = 0.125 um; zf < 0 (the
-//          default) a uniform tube of radius R0, else the tube contracted to rf R0 (default 0.55)
-//          over [0, zf L] with a front L/8 wide (a half sine) that rises to R0 beyond it.
+//   CASE = L/R0,Rc/R0[,zf[,rf[,rt]]]: tube length and container radius in R0 = 0.125 um; zf < 0
+//          (the default) a uniform tube of radius rt R0 (default 1), else the tube contracted to
+//          rf R0 (default 0.55) over [0, zf L] with a front L/8 wide (a half sine) that rises to
+//          rt R0 beyond it.
 //
 // Output per case: a header line "# L/R0 .. Rc/R0 .. Rt/R0 1.00 cells .. nodes .. drag .. mu ..
 // zf .. rf ..", a line "# towed lumen flux per U .. m^2", then per ring "k z/R0 dz/R0 U" (U in m/s
@@ -46,7 +47,7 @@ std::string um(double v) {
   return b;
 }
 
-void measure(double l, double rc, double zf, double rf, int cells) {
+void measure(double l, double rc, double zf, double rf, double rt, int cells) {
   const double L = l * kR0, Rc = rc * kR0, h = Rc / cells;
   const double P = std::round(5 * L / h) * h;
   const json sc = {{"name", "junction_kernel"},
@@ -59,11 +60,11 @@ void measure(double l, double rc, double zf, double rf, int cells) {
   const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
   swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
   auto shape = [&](double z) {
-    if (zf < 0) return kR0;
+    if (zf < 0) return rt * kR0;
     const double x = (z - zf * L) / (L / 8);
     if (x <= -0.5) return rf * kR0;
-    if (x >= 0.5) return kR0;
-    return rf * kR0 + (1 - rf) * kR0 * 0.5 * (1 + std::sin(M_PI * x));
+    if (x >= 0.5) return rt * kR0;
+    return rf * kR0 + (rt - rf) * kR0 * 0.5 * (1 + std::sin(M_PI * x));
   };
   int ring = -1;  // the ring that moves; -1: none (the towed tube)
   swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& R, Eigen::VectorXd& Rt) {
@@ -78,8 +79,8 @@ void measure(double l, double rc, double zf, double rf, int cells) {
   const int n = int(z.size());
   const swim::axi::PrescribedState tow = sw.evaluate(0.0);
   std::printf("# towed lumen flux per U %.9e m^2\n", tow.towed_lumen_flux);
-  std::printf("# L/R0 %.4f Rc/R0 %.4f Rt/R0 1.00 cells %d nodes %d drag %.9e mu %.6e zf %.4f rf %.4f\n", l, rc, cells, n,
-              tow.drag, p.base.fluid.mu, zf, rf);
+  std::printf("# L/R0 %.4f Rc/R0 %.4f Rt/R0 %.2f cells %d nodes %d drag %.9e mu %.6e zf %.4f rf %.4f\n", l, rc, rt,
+              cells, n, tow.drag, p.base.fluid.mu, zf, rf);
   for (ring = 0; ring < n; ++ring) {
     const double dz = 0.5 * ((ring + 1 < n ? z[ring + 1] : z[ring]) - (ring > 0 ? z[ring - 1] : z[ring]));
     std::printf("%d %.9e %.9e %.9e\n", ring, z[ring] / kR0, dz / kR0, sw.evaluate(0.0).velocity);
@@ -124,7 +125,7 @@ int main(int argc, char** argv) {
     else cases.push_back(a);
   }
   if (cases.empty() || cells < 4) {
-    std::fprintf(stderr, "usage: swim_junction_kernels [--cells N >= 4] L/R0,Rc/R0[,zf[,rf]] ...\n"
+    std::fprintf(stderr, "usage: swim_junction_kernels [--cells N >= 4] L/R0,Rc/R0[,zf[,rf[,rt]]] ...\n"
                          "       swim_junction_kernels --expansion [--cells N >= 4] L/R0,Rc/R0,R/R0 ...\n");
     return 2;
   }
@@ -140,14 +141,15 @@ int main(int argc, char** argv) {
         expansion(l, rc, r, cells);
         continue;
       }
-      double l = 0, rc = 0, zf = -1, rf = 0.55;
-      if (std::sscanf(c.c_str(), "%lf,%lf,%lf,%lf", &l, &rc, &zf, &rf) < 2 || !(l > 0) || !(rc > 1) ||
-          !(rf > 0 && rf < 1) || zf >= 1) {
-        std::fprintf(stderr, "swim_junction_kernels: case \"%s\": expected L/R0 > 0, Rc/R0 > 1, zf < 1, 0 < rf < 1\n",
+      double l = 0, rc = 0, zf = -1, rf = 0.55, rt = 1.0;
+      if (std::sscanf(c.c_str(), "%lf,%lf,%lf,%lf,%lf", &l, &rc, &zf, &rf, &rt) < 2 || !(l > 0) || !(rc > 1) ||
+          !(rf > 0 && rf < 1) || zf >= 1 || !(rt > 0 && rt <= 1) || (zf >= 0 && !(rt > rf))) {
+        std::fprintf(stderr,
+                     "swim_junction_kernels: case \"%s\": expected L/R0 > 0, Rc/R0 > 1, zf < 1, 0 < rf < 1, rf < rt <= 1\n",
                      c.c_str());
         return 2;
       }
-      measure(l, rc, zf, rf, cells);
+      measure(l, rc, zf, rf, rt, cells);
     }
   } catch (const std::exception& e) {
     std::fprintf(stderr, "swim_junction_kernels: %s\n", e.what());
