@@ -7,8 +7,9 @@ A grid of prescribed waves -- a step with a sharp front (w = L/8), a step with a
 with L/R0 = 3.2, 6.4, 12.8 in cylinders of Rc/R0 = 1.5, 2, 4 (period about 5 L, a whole number of
 cells; R_f/R0 = 0.55, 10 um/s), each over one transit, run with `swim run --tier axi` (fitted
 method) and `--tier 1d`. Prints one table row per case: displacement per transit on both tiers
-and axi/1D. The axi results are kept in a cache file
-(they do not depend on the 1D model). With --set1d the table has a second 1D column, the 1D tier
+and axi/1D. The axi results are kept in a cache file, by default the shipped
+data/calibration/flow_model_table_axi.json (they do not depend on the 1D model), so the 1D columns
+are redone in seconds. With --set1d the table has a second 1D column, the 1D tier
 with those settings (e.g. --set1d 'model1d.end_effects="open_ends"'), beside the plain one:
 
     tools/flow_model_table.py [--swim build/bin/swim] [--cells 16] [--cache FILE]
@@ -69,7 +70,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--swim", default=os.path.join(os.path.dirname(__file__), "..", "build", "bin", "swim"))
     ap.add_argument("--cells", type=int, default=16, help="axi.grid.cells_across (default 16: h = Rc/8)")
-    ap.add_argument("--cache", default="flow_model_table_axi.json", help="axi results cache (JSON)")
+    ap.add_argument("--cache", default=os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "data",
+                                                    "calibration", "flow_model_table_axi.json"),
+                    help="axi results cache (JSON; the shipped data/calibration/flow_model_table_axi.json holds the "
+                         "grid's axi runs at 16 cells across)")
     ap.add_argument("--set1d", action="append", default=[],
                     help="a --set for a second 1D column (repeatable)")
     ap.add_argument("--only", default=",".join(WAVES), help="waves: " + ",".join(WAVES))
