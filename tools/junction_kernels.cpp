@@ -47,17 +47,23 @@ std::string um(double v) {
   return b;
 }
 
-void measure(double l, double rc, double zf, double rf, double rt, int cells) {
-  const double L = l * kR0, Rc = rc * kR0, h = Rc / cells;
-  const double P = std::round(5 * L / h) * h;
-  const json sc = {{"name", "junction_kernel"},
+/// The steady flows' scene: a tube of length L in the periodic cylinder Rc (period about 5 L, a
+/// whole number of cells), the fitted method at `cells` across; its resolved parameters.
+swim::axi::ParamsAxi tube_scene(const char* name, double L, double Rc, int cells) {
+  const double h = Rc / cells, P = std::round(5 * L / h) * h;
+  const json sc = {{"name", name},
                    {"swimmer", {{"radius", um(kR0)}, {"length", um(L)}}},
                    {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(P)}}},
                    {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
                    {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
                    {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", cells}}}}}};
   json resolved;
-  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  return swim::axi::read_scene_axi(sc, resolved);
+}
+
+void measure(double l, double rc, double zf, double rf, double rt, int cells) {
+  const double L = l * kR0, Rc = rc * kR0;
+  const swim::axi::ParamsAxi p = tube_scene("junction_kernel", L, Rc, cells);
   swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
   auto shape = [&](double z) {
     if (zf < 0) return rt * kR0;
@@ -89,16 +95,8 @@ void measure(double l, double rc, double zf, double rf, double rt, int cells) {
 }
 
 void expansion(double l, double rc, double r, int cells) {
-  const double L = l * kR0, Rc = rc * kR0, h = Rc / cells, R = r * kR0;
-  const double P = std::round(5 * L / h) * h;
-  const json sc = {{"name", "junction_expansion"},
-                   {"swimmer", {{"radius", um(kR0)}, {"length", um(L)}}},
-                   {"container", {{"kind", "cylinder"}, {"radius", um(Rc)}, {"period", um(P)}}},
-                   {"wave", {{"kind", "sine"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"wavelength", um(L)}}},
-                   {"full3d", {{"membrane", {{"axisymmetric", true}}}}},
-                   {"axi", {{"method", "fitted"}, {"grid", {{"cells_across", cells}}}}}};
-  json resolved;
-  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(sc, resolved);
+  const double R = r * kR0;
+  const swim::axi::ParamsAxi p = tube_scene("junction_expansion", l * kR0, rc * kR0, cells);
   swim::axi::AxiWall wall(swim::axi::AxiWallParams{p.base.R0, p.base.L, p.ks, p.D, p.wall_nodes, p.ring_s0});
   swim::axi::RingKinematics kin = [&](double, const std::vector<double>& z, Eigen::VectorXd& Rv, Eigen::VectorXd& Rt) {
     Rv = Eigen::VectorXd::Constant(Eigen::Index(z.size()), R);
