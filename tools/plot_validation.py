@@ -233,6 +233,13 @@ def velocity_figure(case, path):
     plt.close(fig)
 
 
+def nonnegative_axis(ax, key):
+    """A cycle time is positive: its axis starts at zero where an error bar wider than its value
+    would run below it (the bar is cut there)."""
+    if key == "cycle_time_s" and ax.get_ylim()[0] < 0:
+        ax.set_ylim(bottom=0)
+
+
 FIGURE_PANELS = (("displacement_per_cycle_m", "displacement per cycle [nm]", 1e9),
                  ("cycle_time_s", "cycle time [s]", 1.0),
                  ("max_displacement_m", "maximum centre displacement [nm]", 1e9))
@@ -297,6 +304,7 @@ def reference_convergence_figure(case, path):
             ax.axhline(paper * 1e9, color="tab:red", ls=":", lw=1.4, label="paper: maximum displacement over the cycle")
         ax.set_xlim(-0.06 * hmax, 1.06 * hmax)
         ax.set(xlabel="cell size h [nm]", ylabel=ylabel)
+        nonnegative_axis(ax, key)
         ax.grid(alpha=0.3)
         # each panel's legend below it, off the data: the orders differ from figure to figure
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize="small", frameon=False)
@@ -359,6 +367,7 @@ def convergence_figure(case, path):
             ax.axhline(paper * 1e9, color="0.4", ls=":", lw=1.2, label="paper: maximum displacement over the cycle")
         ax.set(xlabel="cell size h [nm]", ylabel=ylabel)
         ax.set_xlim(left=-0.05 * max(h), right=1.2 * max(h))
+        nonnegative_axis(ax, key)
         ax.grid(alpha=0.3)
         handles, labels = ax.get_legend_handles_labels()
         ax.legend(handles, [textwrap.fill(t, 60) for t in labels], loc="upper center", bbox_to_anchor=(0.5, -0.13),
