@@ -356,6 +356,9 @@ class ValidationFigures(unittest.TestCase):
         self.assertAlmostEqual(x[0], 0.0)
         self.assertAlmostEqual(y[0], 34.6, places=6)  # f0 in nm, from the report's coefficients
         self.assertFalse([ln for ln in axes[1].get_lines() if ln.get_label().startswith("3D: fitted")])
+        # 0.59 s +- 0.69 s: a cycle time is positive, so its axis starts at zero and cuts the bar
+        self.assertEqual(axes[1].get_ylim()[0], 0.0)
+        self.assertGreater(axes[1].get_ylim()[1], 1.28)
 
     def test_pareto_labels_do_not_overlap(self):
         import matplotlib.pyplot as plt
