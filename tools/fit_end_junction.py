@@ -49,7 +49,6 @@ class Tube:
 
     def __init__(self, L, Rc, P, shape, mu, N=200):
         self.L, self.Rc, self.mu, self.h = L, Rc, mu, L / N
-
         zp = np.concatenate([[0], (np.arange(N) + 0.5) * self.h, [L]])
         self.zc = zp[1:-1]
         d = np.diff(zp)
@@ -58,7 +57,6 @@ class Tube:
         rho, kap, S, e = annulus(R, Rc, mu)
         a, b = R[:-1], R[1:]
         self.rl = (8 * mu / np.pi) * d / 3 * (a * a + a * b + b * b) / (a**3 * b**3)
-
         self.ra = 0.5 * d * (rho[:-1] + rho[1:])
         self.c = 0.5 * d * (kap[:-1] + kap[1:])
         self.S = 0.5 * (S[:-1] + S[1:])
@@ -152,8 +150,7 @@ def shipped():
     """kCalibratedJunction's 14 coefficients as reduced1d/outer_flow.hpp holds them"""
     src = open(os.path.join(os.path.dirname(os.path.dirname(os.path.abspath(__file__))), "reduced1d", "outer_flow.hpp")).read()
     body = src[src.index("kCalibratedJunction{"):]
-    nums = [float(v) for v in re.findall(r"-?\d+\.\d+(?:e-?\d+)?", body)[:17]]
-    return np.array(nums[:14])
+    return np.array([float(v) for v in re.findall(r"-?\d+\.\d+(?:e-?\d+)?", body)[:14]])
 
 
 def main():
@@ -163,7 +160,6 @@ def main():
     ap.add_argument("--no-fit", action="store_true", help="only the plain and the shipped junction's residuals")
     ap.add_argument("--rim-bands", action="store_true",
                     help="two more bands per shape, centred on the rims (the half of a band inside the tube)")
-
     a = ap.parse_args()
     data = []
     expansions = load_expansion(a.expansion) if a.expansion else []

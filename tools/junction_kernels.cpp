@@ -11,7 +11,7 @@
 //          rf R0 (default 0.55) over [0, zf L] with a front L/8 wide (a half sine) that rises to
 //          rt R0 beyond it.
 //
-// Output per case: a header line "# L/R0 .. Rc/R0 .. Rt/R0 1.00 cells .. nodes .. drag .. mu ..
+// Output per case: a header line "# L/R0 .. Rc/R0 .. Rt/R0 .. cells .. nodes .. drag .. mu ..
 // zf .. rf ..", a line "# towed lumen flux per U .. m^2", then per ring "k z/R0 dz/R0 U" (U in m/s
 // for dR/dt = 1 um/s at ring k alone; dz the ring's share of the wall).
 //
