@@ -95,21 +95,24 @@ inline constexpr EndEffects kOpenEnds{0.2, 0.25};
 /// few tenths of R of an end pushes the tube by rim mu R <dR/dt>, <.> the rate weighted by
 /// exp(-d / (rim_length R)) / (rim_length R) over the distance d from the end (away from the
 /// end for a contraction). The coefficients are fitted to steady flows of the axisymmetric tier
-/// only (tools/fit_end_junction.py): towed tubes and the swimming velocity of every narrow
-/// wall band, on uniform and on partly contracted tubes (L/R0 = 3.2 and 6.4, Rc/R0 = 1.5 to 4).
+/// only (tools/fit_end_junction.py --rim-bands --min-length 3.2): towed tubes and the swimming
+/// velocity of every narrow wall band, the bands at both rims included, on uniform and partly
+/// contracted tubes, the protocol's states of an end segment beside a contracted tube, and the
+/// resistance to a uniform expansion; L/R0 = 3.2 to 12.8, Rc/R0 = 1.5 to 4. Shorter tubes are
+/// left out: their two ends interact, which a junction at each end cannot hold.
 struct EndJunction {
   double b[6][2];       ///< B's entries (B00, B10, B11, B20, B21, B22): value at x_g = 0, slope
   double rim[2];        ///< rim thrust coefficient: value at x_g = 0, slope
   double rim_length;    ///< decay length of the rim weight / R
   double xg_min, xg_max;  ///< the fitted range of ln(Rc / R - 1)
 };
-inline constexpr EndJunction kCalibratedJunction{{{1.7528618, -0.3296076},
-                                                  {0.0469545, -0.0239119},
-                                                  {0.2824024, -0.1213643},
-                                                  {1.6954469, -0.3045723},
-                                                  {-2.5063304, 0.4196936},
-                                                  {-0.0048411, -0.0008607}},
-                                                 {-0.9194222, -0.5815371},
+inline constexpr EndJunction kCalibratedJunction{{{1.8818978, -0.3389392},
+                                                  {0.0360621, -0.0191104},
+                                                  {0.2472167, -0.1088333},
+                                                  {1.8354741, -0.4843892},
+                                                  {-2.3705423, 0.3685582},
+                                                  {-0.0062389, 0.0030796}},
+                                                 {-1.8296007, -1.5365845},
                                                  0.15,
                                                  -0.6931472,
                                                  1.8362112};

@@ -154,22 +154,35 @@ def shipped():
 
 
 def main():
+    global RIM_LENGTH
     ap = argparse.ArgumentParser()
     ap.add_argument("kernels", nargs="*", default=["data/calibration/junction_kernels.txt"])
     ap.add_argument("--expansion", default=None)
     ap.add_argument("--no-fit", action="store_true", help="only the plain and the shipped junction's residuals")
     ap.add_argument("--rim-bands", action="store_true",
                     help="two more bands per shape, centred on the rims (the half of a band inside the tube)")
+    ap.add_argument("--rim-weight", type=float, default=1.0, help="weight of the rim bands' residuals (default 1)")
+    ap.add_argument("--rim-length", type=float, default=RIM_LENGTH, help="the rim weight's decay length / R (default 0.15)")
+    ap.add_argument("--min-length", type=float, default=0.0,
+                    help="leave out the shapes and expansions of tubes shorter than this L/R0 (their ends interact)")
+    ap.add_argument("--expansion-radii", default=None,
+                    help="comma-separated R/R0 of the expansions to use (default all)")
+    ap.add_argument("--start", default=None, help="start the fit from these 14 comma-separated coefficients")
     a = ap.parse_args()
+    RIM_LENGTH = a.rim_length
     data = []
     expansions = load_expansion(a.expansion) if a.expansion else []
-    for c in [c for fn in a.kernels for c in load(fn)]:
+    expansions = [e for e in expansions if e[0] / R0 >= a.min_length - 1e-9]
+    if a.expansion_radii:
+        radii = [float(v) for v in a.expansion_radii.split(",")]
+        expansions = [e for e in expansions if min(abs(e[2] / R0 - r) for r in radii) < 1e-6]
+    for c in [c for fn in a.kernels for c in load(fn) if c["L"] / R0 >= a.min_length - 1e-9]:
         h = c["Rc"] / c["cells"]
         P = round(5 * c["L"] / h) * h
         r = np.array(c["rings"])
         z, U_ring = r[:, 1] * R0, r[:, 3] / 1e-6
         tube = Tube(c["L"], c["Rc"], P, shape_of(c), c["mu"])
-        bands = []
+        bands, weights = [], []
         centres = np.arange(0.25 * R0, c["L"] - 0.25 * R0 + 1e-12, 0.25 * R0)
         if a.rim_bands:
             centres = np.concatenate([[0.0], centres, [c["L"]]])
@@ -178,8 +191,10 @@ def main():
                 x = (zz - zc) / (0.5 * R0)
                 return np.where(abs(x) < 0.5, np.cos(np.pi * x) ** 2, 0.0)
             bands.append(band(tube.zc))
+            weights.append(a.rim_weight if a.rim_bands and zc in (centres[0], centres[-1]) else 1.0)
             c.setdefault("U", []).append(np.sum(U_ring * band(z)))
         c["U"] = np.array(c["U"])
+        c["w"] = np.array(weights)
         data.append((c, tube, bands))
 
     def residuals(p, report=False):
@@ -189,7 +204,7 @@ def main():
                 tube.M[k], tube.rim[k] = junction(p, tube.R[0] if k == 0 else tube.R[-1], c["Rc"], c["mu"])
             U = np.array([tube.solve(b)[2] for b in bands])
             scale = np.abs(c["U"]).max()
-            out.extend((U - c["U"]) / scale)
+            out.extend(c["w"] * (U - c["U"]) / scale)
             drag, flux = tube.tow()
             out += [3 * (drag / c["drag"] - 1), 3 * (flux / c["tq"] - 1)]
             if report:
@@ -212,6 +227,8 @@ def main():
     if a.no_fit:
         return
     start = np.array([1, 0, 0.1, 0, 0.1, 0, 0.5, 0, -0.3, 0, 0.5, 0, 0, 0.0])
+    if a.start:
+        start = np.array([float(v) for v in a.start.split(",")])
     fit = least_squares(residuals, start)
     print(f"fitted ({len(fit.fun)} residuals, cost {fit.cost:.4f}):")
     residuals(fit.x, True)
