@@ -12,8 +12,18 @@ rim's thrust rim mu R <dR/dt>. Fitted by least squares (scipy) to, for every sha
 of narrow wall bands (0.5 R0 wide, every 0.25 R0 along the tube, each relative to the largest of
 that shape) and the towed drag and lumen flux (relative, weight 3). Needs python3-scipy.
 
-    tools/fit_end_junction.py [--no-fit] [--expansion data/calibration/junction_expansion.txt]
-                              [data/calibration/junction_kernels.txt ...]
+    tools/fit_end_junction.py [--no-fit] [--rim-bands] [--rim-weight W] [--rim-length L]
+                              [--min-length L/R0] [--expansion FILE] [--expansion-radii R/R0,...]
+                              [--start c0,...,c13] [KERNEL_FILE ...]
+
+The shipped coefficients come from
+
+    tools/fit_end_junction.py --rim-bands --min-length 3.2 --expansion-radii 0.55,0.82,1 \
+        --expansion data/calibration/junction_expansion.txt data/calibration/junction_kernels.txt \
+        data/calibration/junction_kernels_short.txt data/calibration/junction_kernels_protocol.txt
+
+(--min-length 3.2 leaves out the L/R0 = 1.6 shapes and expansions: a short tube's two ends
+interact, which a junction at each end cannot hold; docs/outer-flow-1d.md §6c).
 
 With --expansion, the residuals also hold, for each uniform tube there (swim_junction_kernels
 --expansion), the relative error of the wall's resistance to a uniform expansion: the lumen's and
