@@ -1,4 +1,6 @@
 // swim validate [SUITE] [--quick]: the 1D-vs-3D validation report (validation/suite.hpp).
+#include <algorithm>
+#include <array>
 #include <cstdio>
 #include <filesystem>
 
@@ -78,6 +80,21 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
               name.c_str(), report["cases"].size(), pass, fail, inconclusive,
               si(report["wall_time_s"].get<double>(), "s").c_str(),
               out.c_str(), plotted ? ", report.md, report.html and figures" : "");
+  // each 1D model against the 1D tier's design targets, over the cases that state them
+  std::vector<std::pair<std::string, std::array<int, 2>>> met;  // label: (met, judged)
+  for (const auto& c : report["cases"])
+    for (const auto& m : c["models1d"])
+      if (m.contains("target_verdicts")) {
+        const std::string label = m["label"];
+        auto it = std::find_if(met.begin(), met.end(), [&](const auto& e) { return e.first == label; });
+        if (it == met.end()) it = met.insert(met.end(), {label, {0, 0}});
+        for (const auto& [k, v] : m["target_verdicts"].items()) {
+          it->second[0] += v == "pass";
+          ++it->second[1];
+        }
+      }
+  for (const auto& [label, n] : met)
+    std::printf("  1D model \"%s\": %d of %d design targets met\n", label.c_str(), n[0], n[1]);
   for (const auto& c : report["cases"])
     if (c.contains("reference") && c["reference"].contains("statement"))
       std::printf("  %s: axisymmetric reference %s\n", c["name"].get<std::string>().c_str(),

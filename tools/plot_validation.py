@@ -633,6 +633,59 @@ def ref_words(report):
             ", the extrapolated 3D reference for the others")
 
 
+TARGET_WORDS = {"displacement_per_cycle": "displacement", "cycle_time": "cycle time",
+                "mean_velocity_per_cycle": "velocity", "velocity_phase_correlation": "U(t)"}
+
+
+def targets_words(tg):
+    """A case's 1D design targets in words: '10 / 15 / 15 %, U(t) ≥ 0.8'"""
+    return (f"{100 * tg['displacement_per_cycle_relative']:g} / {100 * tg['cycle_time_relative']:g} / "
+            f"{100 * tg['mean_velocity_per_cycle_relative']:g} %, U(t) ≥ {tg['velocity_phase_correlation']:g}")
+
+
+def target_text(m):
+    """A 1D model's verdicts against its case's design targets: 'met 2 of 4 (fail: cycle time; inconclusive: U(t))'"""
+    tv = m.get("target_verdicts") or {}
+    if not tv:
+        return "—"
+    met = sum(1 for v in tv.values() if v == "pass")
+    rest = []
+    for status in ("fail", "inconclusive", "not assessed"):
+        names = [TARGET_WORDS.get(k, k) for k, v in tv.items() if v == status]
+        if names:
+            rest.append(f"{status}: {', '.join(names)}")
+    return f"met {met} of {len(tv)}" + (f" ({'; '.join(rest)})" if rest else "")
+
+
+def targets_markdown(report):
+    """The 1D models against the 1D tier's design targets, case by case (cases with targets1d)"""
+    cases = [c for c in report["cases"] if c.get("targets1d")]
+    if not cases:
+        return []
+    labels = []
+    for c in cases:
+        for m in c.get("models1d", []):
+            if m["label"] not in labels:
+                labels.append(m["label"])
+    kinds = {}
+    for c in cases:
+        kinds.setdefault(targets_words(c["targets1d"]), []).append(c["name"])
+    out = ["", "## The 1D models against the 1D tier's design targets", "",
+           "Each 1D model judged by the verdicts' rules (against the case's reference and its error bar) "
+           "with the 1D tier's design targets instead of the suite's thresholds: "
+           + "; ".join(f"{w} for {', '.join(names)}" for w, names in kinds.items())
+           + " (displacement per cycle / cycle time / mean velocity per cycle, and the U(t) phase correlation).",
+           "", "| model | " + " | ".join(c["name"] for c in cases) + " |", "|---" * (len(cases) + 1) + "|"]
+    for label in labels:
+        row = []
+        for c in cases:
+            m = next((m for m in c.get("models1d", []) if m["label"] == label), None)
+            row.append("—" if m is None else (target_text(m) if m.get("has_cycle") else "no cycle"))
+        out.append(f"| {label} | " + " | ".join(row) + " |")
+    return out
+
+
+
 def markdown(report, figs):
     th = report["thresholds"]
     sel = report.get("cases_selected") or []
@@ -658,6 +711,7 @@ def markdown(report, figs):
         elif f.get("reason"):
             status += f": {f['reason']}"
         out.append(f"| {cell(f['claim'])} | {cell(status)} | {cell(finding_values(f))} | {cell(f.get('rule', ''))} |")
+    out += targets_markdown(report)
     ex = report.get("extremes3d") or []
     if ex:
         n_ok = sum(1 for e in ex if e["as_expected"])
@@ -739,13 +793,16 @@ def markdown(report, figs):
                    if c.get("reference") else "against the finest 3D run")
                 + ". A verdict passes when the whole interval lies inside the "
                 "tolerance, fails when it lies wholly outside, and is inconclusive otherwise.", "",
+                *([f"Targets: the 1D tier's design targets for this case ({targets_words(c['targets1d'])}), "
+                   "judged by the same rule.", ""] if c.get("targets1d") else []),
                 "| model | displacement / cycle | vs ref | cycle time | vs ref | mean velocity / cycle | vs ref | "
-                f"U(t) phase corr. {'vs axi; vs 3D' if c.get('reference') else 'vs 3D'} | verdicts | wall time |",
-                "|---|---|---|---|---|---|---|---|---|---|"]
+                f"U(t) phase corr. {'vs axi; vs 3D' if c.get('reference') else 'vs 3D'} | verdicts | "
+                + ("targets | " if c.get("targets1d") else "") + "wall time |",
+                "|---|---|---|---|---|---|---|---|---|" + ("---|" if c.get("targets1d") else "") + "---|"]
         for m in c["models1d"]:
             if not m.get("has_cycle"):
                 out.append(f"| {m['label']} | {m.get('status', '')[:200]} {m.get('no_cycle_reason', '')} "
-                           "| | | | | | | | |")
+                           "| | | | | | | | |" + (" |" if c.get("targets1d") else ""))
                 continue
             e = m.get("relative_error_vs_reference", {})
             re_ = m.get("reference_error_relative", {})
@@ -773,7 +830,8 @@ def markdown(report, figs):
             out.append(f"| {label} | {si(m['displacement_per_cycle_m'], 'm')} | {vs('displacement_per_cycle')} | "
                        f"{si(m['cycle_time_s'], 's')} | {vs('cycle_time')} | "
                        f"{si(m['mean_velocity_per_cycle_m_per_s'], 'm/s')} | {vs('mean_velocity_per_cycle')} | "
-                       f"{u_corr} | {verd} | {si(m['wall_time_s'], 's')} |")
+                       f"{u_corr} | {verd} | " + (f"{target_text(m)} | " if c.get("targets1d") else "")
+                       + f"{si(m['wall_time_s'], 's')} |")
         if "wall_time_ratio_3d_over_1d" in c:
             out += ["", f"Wall time, 3D run at the calibration grid against the first 1D model: "
                         f"{c['wall_time_ratio_3d_over_1d']:.3g} ×."]

@@ -49,6 +49,7 @@ json run_suite(const SuiteOptions& o) {
     // 3. the 1D tier calibrated from 3D
     const std::string cal_file = calibrate_case(c, cache, say, cr, o.run_progress);
     // 4. every 1D model against the references
+    if (const json& tg = case_targets1d(c, suite); tg.is_object()) cr["targets1d"] = tg;
     cr["models1d"] = judge_models(c, suite, cal_file, runs, aruns, cr, say);
     // 5. speed against accuracy
     cr["speed_accuracy"] = speed_accuracy(c, suite, cal_file, runs, cr, cache, say, o.run_progress);

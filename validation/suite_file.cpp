@@ -150,6 +150,22 @@ void check_1d(const json& base, const json& model, const std::string& cal, const
   }
 }
 
+// The four figures' limits of a verdict (the suite's thresholds, the 1D tier's targets), each
+// required: three relative errors in (0, 10] and a correlation in (-1, 1].
+void check_thresholds(const json& th, const std::string& at) {
+  only_keys(th, at, "the limits of the verdicts",
+            {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative",
+             "velocity_phase_correlation"});
+  for (const char* k : {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative"}) {
+    const json& v = member(th, k, at);
+    if (!v.is_number() || !(v.get<double>() > 0 && v.get<double>() <= 10))
+      throw InputError(at + "." + k, scene::show(v), "a relative error above 0 and at most 10 (0.1: 10 %)");
+  }
+  const json& v = member(th, "velocity_phase_correlation", at);
+  if (!v.is_number() || !(v.get<double>() > -1 && v.get<double>() <= 1))
+    throw InputError(at + ".velocity_phase_correlation", scene::show(v), "a correlation above -1 and at most 1");
+}
+
 }  // namespace
 
 std::string find_scene(const std::string& name, const std::string& suite_dir, const std::string& data_dir) {
@@ -246,8 +262,8 @@ json load_suite(const std::string& path, const std::string& data_dir) {
 void check_suite(const json& s, const std::string& path, const std::string& data_dir, bool scenes) {
   if (!s.is_object()) throw InputError("suite", path, "a JSON object with \"cases\" and \"models1d\"");
   only_keys(s, "suite", "a suite file",
-            {"name", "description", "order_range", "thresholds", "cells1d", "rtol1d", "cases", "models1d",
-             "reference_target_relative", "extremes3d"});
+            {"name", "description", "order_range", "thresholds", "targets1d", "cells1d", "rtol1d", "cases",
+             "models1d", "reference_target_relative", "extremes3d"});
   optional_text(s, "name", "suite");
   optional_text(s, "description", "suite");
   const json& cases = member(s, "cases", "suite");
@@ -256,7 +272,7 @@ void check_suite(const json& s, const std::string& path, const std::string& data
     const std::string at = "suite.cases[" + std::to_string(i) + "]";
     only_keys(cases[i], at, "a case",
               {"scene", "grid_key", "grids", "calibration_grid", "time_variants3d", "set", "paper", "group",
-               "sweep_value", "order_range", "reference"});
+               "sweep_value", "order_range", "reference", "targets1d"});
     const json& sc = member(cases[i], "scene", at);
     if (!sc.is_string() || sc.get<std::string>().empty())
       throw InputError(at + ".scene", scene::show(sc), "a scene file name (text)");
@@ -288,6 +304,7 @@ void check_suite(const json& s, const std::string& path, const std::string& data
     }
     if (cases[i].contains("order_range")) parse_order_range(cases[i]["order_range"], at + ".order_range");
     if (cases[i].contains("reference")) check_reference(cases[i]["reference"], at + ".reference");
+    if (cases[i].contains("targets1d")) check_thresholds(cases[i]["targets1d"], at + ".targets1d");
     if (cases[i].contains("time_variants3d")) {
       const json& v = cases[i]["time_variants3d"];
       bool ok = v.is_array();
@@ -348,22 +365,8 @@ void check_suite(const json& s, const std::string& path, const std::string& data
       throw InputError(at + ".calibrated", scene::show(models[i]["calibrated"]), "true or false");
     if (models[i].contains("set")) check_set(models[i]["set"], at + ".set");
   }
-  const json& th = member(s, "thresholds", "suite");
-  only_keys(th, "suite.thresholds", "the thresholds",
-            {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative",
-             "velocity_phase_correlation"});
-  for (const char* k : {"displacement_per_cycle_relative", "cycle_time_relative", "mean_velocity_per_cycle_relative"}) {
-    const json& v = member(th, k, "suite.thresholds");
-    if (!v.is_number() || !(v.get<double>() > 0 && v.get<double>() <= 10))
-      throw InputError(std::string("suite.thresholds.") + k, scene::show(v),
-                       "a relative error above 0 and at most 10 (0.1: 10 %)");
-  }
-  {
-    const json& v = member(th, "velocity_phase_correlation", "suite.thresholds");
-    if (!v.is_number() || !(v.get<double>() > -1 && v.get<double>() <= 1))
-      throw InputError("suite.thresholds.velocity_phase_correlation", scene::show(v),
-                       "a correlation above -1 and at most 1");
-  }
+  check_thresholds(member(s, "thresholds", "suite"), "suite.thresholds");
+  if (s.contains("targets1d")) check_thresholds(s["targets1d"], "suite.targets1d");
   if (!scenes) return;
   // every case's scene, on every grid, with its time-step variants, and every 1D model on it:
   // read by the tiers' own readers here, before anything runs or is written

@@ -152,6 +152,12 @@ SuiteCase open_case(const json& spec, std::size_t index, std::size_t count, cons
   return c;
 }
 
+const json& case_targets1d(const SuiteCase& c, const json& suite) {
+  static const json none;
+  if (c.spec.contains("targets1d")) return c.spec["targets1d"];
+  return suite.contains("targets1d") ? suite["targets1d"] : none;
+}
+
 json case_entry(const SuiteCase& c, const std::string& data_dir) {
   // shipped scenes are named relative to the source tree, so that reports compare across machines
   const fs::path rel = fs::path(c.scene_path).lexically_relative(fs::path(data_dir).parent_path());
@@ -329,6 +335,9 @@ json judge_models(const SuiteCase& c, const json& suite, const std::string& cal_
       if (!judged_velocity(entry).empty()) entry["velocity_judged_against"] = judged_velocity_name(entry);
       // pass, fail or inconclusive against the reference's error bar (verdicts.hpp)
       if (const json v = model_verdicts(entry, suite["thresholds"]); !v.empty()) entry["verdicts"] = v;
+      // the 1D tier's design targets for this case, judged by the same rules (case_targets1d)
+      if (const json& tg = case_targets1d(c, suite); tg.is_object())
+        if (const json v = model_verdicts(entry, tg); !v.empty()) entry["target_verdicts"] = v;
       if (at_cal.record.value("pumped_volume_m3", 0.0) != 0.0)
         entry["pumped_volume_relative_vs_calibration_grid"] =
             relative(r.record.value("pumped_volume_m3", 0.0), at_cal.record["pumped_volume_m3"].get<double>());

@@ -38,6 +38,11 @@ SuiteCase open_case(const json& spec, std::size_t index, std::size_t count, cons
 /// a shipped one), group, grid key, the paper's values, description, sweep value.
 json case_entry(const SuiteCase& c, const std::string& data_dir);
 
+/// The 1D tier's design targets of a case (`cases[].targets1d`, else the suite's `targets1d`;
+/// the keys of `thresholds`), or null when neither gives them. Each 1D model is judged against
+/// them by the thresholds' rules into `target_verdicts`.
+const json& case_targets1d(const SuiteCase& c, const json& suite);
+
 /// 1. The 3D resolution study: the scene on every grid (the finest with membrane frames, about
 /// 12 per cycle of the grid before it). Adds "length_m" and "runs3d".
 std::vector<Run3d> resolution_study(const SuiteCase& c, RunCache& cache, const Say& say, int progress, json& cr);

@@ -227,7 +227,9 @@ TEST(EndEffects, WallBandNearAnEnd) {
                 d_over_R0, U_axi, U1[0], U1[1], U_axi / U1[1], U1[2], U_axi / U1[2]);
     EXPECT_GT(U_axi, 0.0);
     EXPECT_LT(std::abs(U1[0]), 1e-10 * U_axi) << "a band on a uniform tube: lubrication gives no thrust";
-    if (d_over_R0 >= 0.5) EXPECT_GT(U_axi / U1[1], 3.0);
+    if (d_over_R0 >= 0.5) {
+      EXPECT_GT(U_axi / U1[1], 3.0);
+    }
     EXPECT_NEAR(U_axi / U1[2], 1.0, d_over_R0 <= 0.5 ? 0.15 : 0.30) << "the junction at d = " << d_over_R0 << " R0";
     if (d_over_R0 == 0.5) U_near = U_axi;
     U_far = U_axi;

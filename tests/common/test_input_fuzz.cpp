@@ -134,6 +134,27 @@ TEST(StrictSuite, UnknownKeysWrongTypesAndBadValuesAreRejectedNamingTheKey) {
   EXPECT_EQ(suite_key(with([](json& s) { s["thresholds"]["velocity_phase_correlation"] = "high"; }), false),
             "suite.thresholds.velocity_phase_correlation");
   EXPECT_EQ(suite_key(with([](json& s) { s["thresholds"]["typo_relative"] = 0.1; }), false), "suite.thresholds.typo_relative");
+  // the 1D tier's design targets: the thresholds' four keys, each required, at the suite and at a case
+  const json targets = {{"displacement_per_cycle_relative", 0.1}, {"cycle_time_relative", 0.15},
+                        {"mean_velocity_per_cycle_relative", 0.15}, {"velocity_phase_correlation", 0.8}};
+  EXPECT_EQ(suite_key(with([&](json& s) { s["targets1d"] = targets; }), false), "(accepted)");
+  EXPECT_EQ(suite_key(with([&](json& s) { s["cases"][0]["targets1d"] = targets; }), false), "(accepted)");
+  EXPECT_EQ(suite_key(with([&](json& s) {
+              s["targets1d"] = targets;
+              s["targets1d"]["cycle_time_relative"] = 0;
+            }), false),
+            "suite.targets1d.cycle_time_relative");
+  EXPECT_EQ(suite_key(with([&](json& s) {
+              s["cases"][0]["targets1d"] = targets;
+              s["cases"][0]["targets1d"].erase("velocity_phase_correlation");
+            }), false),
+            "suite.cases[0].targets1d.velocity_phase_correlation");
+  EXPECT_EQ(suite_key(with([&](json& s) {
+              s["targets1d"] = targets;
+              s["targets1d"]["velocity_phase_correlation"] = 1.5;
+            }), false),
+            "suite.targets1d.velocity_phase_correlation");
+  EXPECT_EQ(suite_key(with([](json& s) { s["targets1d"] = 0.1; }), false), "suite.targets1d");
   EXPECT_EQ(suite_key(with([](json& s) { s["cells1d"] = {50, -100}; }), false), "suite.cells1d");
   EXPECT_EQ(suite_key(with([](json& s) { s["name"] = 5; }), false), "suite.name");
   EXPECT_EQ(suite_key(with([](json& s) { s["models1d"][0]["calibrated"] = "yes"; }), false), "suite.models1d[0].calibrated");

@@ -288,6 +288,21 @@ class ValidationFigures(unittest.TestCase):
         self.assertEqual(len(ax.get_yticks()), 6)  # -R0, 0, +R0 about each snapshot
         self.assertIn("125", [t.get_text() for t in ax.get_yticklabels()])
 
+    def test_targets_section_counts_what_each_model_met(self):
+        round_wall = {"displacement_per_cycle_relative": 0.1, "cycle_time_relative": 0.15,
+                      "mean_velocity_per_cycle_relative": 0.15, "velocity_phase_correlation": 0.8}
+        m = {"label": "junction", "has_cycle": True,
+             "target_verdicts": {"displacement_per_cycle": "pass", "cycle_time": "fail",
+                                 "mean_velocity_per_cycle": "pass", "velocity_phase_correlation": "inconclusive"}}
+        report = {"cases": [{"name": "round", "targets1d": round_wall, "models1d": [m, {"label": "stalls"}]},
+                            {"name": "other", "models1d": [dict(m, target_verdicts={})]}]}
+        md = "\n".join(self.mod.targets_markdown(report))
+        self.assertIn("10 / 15 / 15 %, U(t) ≥ 0.8 for round", md)
+        self.assertIn("| junction | met 2 of 4 (fail: cycle time; inconclusive: U(t)) |", md)
+        self.assertIn("| stalls | no cycle |", md)
+        self.assertNotIn("other", md, "a case without targets has no column")
+        self.assertEqual(self.mod.targets_markdown({"cases": [{"name": "x", "models1d": []}]}), [])
+
     def test_coarse_grids_are_told_apart(self):
         s = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-8, 0]}
         case = {"name": "c", "models1d": [], "runs3d": [

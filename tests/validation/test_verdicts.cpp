@@ -14,6 +14,7 @@
 #include "common/scene.hpp"
 #include "validation/richardson.hpp"
 #include "validation/suite.hpp"
+#include "validation/suite_phases.hpp"
 #include "validation/verdicts.hpp"
 
 using namespace swim;
@@ -358,4 +359,41 @@ TEST(Findings, OneDAgreementIsJudgedPerFigure) {
   EXPECT_EQ(mv2["status"], "inconclusive") << mv2.dump(1);
   EXPECT_NE(mv2["to_settle"].get<std::string>().find("below 10 % of it on A0.82 (now 30 %)"), std::string::npos)
       << mv2["to_settle"];
+}
+
+// The 1D tier's design targets (`targets1d`): a case's own targets take the place of the
+// suite's, and a model is judged against them by the thresholds' rules. The same model passes
+// the suite's thresholds (25 / 50 / 50 %, 0.8) and fails the round walls' targets
+// (10 / 15 / 15 %, 0.8) on the displacement (-12 %) and the cycle time (+18 %), while the
+// buckling wall's targets (15 / 25 / 25 %, 0.6) it meets.
+TEST(Targets1d, ACaseStatesItsOwnTargetsElseTheSuitesAndTheyJudgeByTheSameRules) {
+  const json round = {{"displacement_per_cycle_relative", 0.10},
+                      {"cycle_time_relative", 0.15},
+                      {"mean_velocity_per_cycle_relative", 0.15},
+                      {"velocity_phase_correlation", 0.8}};
+  const json buckling = {{"displacement_per_cycle_relative", 0.15},
+                         {"cycle_time_relative", 0.25},
+                         {"mean_velocity_per_cycle_relative", 0.25},
+                         {"velocity_phase_correlation", 0.6}};
+  SuiteCase c;
+  EXPECT_TRUE(case_targets1d(c, json::object()).is_null()) << "no targets anywhere: none";
+  const json suite = {{"targets1d", round}};
+  EXPECT_EQ(case_targets1d(c, suite), round) << "the suite's";
+  c.spec = {{"targets1d", buckling}};
+  EXPECT_EQ(case_targets1d(c, suite), buckling) << "the case's own";
+  const json m = {
+      {"relative_error_vs_reference", {{"displacement_per_cycle", -0.12}, {"cycle_time", 0.18}, {"mean_velocity_per_cycle", 0.01}}},
+      {"reference_error_relative", {{"displacement_per_cycle", 0.001}, {"cycle_time", 0.001}, {"mean_velocity_per_cycle", 0.001}}},
+      {"velocity_vs_reference", {{"phase_correlation", 0.85}, {"phase_correlation_grid_spread", 0.02}}}};
+  const json v = model_verdicts(m, kThresholds);
+  for (const char* k : {"displacement_per_cycle", "cycle_time", "mean_velocity_per_cycle", "velocity_phase_correlation"})
+    EXPECT_EQ(v[k], "pass") << k;
+  const json t = model_verdicts(m, round);
+  EXPECT_EQ(t["displacement_per_cycle"], "fail");
+  EXPECT_EQ(t["cycle_time"], "fail");
+  EXPECT_EQ(t["mean_velocity_per_cycle"], "pass");
+  EXPECT_EQ(t["velocity_phase_correlation"], "pass");
+  const json b = model_verdicts(m, buckling);
+  for (const char* k : {"displacement_per_cycle", "cycle_time", "mean_velocity_per_cycle", "velocity_phase_correlation"})
+    EXPECT_EQ(b[k], "pass") << k;
 }
