@@ -246,7 +246,8 @@ TEST(SuiteReference, FindingsAreJudgedAgainstTheAxisymmetricReference) {
 // (round, geometric recovery end, fixed bending rigidity) on both tiers; and the paper's own
 // buckling wall, free to wrinkle, L = 0.2 and 0.4 µm, seeded on every grid with the lobes its
 // estimate grows fastest, whose reference is its own 3D series (no axi reference: that tier is
-// round).
+// round); the 1D tier's design targets, 10 / 15 / 15 % and 0.8 on the round walls, 15 / 25 / 25 %
+// and 0.6 on the buckling wall.
 TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
   const json s = load_suite(SWIM_SOURCE_DIR "/data/validation/converged.json", SWIM_SOURCE_DIR "/data");
   ASSERT_EQ(s["cases"].size(), 7u);
@@ -259,9 +260,14 @@ TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
       EXPECT_EQ(c["set"]["full3d.membrane.seed_mode"], 8);
       EXPECT_EQ(c["set"]["full3d.membrane.seed_amplitude"], 0.01);
       // the L = 0.2 µm series is fitted with the error expansion (four grids); the L = 0.4 µm
-      // series has three, each buckling into the seeded lobes (on 40 cells the wall takes 4)
+      // series has three, each buckling into the seeded lobes (on 40 cells the wall takes 4, on 96
+      // cells 3)
       EXPECT_GE(c["grids"].size(), buckling == 1 ? 4u : 3u);
       EXPECT_GE(c["grids"][0].get<int>(), 48);
+      // the paper's wall has the 1D tier's looser design targets
+      EXPECT_EQ(c["targets1d"]["displacement_per_cycle_relative"], 0.15);
+      EXPECT_EQ(c["targets1d"]["cycle_time_relative"], 0.25);
+      EXPECT_EQ(c["targets1d"]["velocity_phase_correlation"], 0.6);
       continue;
     }
     ++round;
@@ -278,5 +284,10 @@ TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
   }
   EXPECT_EQ(round, 5);
   EXPECT_EQ(buckling, 2);
+  // the round walls take the suite's design targets of the 1D tier
+  EXPECT_EQ(s["targets1d"]["displacement_per_cycle_relative"], 0.1);
+  EXPECT_EQ(s["targets1d"]["cycle_time_relative"], 0.15);
+  EXPECT_EQ(s["targets1d"]["mean_velocity_per_cycle_relative"], 0.15);
+  EXPECT_EQ(s["targets1d"]["velocity_phase_correlation"], 0.8);
   EXPECT_NO_THROW(load_suite(SWIM_SOURCE_DIR "/data/validation/default.json", SWIM_SOURCE_DIR "/data"));
 }
