@@ -3,6 +3,9 @@
 #include <array>
 #include <cstdio>
 #include <filesystem>
+#include <string>
+#include <utility>
+#include <vector>
 
 #include "app/app.hpp"
 #include "app/ranks.hpp"
@@ -66,33 +69,32 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
   const scene::json report = validation::run_suite(o);
   output::write_json(out + "/report.json", report);
   const bool plotted = plot("plot_validation.py", {out});
+  // the verdicts against the suite's thresholds, and each 1D model's against the 1D tier's design
+  // targets over the cases that state them (label: met, judged; in the suite's model order)
   int pass = 0, fail = 0, inconclusive = 0;
+  std::vector<std::pair<std::string, std::array<int, 2>>> met;
   for (const auto& c : report["cases"])
-    for (const auto& m : c["models1d"])
-      if (m.contains("verdicts"))
-        for (const auto& [k, v] : m["verdicts"].items()) {
-          pass += v == "pass";
-          fail += v == "fail";
-          inconclusive += v == "inconclusive";
-        }
+    for (const auto& m : c["models1d"]) {
+      const scene::json verdicts = m.value("verdicts", scene::json::object());
+      for (const auto& [k, v] : verdicts.items()) {
+        pass += v == "pass";
+        fail += v == "fail";
+        inconclusive += v == "inconclusive";
+      }
+      if (!m.contains("target_verdicts")) continue;
+      const std::string label = m["label"];
+      auto it = std::find_if(met.begin(), met.end(), [&](const auto& e) { return e.first == label; });
+      if (it == met.end()) it = met.insert(met.end(), {label, {0, 0}});
+      for (const auto& [k, v] : m["target_verdicts"].items()) {
+        it->second[0] += v == "pass";
+        ++it->second[1];
+      }
+    }
   std::printf("validation suite %s: %zu case(s), %d verdicts pass, %d fail, %d inconclusive; wall time %s\n  -> "
               "%s/report.json%s\n",
               name.c_str(), report["cases"].size(), pass, fail, inconclusive,
               si(report["wall_time_s"].get<double>(), "s").c_str(),
               out.c_str(), plotted ? ", report.md, report.html and figures" : "");
-  // each 1D model against the 1D tier's design targets, over the cases that state them
-  std::vector<std::pair<std::string, std::array<int, 2>>> met;  // label: (met, judged)
-  for (const auto& c : report["cases"])
-    for (const auto& m : c["models1d"])
-      if (m.contains("target_verdicts")) {
-        const std::string label = m["label"];
-        auto it = std::find_if(met.begin(), met.end(), [&](const auto& e) { return e.first == label; });
-        if (it == met.end()) it = met.insert(met.end(), {label, {0, 0}});
-        for (const auto& [k, v] : m["target_verdicts"].items()) {
-          it->second[0] += v == "pass";
-          ++it->second[1];
-        }
-      }
   for (const auto& [label, n] : met)
     std::printf("  1D model \"%s\": %d of %d design targets met\n", label.c_str(), n[0], n[1]);
   for (const auto& c : report["cases"])
