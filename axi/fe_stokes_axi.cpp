@@ -1,9 +1,11 @@
 #include "axi/fe_stokes_axi.hpp"
+#include "axi/supernodal_solve.hpp"
 
 #include <dlfcn.h>
 #include <omp.h>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdlib>
@@ -330,6 +332,53 @@ void FittedStokes::build_schur_pattern() {
       }
   chol_.bval.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
   spare_.bval = chol_.bval;
+
+  // The factored matrix is P S P^T, stored by its upper triangle, with P the fill-reducing
+  // ordering CHOLMOD chooses for S (AMD, postordered), found once here. Factored with the natural
+  // ordering it goes to CHOLMOD's supernodal kernels as it is: given S's lower triangle in its own
+  // order, each factorisation first built the permuted transpose (a 1.4-million-entry copy and its
+  // allocation at 32 cells across: about a third of the worker's time). Each value of S is written
+  // straight into its place in P S P^T (up_src_, up_pen_pos_); S's upper triangle is not stored.
+  {
+    Cholesky probe;
+    probe.cholmod().print = 0;
+    probe.analyzePattern(schur_);
+    if (probe.info() != Eigen::Success || probe.factor() == nullptr)
+      throw NumericalError("the symbolic analysis of the fitted Stokes system's Cholesky failed (CHOLMOD)",
+                           "use fewer cells (axi.fitted.cells_inner, axi.fitted.cells_outer, axi.fitted.gap_columns)");
+    const int* pp = static_cast<const int*>(probe.factor()->Perm);
+    perm_.assign(pp, pp + n_vel_);
+  }
+  std::vector<int> pinv(static_cast<std::size_t>(n_vel_));
+  for (int k = 0; k < n_vel_; ++k) pinv[std::size_t(perm_[std::size_t(k)])] = k;
+  // the lower entries of S (row >= column) as (column, row) of P S P^T's upper triangle
+  std::vector<std::array<int, 3>> entries;  // (new column, new row, entry of S)
+  for (int c = 0; c < n_vel_; ++c)
+    for (int q = souter[c]; q < souter[c + 1]; ++q) {
+      const int r = sinner[std::size_t(q)];
+      if (r < c) continue;
+      const int a = pinv[std::size_t(r)], b = pinv[std::size_t(c)];
+      entries.push_back({std::max(a, b), std::min(a, b), q});
+    }
+  std::sort(entries.begin(), entries.end());
+  std::vector<int> up_of(sinner.size(), -1);  // entry of S -> entry of P S P^T (-1: S's upper triangle)
+  schur_up_.resize(n_vel_, n_vel_);
+  schur_up_.resizeNonZeros(Eigen::Index(entries.size()));
+  int* uo = schur_up_.outerIndexPtr();
+  int* ui = schur_up_.innerIndexPtr();
+  std::fill(uo, uo + n_vel_ + 1, 0);
+  for (std::size_t k = 0; k < entries.size(); ++k) {
+    ++uo[entries[k][0] + 1];
+    ui[k] = entries[k][1];
+    up_of[std::size_t(entries[k][2])] = int(k);
+  }
+  for (int c = 0; c < n_vel_; ++c) uo[c + 1] += uo[c];
+  std::fill(schur_up_.valuePtr(), schur_up_.valuePtr() + entries.size(), 0.0);
+  up_src_.assign(entries.size(), -1);
+  for (std::size_t k = 0; k < schur_src_.size(); ++k)
+    if (up_of[k] >= 0) up_src_[std::size_t(up_of[k])] = schur_src_[k];
+  up_pen_pos_.resize(pen_pos_.size());
+  for (std::size_t k = 0; k < pen_pos_.size(); ++k) up_pen_pos_[k] = up_of[std::size_t(pen_pos_[k])];
 }
 
 FittedStokes::~FittedStokes() {
@@ -385,28 +434,34 @@ void FittedStokes::assemble(const Eigen::SparseMatrix<double>* K, double scale) 
   Geometry g;
   Eigen::Matrix<double, 9, 9> Axx, Arr, Axr;
   Eigen::Matrix<double, 3, 9> Bx, Br;
+  // per element: A = G^T diag(w) G sums over the 9 quadrature points as 9x9 products (G: point by
+  // shape function), the pressure couplings as C^T (...) with C the points' weighted pressure basis
+  Eigen::Matrix<double, 9, 9> Wgx, Wgr, WN;
+  Eigen::Matrix<double, 9, 3> C;
   for (int e = 0; e < E; ++e) {
     element_geometry(e, g);
-    Axx.setZero();
-    Arr.setZero();
-    Axr.setZero();
-    Bx.setZero();
-    Br.setZero();
     for (int q = 0; q < 9; ++q) {
       const double r = g.r[q], W = mu_ * g.wdet[q] * r;
-      const auto gx = g.gx.row(q).transpose();
-      const auto gr = g.gr.row(q).transpose();
-      const auto N = g.N.row(q).transpose();
-      Axx.noalias() += (2.0 * W) * gx * gx.transpose() + W * gr * gr.transpose();
-      Arr.noalias() += (2.0 * W) * gr * gr.transpose() + W * gx * gx.transpose() +
-                       (2.0 * mu_ * g.wdet[q] / r) * N * N.transpose();
-      Axr.noalias() += W * gr * gx.transpose();
-      const double phi[3] = {1.0, (g.x[q] - g.xc) / g.hx, (g.r[q] - g.rc) / g.hr};
-      for (int k = 0; k < 3; ++k) {
-        const double c = -ps_ * g.wdet[q] * phi[k];
-        Bx.row(k) += (c * r) * gx.transpose();
-        Br.row(k) += c * (r * gr + N).transpose();
+      Wgx.row(q) = W * g.gx.row(q);
+      Wgr.row(q) = W * g.gr.row(q);
+      WN.row(q) = (2.0 * mu_ * g.wdet[q] / r) * g.N.row(q);
+      const double c = -ps_ * g.wdet[q];
+      C(q, 0) = c;
+      C(q, 1) = c * (g.x[q] - g.xc) / g.hx;
+      C(q, 2) = c * (g.r[q] - g.rc) / g.hr;
+    }
+    Axx.noalias() = 2.0 * (g.gx.transpose() * Wgx) + g.gr.transpose() * Wgr;
+    Arr.noalias() = 2.0 * (g.gr.transpose() * Wgr) + g.gx.transpose() * Wgx;
+    Arr.noalias() += g.N.transpose() * WN;
+    Axr.noalias() = g.gr.transpose() * Wgx;
+    {
+      Eigen::Matrix<double, 9, 9> rgx, rgrN;
+      for (int q = 0; q < 9; ++q) {
+        rgx.row(q) = g.r[q] * g.gx.row(q);
+        rgrN.row(q) = g.r[q] * g.gr.row(q) + g.N.row(q);
       }
+      Bx.noalias() = C.transpose() * rgx;
+      Br.noalias() = C.transpose() * rgrN;
     }
     const int* P = &pos_[std::size_t(e) * kLoc * kLoc];
     auto add = [&](int i, int j, double v) {
@@ -515,22 +570,28 @@ bool FittedStokes::factor_into(CholeskySlot& slot) const {
   const double inv = 1.0 / slot.pen;
   const double* av = A_.valuePtr();
   const int* outer = A_.outerIndexPtr();
-  double* sv = schur_.valuePtr();
-  for (std::size_t k = 0; k < schur_src_.size(); ++k) sv[k] = av[schur_src_[k]];
+  double* sv = schur_up_.valuePtr();
+  for (std::size_t k = 0; k < up_src_.size(); ++k) sv[k] = av[up_src_[k]];
   std::size_t k = 0;
   for (int c = n_vel_; c < n_; ++c)
     for (int a = outer[c]; a < outer[c + 1]; ++a) {
       const double va = av[a] * inv;
-      for (int b = outer[c]; b < outer[c + 1]; ++b) sv[pen_pos_[k++]] += va * av[b];
+      for (int b = outer[c]; b < outer[c + 1]; ++b, ++k)
+        if (const int p = up_pen_pos_[k]; p >= 0) sv[p] += va * av[b];
     }
   std::copy(av + outer[n_vel_], av + outer[n_], slot.bval.begin());
   const OneOpenMpThread one;  // per thread: the worker's own setting
   if (!slot.analysed) {
-    slot.factor->analyzePattern(schur_);
+    // P S P^T is already in the fill-reducing order: the natural ordering, not postordered again
+    cholmod_common& cm = slot.factor->cholmod();
+    cm.nmethods = 1;
+    cm.method[0].ordering = CHOLMOD_NATURAL;
+    cm.postorder = 0;
+    slot.factor->analyzePattern(schur_up_);
     slot.analysed = slot.factor->info() == Eigen::Success;
     if (!slot.analysed) return false;
   }
-  slot.factor->factorize(schur_);
+  slot.factor->factorize(schur_up_);
   return slot.factor->info() == Eigen::Success;
 }
 
@@ -603,10 +664,8 @@ Eigen::VectorXd FittedStokes::cholesky_apply(const Eigen::VectorXd& v) const {
     for (int q = outer[c]; q < outer[c + 1]; ++q) f[inner[q]] += bval[std::size_t(q - q0)] * gc;
   }
   Eigen::VectorXd z(n_);
-  {
-    const OneOpenMpThread one;
-    z.head(n_vel_) = chol_.factor->solve(f);
-  }
+  supernodal_llt_solve(*chol_.factor->factor(), f, apply_work_, perm_.data());
+  z.head(n_vel_) = f;
   for (int c = n_vel_; c < n_; ++c) {
     double bu = 0.0;
     for (int q = outer[c]; q < outer[c + 1]; ++q) bu += bval[std::size_t(q - q0)] * z[inner[q]];
@@ -682,9 +741,18 @@ void FittedStokes::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const 
   const double* xv = x.data();
   y.resize(n_);
   for (int i = 0; i < n_; ++i) {
-    double s = 0.0;
-    for (int q = outer[i]; q < outer[i + 1]; ++q) s += val[q] * xv[inner[q]];
-    y[i] = s;
+    // four partial sums: one chain of dependent additions bounded a row by the adder's latency
+    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
+    int q = outer[i];
+    const int end = outer[i + 1];
+    for (; q + 3 < end; q += 4) {
+      s0 += val[q] * xv[inner[q]];
+      s1 += val[q + 1] * xv[inner[q + 1]];
+      s2 += val[q + 2] * xv[inner[q + 2]];
+      s3 += val[q + 3] * xv[inner[q + 3]];
+    }
+    for (; q < end; ++q) s0 += val[q] * xv[inner[q]];
+    y[i] = (s0 + s1) + (s2 + s3);
   }
 }
 

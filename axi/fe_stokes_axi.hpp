@@ -316,7 +316,12 @@ class FittedStokes {
   void give_up_cholesky();  ///< UMFPACK's LU until forget_factorisation; counts the fallback
   bool cholesky_factor();  ///< the regularised system's Cholesky; false (no factorisation) when it fails
   Eigen::VectorXd cholesky_apply(const Eigen::VectorXd& v) const;  ///< its solve
-  using Cholesky = Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower>;
+  /// CHOLMOD's supernodal Cholesky through Eigen, its factor open to the product's own
+  /// triangular solves (axi/supernodal_solve.hpp)
+  class Cholesky : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Upper> {
+   public:
+    const cholmod_factor* factor() const { return m_cholmodFactor; }
+  };
   /// A Cholesky of S with what applying it needs: the factored system's B (A_'s pressure
   /// columns' values) and e.
   struct CholeskySlot {
@@ -365,10 +370,16 @@ class FittedStokes {
   static std::unique_ptr<Cholesky> new_cholesky();
   CholeskySlot chol_;   ///< the stored (applied) Cholesky
   CholeskySlot spare_;  ///< the one a worker factors into (swapped with chol_ when installed)
+  mutable Eigen::VectorXd apply_work_;  ///< the triangular solves' workspace (stepping thread only)
   /// S = A + B^T B / e on the velocity unknowns (pattern fixed: A_'s velocity block)
   mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_;
   std::vector<int> schur_src_;  ///< per entry of S: its entry in A_
   std::vector<int> pen_pos_;    ///< per pair of entries of each pressure column of A_: its entry in S
+  /// P S P^T by its upper triangle, the matrix the Cholesky factors (build_schur_pattern)
+  mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_up_;
+  std::vector<int> perm_;        ///< P: row k of P S P^T is row perm_[k] of S
+  std::vector<int> up_src_;      ///< per entry of P S P^T: its entry in A_
+  std::vector<int> up_pen_pos_;  ///< pen_pos_ in P S P^T (-1: an entry of S's upper triangle, not stored)
   void build_schur_pattern();   ///< schur_'s pattern, schur_src_, pen_pos_ (constructor)
   bool background_ = false;
   std::thread worker_;          ///< joinable while a background factorisation is pending

@@ -22,15 +22,17 @@ std::string fmt(double v) {
 // Gap column widths (see the header): w_i(q) = min(wl q^i, wr q^(m-1-i)), q in [1, growth] with
 // sum = G; uniform G/m when no such q exists.
 std::vector<double> gap_widths(double G, int m, double wl, double wr, double growth) {
+  std::vector<double> w(m), qi(m);  // qi: the powers q^i, by products (pow per entry cost 3 % of a run)
   auto widths = [&](double q, std::vector<double>& w) {
+    double p = 1.0;
+    for (int i = 0; i < m; ++i, p *= q) qi[i] = p;
     double s = 0.0;
     for (int i = 0; i < m; ++i) {
-      w[i] = std::min(wl * std::pow(q, i), wr * std::pow(q, m - 1 - i));
+      w[i] = std::min(wl * qi[i], wr * qi[m - 1 - i]);
       s += w[i];
     }
     return s;
   };
-  std::vector<double> w(m);
   const double s1 = widths(1.0, w), s2 = widths(growth, w);
   if (!(s1 <= G && G <= s2)) {
     std::fill(w.begin(), w.end(), G / m);
