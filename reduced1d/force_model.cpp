@@ -105,11 +105,17 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
   V_s = pi * R0 * R0 * L;
   Vel_s = R0 / T_s;
   P_s = C1 * R0;
+  tr_beta = J > 0 ? P.swimmer.traction_end : 0.0;
   for (int j = 0; j < J; ++j) {
     tr_s2.push_back(tq.s[j] * h * tq.s[j] * h);
     tr_w.push_back(1.0 / (tr_s2.back() + 4.0));
     tr_c.push_back(4.0 * mu * tq.c[j] * Vel_s / P_s);
     tr_csum += tr_c.back();
+    // beyond an open end: a wall at rest continues the tube, along which the field decays by
+    // r_j per cell, the root below 1 of r^2 - (2 + a) r + 1 = 0 (a = (s_j h)^2); mixed with the
+    // mirror's 1 by beta
+    const double a = tr_s2.back(), r = 1.0 + 0.5 * a - std::sqrt(a + 0.25 * a * a);
+    tr_g.push_back(1.0 - tr_beta + tr_beta * r);
   }
 }
 
@@ -655,7 +661,14 @@ int ForceModel::res(const double* y, const double* yp, double* F, ModelState& s)
     else  // (the linear tier's own expression, for its rounding)
       F[k + 1] = (inertia ? yp[k + 1] : 0.0) + cv * (C1 * (R[i] - R0) + s.q[i] + P_s * T - s.p[i]);
     F[k + 2] = cp * ((s.Q[i + 1] - s.Q[i]) / h + A0 * yp[k]);
-    if (J > 0) {
+    if (J > 0 && tr_beta != 0.0 && (i == 0 || i + 1 == N)) {  // an open end's cell: the ghost value
+      for (int j = 0; j < J; ++j) {
+        const double phi = y[k + 3 + j];
+        const double left = i > 0 ? y[k - S + 3 + j] : tr_g[j] * phi;
+        const double right = i + 1 < N ? y[k + S + 3 + j] : tr_g[j] * phi;
+        F[k + 3 + j] = (tr_s2[j] * (phi - y[k + 1]) - (left - 2.0 * phi + right)) * tr_w[j];
+      }
+    } else if (J > 0) {
       const int km = i > 0 ? k - S : k, kp = i + 1 < N ? k + S : k;  // mirror ends
       int j = 0;
       for (; j + 4 <= J; j += 4) {  // four fields at a time (the same operations per field)
@@ -710,12 +723,17 @@ void ForceModel::ida_band(const Linearisation& s, const double* y, double cj, co
     band(k + 2, k + 2, c * (cond[i + 1] + cond[i]) * P_s);
     if (i > 0) band(k + 2, k + 2 - S, -c * cond[i] * P_s);
     if (i + 1 < N) band(k + 2, k + 2 + S, -c * cond[i + 1] * P_s);
-    // F_phi_j = ((s_j h)^2 (phi - V) - D2 phi) / ((s_j h)^2 + 4), mirror ends
+    // F_phi_j = ((s_j h)^2 (phi - V) - D2 phi) / ((s_j h)^2 + 4); beyond an open end the ghost
+    // value g_j phi (the mirror's g_j = 1: the diagonal's 2 - g_j per end is then the count of
+    // neighbours, as written for it)
     const int nb = (i > 0) + (i + 1 < N);
     for (int j = 0; j < J; ++j) {
       const int row = k + 3 + j;
       const double w = tr_w[j];
-      band(row, row, (tr_s2[j] + nb) * w);
+      if (tr_beta != 0.0)
+        band(row, row, (tr_s2[j] + 2.0 - (2 - nb) * tr_g[j]) * w);
+      else
+        band(row, row, (tr_s2[j] + nb) * w);
       band(row, k + 1, -tr_s2[j] * w);
       if (i > 0) band(row, row - S, -w);
       if (i + 1 < N) band(row, row + S, -w);

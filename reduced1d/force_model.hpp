@@ -154,6 +154,8 @@ struct ForceModel {
   double T_s, D_s, X_s, V_s, Vel_s, P_s;
   std::vector<double> tr_s2, tr_c;  // (s_j h)^2 and 4 mu c_j Vel_s / P_s (per scaled phi_j)
   std::vector<double> tr_w;         // 1 / ((s_j h)^2 + 4), the scale of the field rows
+  std::vector<double> tr_g;         // the fields' ghost factors beyond an open end (1: mirror)
+  double tr_beta = 0.0;             // model1d.short_wave_traction_end
   double tr_csum = 0;               // sum_j tr_c[j]
 
   // ---- actuation laws of the current protocol state (set_actuation)

@@ -165,6 +165,11 @@ struct Swimmer {
   /// Off in this struct (the library's lubrication-only wall, as the struct's wave defaults
   /// to a prescribed step); the scene layer turns it on for the force-free force-driven wave.
   bool short_wave_traction = false;
+  /// The traction operator's end condition, beta in [0, 1] (model1d.short_wave_traction_end):
+  /// each field's value beyond an open end is (1 - beta + beta r_j) times the end cell's, r_j
+  /// the field's decay along a wall at rest. 0: mirror ends (the wall continued by its own
+  /// motion); 1: the tube continued by a wall at rest (docs/outer-flow-1d.md §2c).
+  double traction_end = 0.0;
   /// Paper mode only:
   Closure closure = Closure::TubeLaw;
   Balance balance = Balance::PerArea;

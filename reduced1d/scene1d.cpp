@@ -283,6 +283,16 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
       throw InputError(m.path("short_wave_traction"), "true",
                        "the short-wave wall traction only applies to wave.kind = \"force_driven\" (a prescribed wave "
                        "fixes R(z,t), and the normal stress then does not change the swimmer's velocity)");
+    if (m.has("short_wave_traction_end")) {
+      const double beta = m.number("short_wave_traction_end", 0.0, Range::closed(0.0, 1.0));
+      if (!p.swimmer.short_wave_traction && beta != 0.0) {
+        char b[32];
+        std::snprintf(b, sizeof b, "%.6g", beta);
+        throw InputError(m.path("short_wave_traction_end"), b,
+                         "the end condition of the short-wave wall traction needs model1d.short_wave_traction = true");
+      }
+      p.swimmer.traction_end = beta;
+    }
     if (p.wall.inertia && !forced)
       throw InputError(m.path("wall_inertia"), "true", "wall inertia only applies to wave.kind = \"force_driven\" "
                                                        "(a prescribed wave fixes R(z,t))");

@@ -15,6 +15,7 @@ const scene::json& section_keys() {
           {"external_drag", "choice:none|resistive_force"}}},
         {"wall_inertia", "boolean"},
         {"short_wave_traction", "boolean"},
+        {"short_wave_traction_end", "number"},
         {"end_effects", "choice:none|open_ends|junction"},
         {"recovery_end", "choice:energy|dead_band|shape"},
         {"axial_bending", {{"source", "choice:none|scene|calibration"}, {"rigidity", "quantity:J@positive"}}}}},

@@ -23,7 +23,7 @@ import numpy as np  # noqa: E402  (a dependency of matplotlib)
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import plot_calibration  # noqa: E402
 
-MODEL_STYLES = ["C1-", "C2--", "C3-.", "C4:", "C5-", "C6--"]
+MODEL_STYLES = ["C1-", "C2--", "C3-.", "C4:", "C5-", "C6--", "C8-.", "C9:", "C7-"]
 
 
 def si(v, unit, digits=3):
@@ -223,10 +223,14 @@ def velocity_figure(case, path):
         title += "\noff scale, not drawn: " + "; ".join(off)
     fig.suptitle(title)
     handles, labels = ax[0].get_legend_handles_labels()
+    # long model labels wrapped, so that three columns fit the figure's width
+    labels = [textwrap.fill(l, 62, subsequent_indent="  ") for l in labels]
     fig.legend(handles, labels, loc="lower center", ncol=3, fontsize="small", frameon=False)
-    # room below the panels for the legend's rows (about 0.18 inch each) and a gap above them
+    # room below the panels for the legend's rows (about 0.18 inch per line; the columns are
+    # filled one after the other, so row r holds the labels r, r + rows and r + 2 rows) and a gap
     rows = math.ceil(len(labels) / 3)
-    below = 0.18 * rows + 0.12
+    lines = sum(max(labels[i].count("\n") + 1 for i in range(r, len(labels), rows)) for r in range(rows))
+    below = 0.18 * lines + 0.12
     fig.set_size_inches(12, 4.0 + below)
     fig.tight_layout(rect=(0, below / (4.0 + below), 1, 1))
     fig.savefig(path, dpi=110)

@@ -143,16 +143,19 @@ TEST(ForceFree, DisplacementIsIndependentOfTheViscosity) {
 // end junction (confined, IDA path with or without the traction) the closure's unknowns are
 // (W, U, Pi_0, Pi_L), four rank-1 terms whose dependence on the state runs through the end
 // cells' radii and pressures, the end radii (held end segments) and the wall velocities near
-// the ends (the rims' thrust).
+// the ends (the rims' thrust). The traction's fields are checked with mirror ends and with the
+// mixed end condition (model1d.short_wave_traction_end = 0.6: the end cells' ghost values).
 TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
   double worst_junction = 0;
   for (bool junction : {false, true})
-  for (bool traction : {false, true})
+  for (double traction_end : {-1.0, 0.0, 0.6})  // -1: no traction
   for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
     for (int N : {37, 60}) {
       if (junction && outer != OuterFlow::Confined) continue;  // the junction belongs to the confined closure
+      const bool traction = traction_end >= 0.0;
       Params p = force_free_cycle(N);
       p.swimmer.short_wave_traction = traction;
+      p.swimmer.traction_end = traction ? traction_end : 0.0;
       p.swimmer.outer = outer;
       p.swimmer.end_junction = junction;
       p.swimmer.a_in = 2e-9;
@@ -164,7 +167,7 @@ TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
           const auto c = test::check_jacobian(p, phase, active, seed);
-          EXPECT_LT(c.max_rel_error, 1e-6) << "junction=" << junction << " traction=" << traction << " N=" << N
+          EXPECT_LT(c.max_rel_error, 1e-6) << "junction=" << junction << " traction end=" << traction_end << " N=" << N
                                            << " phase=" << phase << " active=" << active;
           const int held = phase == 0 ? n - 1 - active : 0;
           EXPECT_EQ(c.rank, held + closure);
