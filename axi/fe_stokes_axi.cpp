@@ -299,21 +299,24 @@ void FittedStokes::build_schur_pattern() {
   // element (a pressure unknown's column holds its element's velocity rows), which A_ couples.
   const int* outer = A_.outerIndexPtr();
   const int* inner = A_.innerIndexPtr();
-  schur_src_.clear();
+  // S's pattern (both triangles, S's own order), per entry its entry in A_, and per pair of
+  // entries of each pressure column of A_ the entry of S it adds to: what P S P^T's maps are
+  // made from (below)
+  std::vector<int> schur_src, pen_pos;
   std::vector<int> souter(n_vel_ + 1, 0), sinner;
   for (int c = 0; c < n_vel_; ++c) {
     for (int q = outer[c]; q < outer[c + 1]; ++q)
       if (inner[q] < n_vel_) {
         sinner.push_back(inner[q]);
-        schur_src_.push_back(q);
+        schur_src.push_back(q);
       }
     souter[c + 1] = int(sinner.size());
   }
-  schur_.resize(n_vel_, n_vel_);
-  schur_.resizeNonZeros(Eigen::Index(sinner.size()));
-  std::copy(souter.begin(), souter.end(), schur_.outerIndexPtr());
-  std::copy(sinner.begin(), sinner.end(), schur_.innerIndexPtr());
-  std::fill(schur_.valuePtr(), schur_.valuePtr() + sinner.size(), 0.0);
+  Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur(n_vel_, n_vel_);
+  schur.resizeNonZeros(Eigen::Index(sinner.size()));
+  std::copy(souter.begin(), souter.end(), schur.outerIndexPtr());
+  std::copy(sinner.begin(), sinner.end(), schur.innerIndexPtr());
+  std::fill(schur.valuePtr(), schur.valuePtr() + sinner.size(), 0.0);
   auto position = [&](int row, int col) {
     const int* b = sinner.data() + souter[col];
     const int* e = sinner.data() + souter[col + 1];
@@ -322,13 +325,12 @@ void FittedStokes::build_schur_pattern() {
       throw std::logic_error("FittedStokes: a pressure unknown couples velocities its element does not");
     return int(it - sinner.data());
   };
-  pen_pos_.clear();
   for (int c = n_vel_; c < n_; ++c)
     for (int a = outer[c]; a < outer[c + 1]; ++a)
       for (int b = outer[c]; b < outer[c + 1]; ++b) {
         if (inner[a] >= n_vel_ || inner[b] >= n_vel_)
           throw std::logic_error("FittedStokes: pressure unknowns coupled to each other");
-        pen_pos_.push_back(position(inner[a], inner[b]));
+        pen_pos.push_back(position(inner[a], inner[b]));
       }
   chol_.bval.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
   spare_.bval = chol_.bval;
@@ -342,7 +344,7 @@ void FittedStokes::build_schur_pattern() {
   {
     Cholesky probe;
     probe.cholmod().print = 0;
-    probe.analyzePattern(schur_);
+    probe.analyzePattern(schur);
     if (probe.info() != Eigen::Success || probe.factor() == nullptr)
       throw NumericalError("the symbolic analysis of the fitted Stokes system's Cholesky failed (CHOLMOD)",
                            "use fewer cells (axi.fitted.cells_inner, axi.fitted.cells_outer, axi.fitted.gap_columns)");
@@ -375,10 +377,10 @@ void FittedStokes::build_schur_pattern() {
   for (int c = 0; c < n_vel_; ++c) uo[c + 1] += uo[c];
   std::fill(schur_up_.valuePtr(), schur_up_.valuePtr() + entries.size(), 0.0);
   up_src_.assign(entries.size(), -1);
-  for (std::size_t k = 0; k < schur_src_.size(); ++k)
-    if (up_of[k] >= 0) up_src_[std::size_t(up_of[k])] = schur_src_[k];
-  up_pen_pos_.resize(pen_pos_.size());
-  for (std::size_t k = 0; k < pen_pos_.size(); ++k) up_pen_pos_[k] = up_of[std::size_t(pen_pos_[k])];
+  for (std::size_t k = 0; k < schur_src.size(); ++k)
+    if (up_of[k] >= 0) up_src_[std::size_t(up_of[k])] = schur_src[k];
+  up_pen_pos_.resize(pen_pos.size());
+  for (std::size_t k = 0; k < pen_pos.size(); ++k) up_pen_pos_[k] = up_of[std::size_t(pen_pos[k])];
 }
 
 FittedStokes::~FittedStokes() {

@@ -89,13 +89,16 @@
 //   [A  B^T; B  -e I],   e = eps d,   d = the largest diagonal entry of the velocity block,
 //   eps = 1e-12 (kPressureRegularisation).
 // The saddle-point system (symmetric: the viscous form, the divergence and the wall's stiffness
-// term are; Cholesky reads the lower triangle) has zero pressure diagonals, so an unpivoted
+// term are) has zero pressure diagonals, so an unpivoted
 // symmetric factorisation of it breaks down; regularised, the pressure (whose block is now
 // diagonal) is eliminated exactly: p = (B u - g) / e and
 //   S u = f + B^T g / e,   S = A + B^T B / e,
 // S symmetric positive definite when A is, with A's own sparsity (the discontinuous pressure
 // couples only one element's velocities, which A couples already). S is factored by CHOLMOD's
-// supernodal Cholesky (its fill-reducing ordering, BLAS-3 kernels). As a preconditioner it is
+// supernodal Cholesky (BLAS-3 kernels) as P S P^T by its upper triangle, P CHOLMOD's own
+// fill-reducing ordering found once, in the natural ordering (no permuted transpose per
+// factorisation); the factor's triangular solves are the product's own (axi/supernodal_solve.hpp).
+// As a preconditioner it is
 // nearly exact: one application leaves a relative residual of about 5e-6 (eps = 1e-10: 2e-5;
 // 1e-8: 3e-3), a second 1e-10. Measured on paper_amplitude_0.82's system at 32 cells across
 // (33 047 unknowns, one core): a numeric factorisation 0.09 s (+0.05 s to form S) and one
@@ -330,8 +333,8 @@ class FittedStokes {
     std::vector<double> bval;
     double pen = 0.0;
   };
-  /// Forms S from the current A_ into schur_ and factors it into `slot` (its symbolic analysis
-  /// on its first use); false when S is not positive definite. Reads A_, writes schur_ and slot
+  /// Forms P S P^T from the current A_ into schur_up_ and factors it into `slot` (its symbolic
+  /// analysis on its first use); false when S is not positive definite. Reads A_, writes schur_up_ and slot
   /// only (safe on a worker thread while the caller's thread reads A_).
   bool factor_into(CholeskySlot& slot) const;
   void launch_background();  ///< spare_ <- the current A_'s Cholesky, on a worker thread
@@ -372,15 +375,14 @@ class FittedStokes {
   CholeskySlot spare_;  ///< the one a worker factors into (swapped with chol_ when installed)
   mutable Eigen::VectorXd apply_work_;  ///< the triangular solves' workspace (stepping thread only)
   /// S = A + B^T B / e on the velocity unknowns (pattern fixed: A_'s velocity block)
-  mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_;
-  std::vector<int> schur_src_;  ///< per entry of S: its entry in A_
-  std::vector<int> pen_pos_;    ///< per pair of entries of each pressure column of A_: its entry in S
   /// P S P^T by its upper triangle, the matrix the Cholesky factors (build_schur_pattern)
   mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_up_;
   std::vector<int> perm_;        ///< P: row k of P S P^T is row perm_[k] of S
   std::vector<int> up_src_;      ///< per entry of P S P^T: its entry in A_
-  std::vector<int> up_pen_pos_;  ///< pen_pos_ in P S P^T (-1: an entry of S's upper triangle, not stored)
-  void build_schur_pattern();   ///< schur_'s pattern, schur_src_, pen_pos_ (constructor)
+  /// per pair of entries of each pressure column of A_: the entry of P S P^T it adds to (-1: an
+  /// entry of S's upper triangle, not stored)
+  std::vector<int> up_pen_pos_;
+  void build_schur_pattern();   ///< P (perm_), schur_up_'s pattern, up_src_, up_pen_pos_ (constructor)
   bool background_ = false;
   std::thread worker_;          ///< joinable while a background factorisation is pending
   bool worker_ok_ = false;      ///< set by the worker: its Cholesky succeeded
