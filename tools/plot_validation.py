@@ -264,6 +264,8 @@ def order_text(e):
         return f"order {e['order']:.2f}" + ("" if obs is not None else " (assumed)")
     if e.get("method") == "expansion_fit":
         return "not asymptotic: f0 + a h + b h² fitted" + (f" (three finest: order {obs:.2f})" if obs is not None else "")
+    if e.get("method") == "lumen_fit":
+        return "smeared lumen T0 (1 − a h)⁻⁴ fitted" + (f" (three finest: order {obs:.2f})" if obs is not None else "")
     return "not asymptotic" + (f", observed order {obs:.2f}" if obs is not None else "")
 
 
@@ -294,6 +296,12 @@ def reference_convergence_figure(case, path):
                 hs = np.linspace(0.0, max(h for h, _ in p3), 60) * 1e-9
                 ff = fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs
                 ax.plot(hs * 1e9, ff * scale, "k--", lw=0.8, label="3D: fitted f0 + a h + b h²")
+            lum = (e3 or {}).get("lumen_fit")
+            if e3 and e3.get("method") == "lumen_fit" and lum and None not in lum.values():
+                # the suite's fitted lumen model T0 (1 - a h)^-4 (report.json), h = 0 to the coarsest grid
+                hs = np.linspace(0.0, max(h for h, _ in p3), 60) * 1e-9
+                ax.plot(hs * 1e9, lum["T0"] * (1.0 - lum["a_per_m"] * hs) ** -4 * scale, "k--", lw=0.8,
+                        label="3D: fitted T0 (1 − a h)⁻⁴")
         if pa:
             ax.plot(*zip(*pa), "s-", color="tab:blue", ms=5,
                     label=f"axisymmetric runs ({ref.get('method', 'axi')}): {order_text(ea)}")
@@ -357,6 +365,14 @@ def convergence_figure(case, path):
                     hs = np.linspace(0.0, max(h), 60) * 1e-9
                     ax.plot(hs * 1e9, (fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs) * scale, "k--",
                             lw=0.8, label="3D: fitted f0 + a h + b h²")
+            elif ref.get("method") == "lumen_fit":
+                what = (" (the smeared lumen: T0 (1 − a h)⁻⁴ fitted to the grids, error = leave-one-out change or "
+                        "the finest pair's line)")
+                lum = ref.get("lumen_fit")
+                if lum and None not in lum.values():  # the suite's fitted lumen model (report.json)
+                    hs = np.linspace(0.0, max(h), 60) * 1e-9
+                    ax.plot(hs * 1e9, lum["T0"] * (1.0 - lum["a_per_m"] * hs) ** -4 * scale, "k--", lw=0.8,
+                            label="3D: fitted T0 (1 − a h)⁻⁴")
             else:
                 what = (" (not asymptotic: finest ± spread" +
                         (f"; observed order {obs:.2f} outside {rng_text}" if obs is not None and
@@ -898,7 +914,8 @@ def reference_markdown(c):
             fr = e.get("finest_3d_relative_error")
             out.append(f"| {words} | {si(e['value_3d'], unit)} ± {si(e['error_3d'], unit)} | "
                        f"{'—' if obs is None else f'{obs:.2f}'}{'' if e.get('asymptotic_3d') else ' (not asymptotic)'}"
-                       f"{'; fit f0 + a h + b h²' if e.get('method_3d') == 'expansion_fit' else ''} | "
+                       f"{'; fit f0 + a h + b h²' if e.get('method_3d') == 'expansion_fit' else ''}"
+                       f"{'; fit T0 (1 − a h)⁻⁴' if e.get('method_3d') == 'lumen_fit' else ''} | "
                        f"{si(e['value_reference'], unit)} ± {si(e['error_reference'], unit)} | "
                        f"{si(e['difference'], unit)} | {si(e['combined_uncertainty'], unit)} | **{e['verdict']}** | "
                        f"{pct(fr)} (h = {si(e.get('finest_3d_cell_size_m'), 'm')}) |")

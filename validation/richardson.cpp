@@ -246,6 +246,92 @@ Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderR
   return e;
 }
 
+namespace {
+
+/// Least-squares line y = c0 + c1 h; false when the grids do not determine it.
+bool fit_line(const std::vector<double>& h, const std::vector<double>& y, double& c0, double& c1) {
+  const double n = double(h.size());
+  double sh = 0, sy = 0, shh = 0, shy = 0;
+  for (std::size_t i = 0; i < h.size(); ++i) {
+    sh += h[i];
+    sy += y[i];
+    shh += h[i] * h[i];
+    shy += h[i] * y[i];
+  }
+  const double det = n * shh - sh * sh;
+  if (!(std::abs(det) > 0.0)) return false;
+  c1 = (n * shy - sh * sy) / det;
+  c0 = (sy - c1 * sh) / n;
+  return std::isfinite(c0) && std::isfinite(c1);
+}
+
+/// T0 of the line through (h, T^-1/4); NaN when it has none (c0 <= 0).
+double lumen_t0(const std::vector<double>& h, const std::vector<double>& T, double* a = nullptr) {
+  std::vector<double> y(T.size());
+  for (std::size_t i = 0; i < T.size(); ++i) y[i] = std::pow(T[i], -0.25);
+  double c0 = 0, c1 = 0;
+  if (!fit_line(h, y, c0, c1) || !(c0 > 0.0)) return std::numeric_limits<double>::quiet_NaN();
+  if (a) *a = -c1 / c0;
+  return std::pow(c0, -4.0);
+}
+
+}  // namespace
+
+Extrapolation lumen_fit(std::vector<double> h, std::vector<double> T) {
+  if (h.size() != T.size() || h.size() < 2)
+    throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
+  std::vector<double> hs, ts;
+  coarse_to_fine(h, T, hs, ts);
+  const std::size_t n = hs.size();
+  const double finest = ts.back();
+  const std::size_t k3 = n >= 3 ? n - 3 : 0;
+  const double spread = *std::max_element(ts.begin() + long(k3), ts.end()) - *std::min_element(ts.begin() + long(k3), ts.end());
+  Extrapolation e;
+  e.value = finest;
+  e.error = spread;
+  auto refuse = [&](const std::string& why) {
+    e.note = "no lumen fit (" + why + "): finest grid, error = spread of the finest three";
+    return e;
+  };
+  if (n < 3) return refuse("fewer than three grids");
+  for (double t : ts)
+    if (!(t > 0.0) || !std::isfinite(t)) return refuse("a cycle time that is not positive");
+  double a = 0;
+  const double t0 = lumen_t0(hs, ts, &a);
+  if (!std::isfinite(t0)) return refuse("the line of T^-1/4 has no positive intercept");
+  if (!(a > 0.0)) return refuse("the cycle does not lengthen towards the coarse grids");
+  if (!(a * hs.front() < 1.0)) return refuse("the fitted lumen closes within the grids (a h >= 1)");
+  double loo = 0;
+  if (n >= 4)
+    for (std::size_t i = 0; i < n; ++i) {
+      std::vector<double> hh, tt;
+      for (std::size_t j = 0; j < n; ++j)
+        if (j != i) {
+          hh.push_back(hs[j]);
+          tt.push_back(ts[j]);
+        }
+      loo = std::max(loo, std::abs(lumen_t0(hh, tt) - t0));
+    }
+  const double pair = std::abs(lumen_t0({hs[n - 2], hs[n - 1]}, {ts[n - 2], ts[n - 1]}) - t0);
+  if (!std::isfinite(loo) || !std::isfinite(pair)) return refuse("a refit without one grid has no intercept");
+  if (std::abs(t0 - finest) > kMaxCorrection * std::abs(finest))
+    return refuse("it would change the finest value by more than half");
+  e.value = t0;
+  e.error = std::max(loo, pair);
+  e.order = 1.0;
+  e.asymptotic = false;
+  e.method = "lumen_fit";
+  e.lumen_a = a;
+  char b[360];
+  std::snprintf(b, sizeof b,
+                "lumen fit T0 (1 - a h)^-4 to %zu grids (the smearing narrows the lumen by a h = %.2f on the finest, "
+                "%.2f on the coarsest; not in the asymptotic range); error = the largest change when one grid is left "
+                "out, or to the two finest grids' line",
+                n, a * hs.back(), a * hs.front());
+  e.note = b;
+  return e;
+}
+
 Extrapolation extrapolate_series(const std::vector<double>& h, const std::vector<double>& f, double assumed_order,
                                  OrderRange range) {
   const Extrapolation r = richardson(h, f, assumed_order, range);

@@ -50,13 +50,15 @@ struct Extrapolation {
   /// differences of opposite sign, or an order beyond the search bracket)
   double observed_order = std::numeric_limits<double>::quiet_NaN();
   bool asymptotic = false;
-  /// "richardson" (or two grids with the assumed order), "expansion_fit", "finest_grid"
+  /// "richardson" (or two grids with the assumed order), "expansion_fit", "lumen_fit", "finest_grid"
   std::string method = "finest_grid";
   std::string note;      ///< how the value was obtained
   /// method "expansion_fit": the fitted a (per m of h) and b (per m^2) of f0 + a h + b h^2;
   /// NaN otherwise
   double expansion_a = std::numeric_limits<double>::quiet_NaN();
   double expansion_b = std::numeric_limits<double>::quiet_NaN();
+  /// method "lumen_fit": the fitted a (per m of h) of T0 (1 - a h)^-4; NaN otherwise
+  double lumen_a = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// Root of f in [lo, hi], where f(lo) and f(hi) differ in sign (GSL Brent, to 1e-14 relative).
@@ -86,6 +88,21 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
 /// half of it (kMaxCorrection). A fitted value is not asymptotic either: `asymptotic` stays
 /// false, `order` is 1 (the leading term) and the note says how it was obtained.
 Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderRange range = kImmersedBoundaryOrders);
+
+/// The cycle time of an immersed-boundary series before its asymptotic range, by the way the
+/// boundary's smearing slows it: the kernel narrows the lumen the flow sees by a fixed multiple
+/// of h (the calibrated hydraulic offsets, docs/validation.md), and the cycle is set by the
+/// lumen's Poiseuille resistance, R^-4, so that
+///   T(h) = T0 (1 - a h)^-4,   i.e.   T^-1/4 = T0^-1/4 (1 - a h),
+/// a straight line in h, fitted by least squares to three or more grids. The error of T0 is the
+/// larger of the largest change of T0 when one grid is left out (four grids or more) and its
+/// distance to the line through the two finest grids alone. Refused (the finest value with the
+/// spread of the finest three as its error, method "finest_grid") with fewer than three grids, a
+/// non-positive time, a line that does not fall towards the coarse grids (a <= 0) or reaches
+/// zero within them (a h >= 1), and a T0 more than half away from the finest value
+/// (kMaxCorrection). The value is not asymptotic (`asymptotic` false, `order` 1: the smearing is
+/// first order) and its note says so. `lumen_a` is a (per m of h).
+Extrapolation lumen_fit(std::vector<double> h, std::vector<double> T);
 
 /// richardson() over the grids; where the finest three are not in the asymptotic range and the
 /// series has four or more grids of a first-order method, expansion_fit() instead (when it is
