@@ -58,6 +58,20 @@ void coarse_to_fine(const std::vector<double>& h, const std::vector<double>& f, 
     if (!(hs[i] < hs[i - 1])) throw InputError("validation grids", std::to_string(hs[i]), "distinct grid spacings");
 }
 
+/// A fit's grids, checked and ordered from the coarsest to the finest (hs, fs), and what a
+/// refused fit returns: the finest value with the spread of the finest three as its error.
+Extrapolation finest_of_series(const std::vector<double>& h, const std::vector<double>& f, std::vector<double>& hs,
+                               std::vector<double>& fs) {
+  if (h.size() != f.size() || h.size() < 2)
+    throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
+  coarse_to_fine(h, f, hs, fs);
+  const std::size_t k3 = fs.size() >= 3 ? fs.size() - 3 : 0;
+  Extrapolation e;
+  e.value = fs.back();
+  e.error = *std::max_element(fs.begin() + long(k3), fs.end()) - *std::min_element(fs.begin() + long(k3), fs.end());
+  return e;
+}
+
 }  // namespace
 
 Extrapolation richardson(std::vector<double> h, std::vector<double> f, double assumed_order, OrderRange range) {
@@ -187,17 +201,10 @@ double expansion_f0(const std::vector<double>& h, const std::vector<double>& f, 
 }  // namespace
 
 Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderRange range) {
-  if (h.size() != f.size() || h.size() < 2)
-    throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
   std::vector<double> hs, fs;
-  coarse_to_fine(h, f, hs, fs);
+  Extrapolation e = finest_of_series(h, f, hs, fs);
   const std::size_t n = hs.size();
   const double finest = fs.back();
-  const std::size_t k3 = n >= 3 ? n - 3 : 0;
-  const double spread = *std::max_element(fs.begin() + long(k3), fs.end()) - *std::min_element(fs.begin() + long(k3), fs.end());
-  Extrapolation e;
-  e.value = finest;
-  e.error = spread;
   auto refuse = [&](const std::string& why) {
     e.note = "no error-expansion fit (" + why + "): finest grid, error = spread of the finest three";
     return e;
@@ -278,17 +285,10 @@ double lumen_t0(const std::vector<double>& h, const std::vector<double>& T, doub
 }  // namespace
 
 Extrapolation lumen_fit(std::vector<double> h, std::vector<double> T) {
-  if (h.size() != T.size() || h.size() < 2)
-    throw InputError("validation grids", std::to_string(h.size()), "two or more grids, one value per grid");
   std::vector<double> hs, ts;
-  coarse_to_fine(h, T, hs, ts);
+  Extrapolation e = finest_of_series(h, T, hs, ts);
   const std::size_t n = hs.size();
   const double finest = ts.back();
-  const std::size_t k3 = n >= 3 ? n - 3 : 0;
-  const double spread = *std::max_element(ts.begin() + long(k3), ts.end()) - *std::min_element(ts.begin() + long(k3), ts.end());
-  Extrapolation e;
-  e.value = finest;
-  e.error = spread;
   auto refuse = [&](const std::string& why) {
     e.note = "no lumen fit (" + why + "): finest grid, error = spread of the finest three";
     return e;
