@@ -317,7 +317,7 @@ Extrapolation lumen_fit(std::vector<double> h, std::vector<double> T) {
   if (std::abs(t0 - finest) > kMaxCorrection * std::abs(finest))
     return refuse("it would change the finest value by more than half");
   e.value = t0;
-  e.error = std::max(loo, pair);
+  e.error = std::max({loo, pair, kLumenModelShare * std::abs(t0 - finest)});
   e.order = 1.0;
   e.asymptotic = false;
   e.method = "lumen_fit";
@@ -326,7 +326,7 @@ Extrapolation lumen_fit(std::vector<double> h, std::vector<double> T) {
   std::snprintf(b, sizeof b,
                 "lumen fit T0 (1 - a h)^-4 to %zu grids (the smearing narrows the lumen by a h = %.2f on the finest, "
                 "%.2f on the coarsest; not in the asymptotic range); error = the largest change when one grid is left "
-                "out, or to the two finest grids' line",
+                "out, the distance to the two finest grids' line, or a quarter of the correction",
                 n, a * hs.back(), a * hs.front());
   e.note = b;
   return e;
