@@ -14,6 +14,7 @@
 #include <numbers>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "common/errors.hpp"
 #include "common/si_format.hpp"
@@ -77,6 +78,24 @@ constexpr int kLoc = 21;  // 9 nodes x 2 velocity components + 3 pressure coeffi
 
 using Clock = std::chrono::steady_clock;
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
+
+/// An n x n column-compressed pattern with zero values from `count` entries in column order (then
+/// row order within a column); colrow(k) gives entry k's (column, row).
+template <class ColRow>
+void sorted_pattern(Eigen::SparseMatrix<double, Eigen::ColMajor, int>& M, int n, std::size_t count, ColRow colrow) {
+  M.resize(n, n);
+  M.resizeNonZeros(Eigen::Index(count));
+  int* outer = M.outerIndexPtr();
+  int* inner = M.innerIndexPtr();
+  std::fill(outer, outer + n + 1, 0);
+  for (std::size_t k = 0; k < count; ++k) {
+    const auto [c, r] = colrow(k);
+    ++outer[c + 1];
+    inner[k] = r;
+  }
+  for (int c = 0; c < n; ++c) outer[c + 1] += outer[c];
+  std::fill(M.valuePtr(), M.valuePtr() + count, 0.0);
+}
 
 // 1D quadratic Lagrange basis on the nodes -1, 0, 1 and its derivative.
 inline double lag(int i, double t) {
@@ -256,17 +275,7 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
   std::sort(keys.begin(), keys.end());
   keys.erase(std::unique(keys.begin(), keys.end()), keys.end());
 
-  A_.resize(n_, n_);
-  A_.resizeNonZeros(Eigen::Index(keys.size()));
-  int* outer = A_.outerIndexPtr();
-  int* inner = A_.innerIndexPtr();
-  std::fill(outer, outer + n_ + 1, 0);
-  for (std::size_t k = 0; k < keys.size(); ++k) {
-    ++outer[keys[k] / n_ + 1];
-    inner[k] = int(keys[k] % n_);
-  }
-  for (int c = 0; c < n_; ++c) outer[c + 1] += outer[c];
-  std::fill(A_.valuePtr(), A_.valuePtr() + keys.size(), 0.0);
+  sorted_pattern(A_, n_, keys.size(), [&](std::size_t k) { return std::pair{int(keys[k] / n_), int(keys[k] % n_)}; });
   keys.clear();
   keys.shrink_to_fit();
 
@@ -363,19 +372,10 @@ void FittedStokes::build_schur_pattern() {
       entries.push_back({std::max(a, b), std::min(a, b), q});
     }
   std::sort(entries.begin(), entries.end());
+  sorted_pattern(schur_up_, n_vel_, entries.size(),
+                 [&](std::size_t k) { return std::pair{entries[k][0], entries[k][1]}; });
   std::vector<int> up_of(sinner.size(), -1);  // entry of S -> entry of P S P^T (-1: S's upper triangle)
-  schur_up_.resize(n_vel_, n_vel_);
-  schur_up_.resizeNonZeros(Eigen::Index(entries.size()));
-  int* uo = schur_up_.outerIndexPtr();
-  int* ui = schur_up_.innerIndexPtr();
-  std::fill(uo, uo + n_vel_ + 1, 0);
-  for (std::size_t k = 0; k < entries.size(); ++k) {
-    ++uo[entries[k][0] + 1];
-    ui[k] = entries[k][1];
-    up_of[std::size_t(entries[k][2])] = int(k);
-  }
-  for (int c = 0; c < n_vel_; ++c) uo[c + 1] += uo[c];
-  std::fill(schur_up_.valuePtr(), schur_up_.valuePtr() + entries.size(), 0.0);
+  for (std::size_t k = 0; k < entries.size(); ++k) up_of[std::size_t(entries[k][2])] = int(k);
   up_src_.assign(entries.size(), -1);
   for (std::size_t k = 0; k < schur_src.size(); ++k)
     if (up_of[k] >= 0) up_src_[std::size_t(up_of[k])] = schur_src[k];

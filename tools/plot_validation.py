@@ -269,6 +269,21 @@ def order_text(e):
     return "not asymptotic" + (f", observed order {obs:.2f}" if obs is not None else "")
 
 
+def fitted_curve(e, hmax_nm):
+    """The 3D extrapolation's fitted curve over h = 0 to hmax_nm (report.json): (h in nm, values in
+    the figure's SI unit, legend label), or None when the extrapolation is not a fit."""
+    if not e:
+        return None
+    hs = np.linspace(0.0, hmax_nm, 60) * 1e-9
+    fit = e.get("expansion")
+    if e.get("method") == "expansion_fit" and fit and None not in fit.values():
+        return hs * 1e9, fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs, "3D: fitted f0 + a h + b h²"
+    lum = e.get("lumen_fit")
+    if e.get("method") == "lumen_fit" and lum and None not in lum.values():
+        return hs * 1e9, lum["T0"] * (1.0 - lum["a_per_m"] * hs) ** -4, "3D: fitted T0 (1 − a h)⁻⁴"
+    return None
+
+
 def reference_convergence_figure(case, path):
     """Both grid series of a case with an axisymmetric reference against h: each figure on its
     own panel, the 3D runs and the axi runs, both extrapolations at h = 0 with their error bars
@@ -289,19 +304,9 @@ def reference_convergence_figure(case, path):
         ea = ref.get(key)
         if p3:
             ax.plot(*zip(*p3), "ko-", ms=5, label=f"3D runs: {order_text(e3)}")
-            fit = (e3 or {}).get("expansion")
-            if e3 and e3.get("method") == "expansion_fit" and fit and None not in fit.values():
-                # the suite's fitted error expansion f0 + a h + b h² (report.json), from h = 0 to
-                # the coarsest grid
-                hs = np.linspace(0.0, max(h for h, _ in p3), 60) * 1e-9
-                ff = fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs
-                ax.plot(hs * 1e9, ff * scale, "k--", lw=0.8, label="3D: fitted f0 + a h + b h²")
-            lum = (e3 or {}).get("lumen_fit")
-            if e3 and e3.get("method") == "lumen_fit" and lum and None not in lum.values():
-                # the suite's fitted lumen model T0 (1 - a h)^-4 (report.json), h = 0 to the coarsest grid
-                hs = np.linspace(0.0, max(h for h, _ in p3), 60) * 1e-9
-                ax.plot(hs * 1e9, lum["T0"] * (1.0 - lum["a_per_m"] * hs) ** -4 * scale, "k--", lw=0.8,
-                        label="3D: fitted T0 (1 − a h)⁻⁴")
+            curve = fitted_curve(e3, max(h for h, _ in p3))  # the suite's fit, h = 0 to the coarsest grid
+            if curve:
+                ax.plot(curve[0], curve[1] * scale, "k--", lw=0.8, label=curve[2])
         if pa:
             ax.plot(*zip(*pa), "s-", color="tab:blue", ms=5,
                     label=f"axisymmetric runs ({ref.get('method', 'axi')}): {order_text(ea)}")
@@ -360,23 +365,16 @@ def convergence_figure(case, path):
                 what = f" (order {ref['order']:.2f}, accepted in {rng_text})" if ref["order"] else ""
             elif ref.get("method") == "expansion_fit":
                 what = " (not asymptotic: f0 + a h + b h² fitted to the grids, error = leave-one-out change)"
-                fit = ref.get("expansion")
-                if fit and None not in fit.values():  # the suite's fitted expansion (report.json)
-                    hs = np.linspace(0.0, max(h), 60) * 1e-9
-                    ax.plot(hs * 1e9, (fit["f0"] + fit["a_per_m"] * hs + fit["b_per_m2"] * hs * hs) * scale, "k--",
-                            lw=0.8, label="3D: fitted f0 + a h + b h²")
             elif ref.get("method") == "lumen_fit":
-                what = (" (the smeared lumen: T0 (1 − a h)⁻⁴ fitted to the grids, error = leave-one-out change or "
-                        "the finest pair's line)")
-                lum = ref.get("lumen_fit")
-                if lum and None not in lum.values():  # the suite's fitted lumen model (report.json)
-                    hs = np.linspace(0.0, max(h), 60) * 1e-9
-                    ax.plot(hs * 1e9, lum["T0"] * (1.0 - lum["a_per_m"] * hs) ** -4 * scale, "k--", lw=0.8,
-                            label="3D: fitted T0 (1 − a h)⁻⁴")
+                what = (" (the smeared lumen: T0 (1 − a h)⁻⁴ fitted to the grids, error = leave-one-out change, "
+                        "the finest pair's line or a quarter of the correction)")
             else:
                 what = (" (not asymptotic: finest ± spread" +
                         (f"; observed order {obs:.2f} outside {rng_text}" if obs is not None and
                          not (rng and rng[0] <= obs <= rng[1]) else "") + ")")
+            curve = fitted_curve(ref, max(h))
+            if curve:
+                ax.plot(curve[0], curve[1] * scale, "k--", lw=0.8, label=curve[2])
             ax.errorbar([0], [ref["value"] * scale], yerr=[ref["error"] * scale], fmt="rs", capsize=4,
                         label="3D reference h → 0 ± error" + what)
         for k, m in enumerate(case["models1d"]):
