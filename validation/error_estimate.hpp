@@ -15,6 +15,13 @@
 // A figure that is positive by its nature (the cycle time) whose lower bound falls below 0
 // has that bound clipped to 0 (with a note giving the unclipped value; E_1 too when it is
 // negative); the error and extrapolated_order0_5, extrapolated_order2 keep the unclipped values.
+//
+// The cycle time is estimated by the smeared lumen's model instead (lumen_two_grid_estimate):
+// the kernel narrows the lumen the flow sees by a multiple of h and the cycle goes as the
+// lumen's R^-4, so the estimate's E_p are taken of y = T^(-1/4), the figure that is linear in h
+// on the converged suite's series (validation::lumen_fit), and mapped back, T = y^-4. The mean
+// velocity per cycle is the displacement per cycle over the cycle time in every run, so its
+// estimate is the ratio of theirs (ratio_estimate).
 #pragma once
 
 #include <string>
@@ -38,6 +45,11 @@ struct TwoGridEstimate {
   bool clipped = false;                ///< interval_low raised to 0 (a positive figure)
   /// why a bound was clipped, or that the grids give opposite signs; empty otherwise
   std::string note;
+  /// what the E_p are extrapolations of: kPowerSeries, kSmearedLumen or kRatio
+  std::string model = kPowerSeries;
+  static constexpr const char* kPowerSeries = "power series in h";
+  static constexpr const char* kSmearedLumen = "smeared lumen: T^(-1/4) as a power series in h";
+  static constexpr const char* kRatio = "ratio of the displacement's and the cycle time's estimates";
 };
 
 /// E_p = fine + (fine - coarse) / (r^p - 1), r = h_coarse / h_fine.
@@ -48,8 +60,24 @@ double extrapolate_two_grids(double fine, double coarse, double h_fine, double h
 /// or h_coarse <= h_fine.
 TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive);
 
+/// The estimate of a cycle time T by the smeared lumen's model: E_p of y = T^(-1/4) (fine and
+/// coarse both positive), mapped back as T = E_p(y)^-4; the interval [min, max] of those, the
+/// error max |E_p - E_1| in T. When an E_p(y) is not positive (the cycle grows with refinement
+/// faster than the model allows) the power-series estimate of T (positive) instead, with a note.
+/// Throws InputError as two_grid_estimate, and for a non-positive fine or coarse figure.
+TwoGridEstimate lumen_two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse);
+
+/// The estimate of a ratio q = a / b from the estimates of a and of b > 0 (the mean velocity
+/// per cycle from the displacement per cycle and the cycle time): E_p = a.E_p / b.E_p; the
+/// interval the extreme ratios of the two intervals' bounds (q is monotone in a and in b > 0,
+/// so every pair of values inside both intervals gives a q inside it); error max |bound - E_1|.
+/// fine and coarse are the two runs' own q. When b's interval reaches 0, the power-series
+/// estimate of q's own two values instead, with a note.
+TwoGridEstimate ratio_estimate(const TwoGridEstimate& a, const TwoGridEstimate& b, double fine, double coarse,
+                               double h_fine, double h_coarse);
+
 /// summary.json's object of one figure: fine, coarse, extrapolated_order1, interval_low,
-/// interval_high, error, extrapolated_order0_5, extrapolated_order2 (and note when clipped).
+/// interval_high, error, extrapolated_order0_5, extrapolated_order2, model (and note when clipped).
 scene::json to_json(const TwoGridEstimate& e);
 
 /// The headline figures of a run (summary.json keys) the estimate covers.
