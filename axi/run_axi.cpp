@@ -65,7 +65,7 @@ class Runner {
  public:
   Runner(const ParamsAxi& p, const json& resolved, const std::string& out, const RunControlAxi& ctl)
       : p_(p), b_(p.base), resolved_(resolved), out_(out), ctl_(ctl), grid_{p.nr, p.nx, p.h},
-        fitted_(p.method == AxiMethod::Fitted), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes, p.ring_s0}),
+        fitted_(p.method == AxiMethod::Fitted), wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes, p.ring_s0, p.poisson_coupling}),
         mesh_(ring_mesh(wall_, b_.R0, b_.L, p.x_start())), e_ref_(wall_.uniform_energy(b_.protocol.R_f)),
         protocol_(effective(), mesh_, e_ref_),
         rec_("axi", fitted_ ? "axisymmetric_fitted_finite_elements" : "axisymmetric_immersed_boundary", b_.L,

@@ -31,7 +31,7 @@ class PrescribedRunner {
  public:
   PrescribedRunner(const ParamsAxi& p, const json& resolved, const std::string& out, const RunControlAxi& ctl)
       : p_(p), b_(p.base), resolved_(resolved), out_(out), ctl_(ctl),
-        wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes, p.ring_s0}),
+        wall_(AxiWallParams{b_.R0, b_.L, p.ks, p.D, p.wall_nodes, p.ring_s0, p.poisson_coupling}),
         rec_("axi", "axisymmetric_fitted_finite_elements", b_.L, series_columns(), wall_.reference_positions()) {
     rec_.keep(ctl.keep_rows);
     t_end_ = b_.duration > 0 ? b_.duration : b_.wave.transit(b_.L);

@@ -38,7 +38,8 @@ const json& section_keys() {
                               {"event_dt", "quantity:s@positive"},
                               {"time_limit", "quantity:s@positive"},
                               {"checkpoint_interval", "quantity:s@positive"},
-                              {"threads", "integer@[1,2]"}}}};
+                              {"threads", "integer@[1,2]"},
+                              {"wall_poisson_coupling", "boolean"}}}};
   return keys;
 }
 
@@ -155,6 +156,9 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   // fitted: 2 factors each step's systems on a second thread while the first solves (docs/axi.md
   // "Linear solves"); not part of the physics (the solves stop at the same residual either way)
   p.threads = int(a.integer("threads", 2, 1, 2));
+  // a diagnostic of the 1D tier's wall, not the 3D network's: false drops the stretching
+  // energy's Poisson coupling (docs/axi.md, "Wall")
+  p.poisson_coupling = a.boolean("wall_poisson_coupling", true);
   a.finish();
 
   // 4. Consistency.

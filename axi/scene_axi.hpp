@@ -51,6 +51,7 @@ struct ParamsAxi {
   double wall_row_aspect = 0.0; ///< fitted: rows graded towards the wall where columns are narrow (FittedMeshParams)
   std::vector<double> ring_s0; ///< reference ring positions (fitted; empty: uniform), m
   double ks = 0.0;             ///< N/m, the network's spring constant
+  bool poisson_coupling = true; ///< axi.wall_poisson_coupling: false is the diagnostic wall of Poisson ratio 0
   double D = 0.0;              ///< J, the wall's bending rigidity
   std::string bending_source;  ///< "full3d.membrane.bending_rigidity" or the k_b mapping used
   // time stepping (immersed boundary: explicit trapezoidal rule with an embedded Euler error

@@ -68,8 +68,14 @@ double sum_sq(const Eigen::VectorXd& v) {
 }
 }  // namespace
 
-double stretching_density(double ks, double ls, double lt, double* dW_dls, double* dW_dlt) {
+double stretching_density(double ks, double ls, double lt, double* dW_dls, double* dW_dlt, bool coupled) {
   const double c = ks / kSqrt3;
+  if (!coupled) {  // Y / 2 = c
+    const double et = lt - 1.0, es = ls - 1.0;
+    if (dW_dls) *dW_dls = 2.0 * c * es;
+    if (dW_dlt) *dW_dlt = 2.0 * c * et;
+    return c * (et * et + es * es);
+  }
   const double q = std::sqrt(0.25 * lt * lt + 0.75 * ls * ls);
   const double et = lt - 1.0, eq = q - 1.0;
   if (dW_dls || dW_dlt) {
@@ -149,7 +155,7 @@ std::vector<double> graded_ring_positions(double L, double spacing, double end_r
 }
 
 double AxiWall::uniform_energy(double R) const {
-  return 2.0 * kPi * p_.R0 * p_.L * stretching_density(p_.ks, 1.0, R / p_.R0);
+  return 2.0 * kPi * p_.R0 * p_.L * stretching_density(p_.ks, 1.0, R / p_.R0, nullptr, nullptr, p_.poisson_coupling);
 }
 
 std::array<double, 2> AxiWall::energies(const Eigen::Matrix3Xd& X) const {
@@ -170,6 +176,7 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
                      "3 x " + std::to_string(n_) + " (one column per wall node)");
   const int n = n_, ne = n - 1;
   const double R0 = p_.R0, ks = p_.ks, D = p_.D, nu = kWallPoisson;
+  const bool coupled = p_.poisson_coupling;
   const double inv_R0 = 1.0 / R0;
   const double G = kPi * R0 * D;   // 2 pi R0 * D/2
   const bool grad = F != nullptr;
@@ -196,7 +203,7 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
     const double lt1 = (ra + kXi1 * dr) / R0, lt2 = (ra + kXi2 * dr) / R0;
     if (grad) {
       double ds1, dt1, ds2, dt2;
-      Es += ws * (stretching_density(ks, ls, lt1, &ds1, &dt1) + stretching_density(ks, ls, lt2, &ds2, &dt2));
+      Es += ws * (stretching_density(ks, ls, lt1, &ds1, &dt1, coupled) + stretching_density(ks, ls, lt2, &ds2, &dt2, coupled));
       const double dEdl = ws * (ds1 + ds2) / h0_[e];  // dE/dl
       const double fx = dEdl * c, fr = dEdl * s;  // dE/dX_{e+1} along the tangent
       (*F)(0, e) += fx;
@@ -207,7 +214,8 @@ double AxiWall::evaluate(const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd* F, std::ar
       (*F)(1, e) -= g1 * (1.0 - kXi1) + g2 * (1.0 - kXi2);
       (*F)(1, e + 1) -= g1 * kXi1 + g2 * kXi2;
     } else {
-      Es += ws * (stretching_density(ks, ls, lt1) + stretching_density(ks, ls, lt2));
+      Es += ws * (stretching_density(ks, ls, lt1, nullptr, nullptr, coupled) +
+                  stretching_density(ks, ls, lt2, nullptr, nullptr, coupled));
     }
   }
 

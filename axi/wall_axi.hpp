@@ -75,6 +75,9 @@ struct AxiWallParams {
   /// Reference positions s0_k of the nodes along the meridian, m: empty for the uniform spacing
   /// L / (nodes - 1), else `nodes` values from 0 to L, strictly increasing.
   std::vector<double> s0;
+  /// false: the stretching energy without the network's Poisson coupling (axi.wall_poisson_coupling,
+  /// a diagnostic; stretching_density)
+  bool poisson_coupling = true;
 };
 
 /// Reference ring positions from 0 to L refined towards both ends: interior spacing at most
@@ -99,8 +102,12 @@ std::vector<double> segment_aligned_ring_positions(double L, double spacing, dou
 
 /// Stretching energy density W_s(lambda_s, lambda_t) per unit reference area (J/m^2) of the
 /// network with spring constant ks (N/m); optionally its partial derivatives.
+/// coupled = false: the diagnostic law without the Poisson coupling (axi.wall_poisson_coupling),
+/// W = (Y/2)[(lambda_t - 1)^2 + (lambda_s - 1)^2] with the network's Y: Poisson ratio 0, and
+/// under a uniform load with free ends (dW/dlambda_s = 0) the same hoop law as the network's,
+/// dW/dlambda_t = Y (lambda_t - 1), at every load.
 double stretching_density(double ks, double lambda_s, double lambda_t, double* dW_dls = nullptr,
-                          double* dW_dlt = nullptr);
+                          double* dW_dlt = nullptr, bool coupled = true);
 
 /// The network's linearised moduli: 2D Young's modulus Y = 2 ks / sqrt(3) (N/m), Poisson 1/3.
 inline double young_modulus_2d(double ks) { return 2.0 * ks / 1.7320508075688772935; }

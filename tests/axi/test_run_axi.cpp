@@ -111,6 +111,15 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
     s["axi"]["rim_refinement"] = bad;
     EXPECT_EQ(input_error_key(s), "axi.rim_refinement") << bad;
   }
+  // the diagnostic wall without the Poisson coupling: a boolean, default true, resolved
+  s = base;
+  json resolved;
+  EXPECT_TRUE(swim::axi::read_scene_axi(s, resolved).poisson_coupling);
+  EXPECT_EQ(resolved["axi"]["wall_poisson_coupling"], true);
+  s["axi"]["wall_poisson_coupling"] = false;
+  EXPECT_FALSE(swim::axi::read_scene_axi(s, resolved).poisson_coupling);
+  s["axi"]["wall_poisson_coupling"] = 0;
+  EXPECT_EQ(input_error_key(s), "axi.wall_poisson_coupling");
 }
 
 namespace {

@@ -252,6 +252,45 @@ TEST(AxiWall, LargeUniformPressureMatchesTheClosedFormFreeEndedSolution) {
   }
 }
 
+// The diagnostic wall without the Poisson coupling (axi.wall_poisson_coupling = false): the
+// linearised law has the network's Y on both axes and no cross term (Poisson ratio 0); under a
+// uniform load with free ends it has the network's hoop law at every load (the same radius,
+// so the same C1 and static tube law), and its length does not change, where the network's
+// grows to sqrt((4 - lt^2)/3) L (+10 % at lt = 0.55).
+TEST(AxiWall, WithoutThePoissonCouplingTheTubeLawIsTheSameAndTheLengthStays) {
+  const double e = 1e-4, Y = swim::axi::young_modulus_2d(kKs);
+  auto W = [&](double es, double et) {
+    return swim::axi::stretching_density(kKs, 1 + es, 1 + et, nullptr, nullptr, false);
+  };
+  const double Wss = (W(e, 0) - 2 * W(0, 0) + W(-e, 0)) / (e * e);
+  const double Wtt = (W(0, e) - 2 * W(0, 0) + W(0, -e)) / (e * e);
+  const double Wst = (W(e, e) - W(e, -e) - W(-e, e) + W(-e, -e)) / (4 * e * e);
+  EXPECT_NEAR(Wss, Y, 1e-6 * Y);
+  EXPECT_NEAR(Wtt, Y, 1e-6 * Y);
+  EXPECT_NEAR(Wst, 0.0, 1e-6 * Y);
+  double ds = 0, dt = 0;
+  const double ls = 1.2, lt = 0.6, h = 1e-6;
+  swim::axi::stretching_density(kKs, ls, lt, &ds, &dt, false);
+  EXPECT_NEAR(ds, (W(ls - 1 + h, lt - 1) - W(ls - 1 - h, lt - 1)) / (2 * h), 1e-8 * kKs);
+  EXPECT_NEAR(dt, (W(ls - 1, lt - 1 + h) - W(ls - 1, lt - 1 - h)) / (2 * h), 1e-8 * kKs);
+
+  const double target = 0.55, P = (1 - target) * Y / kR0;
+  AxiWallParams q{kR0, 8 * kR0, kKs, kD, 81, {}};
+  const auto coupled = swim::axi::relax_under_pressure(AxiWall(q), P);
+  q.poisson_coupling = false;
+  const AxiWall w(q);
+  const auto r = swim::axi::relax_under_pressure(w, P);
+  EXPECT_NEAR(r.mid_radius, target * kR0, 1e-7 * kR0);
+  EXPECT_NEAR(r.mid_radius, coupled.mid_radius, 1e-7 * kR0);
+  EXPECT_NEAR(r.c1, coupled.c1, 1e-6 * coupled.c1);
+  EXPECT_NEAR(r.X(0, w.nodes() - 1), 8 * kR0, 1e-7 * 8 * kR0);
+  EXPECT_NEAR(coupled.X(0, w.nodes() - 1), std::sqrt((4 - target * target) / 3) * 8 * kR0, 1e-7 * 8 * kR0);
+  // its forces are its energy's exact gradient
+  const Eigen::Matrix3Xd X = perturbed(w, 0.05, 7);
+  const auto [err, fmax] = gradient_error(w, X, w.forces(X), [&](const Eigen::Matrix3Xd& Z) { return total(w, Z); });
+  EXPECT_LT(err, 1e-7 * fmax);
+}
+
 TEST(AxiWall, RelaxationReportsBadArgumentsAndNonConvergence) {
   const AxiWall w(AxiWallParams{kR0, 8 * kR0, kKs, kD, 33, {}});
   EXPECT_THROW(swim::axi::relax_under_pressure(w, 0.0), swim::InputError);
