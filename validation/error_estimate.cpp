@@ -10,6 +10,19 @@
 
 namespace swim::validation {
 
+namespace {
+/// E_1, the interval [min, max] of the E_p and the error max |E_p - E_1| from e.extrapolated.
+void spread_of_extrapolations(TwoGridEstimate& e) {
+  e.extrapolated_order1 = e.extrapolated[1];
+  e.interval_low = *std::min_element(e.extrapolated, e.extrapolated + 3);
+  e.interval_high = *std::max_element(e.extrapolated, e.extrapolated + 3);
+  e.error = 0.0;
+  for (double v : e.extrapolated) e.error = std::max(e.error, std::abs(v - e.extrapolated_order1));
+}
+
+void append_note(std::string& note, const std::string& n) { note += (note.empty() ? "" : "; ") + n; }
+}  // namespace
+
 double extrapolate_two_grids(double fine, double coarse, double h_fine, double h_coarse, double order) {
   const double r = h_coarse / h_fine;
   return fine + (fine - coarse) / (std::pow(r, order) - 1.0);
@@ -26,11 +39,8 @@ TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, dou
   e.fine = fine;
   e.coarse = coarse;
   for (int i = 0; i < 3; ++i) e.extrapolated[i] = extrapolate_two_grids(fine, coarse, h_fine, h_coarse, kEstimateOrders[i]);
-  e.extrapolated_order1 = e.extrapolated[1];
-  e.interval_low = *std::min_element(e.extrapolated, e.extrapolated + 3);
-  e.interval_high = *std::max_element(e.extrapolated, e.extrapolated + 3);
-  for (double v : e.extrapolated) e.error = std::max(e.error, std::abs(v - e.extrapolated_order1));
-  auto add_note = [&](const std::string& n) { e.note += (e.note.empty() ? "" : "; ") + n; };
+  spread_of_extrapolations(e);
+  auto add_note = [&](const std::string& n) { append_note(e.note, n); };
   char b[240];
   if ((fine > 0 && coarse < 0) || (fine < 0 && coarse > 0))
     add_note("the two grids give opposite signs: the coarse grid is far from the asymptotic range, so the "
@@ -60,7 +70,7 @@ TwoGridEstimate lumen_two_grid_estimate(double fine, double coarse, double h_fin
   if (!(fine > 0 && coarse > 0)) {
     std::snprintf(b, sizeof b, "the smeared lumen's model needs positive cycle times (%.4g s, %.4g s): the power series "
                   "instead", fine, coarse);
-    power.note += (power.note.empty() ? "" : "; ") + std::string(b);
+    append_note(power.note, b);
     return power;
   }
   const double y_fine = std::pow(fine, -0.25), y_coarse = std::pow(coarse, -0.25);
@@ -74,15 +84,12 @@ TwoGridEstimate lumen_two_grid_estimate(double fine, double coarse, double h_fin
       std::snprintf(b, sizeof b, "the cycle time grows with refinement (%.4g s on the coarse grid, %.4g s on this one) "
                     "faster than the smeared lumen's model allows at order %g: the power series instead",
                     coarse, fine, kEstimateOrders[i]);
-      power.note += (power.note.empty() ? "" : "; ") + std::string(b);
+      append_note(power.note, b);
       return power;
     }
     e.extrapolated[i] = fine * std::pow(y / y_fine, -4.0);  // exactly fine where y = y_fine
   }
-  e.extrapolated_order1 = e.extrapolated[1];
-  e.interval_low = *std::min_element(e.extrapolated, e.extrapolated + 3);
-  e.interval_high = *std::max_element(e.extrapolated, e.extrapolated + 3);
-  for (double v : e.extrapolated) e.error = std::max(e.error, std::abs(v - e.extrapolated_order1));
+  spread_of_extrapolations(e);
   return e;
 }
 
@@ -90,9 +97,9 @@ TwoGridEstimate ratio_estimate(const TwoGridEstimate& a, const TwoGridEstimate& 
                                double h_fine, double h_coarse) {
   if (!(b.interval_low > 0)) {
     TwoGridEstimate e = two_grid_estimate(fine, coarse, h_fine, h_coarse, false);
-    e.note += std::string(e.note.empty() ? "" : "; ") +
-              "the denominator's interval reaches 0, so the ratio of the two estimates is unbounded: the power series of "
-              "this figure's own two values instead";
+    append_note(e.note,
+                "the denominator's interval reaches 0, so the ratio of the two estimates is unbounded: the power series "
+                "of this figure's own two values instead");
     return e;
   }
   TwoGridEstimate e;
