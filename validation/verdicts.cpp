@@ -148,30 +148,51 @@ json finding(const std::string& claim, const std::string& rule, const json& ev) 
   return json{{"claim", claim}, {"status", "not assessed"}, {"rule", rule}, {"evidence", ev}};
 }
 
-/// A claim that values[a] > values[b] for each (a, b) in `pairs`.
-json trend(const std::string& claim, const std::vector<Point>& p, const std::string& missing, const json& ev,
-           const std::vector<std::pair<std::size_t, std::size_t>>& pairs, const std::string& unit,
-           const std::string& settle_suffix = kSettleSuffix) {
+/// The points that have a value, and what the others lack ("CASE: reason", joined).
+std::vector<Point> present(const std::vector<Point>& p, std::vector<std::string>& lacking) {
+  std::vector<Point> q;
+  for (const Point& x : p)
+    if (x.v.missing.empty()) q.push_back(x);
+    else lacking.push_back(x.name() + " (" + x.v.missing + ")");
+  return q;
+}
+
+/// A claim that values[a] > values[b] for each (a, b) that pairs_of(n) gives on n points in
+/// sweep order. Cases without a value leave the claim on the others: pairs_of then runs on the
+/// points that have one (a monotone trend holds across a gap as between neighbours), a
+/// contradiction among them refutes the claim, and otherwise it is at best inconclusive, to be
+/// settled by the missing values. first_required: the claim is about the sweep's first case
+/// (the shortest swimmer), so without its value it is not assessed.
+template <class PairsOf>
+json trend(const std::string& claim, const std::vector<Point>& all, const std::string& missing, const json& ev,
+           const PairsOf& pairs_of, const std::string& unit, const std::string& settle_suffix = kSettleSuffix,
+           bool first_required = false) {
   json f = finding(claim, kTrendRule, ev);
-  if (p.size() < 2) {
+  if (all.size() < 2) {
     f["reason"] = "the suite has fewer than two cases for it";
     return f;
   }
-  if (!missing.empty()) {
+  std::vector<std::string> lacking;
+  const std::vector<Point> p = present(all, lacking);
+  if (p.size() < 2 || (first_required && !all.front().v.missing.empty())) {
     f["reason"] = missing;
     return f;
   }
   json comps = json::array();
   std::vector<std::string> undecided;
-  bool all = true, against = false;
-  for (const auto& [a, b] : pairs) {
+  bool all_support = true, against = false;
+  for (const auto& [a, b] : pairs_of(p.size())) {
     const int o = exceeds(p[a], p[b], unit, comps, undecided);
-    all = all && o > 0;
+    all_support = all_support && o > 0;
     against = against || o < 0;
   }
   f["comparisons"] = comps;
-  f["status"] = against ? "refuted" : all ? "reproduced" : "inconclusive";
-  if (!against && !all) f["to_settle"] = join(undecided, "; ") + settle_suffix;
+  f["status"] = against ? "refuted" : all_support && lacking.empty() ? "reproduced" : "inconclusive";
+  if (!lacking.empty()) f["missing"] = join(lacking, "; ");
+  if (f["status"] == "inconclusive") {
+    if (!lacking.empty()) undecided.insert(undecided.begin(), "values for " + join(lacking, "; "));
+    f["to_settle"] = join(undecided, "; ") + settle_suffix;
+  }
   return f;
 }
 
@@ -306,11 +327,11 @@ json findings(const json& cases, const json& th) {
     // the rule gives on the sweep's n points
     using Pairs = std::vector<std::pair<std::size_t, std::size_t>>;
     const auto pairwise = [&](const std::string& claim, const auto& sweep, const std::string& key, const char* axis,
-                              const char* unit, const auto& pairs_of) {
+                              const char* unit, const auto& pairs_of, bool first_required = false) {
       json ev = json::array();
       std::string missing;
       const auto p = points(sweep, key, axis, ev, missing, one_d);
-      out.push_back(trend(claim + on, p, missing, ev, pairs_of(p.size()), unit, settle_suffix));
+      out.push_back(trend(claim + on, p, missing, ev, pairs_of, unit, settle_suffix, first_required));
     };
     // distance per cycle grows with L: each L against the next
     pairwise("distance per cycle grows with the swimmer length L", aspect, kd, "L_um", "m", [](std::size_t n) {
@@ -331,21 +352,27 @@ json findings(const json& cases, const json& th) {
                Pairs q;
                for (std::size_t j = 1; j < n; ++j) q.emplace_back(0, j);
                return q;
-             });
+             },
+             true);
     // largest at about 50 % deformation (R_f / R0 within 0.1 of 0.5): some case there exceeds
     // every case away from it
     {
       json ev = json::array();
       std::string missing;
-      const auto p = points(amplitude, kv, "R_f_over_R0", ev, missing, one_d);
+      const auto all = points(amplitude, kv, "R_f_over_R0", ev, missing, one_d);
+      std::vector<std::string> lacking;
+      const auto p = present(all, lacking);
+      bool lacking_at = false;  // a case at about 50 % without a value: the claim cannot be refuted
+      for (const Point& x : all)
+        lacking_at = lacking_at || (!x.v.missing.empty() && std::abs((*x.c)["sweep_value"].get<double>() - 0.5) <= 0.1);
       json f = finding("mean velocity per cycle is largest at about 50 % deformation (R_f/R0 within 0.1 of 0.5)" + on,
                        std::string(kTrendRule) + "; a case at about 50 % must exceed every case away from it", ev);
       std::vector<std::size_t> at, away;
       for (std::size_t i = 0; i < p.size(); ++i)
         (std::abs((*p[i].c)["sweep_value"].get<double>() - 0.5) <= 0.1 ? at : away).push_back(i);
-      if (p.size() < 2) f["reason"] = "the suite has fewer than two cases for it";
-      else if (!missing.empty()) f["reason"] = missing;
-      else if (at.empty()) f["reason"] = "the sweep has no case at about 50 % deformation";
+      if (all.size() < 2) f["reason"] = "the suite has fewer than two cases for it";
+      else if (p.size() < 2) f["reason"] = missing;
+      else if (at.empty()) f["reason"] = lacking_at ? missing : "the sweep has no case at about 50 % deformation";
       else if (away.empty()) f["reason"] = "the sweep has no case away from 50 % deformation";
       else {
         json comps = json::array();
@@ -361,9 +388,15 @@ json findings(const json& cases, const json& th) {
           for (std::size_t i = 0; i < at.size(); ++i) beats_all = beats_all && o[i][j] < 0;
           refuted = refuted || beats_all;
         }
+        refuted = refuted && !lacking_at;
+        reproduced = reproduced && lacking.empty();
         f["comparisons"] = comps;
         f["status"] = reproduced ? "reproduced" : refuted ? "refuted" : "inconclusive";
-        if (!reproduced && !refuted) f["to_settle"] = join(undecided, "; ") + settle_suffix;
+        if (!lacking.empty()) f["missing"] = join(lacking, "; ");
+        if (!reproduced && !refuted) {
+          if (!lacking.empty()) undecided.insert(undecided.begin(), "values for " + join(lacking, "; "));
+          f["to_settle"] = join(undecided, "; ") + settle_suffix;
+        }
       }
       out.push_back(f);
     }

@@ -192,7 +192,8 @@ TEST(Findings, DistanceGrowsWithLengthHasThreeOutcomes) {
 // (the first of models1d), each 1D value carrying the tier's grid error (0.5 %). The 1D rows
 // follow the 1D values, not the reference's: here the reference grows with L and the 1D tier
 // shrinks; two 1D values 0.2 % apart are within their error bars (inconclusive, settled by a
-// finer 1D grid); a case whose default model failed leaves the 1D row not assessed, naming it.
+// finer 1D grid); a case whose default model failed leaves the claim on the other cases: at best
+// inconclusive, naming the failed case, and refuted when the others contradict it.
 TEST(Findings, TheTrendsAreAssessedOnTheDefault1DModelToo) {
   const std::string grows = "distance per cycle grows with the swimmer length L";
   const std::string on1d = grows + " (1D tier, the suite's default 1D model)";
@@ -217,7 +218,17 @@ TEST(Findings, TheTrendsAreAssessedOnTheDefault1DModelToo) {
   EXPECT_NE(f["to_settle"].get<std::string>().find("a finer 1D grid"), std::string::npos) << f["to_settle"];
   fs = findings(with_1d(cs, {30 * nm, -1, 90 * nm}), kThresholds);
   f = find(fs, on1d);
-  EXPECT_EQ(f["status"], "not assessed") << f.dump(1);
+  EXPECT_EQ(f["status"], "inconclusive") << f.dump(1);  // L0.8 > L0.2 holds across the gap
+  EXPECT_EQ(f["comparisons"].size(), 1u);
+  EXPECT_EQ(f["comparisons"][0]["outcome"], "supports");
+  EXPECT_NE(f["missing"].get<std::string>().find("L0.4 (the default 1D model (default) has no value: failed: collapsed)"),
+            std::string::npos)
+      << f["missing"];
+  EXPECT_EQ(f["to_settle"].get<std::string>().rfind("values for L0.4", 0), 0u) << f["to_settle"];
+  f = find(findings(with_1d(cs, {30 * nm, -1, 10 * nm}), kThresholds), on1d);
+  EXPECT_EQ(f["status"], "refuted") << f.dump(1);  // a contradiction among the others stands
+  f = find(findings(with_1d(cs, {30 * nm, -1, -1}), kThresholds), on1d);
+  EXPECT_EQ(f["status"], "not assessed") << f.dump(1);  // one value left: nothing to compare
   EXPECT_NE(f["reason"].get<std::string>().find("failed: collapsed"), std::string::npos) << f["reason"];
   int rows = 0;
   for (const auto& g : fs) rows += g["claim"].get<std::string>().find("(1D tier, the suite's default 1D model)") != std::string::npos;
@@ -240,11 +251,23 @@ TEST(Findings, LargestForTheShortestSwimmerHasThreeOutcomes) {
   EXPECT_EQ(f["status"], "reproduced") << f.dump(1);
   f = find(findings(aspect(d, d, d, {15 * nm, 1 * nm}, {22 * nm, 1 * nm}, {17 * nm, 1 * nm}), kThresholds), claim);
   EXPECT_EQ(f["status"], "refuted") << f.dump(1);
+  // without the longest swimmer's value: judged on the other two, at best inconclusive
+  f = find(findings(aspect(d, d, d, {30 * nm, 1 * nm}, {22 * nm, 1 * nm}, {-1, 0}), kThresholds), claim);
+  EXPECT_EQ(f["status"], "inconclusive") << f.dump(1);
+  EXPECT_NE(f["to_settle"].get<std::string>().find("values for L0.8"), std::string::npos) << f["to_settle"];
+  f = find(findings(aspect(d, d, d, {15 * nm, 1 * nm}, {22 * nm, 1 * nm}, {-1, 0}), kThresholds), claim);
+  EXPECT_EQ(f["status"], "refuted") << f.dump(1);
+  // without the shortest swimmer's: the claim is about it, so not assessed
+  f = find(findings(aspect(d, d, d, {-1, 0}, {22 * nm, 1 * nm}, {17 * nm, 1 * nm}), kThresholds), claim);
+  EXPECT_EQ(f["status"], "not assessed") << f.dump(1);
+  EXPECT_NE(f["reason"].get<std::string>().find("L0.2"), std::string::npos) << f["reason"];
 }
 
 // The amplitude claims: distance grows as R_f / R0 falls; the mean velocity is largest at
 // about 50 % (R_f / R0 = 0.55 here) when that case exceeds every other beyond the error bars.
-// A case without a 3D value leaves both not assessed.
+// A case without a 3D value leaves both claims on the other cases: at best inconclusive (the
+// missing case could change them), refuted when the others contradict the claim, and the
+// 50 % claim cannot be refuted while a case at about 50 % has no value.
 TEST(Findings, AmplitudeClaimsHaveThreeOutcomesAndMissingDataIsNotAssessed) {
   const std::string grows = "distance per cycle grows with the deformation amplitude";
   const std::string fifty = "mean velocity per cycle is largest at about 50 %";
@@ -274,10 +297,19 @@ TEST(Findings, AmplitudeClaimsHaveThreeOutcomesAndMissingDataIsNotAssessed) {
   const json fs = findings(amplitude({-1, 0}, d, d, {-1, 0}, {22 * nm, 1 * nm}, {16 * nm, 1 * nm}), kThresholds);
   for (const auto& claim : {grows, fifty}) {
     const json g = find(fs, claim);
-    EXPECT_EQ(g["status"], "not assessed") << g.dump(1);
+    EXPECT_EQ(g["status"], "inconclusive") << g.dump(1);
+    EXPECT_NE(g["missing"].get<std::string>().find("A0.35"), std::string::npos) << g.dump(1);
     EXPECT_TRUE(g["evidence"][0]["value"].is_null());
     EXPECT_EQ(g.dump().find("NaN"), std::string::npos);
   }
+  // the two that have values contradict "grows with the amplitude": refuted without the third
+  EXPECT_EQ(find(findings(amplitude({-1, 0}, {40 * nm, 1 * nm}, {52 * nm, 1 * nm}, v, v, v), kThresholds),
+                 grows)["status"],
+            "refuted");
+  // 0.82 beats 0.35, but 0.55 has no value: the 50 % claim stays inconclusive
+  const json g = find(findings(amplitude(d, d, d, {15 * nm, 1 * nm}, {-1, 0}, {22 * nm, 1 * nm}), kThresholds), fifty);
+  EXPECT_EQ(g["status"], "not assessed") << g.dump(1);  // no case at about 50 % has a value
+  EXPECT_NE(g["reason"].get<std::string>().find("A0.55"), std::string::npos) << g.dump(1);
 }
 
 // "1.5 body lengths/s within 20 %": the interval value ± error inside [1.2, 1.8] reproduces
