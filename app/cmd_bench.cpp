@@ -488,6 +488,7 @@ struct PaperCycle {
   double t_cycle = 0;    ///< its end, or the run's end
   double target_s = 0;   ///< the cycle's wall-time target
   std::vector<std::pair<double, std::string>> split;  ///< wall time parts, largest first
+  std::vector<std::string> sets;  ///< scene overrides beyond the cycle's own (--fine-cycle-set)
 };
 
 /// One cycle of data/scenes/SCENE.json with `sets`, as shipped otherwise (adaptive step,
@@ -536,11 +537,13 @@ PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
 /// mode its buckling estimate grows fastest (seed_mode = "auto": m = 8 lobes of 1e-2 R0, as the
 /// converged suite's paper_aspect_L0.2_seeded), into out/fine_cycle_N. Targets: 4 min at 96
 /// cells, 12 min at 128 (none on other grids).
-PaperCycle run_fine_cycle(const std::string& out, unsigned cores, int cells) {
+PaperCycle run_fine_cycle(const std::string& out, unsigned cores, int cells, const std::vector<std::string>& sets) {
   const double target = cells == 96 ? 240.0 : cells == 128 ? 720.0 : 0.0;
-  return run_cycle(out, cores, "paper_aspect_L0.2",
-                   {"full3d.grid.cells_across=" + std::to_string(cells), "full3d.membrane.seed_mode=auto"},
-                   "fine_cycle_" + std::to_string(cells), target);
+  std::vector<std::string> all = {"full3d.grid.cells_across=" + std::to_string(cells), "full3d.membrane.seed_mode=auto"};
+  all.insert(all.end(), sets.begin(), sets.end());
+  PaperCycle c = run_cycle(out, cores, "paper_aspect_L0.2", all, "fine_cycle_" + std::to_string(cells), target);
+  c.sets = sets;
+  return c;
 }
 
 void print_paper_cycle(const PaperCycle& c) {
@@ -577,6 +580,7 @@ scene::json paper_cycle_json(const PaperCycle& c) {
                    {"time_step", c.run.record.stats.value("time_step", scene::json::object())},
                    {"wall_time_split_s", c.run.record.stats.value("wall_time_split_s", scene::json::object())}};
   if (c.target_s > 0) j["target_wall_time_s"] = c.target_s;
+  if (!c.sets.empty()) j["scene_overrides"] = c.sets;
   return j;
 }
 
@@ -584,7 +588,7 @@ scene::json paper_cycle_json(const PaperCycle& c) {
 /// resolutions, split into its parts, against a bare FFT Stokes solve on the same grid, and
 /// with 1 and 2 threads; then the paper's single cycle (minutes: full bench or --paper-cycle).
 void bench_3d(scene::json& report, const std::string& out, bool quick, bool paper_cycle, unsigned cores,
-              const std::vector<int>& fine_cycles) {
+              const std::vector<int>& fine_cycles, const std::vector<std::string>& fine_sets) {
   std::printf("== 3D tier ==\n");
   print_step_header();
   scene::json grids = scene::json::array();
@@ -611,7 +615,7 @@ void bench_3d(scene::json& report, const std::string& out, bool quick, bool pape
     std::printf("paper single-cycle scene: not run with --quick (swim bench, or --paper-cycle)\n");
   }
   for (int cells : fine_cycles) {
-    const PaperCycle c = run_fine_cycle(out, cores, cells);
+    const PaperCycle c = run_fine_cycle(out, cores, cells, fine_sets);
     print_paper_cycle(c);
     report["full3d_fine_cycle"].push_back(paper_cycle_json(c));
   }
@@ -733,10 +737,19 @@ void bench_axi(scene::json& report, const std::string& out, int cells) {
 }  // namespace
 
 int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const std::string& tier,
-          const std::vector<int>& fine_cycles) {
+          const std::vector<int>& fine_cycles, const std::vector<std::string>& fine_sets) {
   for (int n : fine_cycles)
     if (n < 8 || n > 512 || n % 2)
       throw InputError("--fine-cycle", std::to_string(n), "an even number of cells across from 8 to 512");
+  if (!fine_sets.empty() && fine_cycles.empty())
+    throw InputError("--fine-cycle-set", fine_sets.front(), "overrides of the --fine-cycle runs: give --fine-cycle N too");
+  if (!fine_sets.empty()) {  // the overrides must make a valid scene before anything runs or is written
+    scene::json sc = scene::load_file(data_dir() + "/scenes/paper_aspect_L0.2.json");
+    for (const auto& s : fine_sets) scene::apply_override(sc, s);
+    scene::apply_override(sc, "full3d.grid.cells_across=" + std::to_string(fine_cycles.front()));
+    scene::json resolved;
+    (void)full3d::read_scene3d(sc, resolved);
+  }
   if (!fine_cycles.empty() && tier != "3d" && tier != "all")
     throw InputError("--fine-cycle", std::to_string(fine_cycles.front()), "a 3D figure: with --tier 3d or all");
   const bool do1d = tier == "1d" || tier == "all", do3d = tier == "3d" || tier == "all";
@@ -749,7 +762,7 @@ int bench(const std::string& out_opt, bool quick, bool paper_cycle_opt, const st
   const unsigned cores = std::max(1u, std::thread::hardware_concurrency());
   report["hardware_threads"] = cores;
   if (do1d) bench_1d(report, quick, reps, cores);
-  if (do3d) bench_3d(report, out, quick, paper_cycle, cores, fine_cycles);
+  if (do3d) bench_3d(report, out, quick, paper_cycle, cores, fine_cycles, fine_sets);
   if (do_axi) bench_axi(report, out, quick ? 16 : 32);
   output::write_json(out + "/bench.json", report);
   std::printf("  -> %s/bench.json\n", out.c_str());

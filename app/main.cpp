@@ -4,7 +4,8 @@
 //                       [--error-estimate]
 //   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
 //   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
-//   swim bench [--out DIR] [--quick] [--paper-cycle] [--fine-cycle N ...] [--tier 1d|3d|axi|all]
+//   swim bench [--out DIR] [--quick] [--paper-cycle] [--fine-cycle N ...] [--fine-cycle-set K=V ...]
+//              [--tier 1d|3d|axi|all]
 //   swim scenes
 //   swim demo [--out DIR]
 //   swim calibrate SCENE.json [--out DIR] [--set key.path=value ...] [--wet] [--tube-law] [--overwrite] [--threads N] [--progress|--quiet]
@@ -108,6 +109,10 @@ int main(int argc, char** argv) {
   ben->add_option("--fine-cycle", fine_cycles,
                   "Also run one cycle of the paper's buckling wall (paper_aspect_L0.2, seeded) at N cells across "
                   "(targets: 4 min at 96, 12 min at 128); repeatable");
+  std::vector<std::string> fine_sets;
+  ben->add_option("--fine-cycle-set", fine_sets,
+                  "Override a scene value of the --fine-cycle runs: key.path=value (e.g. "
+                  "full3d.wall_stabilization=bending); repeatable");
 
   CLI::App* sc = cli.add_subcommand("scenes", "List the shipped scenes");
 
@@ -190,7 +195,7 @@ int main(int argc, char** argv) {
     if (*demo) return app::demo(out, progress);
     if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite, scr_confirm, threads3d);
     if (*opt) return app::optimize(opt_spec, out, progress, opt_overwrite, !opt_no_confirm, threads3d);
-    if (*ben) return app::bench(out, quick, paper_cycle, bench_tier, fine_cycles);
+    if (*ben) return app::bench(out, quick, paper_cycle, bench_tier, fine_cycles, fine_sets);
     if (*sc) return app::scenes();
     if (*cal) return app::calibrate(cal_scene, cal_sets, cal_out, cal_wet, cal_overwrite, cal_threads, cal_law, progress);
     if (*val) return app::validate(val_suite, val_quick, val_out, val_threads, progress, val_cases);

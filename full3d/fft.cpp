@@ -38,7 +38,8 @@ std::mutex& planner_mutex() {
 // scratch on every execution (the odd-size RODFT00 rows of the cross sections: 38
 // allocations per batched execution, 1.4 x slower).
 unsigned flags_of(const FftOptions& opt) {
-  return opt.rigor == PlanRigor::Measure ? FFTW_MEASURE : FFTW_ESTIMATE | FFTW_NO_BUFFERING;
+  return opt.rigor == PlanRigor::Measure ? FFTW_MEASURE
+                                         : FFTW_ESTIMATE | (opt.allow_buffering ? 0u : unsigned(FFTW_NO_BUFFERING));
 }
 void set_threads_locked(const FftOptions& opt) {
   if (fftw_threads_init_once()) fftw_plan_with_nthreads(opt.threads > 0 ? opt.threads : 1);

@@ -25,6 +25,9 @@ enum class PlanRigor { Estimate, Measure };
 struct FftOptions {
   int threads = 1;                        ///< FFTW threads per plan (>= 1)
   PlanRigor rigor = PlanRigor::Estimate;  ///< FFTW_ESTIMATE or FFTW_MEASURE
+  /// Estimate plans are made with FFTW_NO_BUFFERING unless this is set: some sizes (a large
+  /// prime factor in a batched real transform) have no plan without buffering.
+  bool allow_buffering = false;
 };
 
 class FftwBuffer {

@@ -70,6 +70,14 @@ IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh m
     throw InputError("IbSolver node_mass", std::to_string(mass_.size()) + " values",
                      "one mass per membrane node (" + std::to_string(mesh_.nodes()) + ")");
   if (!(opt_.max_cfl > 0.0)) throw InputError("full3d.max_cfl", significant(opt_.max_cfl, 4), "a positive number");
+  if (opt_.wall_stabilization != WallStabilization::None) {
+    if (opt_.scheme != IbScheme::ForwardEuler)
+      throw InputError("full3d.wall_stabilization", to_string(opt_.wall_stabilization),
+                       "only with full3d.scheme = forward_euler (or \"none\")");
+    const double D = membrane_.kb * bending_rigidity_per_kb(mesh_, membrane_.bending);
+    stab_ = std::make_unique<WallStabilizer>(mesh_, grid_.h(), fluid.mu, D, opt_.wall_stabilization,
+                                             opt_.stabilization_factor);
+  }
 }
 
 IbState IbSolver::initial_state() const {
@@ -202,6 +210,10 @@ IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
     Xnew = std::move(Y1);
   } else if (opt_.scheme != IbScheme::Midpoint) {
     U = velocity(s.X, F, u, tau);
+    if (stab_) {  // (I + dt B) dX = dt U: the step's mean velocity is dX / dt
+      stab_->apply(dt, U);
+      guard_finite(U, "stabilised node velocity", s.t);
+    }
     Xnew = s.X + dt * U;
   } else {
     const Eigen::Matrix3Xd U0 = velocity(s.X, F, work_uh_, tau_half);
@@ -243,7 +255,7 @@ IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
   return st;
 }
 
-double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
+double IbSolver::explicit_rate(const IbState& s, double dt, int iterations, Eigen::Matrix3Xd* start) {
   const Eigen::Index n = s.X.cols();
   // membrane forces only: the actuation relays are saturating (their level moves by at most
   // one over a ramp of a fraction of delta), so their steep slope bounds an oscillation to the
@@ -256,6 +268,7 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
     r = r * 6364136223846793005ull + 1442695040888963407ull;
     v.data()[i] = double(r >> 11) * (1.0 / 9007199254740992.0) - 0.5;
   }
+  if (start && start->cols() == n) v = *start;
   const double eps = 1e-4 * grid_.h();  // finite-difference amplitude (max node displacement)
   VectorField& f = work_f_;
   VectorField& u = work_uh_;
@@ -281,9 +294,11 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations) {
     spread(grid_, s.X, dF, f, opt_.threads);
     stokes_.step_from_rest(u, f, inertia_step(opt_, dt));
     interpolate(grid_, u, s.X, U, opt_.threads);
+    if (stab_) stab_->apply(dt, U);
     lambda = U.norm() / v.norm();  // |A v| / |v|
     v = -U;
   }
+  if (start) *start = v;
   return lambda;
 }
 

@@ -21,12 +21,14 @@
 
 #include <Eigen/Core>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "full3d/grid.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/stokes.hpp"
+#include "full3d/wall_stabilizer.hpp"
 
 namespace swim::full3d {
 
@@ -76,6 +78,11 @@ struct IbOptions {
   /// sets tau = full3d.adaptive.dt_max, and the Stokes solver then factorises once per run
   /// instead of once per step size (docs/full3d.md, "Adaptive time step").
   double inertia_step = 0.0;
+  /// The stabilised wall update (wall_stabilizer.hpp): which stiffness its model operator
+  /// holds (None: the plain explicit update) and its mobility's multiple of the grid-scale
+  /// sheet mobility. Forward Euler only.
+  WallStabilization wall_stabilization = WallStabilization::None;
+  double stabilization_factor = 1.0;
   StokesOptions stokes{};
 };
 
@@ -133,9 +140,13 @@ class IbSolver {
   /// dominant eigenvalue of X' = U(F(X)) linearised, i.e. of v -> -I S J v with J = dF/dX
   /// (membrane forces, finite differences; the actuation relays saturate and are left out), S the Stokes solve with the step dt on
   /// u^n = 0 (the quasi-steady mobility) and I / spreading the IB transfer operators.
-  /// Forward Euler is stable while dt lambda_max < 2. Power iteration from a fixed
+  /// Forward Euler is stable while dt lambda_max < 2. With the stabilised wall update the
+  /// operator is v -> -(I + dt B)^{-1} I S J v, the rate of the update a step of dt makes,
+  /// which falls as dt grows (dt times it grows). Power iteration from a fixed
   /// pseudo-random start (reproducible), `iterations` coupled solves. Leaves s unchanged.
-  double explicit_rate(const IbState& s, double dt, int iterations = 10);
+  /// `start`: when given and of the mesh's size, the iteration starts from it (a warm start from
+  /// an earlier estimate) and leaves its last vector there.
+  double explicit_rate(const IbState& s, double dt, int iterations = 10, Eigen::Matrix3Xd* start = nullptr);
 
   /// Force the structure exerts on the fluid, -Fbar of eq. (16), N per node.
   Eigen::Matrix3Xd fluid_force(const Eigen::Matrix3Xd& X, double t, const Eigen::Matrix3Xd& accel) const;
@@ -147,6 +158,8 @@ class IbSolver {
 
   const MacGrid& grid() const { return grid_; }
   const CylinderMesh& mesh() const { return mesh_; }
+  /// The stabilised wall update's operator (null without full3d.wall_stabilization).
+  const WallStabilizer* stabilizer() const { return stab_.get(); }
   StokesSolver& stokes() { return stokes_; }
   const StokesSolver& stokes() const { return stokes_; }
   const IbOptions& options() const { return opt_; }
@@ -167,6 +180,7 @@ class IbSolver {
   Eigen::VectorXd mass_;
   IbOptions opt_;
   StokesSolver stokes_;
+  std::unique_ptr<WallStabilizer> stab_;
   ExternalForceFn external_;
   VectorField work_f_, work_u_, work_uh_;  ///< step() work fields, reused between steps
 };

@@ -170,6 +170,13 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
       p.scheme = scheme == "midpoint"    ? IbScheme::Midpoint
                  : scheme == "chebyshev" ? IbScheme::Chebyshev
                                          : IbScheme::ForwardEuler;
+      p.wall_stabilization =
+          wall_stabilization_from(f.choice("wall_stabilization", "none", {"none", "bending"}));
+      p.stabilization_factor = f.number("stabilization_factor", 1.0, Range::closed(0.1, 100.0));
+      if (p.wall_stabilization != WallStabilization::None && p.scheme != IbScheme::ForwardEuler)
+        throw InputError("full3d.wall_stabilization", to_string(p.wall_stabilization),
+                         "only with full3d.scheme = forward_euler (the stabilised update is a forward-Euler step); "
+                         "set full3d.wall_stabilization = \"none\" or full3d.scheme = forward_euler");
     }
     {
       Reader m = f.child("membrane");

@@ -87,6 +87,10 @@ struct Params3d {
   double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md); fixed step
   AdaptiveStep adaptive{};         ///< full3d.adaptive: step control instead of the fixed dt
   IbScheme scheme = IbScheme::ForwardEuler;
+  /// full3d.wall_stabilization, full3d.stabilization_factor: the stabilised wall update
+  /// (wall_stabilizer.hpp; docs/full3d.md, "The stabilised wall step")
+  WallStabilization wall_stabilization = WallStabilization::None;
+  double stabilization_factor = 1.0;
   bool wall_inertia = false;       ///< -m a term of eq. (16) in the fluid-coupled run
   bool navier_stokes = false;      ///< StokesOptions::advection (eq. 28 sub-step before each Stokes step)
   /// energy: the paper's end of recovery (E < energy_tolerance E_ref); dead_band: also ends

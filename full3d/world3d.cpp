@@ -11,6 +11,8 @@ IbOptions ib_options(const Params3d& p) {
   o.dt_key = "full3d.dt";
   o.threads = p.threads;
   o.axisymmetric_wall = p.axisymmetric_wall;
+  o.wall_stabilization = p.wall_stabilization;
+  o.stabilization_factor = p.stabilization_factor;
   o.stokes.fft.threads = p.threads;
   o.stokes.threads = p.threads;
   if (p.container == "cylinder") {

@@ -257,6 +257,17 @@ TEST(CommandLine, BenchRefusesAFineCycleItCannotRun) {
     EXPECT_NE(c.err.find("--fine-cycle"), std::string::npos) << c.err;
     EXPECT_FALSE(fs::exists(d / "b")) << args;
   }
+  // the cycles' scene overrides: only with --fine-cycle, and a value the scene reader refuses
+  // is exit 2 naming its key, before anything runs
+  for (const auto& [args, key] :
+       std::vector<std::pair<std::string, std::string>>{
+           {"--tier 3d --fine-cycle-set full3d.wall_stabilization=bending", "--fine-cycle-set"},
+           {"--tier 3d --fine-cycle 96 --fine-cycle-set full3d.wall_stabilization=elastic", "full3d.wall_stabilization"}}) {
+    const Cli c = swim_cli("bench --quick " + args + " --out \"" + (d / "b").string() + "\"", d);
+    EXPECT_EQ(c.code, 2) << args;
+    EXPECT_NE(c.err.find(key), std::string::npos) << c.err;
+    EXPECT_FALSE(fs::exists(d / "b")) << args;
+  }
   fs::remove_all(d);
 }
 

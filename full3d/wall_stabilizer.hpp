@@ -1,0 +1,107 @@
+// Linear stabilisation of the explicit wall update (full3d.wall_stabilization; docs/full3d.md,
+// "The stabilised wall step").
+//
+// The forward-Euler node update X^{n+1} = X^n + dt U(X^n) is stable while dt lambda < 2 for
+// every mode of the wall coupled through the fluid, lambda = M(k) K(k): the mobility of a wall
+// mode of wavenumber k through the fluid times its elastic stiffness. The stiffest modes sit
+// at the grid scale, k ~ 1/h: stretching gives lambda ~ Y k / mu ~ h^-1 and bending with a
+// rigidity D fixed on every grid lambda ~ D k^3 / mu ~ h^-3, so on fine grids the bending sets
+// the step. The stabilised update solves
+//     (I + dt B) (X^{n+1} - X^n) = dt U(X^n),    B = P^{-1} K,
+// scalar operators on the wall's own mesh (the same for the three components):
+//     K = m0 kappa_b S^T Lt S / l_h   the bending's stiffness near k = 1/h: S the rows of the
+//                                     mesh's graph Laplacian Lg (unit weights) of the nodes off
+//                                     the end rings, Lt its block on those nodes (Lg^3 away
+//                                     from the ends);
+//     P = (I + Lg / (q l_h))^q, q = 8 a low-pass filter: the fluid moves a wall mode finer than
+//                                     the grid less and less (the kernel's transfer function),
+//                                     and B follows it;
+//     kappa_b = A (2 / (3 a^2))^2 D   (a node's bending force A D lap^2 x, with
+//                                      lap ~ -(2 / (3 a^2)) Lg on a triangular lattice of edge a),
+//     l_h = (3/2) (a / h)^2           (Lg's value on a mode of wavenumber 1/h),
+//     m0 = factor * h / (4 mu A)      (the mobility of a sheet mode, 1 / (4 mu k) per area, at k = 1/h),
+// A the mean node area and a the mean rest edge. Per mode, with l = Lg's value on it,
+//     sigma(l) = m0 kappa_b (l^3 / l_h) / (1 + l / (q l_h))^q:
+// near the grid scale (l ~ l_h) it is the bending's own rate there (within e^-1), below it
+// it falls as (k h)^6 where bending goes as (k h)^4, so that the modes the wall's physics lives
+// on (the buckling lobes, the contraction fronts), whose bending is balanced by the load, are
+// not damped as if they were stiff, and above it (the mesh's own scale, a < h/2) it falls
+// again, so that the mesh's fine modes, which the fluid barely moves, are not frozen either.
+// Without the filter (sigma growing as l^3 to the mesh scale) the update froze them and the
+// buckled wall recovered 16-33 % faster on 48 cells across, even with a tenth of m0. The tube's
+// ends are free: a field linear along the axis has no second difference there and S takes no
+// rows of the end rings, so K is zero on it, as the wall's bending is. Per mode the update's
+// factor is 1 - dt lambda / (1 + dt sigma): stable for every dt where sigma >= lambda / 2, and
+// a relative change of order dt sigma of a mode's motion, which vanishes with dt and with h.
+//
+// The mesh is a stack of rings of n_theta nodes, alternate rings offset by half a step, so the
+// graph Laplacian commutes with the rotation by one node: in the azimuthal Fourier modes
+// exp(i m phi) of the nodes' own angles it is, per m, the real tridiagonal matrix along the rings
+//     (Lg_m v)_r = (deg_r - 2 cos(2 pi m / n_theta)) v_r - 2 cos(pi m / n_theta) (v_{r-1} + v_{r+1}),
+// deg_r = 6 (4 on the end rings), and S_m, Lt_m its rows and block of rings 1 .. n_rings - 2.
+// The update solves, per m, (P_m + dt K_m) y = P_m b, a symmetric band of half-width q
+// (LAPACK dpbtrf/dpbtrs): a batched real FFT per ring and component, the band solves and the
+// inverse FFT, O(N log n_theta).
+#pragma once
+
+#include <Eigen/Core>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "full3d/membrane.hpp"
+
+namespace swim::full3d {
+
+/// Whether the wall update is stabilised (full3d.wall_stabilization: none or bending).
+enum class WallStabilization { None, Bending };
+WallStabilization wall_stabilization_from(const std::string& name);
+std::string to_string(WallStabilization w);
+
+class WallStabilizer {
+ public:
+  /// mesh: the wall's mesh (rings of n_theta nodes, rest lengths, node areas); h: the grid's
+  /// cell, m; mu: viscosity, Pa s; D: the wall's bending rigidity, J; factor: m0's multiple of
+  /// the grid-scale mobility (> 0). Throws std::invalid_argument for kind None or a mesh that
+  /// is not a ring stack.
+  WallStabilizer(const CylinderMesh& mesh, double h, double mu, double D, WallStabilization kind,
+                 double factor = 1.0);
+  ~WallStabilizer();
+  WallStabilizer(const WallStabilizer&) = delete;
+  WallStabilizer& operator=(const WallStabilizer&) = delete;
+
+  /// dX <- (I + dt B)^{-1} dX = (P + dt K)^{-1} P dX (3 x N_n, each component alike), dt > 0.
+  void apply(double dt, Eigen::Matrix3Xd& dX) const;
+  /// B x = P^{-1} K x for a 3 x N_n field through the same transforms (the model's rates), 1/s
+  /// times x.
+  Eigen::Matrix3Xd rate(const Eigen::Matrix3Xd& x) const;
+
+  double mobility() const { return m0_; }            ///< m0, m/(N s)
+  double kappa_bending() const { return kappa_b_; }  ///< N/m
+  double laplacian_at_h() const { return l_h_; }     ///< l_h
+  WallStabilization kind() const { return kind_; }
+  /// Factorisations made so far (one per distinct dt).
+  int factorizations() const { return factorizations_; }
+
+ private:
+  struct Impl;
+  struct Factor;
+  const Factor& factor(double dt) const;
+  /// x <- f(m, coefficients) in the azimuthal modes: forward transform, f per mode on the
+  /// n_rings x 6 block (3 components, real and imaginary parts), inverse transform.
+  template <class F>
+  void in_modes(Eigen::Matrix3Xd& x, F&& per_mode) const;
+  WallStabilization kind_;
+  int n_theta_ = 0, n_rings_ = 0, n_modes_ = 0;
+  double m0_ = 0.0, kappa_b_ = 0.0, l_h_ = 0.0;
+  /// per mode m, in LAPACK's lower band storage (row d the d-th sub-diagonal): the stiffness
+  /// K_m = m0 kappa_b S_m^T Lt_m S_m / l_h (1/s), the filter P_m = (I + Lg_m / (q l_h))^q and
+  /// P_m's Cholesky factor
+  std::vector<Eigen::MatrixXd> stiff_, filter_, filter_chol_;
+  std::unique_ptr<Impl> impl_;
+  mutable std::map<double, std::shared_ptr<const Factor>> cache_;
+  mutable int factorizations_ = 0;
+};
+
+}  // namespace swim::full3d
