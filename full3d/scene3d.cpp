@@ -173,6 +173,7 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
       p.wall_stabilization =
           wall_stabilization_from(f.choice("wall_stabilization", "none", {"none", "bending"}));
       p.stabilization_factor = f.number("stabilization_factor", 1.0, Range::closed(0.1, 100.0));
+      p.memory_limit_gib = f.number("memory_limit_gib", 4.0, Range::closed(0.125, 1024.0));
       if (p.wall_stabilization != WallStabilization::None && p.scheme != IbScheme::ForwardEuler)
         throw InputError("full3d.wall_stabilization", to_string(p.wall_stabilization),
                          "only with full3d.scheme = forward_euler (the stabilised update is a forward-Euler step); "

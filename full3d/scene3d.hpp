@@ -91,6 +91,8 @@ struct Params3d {
   /// (wall_stabilizer.hpp; docs/full3d.md, "The stabilised wall step")
   WallStabilization wall_stabilization = WallStabilization::None;
   double stabilization_factor = 1.0;
+  /// full3d.memory_limit_gib: the memory the fluid solver's factors may take, GiB
+  double memory_limit_gib = 4.0;
   bool wall_inertia = false;       ///< -m a term of eq. (16) in the fluid-coupled run
   bool navier_stokes = false;      ///< StokesOptions::advection (eq. 28 sub-step before each Stokes step)
   /// energy: the paper's end of recovery (E < energy_tolerance E_ref); dead_band: also ends

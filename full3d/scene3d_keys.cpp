@@ -17,6 +17,7 @@ const scene::json& section_keys() {
       {"scheme", "choice:forward_euler|midpoint|chebyshev"},
       {"wall_stabilization", "choice:none|bending"},
       {"stabilization_factor", "number@[0.1,100]"},
+      {"memory_limit_gib", "number@[0.125,1024]"},
       {"membrane",
        {{"bending_constant", "quantity:N@non_negative"},
         {"bending_rigidity", "quantity:J@positive"},

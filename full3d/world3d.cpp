@@ -13,6 +13,7 @@ IbOptions ib_options(const Params3d& p) {
   o.axisymmetric_wall = p.axisymmetric_wall;
   o.wall_stabilization = p.wall_stabilization;
   o.stabilization_factor = p.stabilization_factor;
+  o.stokes.memory_limit_gib = p.memory_limit_gib;
   o.stokes.fft.threads = p.threads;
   o.stokes.threads = p.threads;
   if (p.container == "cylinder") {

@@ -59,12 +59,14 @@ record::CycleFigures cycle_figures_of(const record::RunRecord& rec, const json& 
 }
 
 /// The part of a resolved scene that determines its results: without the output settings
-/// (frames, intervals), the checkpoint intervals and the thread count.
+/// (frames, intervals), the checkpoint intervals, the thread count and the fluid solver's memory
+/// limit (how many factors it keeps, not what they solve).
 json physics_of(json resolved) {
   if (resolved.contains("full3d") && resolved["full3d"].is_object()) {
     resolved["full3d"].erase("output");
     resolved["full3d"].erase("checkpoint_interval");
     resolved["full3d"].erase("threads");
+    resolved["full3d"].erase("memory_limit_gib");
   }
   if (resolved.contains("axi") && resolved["axi"].is_object()) {
     resolved["axi"].erase("checkpoint_interval");

@@ -218,6 +218,7 @@ TEST(Adaptive3d, StabilisedWallStepFollowsForwardEulerAndResumesExactly) {
   EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.scheme=\"midpoint\"", "full3d.wall_stabilization=\"bending\""}),
                InputError);
   EXPECT_THROW(cycle({"full3d.wall_stabilization=\"elastic\""}), InputError);
+  EXPECT_THROW(cycle({"full3d.memory_limit_gib=0"}), InputError);
   EXPECT_THROW(cycle({"full3d.wall_stabilization=\"bending\"", "full3d.stabilization_factor=0"}), InputError);
   const std::vector<std::string> base = {"full3d.adaptive.enabled=true", "full3d.grid.cell_size=\"0.02 um\"",
                                          "full3d.checkpoint_interval=\"20 ms\""};

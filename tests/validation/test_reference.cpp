@@ -13,6 +13,8 @@
 
 #include "common/errors.hpp"
 #include "common/scene.hpp"
+#include "full3d/scene3d.hpp"
+#include "validation/run_cache.hpp"
 #include "validation/suite.hpp"
 #include "validation/verdicts.hpp"
 
@@ -290,4 +292,23 @@ TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
   EXPECT_EQ(s["targets1d"]["mean_velocity_per_cycle_relative"], 0.15);
   EXPECT_EQ(s["targets1d"]["velocity_phase_correlation"], 0.8);
   EXPECT_NO_THROW(load_suite(SWIM_SOURCE_DIR "/data/validation/default.json", SWIM_SOURCE_DIR "/data"));
+}
+
+// The 3D run cache's key is the physics of the resolved scene: the thread count and the fluid
+// solver's memory limit (how many factors it keeps) leave it, the wall's stabilised step (a
+// different scheme, a different answer) changes it.
+TEST(RunKey, ThreadsAndMemoryLimitLeaveItTheStabilisedStepChangesIt) {
+  auto key = [](const std::vector<std::string>& sets) {
+    scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/tiny_3d_cycle.json");
+    for (const auto& s : sets) scene::apply_override(sc, s);
+    scene::json resolved;
+    (void)swim::full3d::read_scene3d(sc, resolved);
+    return run_key_3d(resolved);
+  };
+  const std::string base = key({});
+  EXPECT_EQ(key({"full3d.threads=2"}), base);
+  EXPECT_EQ(key({"full3d.memory_limit_gib=8"}), base);
+  EXPECT_NE(key({"full3d.wall_stabilization=\"bending\""}), base);
+  EXPECT_NE(key({"full3d.wall_stabilization=\"bending\"", "full3d.stabilization_factor=2"}),
+            key({"full3d.wall_stabilization=\"bending\""}));
 }
