@@ -1,6 +1,9 @@
 #include "full3d/ib_solver.hpp"
 
 #include <chrono>
+#include <Eigen/Eigenvalues>
+#include <limits>
+#include <stdexcept>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -76,7 +79,7 @@ IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh m
                        "only with full3d.scheme = forward_euler (or \"none\")");
     const double D = membrane_.kb * bending_rigidity_per_kb(mesh_, membrane_.bending);
     stab_ = std::make_unique<WallStabilizer>(mesh_, grid_.h(), fluid.mu, D, opt_.wall_stabilization,
-                                             opt_.stabilization_factor);
+                                             opt_.stabilization_factor, opt_.threads);
   }
 }
 
@@ -209,9 +212,10 @@ IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
     U = (Y1 - s.X) / dt;
     Xnew = std::move(Y1);
   } else if (opt_.scheme != IbScheme::Midpoint) {
+    if (stab_) stab_->apply_root(dt, F);  // the mobility G M G: G on the forces spread...
     U = velocity(s.X, F, u, tau);
-    if (stab_) {  // (I + dt B) dX = dt U: the step's mean velocity is dX / dt
-      stab_->apply(dt, U);
+    if (stab_) {  // ...and on the velocities interpolated: the step's mean velocity
+      stab_->apply_root(dt, U);
       guard_finite(U, "stabilised node velocity", s.t);
     }
     Xnew = s.X + dt * U;
@@ -255,12 +259,8 @@ IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
   return st;
 }
 
-double IbSolver::explicit_rate(const IbState& s, double dt, int iterations, Eigen::Matrix3Xd* start) {
-  const Eigen::Index n = s.X.cols();
-  // membrane forces only: the actuation relays are saturating (their level moves by at most
-  // one over a ramp of a fraction of delta), so their steep slope bounds an oscillation to the
-  // ramp width instead of growing it
-  const Eigen::Matrix3Xd F0 = elastic(s.X);
+Eigen::Matrix3Xd IbSolver::rate_start(Eigen::Index n, const Eigen::Matrix3Xd* start) {
+  if (start && start->cols() == n) return *start;
   // fixed pseudo-random start (a linear congruential sequence): reproducible on resume
   Eigen::Matrix3Xd v(3, n);
   std::uint64_t r = 0x9E3779B97F4A7C15ull;
@@ -268,12 +268,16 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations, Eige
     r = r * 6364136223846793005ull + 1442695040888963407ull;
     v.data()[i] = double(r >> 11) * (1.0 / 9007199254740992.0) - 0.5;
   }
-  if (start && start->cols() == n) v = *start;
+  return v;
+}
+
+template <class Body>
+auto IbSolver::with_linearised_coupling(const IbState& s, double dt, Body&& body) {
+  // membrane forces only: the actuation relays are saturating (their level moves by at most
+  // one over a ramp of a fraction of delta), so their steep slope bounds an oscillation to the
+  // ramp width instead of growing it
+  const Eigen::Matrix3Xd F0 = elastic(s.X);
   const double eps = 1e-4 * grid_.h();  // finite-difference amplitude (max node displacement)
-  VectorField& f = work_f_;
-  VectorField& u = work_uh_;
-  Eigen::Matrix3Xd U;
-  double lambda = 0.0;
   // the pressure is the last step's result (fluid-field output): the estimate must not change it
   struct Restore {
     StokesSolver& s;
@@ -286,20 +290,86 @@ double IbSolver::explicit_rate(const IbState& s, double dt, int iterations, Eige
   } restore{stokes_, stokes_.computes_pressure(), std::nullopt};
   stokes_.compute_pressure(false);
   if (stokes_.computes_pressure()) restore.p = stokes_.pressure();
-  for (int it = 0; it < iterations; ++it) {
+  // A v: the decay rate the (stabilised) update gives the perturbation v, 1/s times v
+  auto apply = [&](const Eigen::Matrix3Xd& v) {
     const double vmax = v.cwiseAbs().maxCoeff();
-    if (!(vmax > 0.0) || !std::isfinite(vmax)) return lambda;
-    v /= vmax;
-    const Eigen::Matrix3Xd dF = (elastic_forces(mesh_, s.X + eps * v, membrane_, opt_.threads) - F0) / eps;
-    spread(grid_, s.X, dF, f, opt_.threads);
-    stokes_.step_from_rest(u, f, inertia_step(opt_, dt));
-    interpolate(grid_, u, s.X, U, opt_.threads);
-    if (stab_) stab_->apply(dt, U);
-    lambda = U.norm() / v.norm();  // |A v| / |v|
-    v = -U;
-  }
+    Eigen::Matrix3Xd U;
+    if (!(vmax > 0.0) || !std::isfinite(vmax)) return U;  // empty: no direction left
+    const double scale = eps / vmax;
+    Eigen::Matrix3Xd dF = (elastic_forces(mesh_, s.X + scale * v, membrane_, opt_.threads) - F0) / scale;
+    if (stab_) stab_->apply_root(dt, dF);
+    spread(grid_, s.X, dF, work_f_, opt_.threads);
+    stokes_.step_from_rest(work_uh_, work_f_, inertia_step(opt_, dt));
+    interpolate(grid_, work_uh_, s.X, U, opt_.threads);
+    if (stab_) stab_->apply_root(dt, U);
+    U = -U;
+    return U;
+  };
+  return body(apply);
+}
+
+double IbSolver::explicit_rate(const IbState& s, double dt, int iterations, Eigen::Matrix3Xd* start) {
+  Eigen::Matrix3Xd v = rate_start(s.X.cols(), start);
+  const double lambda = with_linearised_coupling(s, dt, [&](auto&& apply) {
+    double l = 0.0;
+    for (int it = 0; it < iterations; ++it) {
+      Eigen::Matrix3Xd Av = apply(v);
+      if (Av.size() == 0) return l;
+      l = Av.norm() / v.norm();  // |A v| / |v|
+      const double amax = Av.cwiseAbs().maxCoeff();
+      if (!(amax > 0.0) || !std::isfinite(amax)) return l;
+      v = Av / amax;
+    }
+    return l;
+  });
   if (start) *start = v;
   return lambda;
+}
+
+IbSolver::RateSpectrum IbSolver::explicit_spectrum(const IbState& s, double dt, int iterations,
+                                                   const Eigen::Matrix3Xd* start) {
+  const Eigen::Index n = s.X.cols(), len = 3 * n;
+  const int k_max = std::max(1, iterations);
+  Eigen::MatrixXd V(len, k_max + 1);  // orthonormal Krylov basis
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(k_max + 1, k_max);
+  {
+    const Eigen::Matrix3Xd v0 = rate_start(n, start);
+    const double nv = v0.norm();
+    if (!(nv > 0.0) || !std::isfinite(nv)) throw std::invalid_argument("explicit_spectrum: zero or non-finite start");
+    V.col(0) = Eigen::Map<const Eigen::VectorXd>(v0.data(), len) / nv;
+  }
+  int k = 0;  // Arnoldi steps made
+  with_linearised_coupling(s, dt, [&](auto&& apply) {
+    while (k < k_max) {
+      const Eigen::Matrix3Xd Av = apply(Eigen::Map<const Eigen::Matrix3Xd>(V.col(k).data(), 3, n));
+      if (Av.size() == 0) return 0;
+      Eigen::VectorXd w = Eigen::Map<const Eigen::VectorXd>(Av.data(), len);
+      const double wnorm = w.norm();
+      if (!std::isfinite(wnorm)) return 0;
+      for (int pass = 0; pass < 2; ++pass)  // modified Gram-Schmidt, repeated once
+        for (int i = 0; i <= k; ++i) {
+          const double c = V.col(i).dot(w);
+          H(i, k) += c;
+          w -= c * V.col(i);
+        }
+      H(k + 1, k) = w.norm();
+      ++k;
+      if (!(H(k, k - 1) > 1e-12 * wnorm)) return 0;  // an invariant subspace: the Ritz values are exact
+      V.col(k) = w / H(k, k - 1);
+    }
+    return 0;
+  });
+  RateSpectrum out;
+  if (k == 0) return out;
+  const Eigen::EigenSolver<Eigen::MatrixXd> es(H.topLeftCorner(k, k), true);
+  for (int i = 0; i < k; ++i) {
+    const std::complex<double> mu = es.eigenvalues()(i);
+    const Eigen::VectorXcd y = es.eigenvectors().col(i);
+    out.ritz.push_back(mu);
+    out.residual.push_back(std::abs(mu) > 0.0 ? H(k, k - 1) * std::abs(y(k - 1)) / (y.norm() * std::abs(mu))
+                                              : std::numeric_limits<double>::infinity());
+  }
+  return out;
 }
 
 }  // namespace swim::full3d

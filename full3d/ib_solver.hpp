@@ -20,6 +20,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <complex>
 #include <functional>
 #include <memory>
 #include <string>
@@ -141,12 +142,24 @@ class IbSolver {
   /// (membrane forces, finite differences; the actuation relays saturate and are left out), S the Stokes solve with the step dt on
   /// u^n = 0 (the quasi-steady mobility) and I / spreading the IB transfer operators.
   /// Forward Euler is stable while dt lambda_max < 2. With the stabilised wall update the
-  /// operator is v -> -(I + dt B)^{-1} I S J v, the rate of the update a step of dt makes,
-  /// which falls as dt grows (dt times it grows). Power iteration from a fixed
+  /// operator is v -> -G I S G J v, G = (I + dt B)^{-1/2}, the rate of the update a step of dt
+  /// makes, which falls as dt grows (dt times it grows). Power iteration from a fixed
   /// pseudo-random start (reproducible), `iterations` coupled solves. Leaves s unchanged.
   /// `start`: when given and of the mesh's size, the iteration starts from it (a warm start from
   /// an earlier estimate) and leaves its last vector there.
   double explicit_rate(const IbState& s, double dt, int iterations = 10, Eigen::Matrix3Xd* start = nullptr);
+
+  /// Ritz values of the same operator (with the stabilised wall update: of the update's own
+  /// operator at dt), 1/s, by `iterations` Arnoldi steps from `start` (as explicit_rate), and
+  /// each Ritz pair's residual over |mu|. A step of dt amplifies a mode of rate mu by
+  /// |1 - dt mu|; the power iteration's magnitude bounds that only when the rates are real,
+  /// which this checks (the stabilised update's linearisation G M G H is similar to a
+  /// symmetric matrix).
+  struct RateSpectrum {
+    std::vector<std::complex<double>> ritz;  ///< Ritz values, 1/s
+    std::vector<double> residual;            ///< each pair's residual over |mu|
+  };
+  RateSpectrum explicit_spectrum(const IbState& s, double dt, int iterations, const Eigen::Matrix3Xd* start = nullptr);
 
   /// Force the structure exerts on the fluid, -Fbar of eq. (16), N per node.
   Eigen::Matrix3Xd fluid_force(const Eigen::Matrix3Xd& X, double t, const Eigen::Matrix3Xd& accel) const;
@@ -165,6 +178,13 @@ class IbSolver {
   const IbOptions& options() const { return opt_; }
 
  private:
+  /// The start vector of a rate estimate: `start` when it has the mesh's size, otherwise a
+  /// fixed pseudo-random field (reproducible on resume).
+  static Eigen::Matrix3Xd rate_start(Eigen::Index n, const Eigen::Matrix3Xd* start);
+  /// Calls body(apply) with apply(v) = A v, the linearised (stabilised) update's decay operator
+  /// at s and dt (an empty matrix when v is zero or not finite), the pressure output restored.
+  template <class Body>
+  auto with_linearised_coupling(const IbState& s, double dt, Body&& body);
   void guard_finite(const Eigen::Matrix3Xd& A, const char* what, double t) const;
   /// The elastic forces at X, from the kept pass when it was made at the same X.
   const Eigen::Matrix3Xd& elastic(const Eigen::Matrix3Xd& X) const;

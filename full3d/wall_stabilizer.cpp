@@ -4,73 +4,28 @@
 #include <complex>
 #include <stdexcept>
 
+#include <Eigen/Eigenvalues>
+
 #include "common/errors.hpp"
 #include "full3d/fft.hpp"
-#include "full3d/packed_cholesky.hpp"
-
-extern "C" {
-// LAPACK, Fortran interface (the hidden length of the one-character UPLO argument last)
-void dpbtrf_(const char* uplo, const int* n, const int* kd, double* ab, const int* ldab, int* info,
-             std::size_t uplo_len);
-void dpbtrs_(const char* uplo, const int* n, const int* kd, const int* nrhs, const double* ab, const int* ldab,
-             double* b, const int* ldb, int* info, std::size_t uplo_len);
-}
+#include "full3d/parallel.hpp"
 
 namespace swim::full3d {
 
 namespace {
-/// Factorisations kept (one per step size; the adaptive ladder visits a few dozen at most).
-constexpr std::size_t kCacheSize = 64;
-/// Half-width of the band of the stiffness S^T Lt S.
-constexpr int kBand = 3;
-/// The filter's power q: P = (I + Lg / (q l_h))^q, the half-width of its band.
+/// The filter's power q: P = (I + Lf / (q l_h))^q.
 constexpr int kFilter = 8;
-/// Lower band storage (LAPACK's): column j holds A(j + d, j) in row d.
-using Band = Eigen::MatrixXd;
-double band_at(const Band& a, int i, int j) {
-  if (i < j) std::swap(i, j);
-  const int d = i - j;
-  return d < a.rows() && i < a.cols() ? a(d, j) : 0.0;
-}
-/// The symmetric product a b of two commuting symmetric band matrices (powers of one matrix).
-Band band_product(const Band& a, const Band& b) {
-  const int n = int(a.cols()), p = int(a.rows()) - 1, q = int(b.rows()) - 1, w = p + q;
-  Band c = Band::Zero(w + 1, n);
-  for (int j = 0; j < n; ++j)
-    for (int d = 0; d <= w && j + d < n; ++d) {
-      const int i = j + d;
-      double s = 0.0;
-      for (int k = std::max(0, i - p); k <= std::min(n - 1, i + p); ++k) s += band_at(a, i, k) * band_at(b, k, j);
-      c(d, j) = s;
-    }
-  return c;
-}
-/// y = a x for a symmetric band matrix a and the columns of x.
-void band_multiply(const Band& a, const Eigen::MatrixXd& x, Eigen::MatrixXd& y) {
-  const int n = int(a.cols()), w = int(a.rows()) - 1;
-  y.setZero(x.rows(), x.cols());
-  for (int j = 0; j < n; ++j) {
-    y.row(j) += a(0, j) * x.row(j);
-    for (int d = 1; d <= w && j + d < n; ++d) {
-      y.row(j + d) += a(d, j) * x.row(j);
-      y.row(j) += a(d, j) * x.row(j + d);
-    }
-  }
-}
-void cholesky(Band& a) {
-  const int n = int(a.cols()), kd = int(a.rows()) - 1, ld = int(a.rows());
-  int info = 0;
-  dpbtrf_("L", &n, &kd, a.data(), &ld, &info, 1);
-  if (info != 0) throw LapackError("dpbtrf", info);
-}
-void cholesky_solve(const Band& l, Eigen::MatrixXd& b) {
-  const int n = int(l.cols()), kd = int(l.rows()) - 1, ld = int(l.rows()), nrhs = int(b.cols());
-  int info = 0;
-  dpbtrs_("L", &n, &kd, &nrhs, l.data(), &ld, b.data(), &n, &info, 1);
-  if (info != 0) throw LapackError("dpbtrs", info);
-}
 /// Right-hand sides per mode: three components, real and imaginary parts.
 constexpr int kRhs = 6;
+/// Eigen-decomposition of a symmetric matrix (its symmetric part), eigenvalues clamped at 0
+/// (the operators are positive semi-definite; round-off leaves tiny negative values).
+void symmetric_eigen(const Eigen::MatrixXd& a, Eigen::MatrixXd& vectors, Eigen::VectorXd& values) {
+  const Eigen::MatrixXd sym = 0.5 * (a + a.transpose());
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(sym);
+  if (es.info() != Eigen::Success) throw std::runtime_error("WallStabilizer: eigen-decomposition failed");
+  vectors = es.eigenvectors();
+  values = es.eigenvalues().cwiseMax(0.0);
+}
 }  // namespace
 
 WallStabilization wall_stabilization_from(const std::string& name) {
@@ -89,17 +44,13 @@ struct WallStabilizer::Impl {
   Eigen::VectorXcd twist;  ///< exp(-i m pi / n_theta): the odd rings' half-step offset
 };
 
-struct WallStabilizer::Factor {
-  std::vector<Eigen::MatrixXd> band;  ///< per mode, the Cholesky factor of P_m + dt K_m
-};
-
 WallStabilizer::WallStabilizer(const CylinderMesh& mesh, double h, double mu, double D, WallStabilization kind,
-                               double factor)
+                               double factor, int threads)
     : kind_(kind), n_theta_(mesh.n_theta), n_rings_(mesh.n_rings), impl_(std::make_unique<Impl>()) {
   if (kind == WallStabilization::None) throw std::invalid_argument("WallStabilizer: kind none has no operator");
   if (!(h > 0.0 && mu > 0.0 && factor > 0.0 && D >= 0.0))
     throw std::invalid_argument("WallStabilizer: h, mu and factor must be positive, D non-negative");
-  if (n_theta_ < 3 || n_rings_ < 2 || mesh.nodes() != n_theta_ * n_rings_ || mesh.edges.empty())
+  if (n_theta_ < 3 || n_rings_ < 3 || mesh.nodes() != n_theta_ * n_rings_ || mesh.edges.empty())
     throw std::invalid_argument("WallStabilizer: the mesh is not a stack of rings");
   n_modes_ = n_theta_ / 2 + 1;
   const double area = mesh.node_area.mean();
@@ -109,40 +60,29 @@ WallStabilizer::WallStabilizer(const CylinderMesh& mesh, double h, double mu, do
   kappa_b_ = area * lap * lap * D;
   l_h_ = 1.5 * (edge / h) * (edge / h);
   const double scale = m0_ * kappa_b_ / l_h_;
-  // per mode, Lg_m (tridiagonal), the filter P_m and the stiffness K_m
-  stiff_.resize(std::size_t(n_modes_));
-  filter_.resize(std::size_t(n_modes_));
-  filter_chol_.resize(std::size_t(n_modes_));
   const int n = n_rings_;
   const double c = 1.0 / (kFilter * l_h_);
-  for (int m = 0; m < n_modes_; ++m) {
-    Band L = Band::Zero(2, n);
-    for (int r = 0; r < n; ++r) L(0, r) = (r == 0 || r == n - 1 ? 4.0 : 6.0) - 2.0 * std::cos(2.0 * M_PI * m / n_theta_);
-    for (int r = 0; r + 1 < n; ++r) L(1, r) = -2.0 * std::cos(M_PI * m / n_theta_);
-    // K_m = S^T Lt S: S the interior rings' rows of Lg_m (every column), Lt its interior block
-    // (rings 1 .. n - 2): Lg_m^3 inside, and a field linear along the axis has S f = 0 (the
-    // free ends: no second difference, no bending)
-    auto interior = [&](int p) { return p >= 1 && p <= n - 2; };
-    Band k3 = Band::Zero(kBand + 1, n);
-    for (int j = 0; j < n; ++j)
-      for (int d = 0; d <= kBand && j + d < n; ++d) {
-        const int i = j + d;
-        double sum = 0.0;
-        for (int p = i - 1; p <= i + 1; ++p)
-          for (int q = j - 1; q <= j + 1; ++q)
-            if (interior(p) && interior(q)) sum += band_at(L, p, i) * band_at(L, p, q) * band_at(L, q, j);
-        k3(d, j) = scale * sum;
-      }
-    stiff_[std::size_t(m)] = std::move(k3);
-    // P_m = (I + c Lg_m)^q
-    Band one = c * L;
-    one.row(0).array() += 1.0;
-    Band P = one;
-    for (int k = 1; k < kFilter; ++k) P = band_product(P, one);
-    filter_[std::size_t(m)] = P;
-    cholesky(P);
-    filter_chol_[std::size_t(m)] = std::move(P);
-  }
+  vectors_.resize(std::size_t(n_modes_));
+  rates_.resize(std::size_t(n_modes_));
+  parallel_blocks(n_modes_, threads, [&](long begin, long end, int) {
+    for (long m = begin; m < end; ++m) {
+      // Lg_m (tridiagonal), S its rows of the rings off the ends (1 .. n - 2), Lt their block
+      Eigen::MatrixXd L = Eigen::MatrixXd::Zero(n, n);
+      for (int r = 0; r < n; ++r) L(r, r) = (r == 0 || r == n - 1 ? 4.0 : 6.0) - 2.0 * std::cos(2.0 * M_PI * m / n_theta_);
+      for (int r = 0; r + 1 < n; ++r) L(r, r + 1) = L(r + 1, r) = -2.0 * std::cos(M_PI * m / n_theta_);
+      const Eigen::MatrixXd S = L.middleRows(1, n - 2);
+      const Eigen::MatrixXd K = scale * (S.transpose() * (L.block(1, 1, n - 2, n - 2) * S));
+      // the filter's Laplacian Lf = (S^T S)^{1/2}: Lg in the interior, zero on a field linear
+      // along the axis; P^{-1/2} = (I + Lf / (q l_h))^{-q/2}
+      Eigen::MatrixXd W;
+      Eigen::VectorXd s2;
+      symmetric_eigen(S.transpose() * S, W, s2);
+      const Eigen::VectorXd g = (1.0 + c * s2.cwiseSqrt().array()).pow(-0.5 * kFilter).matrix();
+      const Eigen::MatrixXd Ph = W * g.asDiagonal() * W.transpose();
+      // B_m = P^{-1/2} K P^{-1/2} = U diag(sigma) U^T
+      symmetric_eigen(Ph * K * Ph, vectors_[std::size_t(m)], rates_[std::size_t(m)]);
+    }
+  });
   // batched real transforms of length n_theta: 3 n_rings sequences
   Impl& t = *impl_;
   t.real = FftwBuffer(std::size_t(3 * n_rings_ * n_theta_));
@@ -158,19 +98,10 @@ WallStabilizer::WallStabilizer(const CylinderMesh& mesh, double h, double mu, do
 
 WallStabilizer::~WallStabilizer() = default;
 
-const WallStabilizer::Factor& WallStabilizer::factor(double dt) const {
-  if (auto it = cache_.find(dt); it != cache_.end()) return *it->second;
-  auto f = std::make_shared<Factor>();
-  f->band.resize(filter_.size());
-  for (std::size_t m = 0; m < filter_.size(); ++m) {
-    Band a = filter_[m];
-    a.topRows(kBand + 1) += dt * stiff_[m];
-    cholesky(a);
-    f->band[m] = std::move(a);
-  }
-  if (cache_.size() >= kCacheSize) cache_.erase(cache_.begin());
-  ++factorizations_;
-  return *cache_.emplace(dt, std::move(f)).first->second;
+double WallStabilizer::largest_rate() const {
+  double r = 0.0;
+  for (const auto& v : rates_) r = std::max(r, v.maxCoeff());
+  return r;
 }
 
 template <class F>
@@ -208,27 +139,33 @@ void WallStabilizer::in_modes(Eigen::Matrix3Xd& x, F&& per_mode) const {
       for (int c = 0; c < 3; ++c) x(c, r * nt + i) = re[(c * nr + r) * nt + i] * inv;
 }
 
-void WallStabilizer::apply(double dt, Eigen::Matrix3Xd& dX) const {
-  if (!(dt > 0.0)) throw std::invalid_argument("WallStabilizer::apply: dt must be positive");
-  if (dX.cols() != n_theta_ * n_rings_) throw std::invalid_argument("WallStabilizer::apply: wrong number of nodes");
-  const Factor& f = factor(dt);
-  Eigen::MatrixXd y;
-  in_modes(dX, [&](int m, Eigen::MatrixXd& b) {  // (P + dt K) y = P b
-    band_multiply(filter_[std::size_t(m)], b, y);
-    cholesky_solve(f.band[std::size_t(m)], y);
-    b = y;
+template <class G>
+void WallStabilizer::spectral(Eigen::Matrix3Xd& x, G&& gain) const {
+  if (x.cols() != n_theta_ * n_rings_) throw std::invalid_argument("WallStabilizer: wrong number of nodes");
+  Eigen::MatrixXd y, z;
+  in_modes(x, [&](int m, Eigen::MatrixXd& b) {  // U diag(gain(sigma)) U^T b
+    const Eigen::MatrixXd& U = vectors_[std::size_t(m)];
+    const Eigen::VectorXd& sigma = rates_[std::size_t(m)];
+    y.noalias() = U.transpose() * b;
+    for (Eigen::Index i = 0; i < y.rows(); ++i) y.row(i) *= gain(sigma[i]);
+    z.noalias() = U * y;
+    b = z;
   });
 }
 
+void WallStabilizer::apply_root(double dt, Eigen::Matrix3Xd& x) const {
+  if (!(dt > 0.0)) throw std::invalid_argument("WallStabilizer::apply_root: dt must be positive");
+  spectral(x, [dt](double sigma) { return 1.0 / std::sqrt(1.0 + dt * sigma); });
+}
+
+void WallStabilizer::apply(double dt, Eigen::Matrix3Xd& x) const {
+  if (!(dt > 0.0)) throw std::invalid_argument("WallStabilizer::apply: dt must be positive");
+  spectral(x, [dt](double sigma) { return 1.0 / (1.0 + dt * sigma); });
+}
+
 Eigen::Matrix3Xd WallStabilizer::rate(const Eigen::Matrix3Xd& x) const {
-  if (x.cols() != n_theta_ * n_rings_) throw std::invalid_argument("WallStabilizer::rate: wrong number of nodes");
   Eigen::Matrix3Xd out = x;
-  Eigen::MatrixXd y;
-  in_modes(out, [&](int m, Eigen::MatrixXd& b) {  // P^{-1} K b
-    band_multiply(stiff_[std::size_t(m)], b, y);
-    cholesky_solve(filter_chol_[std::size_t(m)], y);
-    b = y;
-  });
+  spectral(out, [](double sigma) { return sigma; });
   return out;
 }
 

@@ -6,16 +6,26 @@
 // mode of wavenumber k through the fluid times its elastic stiffness. The stiffest modes sit
 // at the grid scale, k ~ 1/h: stretching gives lambda ~ Y k / mu ~ h^-1 and bending with a
 // rigidity D fixed on every grid lambda ~ D k^3 / mu ~ h^-3, so on fine grids the bending sets
-// the step. The stabilised update solves
-//     (I + dt B) (X^{n+1} - X^n) = dt U(X^n),    B = P^{-1} K,
-// scalar operators on the wall's own mesh (the same for the three components):
+// the step. The stabilised update is
+//     X^{n+1} - X^n = dt G M G F(X^n),    G = (I + dt B)^{-1/2},
+// M the coupled mobility (spreading, the Stokes solve, interpolation) and F the node forces:
+// a forward-Euler step of the wall's dynamics with the mobility G M G in place of M. G is
+// symmetric positive definite, so G M G is symmetric positive semi-definite like M: the
+// update moves the wall down its energy, and its linearisation G M G H (H the wall's
+// stiffness) has real eigenvalues, so that a power iteration's largest magnitude is its
+// stability limit. (The one-sided form (I + dt B)^{-1} M F is neither: with M and B not
+// commuting its linearisation has complex eigenvalues, and on 128-160 cells across it grew a
+// mesh distortion at steps the magnitude estimate allowed.) B is a scalar operator on the
+// wall's own mesh (the same for the three components),
+//     B = P^{-1/2} K P^{-1/2},
 //     K = m0 kappa_b S^T Lt S / l_h   the bending's stiffness near k = 1/h: S the rows of the
 //                                     mesh's graph Laplacian Lg (unit weights) of the nodes off
 //                                     the end rings, Lt its block on those nodes (Lg^3 away
 //                                     from the ends);
-//     P = (I + Lg / (q l_h))^q, q = 8 a low-pass filter: the fluid moves a wall mode finer than
-//                                     the grid less and less (the kernel's transfer function),
-//                                     and B follows it;
+//     P = (I + Lf / (q l_h))^q, q = 8 a low-pass filter, Lf = (S^T S)^{1/2} (Lg away from the
+//                                     ends): the fluid moves a wall mode finer than the grid
+//                                     less and less (the kernel's transfer function), and B
+//                                     follows it;
 //     kappa_b = A (2 / (3 a^2))^2 D   (a node's bending force A D lap^2 x, with
 //                                      lap ~ -(2 / (3 a^2)) Lg on a triangular lattice of edge a),
 //     l_h = (3/2) (a / h)^2           (Lg's value on a mode of wavenumber 1/h),
@@ -29,23 +39,23 @@
 // again, so that the mesh's fine modes, which the fluid barely moves, are not frozen either.
 // Without the filter (sigma growing as l^3 to the mesh scale) the update froze them and the
 // buckled wall recovered 16-33 % faster on 48 cells across, even with a tenth of m0. The tube's
-// ends are free: a field linear along the axis has no second difference there and S takes no
-// rows of the end rings, so K is zero on it, as the wall's bending is. Per mode the update's
-// factor is 1 - dt lambda / (1 + dt sigma): stable for every dt where sigma >= lambda / 2, and
-// a relative change of order dt sigma of a mode's motion, which vanishes with dt and with h.
+// ends are free: a field linear along the axis has S f = 0, so K, Lf and B are zero on it, as
+// the wall's bending is, and G leaves it alone (the tube's stretching and tilting, its rigid
+// translations). Per mode shared by M H and B the update's factor is 1 - dt lambda / (1 + dt
+// sigma): stable for every dt where sigma >= lambda / 2, and a relative change of order dt sigma
+// of a mode's motion, which vanishes with dt and with h.
 //
 // The mesh is a stack of rings of n_theta nodes, alternate rings offset by half a step, so the
 // graph Laplacian commutes with the rotation by one node: in the azimuthal Fourier modes
 // exp(i m phi) of the nodes' own angles it is, per m, the real tridiagonal matrix along the rings
 //     (Lg_m v)_r = (deg_r - 2 cos(2 pi m / n_theta)) v_r - 2 cos(pi m / n_theta) (v_{r-1} + v_{r+1}),
 // deg_r = 6 (4 on the end rings), and S_m, Lt_m its rows and block of rings 1 .. n_rings - 2.
-// The update solves, per m, (P_m + dt K_m) y = P_m b, a symmetric band of half-width q
-// (LAPACK dpbtrf/dpbtrs): a batched real FFT per ring and component, the band solves and the
-// inverse FFT, O(N log n_theta).
+// B_m = U_m diag(sigma_m) U_m^T is decomposed once per run (dense symmetric eigen-problems of
+// n_rings, spread over the threads); G and B are then a batched real FFT per ring and
+// component, two dense products per mode and the inverse FFT.
 #pragma once
 
 #include <Eigen/Core>
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -63,45 +73,46 @@ class WallStabilizer {
  public:
   /// mesh: the wall's mesh (rings of n_theta nodes, rest lengths, node areas); h: the grid's
   /// cell, m; mu: viscosity, Pa s; D: the wall's bending rigidity, J; factor: m0's multiple of
-  /// the grid-scale mobility (> 0). Throws std::invalid_argument for kind None or a mesh that
-  /// is not a ring stack.
+  /// the grid-scale mobility (> 0); threads: for the per-mode decompositions. Throws
+  /// std::invalid_argument for kind None or a mesh that is not a stack of three or more rings.
   WallStabilizer(const CylinderMesh& mesh, double h, double mu, double D, WallStabilization kind,
-                 double factor = 1.0);
+                 double factor = 1.0, int threads = 1);
   ~WallStabilizer();
   WallStabilizer(const WallStabilizer&) = delete;
   WallStabilizer& operator=(const WallStabilizer&) = delete;
 
-  /// dX <- (I + dt B)^{-1} dX = (P + dt K)^{-1} P dX (3 x N_n, each component alike), dt > 0.
-  void apply(double dt, Eigen::Matrix3Xd& dX) const;
-  /// B x = P^{-1} K x for a 3 x N_n field through the same transforms (the model's rates), 1/s
-  /// times x.
+  /// x <- G x = (I + dt B)^{-1/2} x (3 x N_n, each component alike), dt > 0: the update's
+  /// filter, applied to the node forces before they are spread and to the node velocities
+  /// interpolated back.
+  void apply_root(double dt, Eigen::Matrix3Xd& x) const;
+  /// x <- (I + dt B)^{-1} x = G^2 x, dt > 0.
+  void apply(double dt, Eigen::Matrix3Xd& x) const;
+  /// B x for a 3 x N_n field (the model's rates), 1/s times x.
   Eigen::Matrix3Xd rate(const Eigen::Matrix3Xd& x) const;
+  /// The largest rate of B, 1/s.
+  double largest_rate() const;
 
   double mobility() const { return m0_; }            ///< m0, m/(N s)
   double kappa_bending() const { return kappa_b_; }  ///< N/m
   double laplacian_at_h() const { return l_h_; }     ///< l_h
   WallStabilization kind() const { return kind_; }
-  /// Factorisations made so far (one per distinct dt).
-  int factorizations() const { return factorizations_; }
 
  private:
   struct Impl;
-  struct Factor;
-  const Factor& factor(double dt) const;
   /// x <- f(m, coefficients) in the azimuthal modes: forward transform, f per mode on the
   /// n_rings x 6 block (3 components, real and imaginary parts), inverse transform.
   template <class F>
   void in_modes(Eigen::Matrix3Xd& x, F&& per_mode) const;
+  /// x <- U diag(gain(sigma)) U^T x per mode.
+  template <class G>
+  void spectral(Eigen::Matrix3Xd& x, G&& gain) const;
   WallStabilization kind_;
   int n_theta_ = 0, n_rings_ = 0, n_modes_ = 0;
   double m0_ = 0.0, kappa_b_ = 0.0, l_h_ = 0.0;
-  /// per mode m, in LAPACK's lower band storage (row d the d-th sub-diagonal): the stiffness
-  /// K_m = m0 kappa_b S_m^T Lt_m S_m / l_h (1/s), the filter P_m = (I + Lg_m / (q l_h))^q and
-  /// P_m's Cholesky factor
-  std::vector<Eigen::MatrixXd> stiff_, filter_, filter_chol_;
+  /// per mode m: B_m's eigenvectors U_m (n_rings x n_rings, orthonormal) and rates sigma_m, 1/s
+  std::vector<Eigen::MatrixXd> vectors_;
+  std::vector<Eigen::VectorXd> rates_;
   std::unique_ptr<Impl> impl_;
-  mutable std::map<double, std::shared_ptr<const Factor>> cache_;
-  mutable int factorizations_ = 0;
 };
 
 }  // namespace swim::full3d

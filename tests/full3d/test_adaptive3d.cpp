@@ -212,8 +212,8 @@ TEST(Adaptive3d, ChebyshevResumeEqualsUninterruptedRun) {
 // wall step") on the tiny cycle at h = 20 nm: the keys are validated, the run follows the
 // forward-Euler run (the same displacement and cycle time within 2 %: the stabilisation changes
 // a mode's motion by dt sigma, small on the modes this wall moves in), and a run killed and
-// resumed repeats the uninterrupted one to the last bit (the factorisations and the rate
-// estimates follow from the checkpointed state).
+// resumed repeats the uninterrupted one to the last bit (the model's decomposition depends on
+// the mesh alone, and the rate estimates follow from the checkpointed state).
 TEST(Adaptive3d, StabilisedWallStepFollowsForwardEulerAndResumesExactly) {
   EXPECT_THROW(cycle({"full3d.adaptive.enabled=true", "full3d.scheme=\"midpoint\"", "full3d.wall_stabilization=\"bending\""}),
                InputError);
