@@ -1,15 +1,15 @@
 #include "full3d/ib_solver.hpp"
 
-#include <chrono>
 #include <Eigen/Eigenvalues>
-#include <limits>
-#include <stdexcept>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <optional>
+#include <stdexcept>
 #include <string>
 #include <utility>
 

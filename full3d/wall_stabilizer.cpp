@@ -142,14 +142,13 @@ void WallStabilizer::in_modes(Eigen::Matrix3Xd& x, F&& per_mode) const {
 template <class G>
 void WallStabilizer::spectral(Eigen::Matrix3Xd& x, G&& gain) const {
   if (x.cols() != n_theta_ * n_rings_) throw std::invalid_argument("WallStabilizer: wrong number of nodes");
-  Eigen::MatrixXd y, z;
+  Eigen::MatrixXd y;
   in_modes(x, [&](int m, Eigen::MatrixXd& b) {  // U diag(gain(sigma)) U^T b
     const Eigen::MatrixXd& U = vectors_[std::size_t(m)];
     const Eigen::VectorXd& sigma = rates_[std::size_t(m)];
     y.noalias() = U.transpose() * b;
     for (Eigen::Index i = 0; i < y.rows(); ++i) y.row(i) *= gain(sigma[i]);
-    z.noalias() = U * y;
-    b = z;
+    b.noalias() = U * y;
   });
 }
 
