@@ -62,9 +62,6 @@ int chebyshev_stages_for(double dt, double lambda, double fraction, int max_stag
   return max_stages;
 }
 
-namespace {
-}  // namespace
-
 IbSolver::IbSolver(const MacGrid& grid, const FluidParams& fluid, CylinderMesh mesh, MembraneParams membrane,
                    Eigen::VectorXd node_mass, IbOptions opt)
     : grid_(grid), mesh_(std::move(mesh)), membrane_(membrane), mass_(std::move(node_mass)), opt_(opt),

@@ -71,12 +71,22 @@ WallStabilizer::WallStabilizer(const CylinderMesh& mesh, double h, double mu, do
       for (int r = 0; r < n; ++r) L(r, r) = (r == 0 || r == n - 1 ? 4.0 : 6.0) - 2.0 * std::cos(2.0 * M_PI * m / n_theta_);
       for (int r = 0; r + 1 < n; ++r) L(r, r + 1) = L(r + 1, r) = -2.0 * std::cos(M_PI * m / n_theta_);
       const Eigen::MatrixXd S = L.middleRows(1, n - 2);
-      const Eigen::MatrixXd K = scale * (S.transpose() * (L.block(1, 1, n - 2, n - 2) * S));
-      // the filter's Laplacian Lf = (S^T S)^{1/2}: Lg in the interior, zero on a field linear
+      Eigen::MatrixXd K = S.transpose() * (L.block(1, 1, n - 2, n - 2) * S);
+      Eigen::MatrixXd S2 = S.transpose() * S;
+      // the end rings' own bending along them, E = (3/2) R (R the ring's second difference,
+      // in Lg's units): the free rims' modes that S does not see (its null space holds, per
+      // mode m > 0, a pair decaying from each end), zero on a field constant on the ring
+      const double e = 1.5 * (2.0 - 2.0 * std::cos(2.0 * M_PI * m / n_theta_));
+      for (int r : {0, n - 1}) {
+        K(r, r) += e * e * e;
+        S2(r, r) += e * e;
+      }
+      K *= scale;
+      // the filter's Laplacian Lf = (S^T S + E^T E)^{1/2}: Lg in the interior, zero on a field linear
       // along the axis; P^{-1/2} = (I + Lf / (q l_h))^{-q/2}
       Eigen::MatrixXd W;
       Eigen::VectorXd s2;
-      symmetric_eigen(S.transpose() * S, W, s2);
+      symmetric_eigen(S2, W, s2);
       const Eigen::VectorXd g = (1.0 + c * s2.cwiseSqrt().array()).pow(-0.5 * kFilter).matrix();
       const Eigen::MatrixXd Ph = W * g.asDiagonal() * W.transpose();
       // B_m = P^{-1/2} K P^{-1/2} = U diag(sigma) U^T
