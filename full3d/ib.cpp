@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "full3d/kernel.hpp"
@@ -82,9 +83,37 @@ inline NodeStencilsYZ stencils_yz(const MacGrid& g, double y, double z) {
 
 namespace {
 
-// f (+)= spread(F); with zero_first, each thread first zeroes its own z planes of f.
+/// The support of a spread from the nodes X: the cells within 3 of a node's cell in every
+/// direction (a stencil reaches 2 cells either way, the staggered components half a cell
+/// more), the whole direction where that covers it, where it crosses a periodic y or z seam,
+/// or where a node is not finite.
+SpreadSupport support_of(const MacGrid& g, const Eigen::Matrix3Xd& X) {
+  SpreadSupport s;
+  s.valid = true;
+  constexpr int kMargin = 3;
+  for (int d = 0; d < 3; ++d) {
+    const int n = g.n(d);
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (Eigen::Index k = 0; k < X.cols(); ++k) {
+      const double v = X(d, k) / g.h();
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    s.whole[d] = true;
+    if (!(std::isfinite(lo) && std::isfinite(hi)) || hi - lo > 4.0 * n) continue;
+    s.lo[d] = int(std::floor(lo)) - kMargin;
+    s.hi[d] = int(std::floor(hi)) + kMargin;
+    if (s.hi[d] - s.lo[d] + 1 >= n) continue;
+    if (d > 0 && g.periodic(d) && (s.lo[d] < 0 || s.hi[d] >= n)) continue;
+    s.whole[d] = false;
+  }
+  return s;
+}
+
+// f (+)= spread(F); with zero_first, each thread first zeroes its own z planes of f (within
+// `zero`'s support when it is valid).
 void spread_impl(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f,
-                 int threads, bool zero_first) {
+                 int threads, bool zero_first, const SpreadSupport& zero = SpreadSupport{}) {
   const long N = long(X.cols());
   if (N == 0 && !zero_first) return;
   const double ih3 = 1.0 / (g.h() * g.h() * g.h());
@@ -118,12 +147,36 @@ void spread_impl(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matri
   parallel_blocks(T, T, [&](long tb, long, int) {
     const int t = int(tb), lo = bound[t], hi = bound[t + 1];
     if (hi <= lo) return;
-    if (zero_first)
+    if (zero_first && !zero.valid)
       for (int c = 0; c < 3; ++c) {
         const auto& d = dims[c];
         const std::size_t plane = std::size_t(d[0]) * d[1];
         const int p1 = std::min(hi, d[2]);
         if (p1 > lo) std::fill(f.c[c].data() + lo * plane, f.c[c].data() + p1 * plane, 0.0);
+      }
+    if (zero_first && zero.valid)
+      for (int c = 0; c < 3; ++c) {
+        const auto& d = dims[c];
+        // y and z: clamped (a periodic seam crossing makes the support whole there); x: up to
+        // two runs across the periodic seam
+        const int z0 = std::max(lo, zero.whole[2] ? 0 : std::max(0, zero.lo[2]));
+        const int z1 = std::min({hi, d[2], zero.whole[2] ? d[2] : zero.hi[2] + 1});
+        const int y0 = zero.whole[1] ? 0 : std::max(0, zero.lo[1]);
+        const int y1 = zero.whole[1] ? d[1] : std::min(d[1], zero.hi[1] + 1);
+        int runs[2][2] = {{0, d[0]}, {0, 0}};
+        if (!zero.whole[0]) {
+          const int a = wrap(zero.lo[0], d[0]), len = zero.hi[0] - zero.lo[0] + 1;
+          runs[0][0] = a;
+          runs[0][1] = std::min(d[0], a + len);
+          runs[1][1] = a + len - runs[0][1];  // the part past the seam, from 0
+        }
+        double* out = f.c[c].data();
+        for (int zz = z0; zz < z1; ++zz)
+          for (int yy = y0; yy < y1; ++yy) {
+            double* row = out + (std::size_t(zz) * d[1] + yy) * d[0];
+            for (const auto& r : runs)
+              if (r[1] > r[0]) std::fill(row + r[0], row + r[1], 0.0);
+          }
       }
     for (long k = 0; k < N; ++k) {
       if (T > 1) {
@@ -190,9 +243,14 @@ void spread_add(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix
 }
 
 void spread(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f,
-            int threads) {
-  if (f.c[0].size() != g.size(0) || f.c[1].size() != g.size(1) || f.c[2].size() != g.size(2)) f = VectorField(g);
-  spread_impl(g, X, F, f, threads, true);
+            int threads, SpreadSupport* support) {
+  SpreadSupport zero;  // invalid: the whole field
+  if (f.c[0].size() != g.size(0) || f.c[1].size() != g.size(1) || f.c[2].size() != g.size(2))
+    f = VectorField(g);
+  else if (support)
+    zero = *support;
+  spread_impl(g, X, F, f, threads, true, zero);
+  if (support) *support = support_of(g, X);
 }
 
 void interpolate(const MacGrid& g, const VectorField& u, const Eigen::Matrix3Xd& X, Eigen::Matrix3Xd& U,

@@ -37,9 +37,22 @@
 
 namespace swim::full3d {
 
+/// The part of a field that spread() wrote: per direction the cell indices [lo, hi] around
+/// the nodes (unwrapped along a periodic direction), or the whole direction. A field is zero
+/// outside the support of the spread that last wrote it.
+struct SpreadSupport {
+  bool valid = false;  ///< false: unknown (the whole field may hold values)
+  int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
+  bool whole[3] = {true, true, true};
+};
+
 /// f = spread(F) over the whole field (f is overwritten). X, F: 3 x N (m, N).
+/// `support`: when given and valid, the support of the spread that last wrote f, which the
+/// caller guarantees has not been changed since: only that part is zeroed (a tube fills a few
+/// per cent of a fine grid, whose full zeroing took most of a spread). It is then set to this
+/// spread's support. The result is the same either way.
 void spread(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f,
-            int threads = 1);
+            int threads = 1, SpreadSupport* support = nullptr);
 /// f += spread(F).
 void spread_add(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f,
                 int threads = 1);

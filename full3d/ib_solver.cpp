@@ -177,7 +177,7 @@ IbStepStats IbSolver::step(IbState& s, double dt, int stages) {
   // one velocity evaluation: the force FY at the nodes Y spread, the Stokes step of tau from
   // the step's u^n into `into`, and the node velocities interpolated from it
   auto velocity = [&](const Eigen::Matrix3Xd& Y, const Eigen::Matrix3Xd& FY, VectorField& into, double tau_s) {
-    spread(grid_, Y, FY, f, opt_.threads);
+    spread(grid_, Y, FY, f, opt_.threads, &f_support_);
     lap(st.time_spread);
     const StokesStats ss = stokes_.step(s.u, into, f, tau_s);
     lap(st.time_fluid);
@@ -295,7 +295,7 @@ auto IbSolver::with_linearised_coupling(const IbState& s, double dt, Body&& body
     const double scale = eps / vmax;
     Eigen::Matrix3Xd dF = (elastic_forces(mesh_, s.X + scale * v, membrane_, opt_.threads) - F0) / scale;
     if (stab_) stab_->apply_root(dt, dF);
-    spread(grid_, s.X, dF, work_f_, opt_.threads);
+    spread(grid_, s.X, dF, work_f_, opt_.threads, &f_support_);
     stokes_.step_from_rest(work_uh_, work_f_, inertia_step(opt_, dt));
     interpolate(grid_, work_uh_, s.X, U, opt_.threads);
     if (stab_) stab_->apply_root(dt, U);

@@ -27,6 +27,7 @@
 #include <vector>
 
 #include "full3d/grid.hpp"
+#include "full3d/ib.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/stokes.hpp"
 #include "full3d/wall_stabilizer.hpp"
@@ -203,6 +204,8 @@ class IbSolver {
   std::unique_ptr<WallStabilizer> stab_;
   ExternalForceFn external_;
   VectorField work_f_, work_u_, work_uh_;  ///< step() work fields, reused between steps
+  /// the support of work_f_'s last spread: every write to work_f_ is a spread given it
+  SpreadSupport f_support_;
 };
 
 }  // namespace swim::full3d

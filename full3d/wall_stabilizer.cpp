@@ -1,5 +1,6 @@
 #include "full3d/wall_stabilizer.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <stdexcept>
@@ -46,7 +47,8 @@ struct WallStabilizer::Impl {
 
 WallStabilizer::WallStabilizer(const CylinderMesh& mesh, double h, double mu, double D, WallStabilization kind,
                                double factor, int threads)
-    : kind_(kind), n_theta_(mesh.n_theta), n_rings_(mesh.n_rings), impl_(std::make_unique<Impl>()) {
+    : kind_(kind), threads_(std::max(1, threads)), n_theta_(mesh.n_theta), n_rings_(mesh.n_rings),
+      impl_(std::make_unique<Impl>()) {
   if (kind == WallStabilization::None) throw std::invalid_argument("WallStabilizer: kind none has no operator");
   if (!(h > 0.0 && mu > 0.0 && factor > 0.0 && D >= 0.0))
     throw std::invalid_argument("WallStabilizer: h, mu and factor must be positive, D non-negative");
@@ -124,24 +126,28 @@ void WallStabilizer::in_modes(Eigen::Matrix3Xd& x, F&& per_mode) const {
       for (int c = 0; c < 3; ++c) re[(c * nr + r) * nt + i] = x(c, r * nt + i);
   t.forward.execute();
   auto* z = reinterpret_cast<std::complex<double>*>(t.spec.complex());
-  Eigen::MatrixXd rhs(nr, kRhs);
-  for (int m = 0; m < nm; ++m) {
-    const std::complex<double> tw = t.twist[m];
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < nr; ++r) {
-        std::complex<double> v = z[(c * nr + r) * nm + m];
-        if (r % 2) v *= tw;  // the coefficient of exp(i m phi) at the odd rings' own angles
-        rhs(r, 2 * c) = v.real();
-        rhs(r, 2 * c + 1) = v.imag();
-      }
-    per_mode(m, rhs);
-    for (int c = 0; c < 3; ++c)
-      for (int r = 0; r < nr; ++r) {
-        std::complex<double> v(rhs(r, 2 * c), rhs(r, 2 * c + 1));
-        if (r % 2) v *= std::conj(tw);
-        z[(c * nr + r) * nm + m] = v;
-      }
-  }
+  // the modes are independent (each writes its own column of the spectra): blocks of modes
+  // over the threads, the same operations in the same order whatever their number
+  parallel_blocks(nm, threads_, [&](long m_begin, long m_end, int) {
+    Eigen::MatrixXd rhs(nr, kRhs);
+    for (long m = m_begin; m < m_end; ++m) {
+      const std::complex<double> tw = t.twist[m];
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < nr; ++r) {
+          std::complex<double> v = z[(c * nr + r) * nm + m];
+          if (r % 2) v *= tw;  // the coefficient of exp(i m phi) at the odd rings' own angles
+          rhs(r, 2 * c) = v.real();
+          rhs(r, 2 * c + 1) = v.imag();
+        }
+      per_mode(int(m), rhs);
+      for (int c = 0; c < 3; ++c)
+        for (int r = 0; r < nr; ++r) {
+          std::complex<double> v(rhs(r, 2 * c), rhs(r, 2 * c + 1));
+          if (r % 2) v *= std::conj(tw);
+          z[(c * nr + r) * nm + m] = v;
+        }
+    }
+  });
   t.inverse.execute();
   const double inv = 1.0 / nt;
   for (int r = 0; r < nr; ++r)
@@ -152,11 +158,10 @@ void WallStabilizer::in_modes(Eigen::Matrix3Xd& x, F&& per_mode) const {
 template <class G>
 void WallStabilizer::spectral(Eigen::Matrix3Xd& x, G&& gain) const {
   if (x.cols() != n_theta_ * n_rings_) throw std::invalid_argument("WallStabilizer: wrong number of nodes");
-  Eigen::MatrixXd y;
   in_modes(x, [&](int m, Eigen::MatrixXd& b) {  // U diag(gain(sigma)) U^T b
     const Eigen::MatrixXd& U = vectors_[std::size_t(m)];
     const Eigen::VectorXd& sigma = rates_[std::size_t(m)];
-    y.noalias() = U.transpose() * b;
+    Eigen::MatrixXd y = U.transpose() * b;
     for (Eigen::Index i = 0; i < y.rows(); ++i) y.row(i) *= gain(sigma[i]);
     b.noalias() = U * y;
   });

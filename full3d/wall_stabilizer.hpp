@@ -83,7 +83,7 @@ class WallStabilizer {
  public:
   /// mesh: the wall's mesh (rings of n_theta nodes, rest lengths, node areas); h: the grid's
   /// cell, m; mu: viscosity, Pa s; D: the wall's bending rigidity, J; factor: m0's multiple of
-  /// the grid-scale mobility (> 0); threads: for the per-mode decompositions. Throws
+  /// the grid-scale mobility (> 0); threads: for the per-mode decompositions and products. Throws
   /// std::invalid_argument for kind None or a mesh that is not a stack of three or more rings.
   WallStabilizer(const CylinderMesh& mesh, double h, double mu, double D, WallStabilization kind,
                  double factor = 1.0, int threads = 1);
@@ -117,6 +117,7 @@ class WallStabilizer {
   template <class G>
   void spectral(Eigen::Matrix3Xd& x, G&& gain) const;
   WallStabilization kind_;
+  int threads_ = 1;  ///< for the per-mode products of every application
   int n_theta_ = 0, n_rings_ = 0, n_modes_ = 0;
   double m0_ = 0.0, kappa_b_ = 0.0, l_h_ = 0.0;
   /// per mode m: B_m's eigenvectors U_m (n_rings x n_rings, orthonormal) and rates sigma_m, 1/s

@@ -72,6 +72,55 @@ TEST(ImmersedBoundary, SpreadAndInterpolateAreAdjoint) {
   }
 }
 
+// A spread given the support of the field's last spread zeroes only that part, and gives the
+// field a fresh spread gives, bit for bit: clusters of nodes that move (across the periodic x
+// seam, next to a duct wall, across a periodic y/z seam), on one and two threads.
+TEST(ImmersedBoundary, SpreadWithTheLastSupportEqualsAFreshSpread) {
+  std::mt19937 rng(5);
+  for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
+    const MacGrid g(24, 14, 16, 0.05, kind);
+    // a cluster of nodes about a centre (a tube's few per cent of the grid)
+    auto cluster = [&](const Eigen::Vector3d& c) {
+      std::uniform_real_distribution<double> U(-0.12, 0.12);
+      Eigen::Matrix3Xd X(3, 30);
+      for (int k = 0; k < 30; ++k) X.col(k) = c + Eigen::Vector3d(U(rng), U(rng), U(rng));
+      return X;
+    };
+    const double lo = 2.2 * g.h() + 0.12;  // keeps the duct's clusters off the walls' stencils
+    const std::vector<Eigen::Vector3d> centres = {
+        {0.6, 0.35, 0.4},                          // inside
+        {0.02, 0.35, 0.4},                         // across the periodic x seam
+        {1.18, 0.35, 0.4},                         // across it from the other side
+        {0.6, lo, g.length(2) - lo},               // next to walls (duct), near the y/z seams (box)
+        {0.6, 0.01, 0.79},                         // across the y and z seams (box only)
+        {0.3, 0.5, 0.2}};
+    for (int threads : {1, 2}) {
+      VectorField kept(g);
+      SpreadSupport support;
+      int spreads = 0;
+      for (const Eigen::Vector3d& c : centres) {
+        if (kind == GridBoundary::SquareDuct && (c[1] < lo || c[2] > g.length(2) - lo)) continue;
+        const Eigen::Matrix3Xd X = cluster(c);
+        const Eigen::Matrix3Xd F = random_forces(30, rng);
+        spread(g, X, F, kept, threads, &support);
+        ++spreads;
+        VectorField fresh(g);
+        spread(g, X, F, fresh, threads);
+        for (int comp = 0; comp < 3; ++comp)
+          ASSERT_EQ(kept.c[comp], fresh.c[comp]) << to_string(kind) << ", centre " << c.transpose() << ", component "
+                                                 << comp << ", " << threads << " threads";
+        EXPECT_TRUE(support.valid);
+      }
+      EXPECT_GE(spreads, 5);
+      // the support of a cluster away from every seam is a small part of the grid
+      support = SpreadSupport{};
+      spread(g, cluster(centres[0]), random_forces(30, rng), kept, threads, &support);
+      EXPECT_FALSE(support.whole[0] || support.whole[1] || support.whole[2]) << to_string(kind);
+      EXPECT_LT(support.hi[0] - support.lo[0] + 1, g.nx());
+    }
+  }
+}
+
 TEST(ImmersedBoundary, InterpolationReproducesConstantsAndLinearFields) {
   std::mt19937 rng(4);
   for (auto kind : {GridBoundary::PeriodicBox, GridBoundary::SquareDuct}) {
