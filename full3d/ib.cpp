@@ -110,8 +110,8 @@ SpreadSupport support_of(const MacGrid& g, const Eigen::Matrix3Xd& X) {
   return s;
 }
 
-// f (+)= spread(F); with zero_first, each thread first zeroes its own z planes of f (within
-// `zero`'s support when it is valid).
+// f (+)= spread(F); with zero_first, each thread first zeroes its own z planes of f within
+// `zero`'s box (whole in every direction by default).
 void spread_impl(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matrix3Xd& F, VectorField& f,
                  int threads, bool zero_first, const SpreadSupport& zero = SpreadSupport{}) {
   const long N = long(X.cols());
@@ -147,14 +147,7 @@ void spread_impl(const MacGrid& g, const Eigen::Matrix3Xd& X, const Eigen::Matri
   parallel_blocks(T, T, [&](long tb, long, int) {
     const int t = int(tb), lo = bound[t], hi = bound[t + 1];
     if (hi <= lo) return;
-    if (zero_first && !zero.valid)
-      for (int c = 0; c < 3; ++c) {
-        const auto& d = dims[c];
-        const std::size_t plane = std::size_t(d[0]) * d[1];
-        const int p1 = std::min(hi, d[2]);
-        if (p1 > lo) std::fill(f.c[c].data() + lo * plane, f.c[c].data() + p1 * plane, 0.0);
-      }
-    if (zero_first && zero.valid)
+    if (zero_first)  // the support's box of the thread's planes (all of them for an unknown support)
       for (int c = 0; c < 3; ++c) {
         const auto& d = dims[c];
         // y and z: clamped (a periodic seam crossing makes the support whole there); x: up to

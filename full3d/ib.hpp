@@ -45,7 +45,7 @@ namespace swim::full3d {
 /// the nodes (unwrapped along a periodic direction), or the whole direction. A field is zero
 /// outside the support of the spread that last wrote it.
 struct SpreadSupport {
-  bool valid = false;  ///< false: unknown (the whole field may hold values)
+  bool valid = false;  ///< false: unknown (the whole field may hold values; `whole` is then set)
   int lo[3] = {0, 0, 0}, hi[3] = {0, 0, 0};
   bool whole[3] = {true, true, true};
 };
