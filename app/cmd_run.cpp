@@ -21,6 +21,7 @@
 #include "common/scene.hpp"
 #include "common/si_format.hpp"
 #include "full3d/run3d.hpp"
+#include "full3d/run3d_output.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
@@ -248,16 +249,10 @@ int run3d(const RunOptions& o, const scene::json& sc) {
       }
     }
   }
-  // a wall that buckled into lobes beyond half a cell: its pattern, and the displacement
-  // that depends on it, follow the grid (docs/full3d.md, "Wall wrinkling")
+  // a wall that buckled into lobes beyond half a cell: what chose the lobes (the seed or the
+  // grid), and whether they changed during the run (full3d::wrinkle_note)
   std::fflush(stdout);  // the note follows the result line, also when both go to one file
-  if (s.contains("max_wrinkle_over_h") && s["max_wrinkle_over_h"].get<double>() > 0.5)
-    std::fprintf(stderr,
-                 "swim: note: the tube wall wrinkled (azimuthal lobes up to %s RMS, %.2g cells): without a seed the "
-                 "lobes follow the grid, so the displacement depends on full3d.grid.cells_across; a seed "
-                 "(full3d.membrane.seed_mode, seed_amplitude) chooses them, a wall stiff enough in bending "
-                 "(full3d.membrane.bending_rigidity) keeps it round (docs/full3d.md \"Wall wrinkling\")\n",
-                 si(s["max_wrinkle_m"].get<double>(), "m").c_str(), s["max_wrinkle_over_h"].get<double>());
+  if (const std::string note = full3d::wrinkle_note(s); !note.empty()) std::fprintf(stderr, "%s\n", note.c_str());
   plot_and_list(out, o.plot, had_plot);
   if (r.failed) {
     std::fprintf(stderr, "swim: %s\n  partial results and the last checkpoint kept in %s\n", r.message.c_str(),

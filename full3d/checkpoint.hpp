@@ -28,7 +28,7 @@ namespace swim::full3d {
 
 /// 5: checksums and the scene hash with the standard FNV-1a 64 offset basis (version 4 used
 /// the legacy basis, common/checksum.hpp; such a checkpoint is refused with a message saying so).
-inline constexpr std::uint32_t kCheckpointVersion = 5;
+inline constexpr std::uint32_t kCheckpointVersion = 6;
 
 class CheckpointWriter {
  public:

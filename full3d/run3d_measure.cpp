@@ -77,6 +77,49 @@ WallWrinkle wall_wrinkle_shape(const CylinderMesh& mesh, const Eigen::Matrix3Xd&
   return {rms, rms > 1e-9 * ring_r[ring] ? lobe_mode(mesh, X, node_r, ring_r, ring) : 0};
 }
 
+void CycleWrinkles::add(int cycle, double amplitude_m, int mode) {
+  if (cycles_.empty() || cycles_.back().cycle != cycle) {
+    Cycle c;
+    c.cycle = cycle;
+    cycles_.push_back(c);
+  }
+  Cycle& c = cycles_.back();
+  if (amplitude_m > c.max_wrinkle_m) c.max_wrinkle_m = amplitude_m, c.max_wrinkle_mode = mode;
+  if (amplitude_m > threshold_ && mode > 0 && std::find(c.modes.begin(), c.modes.end(), mode) == c.modes.end())
+    c.modes.push_back(mode);
+}
+
+std::vector<int> CycleWrinkles::modes() const {
+  std::vector<int> all;
+  for (const Cycle& c : cycles_)
+    for (int m : c.modes)
+      if (std::find(all.begin(), all.end(), m) == all.end()) all.push_back(m);
+  return all;
+}
+
+std::vector<double> CycleWrinkles::flat() const {
+  std::vector<double> v;
+  for (const Cycle& c : cycles_) {
+    v.insert(v.end(), {double(c.cycle), c.max_wrinkle_m, double(c.max_wrinkle_mode), double(c.modes.size())});
+    for (int m : c.modes) v.push_back(double(m));
+  }
+  return v;
+}
+
+void CycleWrinkles::unflatten(const std::vector<double>& v) {
+  cycles_.clear();
+  for (std::size_t k = 0; k + 4 <= v.size();) {
+    Cycle c;
+    c.cycle = int(v[k]);
+    c.max_wrinkle_m = v[k + 1];
+    c.max_wrinkle_mode = int(v[k + 2]);
+    const std::size_t n = std::size_t(v[k + 3]);
+    k += 4;
+    for (std::size_t i = 0; i < n && k < v.size(); ++i, ++k) c.modes.push_back(int(v[k]));
+    cycles_.push_back(std::move(c));
+  }
+}
+
 void WallSplit::add_step(const IbStepStats& st) {
   add("step_forces", st.time_forces);
   add("step_spread", st.time_spread);
@@ -100,7 +143,7 @@ record::RunRecord new_record(const RunSetup& run) {
 }
 
 Measurements::Measurements(const RunSetup& run, record::RunRecord& rec, EnergySource energy)
-    : run_(run), rec_(rec), energy_source_(std::move(energy)) {
+    : run_(run), rec_(rec), wrinkles_(0.5 * run.p.h), energy_source_(std::move(energy)) {
   const Params3d& p = run.p;
   const double q_static = p.c1_estimate() * (p.R0 - p.protocol.R_f);
   e_cap_ = p.energy_growth * run.e_ref * std::max(1.0, std::pow(p.protocol.q / q_static, 2));
@@ -220,6 +263,9 @@ void Measurements::record(const IbState& s, const ProtocolState& st, long n, dou
     vol += 0.5 * M_PI * (rr[r] * rr[r] + rr[r + 1] * rr[r + 1]) * (xr[r + 1] - xr[r]);
   const WallWrinkle wrinkle = wall_wrinkle_shape(mesh, s.X, rn, rr);
   if (wrinkle.amplitude > max_wrinkle_) max_wrinkle_ = wrinkle.amplitude, max_wrinkle_mode_ = wrinkle.mode;
+  // the row at a cycle's end belongs to the cycle that ended there
+  const bool at_end = !st.cycle_end.empty() && s.t <= st.cycle_end.back();
+  wrinkles_.add(int(st.cycles_completed) + (at_end ? 0 : 1), wrinkle.amplitude, wrinkle.mode);
   const double row[] = {s.t, s.X.row(0).mean() - x_center0_, s.V.row(0).mean(), es + eb + ek, rn.minCoeff(),
                         rn.maxCoeff(), q_rear_, q_front_, vol_rear_, vol_front_, vol, double(st.phase), es, eb, ek,
                         double(st.active), double(st.cycles_completed), last_cfl_, double(last_iterations_),
@@ -267,11 +313,13 @@ void Measurements::records(Self& self, F&& f) {
 
 void Measurements::save(CheckpointWriter& w) const {
   records(*this, CheckpointOut(w));
+  w.put("wrinkle_cycles", wrinkles_.flat());
   rec_.save([&](const std::string& name, const std::vector<double>& v) { w.put(name, v); });
 }
 
 void Measurements::load(const CheckpointReader& r) {
   records(*this, CheckpointIn(r));
+  wrinkles_.unflatten(r.get_vector("wrinkle_cycles"));
   rec_.load([&](const std::string& name) { return r.get_vector(name); });
 }
 

@@ -42,6 +42,38 @@ struct WallWrinkle {
 WallWrinkle wall_wrinkle_shape(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, const Eigen::VectorXd& node_r,
                                const Eigen::VectorXd& ring_r);
 
+/// The wall's lobes cycle by cycle (docs/full3d.md, "Ring buckling and the seed imperfection"),
+/// from the wrinkle of each recorded row: for each protocol cycle (1 = the first; the cycle in
+/// progress at the run's end included), the largest wrinkle and its lobe number, and every lobe
+/// number the wall showed while its wrinkle exceeded the threshold (half a cell), in the order
+/// they first appeared. A seeded wall whose lobes turn from the seed's m to another while
+/// buckled (a recovery that leaves a small wrinkle of another shape, which the next contraction
+/// grows) shows two modes: the later cycles then belong to another buckled shape.
+class CycleWrinkles {
+ public:
+  struct Cycle {
+    int cycle = 0;
+    double max_wrinkle_m = 0.0;
+    int max_wrinkle_mode = 0;
+    std::vector<int> modes;  ///< lobe numbers seen above the threshold, first appearance first
+  };
+  explicit CycleWrinkles(double threshold_m = 0.0) : threshold_(threshold_m) {}
+  /// One recorded row: the cycle it belongs to (cycles completed + 1), the wrinkle (m) and its
+  /// lobe number (0: round).
+  void add(int cycle, double amplitude_m, int mode);
+  const std::vector<Cycle>& cycles() const { return cycles_; }
+  /// The lobe numbers seen above the threshold over the whole run, first appearance first.
+  std::vector<int> modes() const;
+  double threshold() const { return threshold_; }
+  /// For checkpoints: per cycle [cycle, max wrinkle, its mode, number of modes, the modes...].
+  std::vector<double> flat() const;
+  void unflatten(const std::vector<double>& v);
+
+ private:
+  double threshold_;
+  std::vector<Cycle> cycles_;
+};
+
 /// An empty record of a 3D run (tier, model, length, columns, reference ring positions).
 record::RunRecord new_record(const RunSetup& run);
 
@@ -102,6 +134,8 @@ class Measurements {
   /// The largest wall wrinkle of the recorded rows (m) and its lobe number (wall_wrinkle_shape).
   double max_wrinkle() const { return max_wrinkle_; }
   int max_wrinkle_mode() const { return int(max_wrinkle_mode_); }
+  /// The wall's lobes cycle by cycle (threshold: half a cell).
+  const CycleWrinkles& cycle_wrinkles() const { return wrinkles_; }
   WallSplit& split() { return split_; }
   const WallSplit& split() const { return split_; }
 
@@ -129,6 +163,7 @@ class Measurements {
   long iterations_total_ = 0, last_iterations_ = 0;
   long last_recorded_ = -1;
   double max_wrinkle_ = 0.0, max_wrinkle_mode_ = 0.0;
+  CycleWrinkles wrinkles_;
   mutable double parts_t_ = -1.0;
   mutable const double* parts_x_ = nullptr;
   mutable std::array<double, 2> parts_{};

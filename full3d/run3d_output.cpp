@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "common/output.hpp"
+#include "common/si_format.hpp"
 #include "full3d/buckling_estimate.hpp"
 
 namespace swim::full3d {
@@ -58,6 +59,81 @@ std::uintmax_t size_of(const std::string& path) {
   return ec ? 0 : n;
 }
 }  // namespace
+
+json wrinkle_by_cycle_json(const CycleWrinkles& w) {
+  json a = json::array();
+  for (const CycleWrinkles::Cycle& c : w.cycles())
+    a.push_back({{"cycle", c.cycle},
+                 {"max_wrinkle_m", c.max_wrinkle_m},
+                 {"max_wrinkle_mode", c.max_wrinkle_mode},
+                 {"modes_over_half_cell", c.modes}});
+  return a;
+}
+
+std::string wrinkle_note(const json& s) {
+  if (!s.contains("max_wrinkle_over_h") || !s.contains("max_wrinkle_m") || s["max_wrinkle_over_h"].get<double>() <= 0.5)
+    return "";
+  const double w = s["max_wrinkle_m"].get<double>(), wh = s["max_wrinkle_over_h"].get<double>();
+  const int seed = s.contains("derived") && s["derived"].contains("seed_mode") ? s["derived"]["seed_mode"].get<int>() : 0;
+  const double eps =
+      s.contains("derived") && s["derived"].contains("seed_amplitude") ? s["derived"]["seed_amplitude"].get<double>() : 0.0;
+  std::vector<int> modes;
+  if (s.contains("wrinkle_modes_over_half_cell")) modes = s["wrinkle_modes_over_half_cell"].get<std::vector<int>>();
+  if (modes.empty() && s.contains("max_wrinkle_mode") && s["max_wrinkle_mode"].get<int>() > 0)
+    modes.push_back(s["max_wrinkle_mode"].get<int>());
+  char buf[1024];
+  std::string note;
+  const std::string lobes = modes.empty() ? std::string("lobes") : "m = " + std::to_string(modes.front()) + " lobes";
+  if (seed > 0) {
+    std::snprintf(buf, sizeof buf,
+                  "swim: note: the tube wall buckled into %s (up to %s RMS, %.2g cells); the seed "
+                  "(full3d.membrane.seed_mode = %d, seed_amplitude = %.3g R0) ",
+                  lobes.c_str(), si(w, "m").c_str(), wh, seed, eps);
+    note = buf;
+    note += !modes.empty() && modes.front() != seed
+                ? "did not choose them: the wall grew another lobe number than the seed's, so the displacement "
+                  "depends on full3d.grid.cells_across (docs/full3d.md \"Ring buckling and the seed imperfection\")"
+                : "chose them on this grid (docs/full3d.md \"Ring buckling and the seed imperfection\")";
+  } else {
+    std::snprintf(buf, sizeof buf,
+                  "swim: note: the tube wall wrinkled into %s (up to %s RMS, %.2g cells): without a seed the "
+                  "lobes follow the grid, so the displacement depends on full3d.grid.cells_across; a seed "
+                  "(full3d.membrane.seed_mode, seed_amplitude) chooses them, a wall stiff enough in bending "
+                  "(full3d.membrane.bending_rigidity) keeps it round (docs/full3d.md \"Wall wrinkling\")",
+                  lobes.c_str(), si(w, "m").c_str(), wh);
+    note = buf;
+  }
+  if (modes.size() >= 2) {
+    // the cycle where each later lobe number first exceeded half a cell
+    std::string change;
+    int first_change = 0, first_buckled = 0;
+    if (s.contains("wrinkle_by_cycle"))
+      for (std::size_t k = 0; k < modes.size(); ++k)
+        for (const auto& c : s["wrinkle_by_cycle"]) {
+          const auto cm = c["modes_over_half_cell"].get<std::vector<int>>();
+          if (std::find(cm.begin(), cm.end(), modes[k]) != cm.end()) {
+            const int cyc = c["cycle"].get<int>();
+            if (k == 0) {
+              first_buckled = cyc;
+              break;
+            }
+            if (first_change == 0) first_change = cyc;
+            change += (change.empty() ? "" : ", then ") + std::string("to m = ") + std::to_string(modes[k]) +
+                      " in cycle " + std::to_string(cyc);
+            break;
+          }
+        }
+    std::snprintf(buf, sizeof buf, "\nswim: note: the wall's lobes changed from m = %d %s (summary.json wrinkle_by_cycle): ",
+                  modes.front(), change.empty() ? "to another lobe number" : change.c_str());
+    note += buf;
+    note += first_change > first_buckled
+                ? "the cycles from there on follow another buckled shape and do not repeat the earlier ones; compare "
+                  "designs by the cycles before the change"
+                : "the wall took another branch within its first buckled cycle, which the grid and the step can "
+                  "tip; compare designs, and grids of one design, only on the same branch";
+  }
+  return note;
+}
 
 RunOutput::RunOutput(const RunSetup& run, const json& resolved, std::string dir, bool vtk, bool fluid,
                      record::RunRecord& rec)
@@ -183,6 +259,8 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                  {"max_wrinkle_m", wmax},
                  {"max_wrinkle_over_h", wmax / p.h},
                  {"max_wrinkle_mode", measured.max_wrinkle_mode()},
+                 {"wrinkle_by_cycle", wrinkle_by_cycle_json(measured.cycle_wrinkles())},
+                 {"wrinkle_modes_over_half_cell", measured.cycle_wrinkles().modes()},
                  {"steps", n},
                  {"steps_per_cycle", stepper.steps_per_cycle()}};
   record::check_plausible(rec_);

@@ -16,6 +16,19 @@
 
 namespace swim::full3d {
 
+/// summary.json's "wrinkle_by_cycle": per protocol cycle, {"cycle", "max_wrinkle_m",
+/// "max_wrinkle_mode", "modes_over_half_cell"} (CycleWrinkles).
+scene::json wrinkle_by_cycle_json(const CycleWrinkles& w);
+
+/// The note `swim run` prints after a 3D run whose wall wrinkled beyond half a cell, from its
+/// summary.json (empty when it did not, or the summary has no wrinkle figures). It names the lobe
+/// number the wall buckled into and what chose it: the seed (`derived.seed_mode`,
+/// `derived.seed_amplitude`), or, without one, the grid. It says so when the wall grew another
+/// lobe number than the seed's, and when its lobes changed from one buckled shape to another
+/// during the run (`wrinkle_modes_over_half_cell` holds two or more), naming the cycle where the
+/// new lobes first exceeded half a cell: the cycles from there on belong to another buckled shape.
+std::string wrinkle_note(const scene::json& summary);
+
 class RunOutput {
  public:
   /// vtk: membrane frames; fluid: fluid frames. The record's rows and ring radii stream into

@@ -48,6 +48,9 @@ def wrinkle(run):
         return "—"
     if run.get("max_wrinkle_over_h", 1.0) < 1e-6:
         return "round"
+    modes = run.get("wrinkle_modes_over_half_cell") or []
+    if len(modes) >= 2:  # the lobes changed during the run
+        return si(run["max_wrinkle_m"], "m") + " (m = " + ", then ".join(str(m) for m in modes) + ")"
     mode = run.get("max_wrinkle_mode")
     return si(run["max_wrinkle_m"], "m") + (f" (m = {mode})" if mode else "")
 
@@ -767,6 +770,11 @@ def markdown(report, figs):
                     f"{max(r['max_wrinkle_over_h'] for r in wr):.1f} h): the hoop-compressed wall buckled into "
                     f"{pattern}, and the 1D tier, which assumes a round tube, "
                     "cannot represent them (docs/full3d.md, \"Wall wrinkling\")."]
+            changed = [r for r in wr if len(r.get("wrinkle_modes_over_half_cell") or []) >= 2]
+            if changed:
+                out[-1] += (f" On {len(changed)} of these grids the lobes changed during the run (the cell lists them in "
+                            "order): a run whose lobes change follows another buckled branch from there on "
+                            "(docs/full3d.md, \"Ring buckling and the seed imperfection\").")
         ref = c["reference3d"]
         rng = ref.get("order_range")
         out += ["", "Extrapolated 3D reference (h → 0"

@@ -368,6 +368,9 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   // existed have none)
   for (const char* k : {"max_wrinkle_m", "max_wrinkle_over_h", "max_wrinkle_mode"})
     if (summary.contains(k) && summary[k].is_number()) r.record[k] = summary[k];
+  // the lobe numbers the wall showed above half a cell, in order (two or more: they changed)
+  if (summary.contains("wrinkle_modes_over_half_cell") && summary["wrinkle_modes_over_half_cell"].is_array())
+    r.record["wrinkle_modes_over_half_cell"] = summary["wrinkle_modes_over_half_cell"];
   // the lobes seeded in the wall's stress-free shape (0: none)
   if (summary.contains("derived") && summary["derived"].is_object() && summary["derived"].contains("seed_mode") &&
       summary["derived"]["seed_mode"].is_number())

@@ -359,7 +359,7 @@ TEST(RunFolderCli, BothTiersWriteTheSameKeysAndColumns) {
   // the tier-specific summary keys, documented in docs/outputs.md
   const std::set<std::string> only1d = {"pumped_volume_lab_m3", "brownian"};
   const std::set<std::string> only3d = {"steps", "steps_per_cycle", "max_edge_over_h", "max_wrinkle_m", "max_wrinkle_over_h",
-                                           "max_wrinkle_mode"};
+                                           "max_wrinkle_mode", "wrinkle_by_cycle", "wrinkle_modes_over_half_cell"};
   std::set<std::string> ka, kb;
   for (const auto& [k, v] : a.items())
     if (!only1d.count(k)) ka.insert(k);
@@ -605,4 +605,36 @@ TEST(CalibrateCli, ProgressLinesWithProgressNoneWithQuiet) {
   EXPECT_EQ(off.err.find("% "), std::string::npos) << off.err;
   EXPECT_EQ(off.err.find("done in"), std::string::npos) << off.err;
   fs::remove_all(d);
+}
+
+namespace {
+const std::string kL02 = SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json";
+}
+
+// A seeded 3D run of the paper's buckling wall (24 cells across, one cycle, about 8 s): the
+// summary records the lobes cycle by cycle (the cycle's largest wrinkle is the run's, in the
+// seeded m = 8, the only lobe number shown above half a cell), and the note names the lobes
+// and the seed that chose them and reports no change.
+TEST(RunFolderCli, ASeededBucklingRunRecordsItsLobesCycleByCycle) {
+  const fs::path d = tmpdir("lobes");
+  const fs::path out = d / "run";
+  const Cli c = swim_cli("run \"" + kL02 + "\" --tier 3d --threads 1 --set full3d.grid.cells_across=24" +
+                             " --set full3d.membrane.seed_mode=8 --set full3d.membrane.seed_amplitude=0.01" +
+                             " --out \"" + out.string() + "\"",
+                         d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json s = summary_of(out);
+  ASSERT_EQ(s["cycles_completed"].get<int>(), 1);
+  ASSERT_TRUE(s["wrinkle_by_cycle"].is_array());
+  ASSERT_EQ(s["wrinkle_by_cycle"].size(), 1u);  // the row at the cycle's end belongs to the cycle
+  const json& c1 = s["wrinkle_by_cycle"][0];
+  EXPECT_EQ(c1["cycle"].get<int>(), 1);
+  EXPECT_EQ(c1["max_wrinkle_m"].get<double>(), s["max_wrinkle_m"].get<double>());
+  EXPECT_EQ(c1["max_wrinkle_mode"].get<int>(), 8);
+  EXPECT_GT(s["max_wrinkle_over_h"].get<double>(), 0.5);
+  EXPECT_EQ(c1["modes_over_half_cell"].get<std::vector<int>>(), std::vector<int>({8}));
+  EXPECT_EQ(s["wrinkle_modes_over_half_cell"].get<std::vector<int>>(), std::vector<int>({8}));
+  EXPECT_NE(c.err.find("buckled into m = 8 lobes"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("full3d.membrane.seed_mode = 8"), std::string::npos) << c.err;
+  EXPECT_EQ(c.err.find("lobes changed"), std::string::npos) << c.err;
 }

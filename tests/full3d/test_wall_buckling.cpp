@@ -23,6 +23,7 @@
 #include "full3d/buckling_estimate.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/run3d_measure.hpp"
+#include "full3d/run3d_output.hpp"
 #include "full3d/scene3d.hpp"
 
 using namespace swim;
@@ -474,4 +475,93 @@ TEST(WallSeed, AutoSeedIsTheBucklingEstimatesFastestModeOnEveryGrid) {
   } catch (const InputError& e) {
     EXPECT_EQ(e.key(), "full3d.membrane.seed_mode");
   }
+}
+
+// The wall's lobes cycle by cycle (CycleWrinkles): each row goes to its cycle, the largest
+// wrinkle of a cycle and its lobe number are kept, and a lobe number counts as shown only
+// while the wrinkle exceeds the threshold (half a cell), in the order it first appeared. The
+// rows of a seeded two-cycle run on 128 cells whose second recovery turned from 8 to 4 lobes
+// (t, cycle, wrinkle, mode, with h = 3.9 nm) are the pattern.
+TEST(WallSeed, TheLobesAreRecordedCycleByCycle) {
+  const double h = 3.90625e-9;
+  CycleWrinkles w(0.5 * h);
+  w.add(1, 0.88e-9, 8);   // the seed, below half a cell
+  w.add(1, 11.8e-9, 8);   // the first contraction buckles it
+  w.add(1, 1.9e-9, 5);    // a small wrinkle of another shape: not shown
+  w.add(2, 1.96e-9, 8);
+  w.add(2, 11.8e-9, 4);   // the second recovery turns to m = 4
+  w.add(2, 6.0e-9, 8);
+  w.add(3, 1.9e-9, 4);
+  ASSERT_EQ(w.cycles().size(), 3u);
+  EXPECT_EQ(w.cycles()[0].cycle, 1);
+  EXPECT_DOUBLE_EQ(w.cycles()[0].max_wrinkle_m, 11.8e-9);
+  EXPECT_EQ(w.cycles()[0].max_wrinkle_mode, 8);
+  EXPECT_EQ(w.cycles()[0].modes, std::vector<int>({8}));
+  EXPECT_EQ(w.cycles()[1].modes, std::vector<int>({8, 4}));
+  EXPECT_EQ(w.cycles()[1].max_wrinkle_mode, 4);
+  EXPECT_TRUE(w.cycles()[2].modes.empty());
+  EXPECT_EQ(w.modes(), std::vector<int>({8, 4}));
+  // the checkpoint's flat form reads back to the same record
+  CycleWrinkles r(0.5 * h);
+  r.unflatten(w.flat());
+  ASSERT_EQ(r.cycles().size(), 3u);
+  for (std::size_t k = 0; k < 3; ++k) {
+    EXPECT_EQ(r.cycles()[k].cycle, w.cycles()[k].cycle);
+    EXPECT_EQ(r.cycles()[k].max_wrinkle_m, w.cycles()[k].max_wrinkle_m);
+    EXPECT_EQ(r.cycles()[k].max_wrinkle_mode, w.cycles()[k].max_wrinkle_mode);
+    EXPECT_EQ(r.cycles()[k].modes, w.cycles()[k].modes);
+  }
+  const scene::json j = wrinkle_by_cycle_json(w);
+  ASSERT_EQ(j.size(), 3u);
+  EXPECT_EQ(j[1]["modes_over_half_cell"].get<std::vector<int>>(), std::vector<int>({8, 4}));
+}
+
+// What `swim run` says after a 3D run whose wall wrinkled (wrinkle_note): nothing below half a
+// cell; what chose the lobes (the seed, naming its keys, or the grid); a wall that grew another
+// lobe number than the seed's; and lobes that changed during the run, naming the cycle.
+TEST(WallSeed, TheRunsNoteNamesWhatChoseTheLobesAndAChange) {
+  auto summary = [](double over_h, int seed, std::vector<int> modes, scene::json by_cycle) {
+    scene::json s;
+    s["max_wrinkle_m"] = over_h * 3.90625e-9;
+    s["max_wrinkle_over_h"] = over_h;
+    s["max_wrinkle_mode"] = modes.empty() ? 0 : modes.front();
+    s["wrinkle_modes_over_half_cell"] = modes;
+    s["wrinkle_by_cycle"] = by_cycle;
+    s["derived"] = {{"seed_mode", seed}, {"seed_amplitude", seed > 0 ? 0.01 : 0.0}};
+    return s;
+  };
+  const scene::json one = scene::json::array({{{"cycle", 1}, {"modes_over_half_cell", {8}}}});
+  const scene::json two = scene::json::array(
+      {{{"cycle", 1}, {"modes_over_half_cell", {8}}}, {{"cycle", 2}, {"modes_over_half_cell", {8, 4}}}});
+  const auto has = [](const std::string& s, const char* what) { return s.find(what) != std::string::npos; };
+
+  EXPECT_EQ(wrinkle_note(summary(0.4, 8, {}, scene::json::array())), "");
+  EXPECT_EQ(wrinkle_note(scene::json::object()), "");
+
+  const std::string seeded = wrinkle_note(summary(3.0, 8, {8}, one));
+  EXPECT_TRUE(has(seeded, "buckled into m = 8 lobes")) << seeded;
+  EXPECT_TRUE(has(seeded, "full3d.membrane.seed_mode = 8")) << seeded;
+  EXPECT_TRUE(has(seeded, "chose them")) << seeded;
+  EXPECT_FALSE(has(seeded, "did not choose")) << seeded;
+  EXPECT_FALSE(has(seeded, "changed")) << seeded;
+
+  const std::string other = wrinkle_note(summary(3.0, 8, {4}, scene::json::array({{{"cycle", 1}, {"modes_over_half_cell", {4}}}})));
+  EXPECT_TRUE(has(other, "buckled into m = 4 lobes")) << other;
+  EXPECT_TRUE(has(other, "did not choose them")) << other;
+
+  const std::string changed = wrinkle_note(summary(3.0, 8, {8, 4}, two));
+  EXPECT_TRUE(has(changed, "chose them")) << changed;
+  EXPECT_TRUE(has(changed, "lobes changed from m = 8 to m = 4 in cycle 2")) << changed;
+  EXPECT_TRUE(has(changed, "cycles before the change")) << changed;
+  // a change within the first cycle (the L = 0.4 um tube's recovery turns from 8 to 4 lobes)
+  const std::string within = wrinkle_note(
+      summary(3.0, 8, {8, 4}, scene::json::array({{{"cycle", 1}, {"modes_over_half_cell", {8, 4}}}})));
+  EXPECT_TRUE(has(within, "lobes changed from m = 8 to m = 4 in cycle 1")) << within;
+  EXPECT_TRUE(has(within, "another branch within its first buckled cycle")) << within;
+  EXPECT_FALSE(has(within, "cycles before the change")) << within;
+
+  const std::string grid = wrinkle_note(summary(1.2, 0, {4}, scene::json::array({{{"cycle", 1}, {"modes_over_half_cell", {4}}}})));
+  EXPECT_TRUE(has(grid, "wrinkled into m = 4 lobes")) << grid;
+  EXPECT_TRUE(has(grid, "without a seed the lobes follow the grid")) << grid;
+  EXPECT_FALSE(has(grid, "changed")) << grid;
 }

@@ -389,5 +389,22 @@ class ValidationFigures(unittest.TestCase):
                 self.assertFalse(boxes[i].overlaps(boxes[j]))
 
 
+class ValidationWrinkleCell(unittest.TestCase):
+    """The report's wall-wrinkle cell: the lobe number, the lobes in order when they changed
+    during the run, "round" for a wall held axisymmetric."""
+
+    def setUp(self):
+        self.mod = load("plot_validation")
+
+    def test_lobes_and_their_change(self):
+        run = {"max_wrinkle_m": 11.6e-9, "max_wrinkle_over_h": 3.0, "max_wrinkle_mode": 8}
+        self.assertEqual(self.mod.wrinkle(run), "11.6 nm (m = 8)")
+        run["wrinkle_modes_over_half_cell"] = [8]
+        self.assertEqual(self.mod.wrinkle(run), "11.6 nm (m = 8)")
+        run["wrinkle_modes_over_half_cell"] = [8, 4]
+        self.assertEqual(self.mod.wrinkle(run), "11.6 nm (m = 8, then 4)")
+        self.assertEqual(self.mod.wrinkle({"max_wrinkle_m": 1e-20, "max_wrinkle_over_h": 1e-12}), "round")
+
+
 if __name__ == "__main__":
     unittest.main()
