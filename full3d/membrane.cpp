@@ -111,18 +111,31 @@ void set_reference_geometry(CylinderMesh& m) {
   }
 }
 
-void seed_ring_mode(CylinderMesh& mesh, int m, double eps) {
-  if (!(m == 0 || m >= 2)) throw InputError("full3d.membrane.seed_mode", std::to_string(m), "0 (no seed) or >= 2");
-  if (!(eps >= 0.0 && eps < 0.5))
-    throw InputError("full3d.membrane.seed_amplitude", num(eps), "a fraction of R0 in [0, 0.5)");
-  if (m == 0 || eps == 0.0) return;
-  if (!(2 * m < mesh.n_theta))
-    throw InputError("full3d.membrane.seed_mode", std::to_string(m),
-                     "fewer than half the nodes per ring (" + std::to_string(mesh.n_theta) +
-                         " on this mesh), so that the ring resolves the lobes");
+void seed_ring_mode(CylinderMesh& mesh, int m, double eps) { seed_ring_modes(mesh, {{m, eps}}); }
+
+void seed_ring_modes(CylinderMesh& mesh, const std::vector<std::pair<int, double>>& modes) {
+  std::vector<std::pair<int, double>> used;
+  double total = 0.0;
+  for (const auto& [m, eps] : modes) {
+    if (!(m == 0 || m >= 2)) throw InputError("full3d.membrane.seed_mode", std::to_string(m), "0 (no seed) or >= 2");
+    if (!(eps >= 0.0 && eps < 0.5))
+      throw InputError("full3d.membrane.seed_amplitude", num(eps), "a fraction of R0 in [0, 0.5)");
+    if (m == 0 || eps == 0.0) continue;
+    if (!(2 * m < mesh.n_theta))
+      throw InputError("full3d.membrane.seed_mode", std::to_string(m),
+                       "fewer than half the nodes per ring (" + std::to_string(mesh.n_theta) +
+                           " on this mesh), so that the ring resolves the lobes");
+    used.emplace_back(m, eps);
+    total += eps;
+  }
+  if (used.empty()) return;
+  if (!(total < 0.5))
+    throw InputError("full3d.membrane.seed_amplitude", num(total), "seed amplitudes adding up to less than 0.5 R0");
   for (int i = 0; i < mesh.nodes(); ++i) {
     const double dy = mesh.X0(1, i) - mesh.axis_start[1], dz = mesh.X0(2, i) - mesh.axis_start[2];
-    const double f = 1.0 + eps * std::cos(m * std::atan2(dz, dy));
+    const double phi = std::atan2(dz, dy);
+    double f = 1.0 + used[0].second * std::cos(used[0].first * phi);
+    for (std::size_t k = 1; k < used.size(); ++k) f += used[k].second * std::cos(used[k].first * phi);
     mesh.X0(1, i) = mesh.axis_start[1] + f * dy;
     mesh.X0(2, i) = mesh.axis_start[2] + f * dz;
   }
@@ -169,10 +182,13 @@ CylinderMesh make_cylinder_with_spacing(double R0, double L, double spacing, con
 }
 
 CylinderMesh make_cylinder_for_grid(double R0, double L, double h, const Eigen::Vector3d& axis_start,
-                                    double safety) {
+                                    double safety, int ring_multiple) {
   if (!(h > 0.0)) throw InputError("grid.h", num(h), "a positive cell size in m");
+  if (ring_multiple < 1)
+    throw InputError("full3d.membrane.ring_nodes_multiple", std::to_string(ring_multiple), "an integer >= 1");
   const double limit = safety * 0.5 * h;
-  for (int n = n_theta_for_spacing(R0, limit);; ++n) {
+  const int n0 = n_theta_for_spacing(R0, limit);
+  for (int n = (n0 + ring_multiple - 1) / ring_multiple * ring_multiple;; n += ring_multiple) {
     CylinderMesh m = make_cylinder(R0, L, n, axis_start);
     if (max_edge_length(m, m.X0) < limit) return m;
   }

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 #include <array>
 #include <vector>
+#include <utility>
 
 namespace swim::full3d {
 
@@ -63,6 +64,10 @@ void set_reference_geometry(CylinderMesh& mesh);
 /// tube is an unstressed tube with lobes of amplitude eps R0. m = 0 or eps = 0: no change.
 /// Throws swim::InputError for m = 1 or m < 0, eps outside [0, 0.5) and 2 m >= n_theta.
 void seed_ring_mode(CylinderMesh& mesh, int m, double eps);
+/// The same with several lobe numbers at once: r = R0 (1 + sum_k eps_k cos(m_k phi)) (pairs
+/// (m_k, eps_k); a pair with m = 0 or eps = 0 adds nothing), each pair checked as above, the
+/// sum's amplitude below 0.5. One pair gives seed_ring_mode's mesh bit for bit.
+void seed_ring_modes(CylinderMesh& mesh, const std::vector<std::pair<int, double>>& modes);
 
 /// How a uniform radial load acts on the wall: Hydrostatic, a pressure normal to the deformed
 /// wall (a fluid); CentrallyDirected, a force of fixed magnitude per reference area directed at
@@ -87,9 +92,11 @@ int fastest_ring_mode(double P, double D, double R, RingLoad load, int m_max = 6
 int n_theta_for_spacing(double R0, double spacing);
 /// Cylinder with target node spacing (m).
 CylinderMesh make_cylinder_with_spacing(double R0, double L, double spacing, const Eigen::Vector3d& axis_start);
-/// Coarsest mesh whose longest reference edge is below safety * h/2 (paper's no-leak rule).
+/// Coarsest mesh whose longest reference edge is below safety * h/2 (paper's no-leak rule),
+/// with a node count per ring that is a multiple of `ring_multiple` (full3d.membrane.
+/// ring_nodes_multiple; 1: any count).
 CylinderMesh make_cylinder_for_grid(double R0, double L, double h, const Eigen::Vector3d& axis_start,
-                                    double safety = 0.9);
+                                    double safety = 0.9, int ring_multiple = 1);
 
 double max_edge_length(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X);
 /// Throws swim::NumericalError if an edge is >= h/2 (fluid would leak through the membrane).

@@ -126,11 +126,20 @@ std::string wrinkle_note(const json& s) {
     std::snprintf(buf, sizeof buf, "\nswim: note: the wall's lobes changed from m = %d %s (summary.json wrinkle_by_cycle): ",
                   modes.front(), change.empty() ? "to another lobe number" : change.c_str());
     note += buf;
+    const int secondary = s.contains("derived") && s["derived"].contains("secondary_seed_mode")
+                              ? s["derived"]["secondary_seed_mode"].get<int>()
+                              : 0;
+    if (secondary > 0 && modes[1] == secondary)
+      note += "the secondary seed (full3d.membrane.secondary_seed_mode = " + std::to_string(secondary) +
+              ") chose the new lobes; ";
     note += first_change > first_buckled
                 ? "the cycles from there on follow another buckled shape and do not repeat the earlier ones; compare "
                   "designs by the cycles before the change"
-                : "the wall took another branch within its first buckled cycle, which the grid and the step can "
-                  "tip; compare designs, and grids of one design, only on the same branch";
+                : secondary > 0 && modes[1] == secondary
+                      ? "the wall took that branch within its first buckled cycle"
+                      : "the wall took another branch within its first buckled cycle, which the grid and the step "
+                        "can tip; compare designs, and grids of one design, only on the same branch (a secondary "
+                        "seed and full3d.membrane.ring_nodes_multiple = 4 choose it: docs/full3d.md)";
   }
   return note;
 }
@@ -249,6 +258,8 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                   {"bending_model", p.bending_model == Params3d::BendingModel::FixedKb ? "fixed_kb" : "rigidity"},
                   {"seed_mode", p.seed_mode},
                   {"seed_amplitude", p.seed_amplitude},
+                  {"secondary_seed_mode", p.secondary_seed_mode},
+                  {"secondary_seed_amplitude", p.secondary_seed_amplitude},
                   {"segment_boundaries_m", protocol.boundaries()}};
   if (!p.dry && p.protocol.q > 0.0 && !p.axisymmetric_wall) rec_.derived["buckling_estimate"] = buckling_estimate(p);
   // the largest edge at the output steps; the no-leak guard needs < 0.5 h

@@ -48,12 +48,12 @@ ProtocolParams effective_protocol(const Params3d& p, const CylinderMesh& mesh) {
 }
 
 CylinderMesh make_round_mesh(const Params3d& p) {
-  return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor);
+  return make_cylinder_for_grid(p.R0, p.L, p.h, p.axis_start(), p.spacing_factor, p.ring_nodes_multiple);
 }
 
 CylinderMesh make_mesh(const Params3d& p) {
   CylinderMesh mesh = make_round_mesh(p);
-  seed_ring_mode(mesh, p.seed_mode, p.seed_amplitude);
+  seed_ring_modes(mesh, {{p.seed_mode, p.seed_amplitude}, {p.secondary_seed_mode, p.secondary_seed_amplitude}});
   return mesh;
 }
 
@@ -229,10 +229,25 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
       if (p.seed_amplitude > 0.0 && p.seed_mode == 0 && !p.seed_auto)
         throw InputError(m.path("seed_amplitude"), fmt(p.seed_amplitude, ""),
                          "a seed needs its lobe number: give full3d.membrane.seed_mode >= 2 as well");
+      p.secondary_seed_mode = int(m.integer("secondary_seed_mode", 0, 0, 64));
+      if (p.secondary_seed_mode == 1)
+        throw InputError(m.path("secondary_seed_mode"), "1",
+                         "0 (no secondary seed) or a lobe number >= 2 (m = 1 is a sideways shift of the ring)");
+      p.secondary_seed_amplitude = m.number("secondary_seed_amplitude", 0.0, Range::closed(0.0, 0.1));
+      if ((p.secondary_seed_amplitude > 0.0) != (p.secondary_seed_mode > 0))
+        throw InputError(p.secondary_seed_mode > 0 ? m.path("secondary_seed_mode") : m.path("secondary_seed_amplitude"),
+                         p.secondary_seed_mode > 0 ? std::to_string(p.secondary_seed_mode)
+                                                   : fmt(p.secondary_seed_amplitude, ""),
+                         "a secondary seed needs both its lobe number (full3d.membrane.secondary_seed_mode >= 2) "
+                         "and its amplitude (full3d.membrane.secondary_seed_amplitude > 0)");
+      if (p.secondary_seed_mode > 0 && p.secondary_seed_mode == p.seed_mode)
+        throw InputError(m.path("secondary_seed_mode"), std::to_string(p.secondary_seed_mode),
+                         "a lobe number other than full3d.membrane.seed_mode's (" + std::to_string(p.seed_mode) + ")");
       p.membrane.bending = m.choice("bending_form", "reference_angle", {"reference_angle", "printed"}) == "printed"
                                ? BendingForm::Printed
                                : BendingForm::ReferenceAngle;
       p.spacing_factor = m.number("spacing_factor", 0.6, Range::open(0.0, 1.0));
+      p.ring_nodes_multiple = int(m.integer("ring_nodes_multiple", 1, 1, 64));
       p.axisymmetric_wall = m.boolean("axisymmetric", false);
       m.finish();
     }
@@ -319,7 +334,7 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
   // The wall's bending rigidity D and eq. (8)'s k_b on this mesh (D / k_b scales with the edge
   // length; measured on the unseeded mesh, the seed being an imperfection of the same wall)
   const double per_kb_run = bending_rigidity_per_kb(
-      p.seed_amplitude > 0.0 ? make_round_mesh(p) : mesh,
+      p.seed_amplitude > 0.0 || p.secondary_seed_amplitude > 0.0 ? make_round_mesh(p) : mesh,
       p.membrane.bending);
   if (p.bending_model == Params3d::BendingModel::FixedKb) {
     p.bending_rigidity = p.membrane.kb * per_kb_run;
@@ -341,6 +356,10 @@ Params3d read_scene3d(const json& scene, json& resolved, bool prescribed_waves) 
                        "the buckling estimate's mode " + std::to_string(p.seed_mode) + " needs more than " +
                            std::to_string(2 * p.seed_mode) + " nodes per ring; this grid has " +
                            std::to_string(mesh.n_theta) + " (refine full3d.grid.cells_across or give a lobe number)");
+    if (p.secondary_seed_mode > 0 && p.secondary_seed_mode == p.seed_mode)
+      throw InputError("full3d.membrane.secondary_seed_mode", std::to_string(p.secondary_seed_mode),
+                       "a lobe number other than the one full3d.membrane.seed_mode = \"auto\" resolves to (" +
+                           std::to_string(p.seed_mode) + ")");
   }
   return p;
 }

@@ -80,10 +80,19 @@ struct Params3d {
   /// estimate of the contraction grows fastest in the fluid (buckling_estimate.hpp,
   /// auto_seed_mode), 0 when every stage is stable or the wall is held axisymmetric.
   bool seed_auto = false;
+  /// full3d.membrane.secondary_seed_mode, secondary_seed_amplitude: a second lobe number of the
+  /// stress-free shape, added to the seed (seed_ring_modes); 0: none. The lobes a buckled wall's
+  /// secondary instability grows (docs/full3d.md, "Lobes that change: the secondary instability").
+  int secondary_seed_mode = 0;
+  double secondary_seed_amplitude = 0.0;
   /// full3d.membrane.axisymmetric: the wall moves in axisymmetric ring motions only
   /// (IbOptions::axisymmetric_wall); false (default): every node follows the fluid.
   bool axisymmetric_wall = false;
   double spacing_factor = 0.6;     ///< longest reference edge < factor * h/2 (docs/full3d.md)
+  /// full3d.membrane.ring_nodes_multiple: the node count per ring is a multiple of it (1: the
+  /// coarsest count the spacing allows). 4 gives every grid the square's symmetry of the
+  /// Cartesian fluid grid (docs/full3d.md, "Lobes that change: the secondary instability").
+  int ring_nodes_multiple = 1;
   double dt = 1e-3;                ///< s (resolution study: docs/performance-3d.md); fixed step
   AdaptiveStep adaptive{};         ///< full3d.adaptive: step control instead of the fixed dt
   IbScheme scheme = IbScheme::ForwardEuler;

@@ -144,6 +144,8 @@ full3d::Params3d in_cylinder(const full3d::Params3d& scene) {
   full3d::Params3d p = scene;
   p.seed_mode = 0;
   p.seed_amplitude = 0.0;
+  p.secondary_seed_mode = 0;
+  p.secondary_seed_amplitude = 0.0;
   if (p.container != "cylinder") {
     p.container = "cylinder";
     p.ny += 2;

@@ -21,6 +21,7 @@
 #include "common/errors.hpp"
 #include "common/scene.hpp"
 #include "full3d/buckling_estimate.hpp"
+#include "full3d/ib_solver.hpp"
 #include "full3d/membrane.hpp"
 #include "full3d/run3d_measure.hpp"
 #include "full3d/run3d_output.hpp"
@@ -559,9 +560,135 @@ TEST(WallSeed, TheRunsNoteNamesWhatChoseTheLobesAndAChange) {
   EXPECT_TRUE(has(within, "lobes changed from m = 8 to m = 4 in cycle 1")) << within;
   EXPECT_TRUE(has(within, "another branch within its first buckled cycle")) << within;
   EXPECT_FALSE(has(within, "cycles before the change")) << within;
+  // ... and when the secondary seed chose the new lobes, the note says so
+  scene::json chosen = summary(3.0, 8, {8, 4}, scene::json::array({{{"cycle", 1}, {"modes_over_half_cell", {8, 4}}}}));
+  chosen["derived"]["secondary_seed_mode"] = 4;
+  const std::string seeded2 = wrinkle_note(chosen);
+  EXPECT_TRUE(has(seeded2, "secondary_seed_mode = 4) chose the new lobes")) << seeded2;
+  EXPECT_FALSE(has(seeded2, "can tip")) << seeded2;
 
   const std::string grid = wrinkle_note(summary(1.2, 0, {4}, scene::json::array({{{"cycle", 1}, {"modes_over_half_cell", {4}}}})));
   EXPECT_TRUE(has(grid, "wrinkled into m = 4 lobes")) << grid;
   EXPECT_TRUE(has(grid, "without a seed the lobes follow the grid")) << grid;
   EXPECT_FALSE(has(grid, "changed")) << grid;
+}
+
+// ---- lobes that change: the secondary instability (docs/full3d.md) ----
+
+// The secondary seed adds its lobes to the seed's, each at its amplitude, and the scene refuses
+// a secondary seed that is not one: a lobe number of 1, a number without an amplitude or an
+// amplitude without a number, and the seed's own lobe number (also the one "auto" resolves to).
+TEST(WallSeed, TheSecondarySeedAddsItsLobesToTheSeeds) {
+  const Params3d p = paper_scene(48, {"full3d.membrane.seed_mode=8", "full3d.membrane.seed_amplitude=0.01",
+                                      "full3d.membrane.secondary_seed_mode=4",
+                                      "full3d.membrane.secondary_seed_amplitude=0.001"});
+  EXPECT_EQ(p.secondary_seed_mode, 4);
+  const CylinderMesh mesh = make_mesh(p);
+  const std::vector<double> s = ring_spectrum(mesh, mesh.X0, mesh.n_rings / 2);
+  EXPECT_NEAR(s[8], 0.01 * kR0, 1e-6 * kR0);
+  EXPECT_NEAR(s[4], 0.001 * kR0, 1e-6 * kR0);
+  for (int m : {2, 3, 5, 6, 7}) EXPECT_LT(s[std::size_t(m)], 1e-9 * kR0) << m;
+  // one pair gives the single seed's mesh bit for bit; the seeded wall keeps the round wall's D
+  CylinderMesh a = make_round_mesh(p), b = make_round_mesh(p);
+  seed_ring_mode(a, 8, 0.01);
+  seed_ring_modes(b, {{8, 0.01}, {4, 0.0}});
+  EXPECT_EQ((a.X0 - b.X0).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_NEAR(p.bending_rigidity, paper_scene(48, {}).bending_rigidity, 1e-12 * p.bending_rigidity);
+  auto refused_key = [](const std::vector<std::string>& sets) {
+    try {
+      paper_scene(48, sets);
+    } catch (const InputError& err) {
+      return err.key();
+    }
+    return std::string("accepted");
+  };
+  EXPECT_EQ(refused_key({"full3d.membrane.secondary_seed_mode=1", "full3d.membrane.secondary_seed_amplitude=0.001"}),
+            "full3d.membrane.secondary_seed_mode");
+  EXPECT_EQ(refused_key({"full3d.membrane.secondary_seed_mode=4"}), "full3d.membrane.secondary_seed_mode");
+  EXPECT_EQ(refused_key({"full3d.membrane.secondary_seed_amplitude=0.001"}), "full3d.membrane.secondary_seed_amplitude");
+  EXPECT_EQ(refused_key({"full3d.membrane.seed_mode=8", "full3d.membrane.seed_amplitude=0.01",
+                         "full3d.membrane.secondary_seed_mode=8", "full3d.membrane.secondary_seed_amplitude=0.001"}),
+            "full3d.membrane.secondary_seed_mode");
+  EXPECT_EQ(refused_key({"full3d.membrane.seed_mode=\"auto\"", "full3d.membrane.secondary_seed_mode=8",
+                         "full3d.membrane.secondary_seed_amplitude=0.001"}),
+            "full3d.membrane.secondary_seed_mode");
+  EXPECT_EQ(refused_key({"full3d.membrane.secondary_seed_mode=4", "full3d.membrane.secondary_seed_amplitude=0.2"}),
+            "full3d.membrane.secondary_seed_amplitude");
+  EXPECT_EQ(refused_key({"full3d.membrane.ring_nodes_multiple=0"}), "full3d.membrane.ring_nodes_multiple");
+}
+
+// full3d.membrane.ring_nodes_multiple = 4: on every grid of the suite's series the node count
+// per ring is the smallest multiple of 4 the spacing rule allows (at most 3 more than without
+// the key), and the seeded wall (8 and 4 lobes) is mapped onto itself by the quarter turn about
+// its axis, node onto node, as the Cartesian fluid grid is. Without the key the 96-cell grid
+// has 503 nodes per ring, a prime, and no quarter turn maps it onto itself.
+TEST(WallSeed, ARingNodeMultipleOfFourGivesEveryGridTheSquaresSymmetry) {
+  const std::vector<std::string> seeds = {"full3d.membrane.seed_mode=8", "full3d.membrane.seed_amplitude=0.01",
+                                          "full3d.membrane.secondary_seed_mode=4",
+                                          "full3d.membrane.secondary_seed_amplitude=0.001"};
+  auto quarter_turn_maps_nodes_onto_nodes = [](const CylinderMesh& mesh) {
+    if (mesh.n_theta % 4 != 0) return false;
+    const int q = mesh.n_theta / 4;
+    double worst = 0.0;
+    for (int r = 0; r < mesh.n_rings; ++r)
+      for (int i = 0; i < mesh.n_theta; ++i) {
+        const int k = mesh.node(r, i), l = mesh.node(r, (i + q) % mesh.n_theta);
+        const double dy = mesh.X0(1, k) - mesh.axis_start[1], dz = mesh.X0(2, k) - mesh.axis_start[2];
+        const Eigen::Vector3d turned(mesh.X0(0, k), mesh.axis_start[1] - dz, mesh.axis_start[2] + dy);
+        worst = std::max(worst, (turned - mesh.X0.col(l)).norm());
+      }
+    return worst < 1e-12 * mesh.radius;
+  };
+  for (int cells : {48, 64, 80, 96, 128}) {
+    std::vector<std::string> sets = seeds;
+    const CylinderMesh free = make_mesh(paper_scene(cells, sets));
+    sets.push_back("full3d.membrane.ring_nodes_multiple=4");
+    const Params3d p = paper_scene(cells, sets);
+    const CylinderMesh mesh = make_mesh(p);
+    EXPECT_EQ(mesh.n_theta % 4, 0) << cells;
+    EXPECT_GE(mesh.n_theta, free.n_theta) << cells;
+    EXPECT_LE(mesh.n_theta, free.n_theta + 3) << cells;
+    EXPECT_LT(max_edge_length(make_round_mesh(p), make_round_mesh(p).X0), 0.5 * p.spacing_factor * p.h) << cells;
+    EXPECT_TRUE(quarter_turn_maps_nodes_onto_nodes(mesh)) << cells;
+    if (cells == 96) {
+      EXPECT_EQ(free.n_theta, 503);
+      EXPECT_FALSE(quarter_turn_maps_nodes_onto_nodes(free));
+    }
+  }
+}
+
+// The coupled step keeps the square's symmetry: a seeded tube (8 and 4 lobes) on 4k nodes per
+// ring, centred in a periodic box of 16^3 cells, compressed by 10 % and left to relax for 20
+// steps, keeps its odd lobes (m = 3, 5, 7: the pairs a buckled m = 8 wall's secondary
+// instability grows, with 4 + 4) at round-off; on 4k + 1 nodes per ring the fluid grid's
+// four-fold pattern and the ring's own do not match, and the same steps put them at the
+// discretisation's level, 10^4 times higher or more. Which pair a buckled wall grows therefore
+// depends on whether its grid admits the odd ones (docs/full3d.md).
+TEST(WallSeed, TheCoupledStepKeepsTheSquaresSymmetryOnFourfoldRings) {
+  constexpr int kN = 16;
+  constexpr double kBox = 0.5e-6, kL = 0.4e-6;
+  const MacGrid grid{kN, kN, kN, kBox / kN, GridBoundary::PeriodicBox};
+  const Eigen::Vector3d start(0.05e-6, 0.25e-6, 0.25e-6);
+  const CylinderMesh fourfold = make_cylinder_for_grid(kR0, kL, kBox / kN, start, 0.9, 4);
+  auto odd_over_even = [&](int n_theta) {
+    CylinderMesh mesh = make_cylinder(kR0, kL, n_theta, start);
+    seed_ring_modes(mesh, {{8, 0.01}, {4, 0.001}});
+    IbSolver s(grid, FluidParams{1.0e3, 1.2e-3}, mesh, MembraneParams{}, Eigen::VectorXd::Zero(mesh.nodes()), IbOptions{});
+    IbState st = s.initial_state();
+    for (int i = 0; i < mesh.nodes(); ++i) st.X.col(i) = start + Eigen::Vector3d(st.X(0, i) - start[0], 0.9 * (st.X(1, i) - start[1]),
+                                                                           0.9 * (st.X(2, i) - start[2]));
+    for (int k = 0; k < 20; ++k) s.step(st, 2e-6);
+    double odd = 0.0, even = 0.0;
+    for (int r = 0; r < mesh.n_rings; ++r) {
+      const std::vector<double> sp = ring_spectrum(mesh, st.X, r);
+      odd = std::max({odd, sp[3], sp[5], sp[7]});
+      even = std::max(even, sp[8]);
+    }
+    std::printf("%d nodes per ring: largest odd lobe %.3g of the m = 8 lobes\n", n_theta, odd / even);
+    return odd / even;
+  };
+  ASSERT_EQ(fourfold.n_theta % 4, 0);
+  const double sym = odd_over_even(fourfold.n_theta), broken = odd_over_even(fourfold.n_theta + 1);
+  EXPECT_LT(sym, 1e-11);
+  EXPECT_GT(broken, 1e4 * std::max(sym, 1e-16));
 }
