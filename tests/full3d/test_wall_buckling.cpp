@@ -64,6 +64,16 @@ Params3d paper_scene(int cells, const std::vector<std::string>& sets) {
   return read_scene3d(sc, resolved);
 }
 
+// The key the scene reader names when it refuses paper_scene(cells, sets), "accepted" when it does not.
+std::string refused_scene_key(int cells, const std::vector<std::string>& sets) {
+  try {
+    paper_scene(cells, sets);
+  } catch (const InputError& err) {
+    return err.key();
+  }
+  return "accepted";
+}
+
 // Amplitudes |c_m| (m = 0 .. n_theta/2) of the radial displacement r_i - R_ref of one ring,
 // c_m = (2 / n) sum_i (r_i - R_ref) exp(-i m phi_i), phi_i the node's reference angle.
 std::vector<double> ring_spectrum(const CylinderMesh& mesh, const Eigen::Matrix3Xd& X, int ring) {
@@ -332,14 +342,7 @@ TEST(WallSeed, SceneKeysSeedTheRunsMesh) {
   // the seeded wall has the unseeded wall's rigidity
   EXPECT_NEAR(p.bending_rigidity, paper_scene(24, {}).bending_rigidity, 1e-12 * p.bending_rigidity);
   EXPECT_NEAR(p.membrane.kb, paper_scene(24, {}).membrane.kb, 1e-12 * p.membrane.kb);
-  auto refused_key = [](const std::vector<std::string>& sets) {
-    try {
-      paper_scene(24, sets);
-    } catch (const InputError& err) {
-      return err.key();
-    }
-    return std::string("accepted");
-  };
+  auto refused_key = [](const std::vector<std::string>& sets) { return refused_scene_key(24, sets); };
   EXPECT_EQ(refused_key({"full3d.membrane.seed_mode=1", "full3d.membrane.seed_amplitude=0.01"}),
             "full3d.membrane.seed_mode");
   EXPECT_EQ(refused_key({"full3d.membrane.seed_amplitude=0.01"}), "full3d.membrane.seed_amplitude");
@@ -594,14 +597,7 @@ TEST(WallSeed, TheSecondarySeedAddsItsLobesToTheSeeds) {
   seed_ring_modes(b, {{8, 0.01}, {4, 0.0}});
   EXPECT_EQ((a.X0 - b.X0).cwiseAbs().maxCoeff(), 0.0);
   EXPECT_NEAR(p.bending_rigidity, paper_scene(48, {}).bending_rigidity, 1e-12 * p.bending_rigidity);
-  auto refused_key = [](const std::vector<std::string>& sets) {
-    try {
-      paper_scene(48, sets);
-    } catch (const InputError& err) {
-      return err.key();
-    }
-    return std::string("accepted");
-  };
+  auto refused_key = [](const std::vector<std::string>& sets) { return refused_scene_key(48, sets); };
   EXPECT_EQ(refused_key({"full3d.membrane.secondary_seed_mode=1", "full3d.membrane.secondary_seed_amplitude=0.001"}),
             "full3d.membrane.secondary_seed_mode");
   EXPECT_EQ(refused_key({"full3d.membrane.secondary_seed_mode=4"}), "full3d.membrane.secondary_seed_mode");
