@@ -55,6 +55,40 @@ def wrinkle(run):
     return si(run["max_wrinkle_m"], "m") + (f" (m = {mode})" if mode else "")
 
 
+def wrinkle_paragraph(runs):
+    """The report's paragraph on the 3D wall's wrinkle over a case's grids (empty when no grid
+    wrinkled beyond half a cell): how far, into which lobes, and what chose them (the seeds,
+    the secondary instability's seed, or the grid)."""
+    wr = [r for r in runs if r.get("max_wrinkle_over_h", 0) > 0.5]
+    if not wr:
+        return []
+    seeds = {r.get("seed_mode", 0) for r in wr}
+    seconds = {r.get("secondary_seed_mode", 0) for r in wr}
+    # the lobes each run showed: its largest wrinkle's, and those above half a cell
+    shown = [{r.get("max_wrinkle_mode")} | set(r.get("wrinkle_modes_over_half_cell") or []) for r in wr]
+    seed = next(iter(seeds)) if len(seeds) == 1 else 0
+    second = next(iter(seconds)) if len(seconds) == 1 else 0
+    seeded = seed > 0 and all(m <= {seed, second} - {0} for m in shown)
+    both = seeded and second > 0 and all(second in m for m in shown)
+    pattern = (f"the m = {seed} lobes seeded in its stress-free shape and then, by the buckled wall's secondary "
+               f"instability, the m = {second} lobes of its secondary seed, on every grid (the seeds choose them: "
+               "docs/full3d.md, \"Lobes that change: the secondary instability\")" if both
+               else f"the m = {seed} lobes seeded in its stress-free shape, on every grid (the seed chooses "
+               "them: docs/full3d.md, \"Ring buckling and the seed imperfection\")" if seeded
+               else "lobes whose pattern follows the grid")
+    out = ["", "Wall wrinkle: the largest RMS departure of the 3D wall from axisymmetry (m: its lobe number). "
+            f"On {len(wr)} of {len(runs)} grids it exceeds h/2 (up to "
+            f"{max(r['max_wrinkle_over_h'] for r in wr):.1f} h): the hoop-compressed wall buckled into "
+            f"{pattern}, and the 1D tier, which assumes a round tube, "
+            "cannot represent them (docs/full3d.md, \"Wall wrinkling\")."]
+    changed = [r for r in wr if len(r.get("wrinkle_modes_over_half_cell") or []) >= 2]
+    if changed and not both:
+        out[-1] += (f" On {len(changed)} of these grids the lobes changed during the run (the cell lists them in "
+                    "order): a run whose lobes change follows another buckled branch from there on "
+                    "(docs/full3d.md, \"Lobes that change: the secondary instability\").")
+    return out
+
+
 def evidence_value(key, v):
     """One value of a finding's evidence: SI prefixes for lengths and speeds, a dash for a
     value the suite could not compute (a case whose 3D runs all failed)."""
@@ -757,24 +791,7 @@ def markdown(report, figs):
                        f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | "
                        f"{wrinkle(r)} | {r['steps']} | "
                        f"{si(r['wall_time_s'], 's')}{' (cached)' if r['cached'] else ''} |")
-        wr = [r for r in c["runs3d"] if r.get("max_wrinkle_over_h", 0) > 0.5]
-        if wr:
-            seeds = {r.get("seed_mode", 0) for r in wr}
-            modes = {r.get("max_wrinkle_mode") for r in wr}
-            seeded = len(seeds) == 1 and 0 not in seeds and modes == seeds
-            pattern = (f"the m = {seeds.pop()} lobes seeded in its stress-free shape, on every grid (the seed chooses "
-                       "them: docs/full3d.md, \"Ring buckling and the seed imperfection\")" if seeded
-                       else "lobes whose pattern follows the grid")
-            out += ["", "Wall wrinkle: the largest RMS departure of the 3D wall from axisymmetry (m: its lobe number). "
-                    f"On {len(wr)} of {len(c['runs3d'])} grids it exceeds h/2 (up to "
-                    f"{max(r['max_wrinkle_over_h'] for r in wr):.1f} h): the hoop-compressed wall buckled into "
-                    f"{pattern}, and the 1D tier, which assumes a round tube, "
-                    "cannot represent them (docs/full3d.md, \"Wall wrinkling\")."]
-            changed = [r for r in wr if len(r.get("wrinkle_modes_over_half_cell") or []) >= 2]
-            if changed:
-                out[-1] += (f" On {len(changed)} of these grids the lobes changed during the run (the cell lists them in "
-                            "order): a run whose lobes change follows another buckled branch from there on "
-                            "(docs/full3d.md, \"Ring buckling and the seed imperfection\").")
+        out += wrinkle_paragraph(c["runs3d"])
         ref = c["reference3d"]
         rng = ref.get("order_range")
         out += ["", "Extrapolated 3D reference (h → 0"

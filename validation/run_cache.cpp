@@ -375,6 +375,9 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   if (summary.contains("derived") && summary["derived"].is_object() && summary["derived"].contains("seed_mode") &&
       summary["derived"]["seed_mode"].is_number())
     r.record["seed_mode"] = summary["derived"]["seed_mode"];
+  if (summary.contains("derived") && summary["derived"].is_object() &&
+      summary["derived"].contains("secondary_seed_mode") && summary["derived"]["secondary_seed_mode"].is_number())
+    r.record["secondary_seed_mode"] = summary["derived"]["secondary_seed_mode"];
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number()) {
     r.max_displacement = summary["max_displacement_m"].get<double>();
     r.record["max_displacement_m"] = r.max_displacement;

@@ -405,6 +405,21 @@ class ValidationWrinkleCell(unittest.TestCase):
         self.assertEqual(self.mod.wrinkle(run), "11.6 nm (m = 8, then 4)")
         self.assertEqual(self.mod.wrinkle({"max_wrinkle_m": 1e-20, "max_wrinkle_over_h": 1e-12}), "round")
 
+    def test_the_wrinkle_paragraph_names_what_chose_the_lobes(self):
+        """A case whose grids all grew the seed's lobes and then the secondary seed's is
+        said to follow its seeds; one grid that took other lobes makes it the grid's."""
+        def run(modes, secondary=4):
+            return {"max_wrinkle_m": 16e-9, "max_wrinkle_over_h": 3.0, "max_wrinkle_mode": modes[-1],
+                    "wrinkle_modes_over_half_cell": modes, "seed_mode": 8, "secondary_seed_mode": secondary}
+        grids = [run([8, 4]), run([8, 4]), run([8, 4])]
+        text = " ".join(self.mod.wrinkle_paragraph(grids))
+        self.assertIn("the m = 4 lobes of its secondary seed, on every grid", text)
+        self.assertNotIn("follows the grid", text)
+        text = " ".join(self.mod.wrinkle_paragraph(grids[:2] + [run([8, 3, 5])]))
+        self.assertIn("lobes whose pattern follows the grid", text)
+        text = " ".join(self.mod.wrinkle_paragraph([run([8], 0)] * 2))
+        self.assertIn("the m = 8 lobes seeded in its stress-free shape, on every grid", text)
+
 
 if __name__ == "__main__":
     unittest.main()
