@@ -88,6 +88,9 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   if (b.seed_amplitude > 0.0)
     throw InputError("full3d.membrane.seed_amplitude", fmt(b.seed_amplitude, ""),
                      "the axisymmetric tier's wall is round (no lobes): set it to 0 or run --tier 3d");
+  if (b.secondary_seed_amplitude > 0.0)
+    throw InputError("full3d.membrane.secondary_seed_amplitude", fmt(b.secondary_seed_amplitude, ""),
+                     "the axisymmetric tier's wall is round (no lobes): set it to 0 or run --tier 3d");
   p.D = b.bending_rigidity;
   p.bending_source = b.bending_source;
 

@@ -98,6 +98,15 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
   s = base;
   s["axi"]["unknown"] = 1;
   EXPECT_EQ(input_error_key(s), "axi.unknown");
+  // the round wall has no lobes: neither seed is one it can hold
+  s = base;
+  s["full3d"]["membrane"]["seed_mode"] = 8;
+  s["full3d"]["membrane"]["seed_amplitude"] = 0.01;
+  EXPECT_EQ(input_error_key(s), "full3d.membrane.seed_amplitude");
+  s = base;
+  s["full3d"]["membrane"]["secondary_seed_mode"] = 4;
+  s["full3d"]["membrane"]["secondary_seed_amplitude"] = 0.001;
+  EXPECT_EQ(input_error_key(s), "full3d.membrane.secondary_seed_amplitude");
   s = base;
   s["axi"]["tolerance"] = 0.0;
   EXPECT_EQ(input_error_key(s), "axi.tolerance");
