@@ -64,7 +64,6 @@ class CycleWrinkles {
   const std::vector<Cycle>& cycles() const { return cycles_; }
   /// The lobe numbers seen above the threshold over the whole run, first appearance first.
   std::vector<int> modes() const;
-  double threshold() const { return threshold_; }
   /// For checkpoints: per cycle [cycle, max wrinkle, its mode, number of modes, the modes...].
   std::vector<double> flat() const;
   void unflatten(const std::vector<double>& v);

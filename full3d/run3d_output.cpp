@@ -74,9 +74,12 @@ std::string wrinkle_note(const json& s) {
   if (!s.contains("max_wrinkle_over_h") || !s.contains("max_wrinkle_m") || s["max_wrinkle_over_h"].get<double>() <= 0.5)
     return "";
   const double w = s["max_wrinkle_m"].get<double>(), wh = s["max_wrinkle_over_h"].get<double>();
-  const int seed = s.contains("derived") && s["derived"].contains("seed_mode") ? s["derived"]["seed_mode"].get<int>() : 0;
-  const double eps =
-      s.contains("derived") && s["derived"].contains("seed_amplitude") ? s["derived"]["seed_amplitude"].get<double>() : 0.0;
+  // a value of summary.json's "derived", 0 when absent
+  const auto derived = [&](const char* key) {
+    return s.contains("derived") && s["derived"].contains(key) ? s["derived"][key].get<double>() : 0.0;
+  };
+  const int seed = int(derived("seed_mode")), secondary = int(derived("secondary_seed_mode"));
+  const double eps = derived("seed_amplitude");
   std::vector<int> modes;
   if (s.contains("wrinkle_modes_over_half_cell")) modes = s["wrinkle_modes_over_half_cell"].get<std::vector<int>>();
   if (modes.empty() && s.contains("max_wrinkle_mode") && s["max_wrinkle_mode"].get<int>() > 0)
@@ -104,31 +107,27 @@ std::string wrinkle_note(const json& s) {
     note = buf;
   }
   if (modes.size() >= 2) {
-    // the cycle where each later lobe number first exceeded half a cell
-    std::string change;
-    int first_change = 0, first_buckled = 0;
-    if (s.contains("wrinkle_by_cycle"))
-      for (std::size_t k = 0; k < modes.size(); ++k)
+    // the cycle where a lobe number first exceeded half a cell (0: not recorded)
+    const auto first_cycle = [&](int m) {
+      if (s.contains("wrinkle_by_cycle"))
         for (const auto& c : s["wrinkle_by_cycle"]) {
           const auto cm = c["modes_over_half_cell"].get<std::vector<int>>();
-          if (std::find(cm.begin(), cm.end(), modes[k]) != cm.end()) {
-            const int cyc = c["cycle"].get<int>();
-            if (k == 0) {
-              first_buckled = cyc;
-              break;
-            }
-            if (first_change == 0) first_change = cyc;
-            change += (change.empty() ? "" : ", then ") + std::string("to m = ") + std::to_string(modes[k]) +
-                      " in cycle " + std::to_string(cyc);
-            break;
-          }
+          if (std::find(cm.begin(), cm.end(), m) != cm.end()) return c["cycle"].get<int>();
         }
+      return 0;
+    };
+    const int first_buckled = first_cycle(modes.front());
+    std::string change;
+    int first_change = 0;
+    for (std::size_t k = 1; k < modes.size(); ++k)
+      if (const int cyc = first_cycle(modes[k]); cyc > 0) {
+        if (first_change == 0) first_change = cyc;
+        change += (change.empty() ? "" : ", then ") + std::string("to m = ") + std::to_string(modes[k]) + " in cycle " +
+                  std::to_string(cyc);
+      }
     std::snprintf(buf, sizeof buf, "\nswim: note: the wall's lobes changed from m = %d %s (summary.json wrinkle_by_cycle): ",
                   modes.front(), change.empty() ? "to another lobe number" : change.c_str());
     note += buf;
-    const int secondary = s.contains("derived") && s["derived"].contains("secondary_seed_mode")
-                              ? s["derived"]["secondary_seed_mode"].get<int>()
-                              : 0;
     if (secondary > 0 && modes[1] == secondary)
       note += "the secondary seed (full3d.membrane.secondary_seed_mode = " + std::to_string(secondary) +
               ") chose the new lobes; ";

@@ -371,13 +371,10 @@ Run3d RunCache::run_3d(const json& sc, double frame_interval, int progress) {
   // the lobe numbers the wall showed above half a cell, in order (two or more: they changed)
   if (summary.contains("wrinkle_modes_over_half_cell") && summary["wrinkle_modes_over_half_cell"].is_array())
     r.record["wrinkle_modes_over_half_cell"] = summary["wrinkle_modes_over_half_cell"];
-  // the lobes seeded in the wall's stress-free shape (0: none)
-  if (summary.contains("derived") && summary["derived"].is_object() && summary["derived"].contains("seed_mode") &&
-      summary["derived"]["seed_mode"].is_number())
-    r.record["seed_mode"] = summary["derived"]["seed_mode"];
-  if (summary.contains("derived") && summary["derived"].is_object() &&
-      summary["derived"].contains("secondary_seed_mode") && summary["derived"]["secondary_seed_mode"].is_number())
-    r.record["secondary_seed_mode"] = summary["derived"]["secondary_seed_mode"];
+  // the lobes seeded in the wall's stress-free shape, and the secondary seed's (0: none)
+  if (summary.contains("derived") && summary["derived"].is_object())
+    for (const char* k : {"seed_mode", "secondary_seed_mode"})
+      if (summary["derived"].contains(k) && summary["derived"][k].is_number()) r.record[k] = summary["derived"][k];
   if (summary.contains("max_displacement_m") && summary["max_displacement_m"].is_number()) {
     r.max_displacement = summary["max_displacement_m"].get<double>();
     r.record["max_displacement_m"] = r.max_displacement;
