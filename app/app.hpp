@@ -30,8 +30,11 @@ int run(const RunOptions& o);
 int demo(const std::string& out, int progress);
 /// swim screen: a 1D sweep; confirm > 0: that many designs also run in 3D with `threads`
 /// threads each (design/confirm.hpp), reported in confirm.json, confirm.md and confirm.png.
+/// grid_check > 0: every design also runs on twice its cells, and the metric's relative change
+/// is reported per design (designs.csv) and over the sweep (screen.json "grid_check"), with
+/// grid_check the tolerance the change is counted against.
 int screen(const std::string& sweep, const std::string& out, int jobs, int progress, bool overwrite, int confirm = 0,
-           int threads = 1);
+           int threads = 1, double grid_check = 0);
 /// swim optimize: a continuous design search on the 1D tier (design/optimize.hpp); confirm:
 /// the best design also runs in 3D with `threads` threads.
 int optimize(const std::string& spec, const std::string& out, int progress, bool overwrite, bool confirm, int threads);

@@ -5,6 +5,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <cmath>
+#include <limits>
 
 #include "app/app.hpp"
 #include "app/ranks.hpp"
@@ -186,10 +188,89 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   return s;
 }
 
+// --grid-check: the sweep's design k on `factor` times its cells (numerics1d.cells), read from
+// its scene as a user's --set would give it.
+reduced1d::Params refined_design(const sweep::Sweep& sw, size_t k, const reduced1d::Params& at_n, int factor) {
+  scene::json sc = sw.design(k);
+  scene::apply_override(sc, "numerics1d.cells=" + std::to_string(at_n.numerics.cells * factor));
+  scene::json resolved;
+  return reduced1d::read_scene(sc, resolved, sw.base_dir);
+}
+
+// The grid check's summary (screen.json "grid_check"): per design the metric's relative change
+// from N to factor N cells, the designs beyond `tolerance`, the rank agreement of the two
+// rankings over the designs that completed on both grids, and the best design on each.
+scene::json grid_check_summary(const sweep::Sweep& sw, const std::vector<reduced1d::DesignOutcome>& at_n,
+                               const std::vector<reduced1d::DesignOutcome>& refined, int factor, double tolerance,
+                               std::vector<double>& change) {
+  std::vector<double> x, y;
+  std::vector<size_t> both;
+  long over = 0, failed_refined = 0, largest_at = -1;
+  double largest = 0;
+  change.assign(at_n.size(), std::numeric_limits<double>::quiet_NaN());  // (never written: a cell stays empty)
+  for (size_t k = 0; k < at_n.size(); ++k) {
+    if (!refined[k].ok) {
+      if (at_n[k].ok) ++failed_refined;
+      continue;
+    }
+    if (!at_n[k].ok) continue;
+    const double a = reduced1d::metric_value(at_n[k].metrics, sw.metric);
+    const double b = reduced1d::metric_value(refined[k].metrics, sw.metric);
+    if (!std::isfinite(a) || !std::isfinite(b) || b == 0) continue;
+    change[k] = (a - b) / std::abs(b);
+    if (std::abs(change[k]) > tolerance) ++over;
+    if (std::abs(change[k]) > largest) largest = std::abs(change[k]), largest_at = static_cast<long>(k);
+    x.push_back(a);
+    y.push_back(b);
+    both.push_back(k);
+  }
+  const auto best_of = [&](const std::vector<double>& v) {
+    size_t i = 0;
+    for (size_t j = 1; j < v.size(); ++j)
+      if (sw.maximize ? v[j] > v[i] : v[j] < v[i]) i = j;
+    return static_cast<long>(both[i]);
+  };
+  scene::json g = {{"cells_factor", factor},
+                   {"tolerance_relative", tolerance},
+                   {"change_definition", "(metric on N cells - metric on " + std::to_string(factor) +
+                                             " N cells) / |metric on " + std::to_string(factor) + " N cells|"},
+                   {"designs_compared", both.size()},
+                   {"designs_over_tolerance", over},
+                   {"failed_on_refined_grid", failed_refined}};
+  if (both.empty()) {
+    g["status"] = "no design completed on both grids";
+    return g;
+  }
+  std::vector<double> abs_change;
+  for (size_t k : both) abs_change.push_back(std::abs(change[k]));
+  std::sort(abs_change.begin(), abs_change.end());
+  g["status"] = "ok";
+  g["largest_change_relative"] = change[largest_at < 0 ? both[0] : largest_at];
+  g["largest_change_design"] = largest_at < 0 ? static_cast<long>(both[0]) : largest_at;
+  const size_t mid = abs_change.size() / 2;
+  g["median_abs_change_relative"] =
+      abs_change.size() % 2 ? abs_change[mid] : 0.5 * (abs_change[mid - 1] + abs_change[mid]);
+  const long best_n = best_of(x), best_refined = best_of(y);
+  g["best_design"] = best_n;
+  g["best_design_on_refined_grid"] = best_refined;
+  g["best_design_unchanged"] = best_n == best_refined;
+  if (both.size() >= 2) {
+    const design::RankAgreement ra = design::rank_agreement(x, y);
+    g["kendall_tau"] = ra.kendall_defined ? scene::json(ra.kendall_tau) : scene::json(nullptr);
+    g["spearman_rho"] = ra.spearman_rho;
+    g["misranked_pairs"] = ra.misranked.size();
+  }
+  return g;
+}
+
 }  // namespace
 
 int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, int progress, bool overwrite,
-           int confirm, int threads) {
+           int confirm, int threads, double grid_check) {
+  const int factor = 2;  // --grid-check: every design again on twice its cells
+  if (grid_check != 0 && !(grid_check > 0 && grid_check < 1))
+    throw InputError("--grid-check", std::to_string(grid_check),
+                     "a relative tolerance of the metric's change on twice the cells, in (0, 1), e.g. 0.05");
   const sweep::Sweep sw = sweep::read_sweep(sweep_path, reduced1d::metric_names());
   check_sweep_scenes(sw);
   // --confirm K: checked in full (K, the metric, every design's 3D scene) before any 1D run
@@ -227,6 +308,17 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
       throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) + "): " + e.what());
     }
   }
+  const size_t n_designs = designs.size();
+  if (grid_check > 0) {
+    for (size_t k = 0; k < n_designs; ++k) {
+      try {
+        designs.push_back(refined_design(sw, k, designs[k], factor));
+      } catch (const InputError& e) {
+        throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) +
+                                          ") on " + std::to_string(factor) + " times its cells (--grid-check): " + e.what());
+      }
+    }
+  }
   const std::string name = fs::path(sweep_path).stem().string();
   const std::string out = out_opt.empty() ? "out/screen-" + name : out_opt;
   // The folder belongs to this sweep (lock, another run's results refused unless --overwrite,
@@ -234,6 +326,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   scene::json identity = {{"base", sw.base}, {"metric", sw.metric}, {"goal", sw.maximize ? "max" : "min"}};
   for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
   if (const scene::json c = design::confirm_identity(sw.confirm); !c.is_null()) identity["confirm"] = c;
+  if (grid_check > 0) identity["grid_check"] = {{"cells_factor", factor}, {"tolerance_relative", grid_check}};
   // the 3D runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
   output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json", "confirm-runs"});
 
@@ -246,11 +339,15 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     // hide the hand-over; the outcomes come back exactly as computed
     std::vector<ranks::Task> tasks;
     const std::string base_dir = fs::absolute(sw.base_dir).string();
-    for (size_t k = 0; k < sw.count(); ++k)
-      tasks.push_back({"1D run of design " + std::to_string(k),
-                       {{"kind", "1d"}, {"scene", sw.design(k)}, {"base_dir", base_dir}},
-                       cost_1d(designs[k]),
+    for (size_t i = 0; i < designs.size(); ++i) {
+      const size_t k = i % n_designs;
+      scene::json sc = sw.design(k);
+      if (i >= n_designs) scene::apply_override(sc, "numerics1d.cells=" + std::to_string(designs[i].numerics.cells));
+      tasks.push_back({"1D run of design " + std::to_string(k) + (i >= n_designs ? " (grid check)" : ""),
+                       {{"kind", "1d"}, {"scene", sc}, {"base_dir", base_dir}},
+                       cost_1d(designs[i]),
                        {}});
+    }
     const ranks::Outcome r =
         ranks::distribute(tasks, run_task, 2, [&](size_t, const scene::json&) { bar.update(static_cast<double>(++finished)); });
     for (const auto& x : r.results) {
@@ -267,6 +364,15 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   }
   bar.done();
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  std::vector<reduced1d::DesignOutcome> refined;
+  std::vector<double> change;
+  scene::json grid_j;
+  if (grid_check > 0) {
+    refined.assign(std::make_move_iterator(results.begin() + static_cast<long>(n_designs)),
+                   std::make_move_iterator(results.end()));
+    results.resize(n_designs);
+    grid_j = grid_check_summary(sw, results, refined, factor, grid_check, change);
+  }
 
   // designs.csv: axis values as given and, for a quantity, in SI with the unit in the column
   // name as series.csv has it (swimmer.length, swimmer.length_m); a number or a choice
@@ -283,6 +389,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   }
   csv << ",status";
   for (const auto& m : names) csv << "," << m;
+  // --grid-check: the design on twice its cells, the metric there and its relative change
+  if (grid_check > 0) csv << ",grid_check_cells,grid_check_status,grid_check_" << sw.metric << ",grid_check_change_relative";
   csv << ",cycles_completed,wall_time_s\n";
   long best = -1, failed = 0;
   for (size_t k = 0; k < results.size(); ++k) {
@@ -299,6 +407,14 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     for (const auto& m : names) {
       std::snprintf(b, sizeof b, "%.8g", reduced1d::metric_value(r.metrics, m));
       csv << "," << (r.ok ? b : "");
+    }
+    if (grid_check > 0) {
+      const auto& q = refined[k];
+      csv << "," << designs[n_designs + k].numerics.cells << "," << (q.ok ? "ok" : "failed: " + csv_field(q.message));
+      std::snprintf(b, sizeof b, "%.8g", reduced1d::metric_value(q.metrics, sw.metric));
+      csv << "," << (q.ok ? b : "");
+      std::snprintf(b, sizeof b, "%.6g", change[k]);
+      csv << "," << (std::isfinite(change[k]) ? b : "");
     }
     csv << "," << r.metrics.cycles_completed << "," << r.wall_time_s << "\n";
     if (!r.ok) {
@@ -326,6 +442,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     summary["best_metric_value"] = reduced1d::metric_value(results[best].metrics, sw.metric);
     summary["best_scene"] = sw.design(best);
   }
+  if (grid_check > 0) summary["grid_check"] = grid_j;
   std::vector<std::string> plot_args = {out + "/designs.csv", out + "/screen.png", sw.metric, sw.name,
                                         std::string("--goal=") + (sw.maximize ? "max" : "min")};
   for (const auto& a : sw.axes) plot_args.push_back(a.key);
@@ -348,6 +465,23 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
               sw.maximize ? "max" : "min", best, describe(sw, best).c_str(),
               shown(reduced1d::metric_value(results[best].metrics, sw.metric), sw.metric).c_str(), out.c_str(),
               out.c_str());
+  if (grid_check > 0 && grid_j["status"] == "ok") {
+    const long worst = grid_j["largest_change_design"].get<long>();
+    char tau[48] = "undefined";
+    if (grid_j.contains("kendall_tau") && grid_j["kendall_tau"].is_number())
+      std::snprintf(tau, sizeof tau, "%.3g", grid_j["kendall_tau"].get<double>());
+    std::printf("grid check on %d times the cells: %ld of %zu designs change their %s by more than %.3g %%; largest "
+                "%+.3g %% (design %ld: %s); median %.3g %%; Kendall tau of the two rankings %s; the best design %s\n",
+                factor, grid_j["designs_over_tolerance"].get<long>(), grid_j["designs_compared"].get<size_t>(),
+                sw.metric.c_str(), 100 * grid_check, 100 * grid_j["largest_change_relative"].get<double>(), worst,
+                describe(sw, static_cast<size_t>(worst)).c_str(), 100 * grid_j["median_abs_change_relative"].get<double>(),
+                tau,
+                grid_j["best_design_unchanged"].get<bool>()
+                    ? "is the same"
+                    : ("differs: design " + std::to_string(grid_j["best_design_on_refined_grid"].get<long>())).c_str());
+  } else if (grid_check > 0) {
+    std::printf("grid check on %d times the cells: %s\n", factor, grid_j["status"].get<std::string>().c_str());
+  }
   std::fflush(stdout);
   int code = 0;
   if (confirm > 0) {

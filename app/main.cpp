@@ -2,7 +2,7 @@
 //
 //   swim run SCENE.json [--tier 1d|3d|axi] [--out DIR] [--set key.path=value ...] [--plot] [--resume DIR] [--overwrite] [--threads N]
 //                       [--error-estimate]
-//   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N]
+//   swim screen SWEEP.json [--out DIR] [--jobs N] [--overwrite] [--confirm K] [--threads N] [--grid-check TOL]
 //   swim optimize SPEC.json [--out DIR] [--overwrite] [--no-confirm] [--threads N]
 //   swim bench [--out DIR] [--quick] [--paper-cycle] [--fine-cycle N ...] [--fine-cycle-set K=V ...]
 //              [--tier 1d|3d|axi|all]
@@ -80,6 +80,11 @@ int main(int argc, char** argv) {
                   "Also run K designs in 3D (the K/2 best and K/2 spread over the rest) and report the rank agreement")
       ->check(CLI::Range(0, 100000));
   scr->add_option("--threads", threads3d, "Threads of each 3D run (default 1)")->check(CLI::Range(1, 1024));
+  double scr_grid_check = 0;
+  scr->add_option("--grid-check", scr_grid_check,
+                  "Also run every design on twice its cells (numerics1d.cells) and report the metric's relative change "
+                  "per design, the designs whose change exceeds this tolerance (e.g. 0.05) and whether the ranking holds")
+      ->check(CLI::Range(0.0, 1.0));
   bool scr_overwrite = false;
   scr->add_flag("--overwrite", scr_overwrite, "Replace another run's results in the output folder (its files are removed first)");
   add_progress(scr);
@@ -193,7 +198,7 @@ int main(int argc, char** argv) {
       return app::run(ro);
     }
     if (*demo) return app::demo(out, progress);
-    if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite, scr_confirm, threads3d);
+    if (*scr) return app::screen(sweep, out, jobs, progress, scr_overwrite, scr_confirm, threads3d, scr_grid_check);
     if (*opt) return app::optimize(opt_spec, out, progress, opt_overwrite, !opt_no_confirm, threads3d);
     if (*ben) return app::bench(out, quick, paper_cycle, bench_tier, fine_cycles, fine_sets);
     if (*sc) return app::scenes();

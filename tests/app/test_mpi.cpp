@@ -119,7 +119,8 @@ TEST(MpiScreen, ThreeRanksWriteTheDesignsAndTheConfirmationOfOneProcess) {
   SKIP_WITHOUT_MPI();
   const fs::path d = swim::test::scratch_dir("swim_mpi_screen");
   write(d / "tiny.json", tiny_sweep("20 ms"));
-  const std::string args = " screen \"" + (d / "tiny.json").string() + "\" --confirm 4 --quiet --out ";
+  // (with the grid check: each design's second run, on twice its cells, is a task of its own)
+  const std::string args = " screen \"" + (d / "tiny.json").string() + "\" --confirm 4 --grid-check 0.05 --quiet --out ";
   const Cli one = sh("\"" + kSwim + "\"" + args + "\"" + (d / "one").string() + "\" --jobs 1", d, "one");
   ASSERT_EQ(one.code, 0) << one.err;
   const Cli three = sh(mpirun() + "\"" + kSwim + "\"" + args + "\"" + (d / "three").string() + "\"", d, "three");
@@ -137,8 +138,10 @@ TEST(MpiScreen, ThreeRanksWriteTheDesignsAndTheConfirmationOfOneProcess) {
   EXPECT_TRUE(s3["mpi"]["lost_ranks"].empty());
   long kept = 0;
   for (const auto& [r, n] : s3["mpi"]["tasks_per_rank"].items()) kept += n.get<long>();
-  EXPECT_EQ(kept, 5 + 4);  // five 1D designs, four 3D runs
+  EXPECT_EQ(kept, 2 * 5 + 4);  // five 1D designs on two grids, four 3D runs
   EXPECT_FALSE(read(d / "one/screen.json").contains("mpi"));
+  EXPECT_EQ(s3["grid_check"], read(d / "one/screen.json")["grid_check"]);
+  EXPECT_EQ(s3["grid_check"]["designs_compared"], 5);
 }
 
 TEST(MpiScreen, AKilledRankIsReportedItsRunsRedoneOrTheRestartReusesTheFinishedRuns) {
