@@ -168,6 +168,7 @@ int run3d(const RunOptions& o, const scene::json& sc) {
   scene::json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
   check_other_tier(sc, "3d");
+  full3d::check_fluid_memory(p);
   check_output_size(estimate_output(p), sc);
   if (!o.resume.empty() && !o.out.empty() && fs::path(o.out) != fs::path(o.resume))
     throw InputError("--out", o.out, "with --resume the run continues in the resumed folder; omit --out");

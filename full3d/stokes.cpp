@@ -20,6 +20,24 @@ std::string gib(double bytes) { return std::to_string(bytes / (1024.0 * 1024.0 *
 
 }  // namespace
 
+int factor_slots(const MacGrid& g, const StokesOptions& o) {
+  if (g.boundary() == GridBoundary::PeriodicBox) return CapacitanceStokes::kCachedAlphas;
+  // The factors of as many dt values as fit the memory limit (up to kCachedAlphas); at least
+  // two, the midpoint scheme's dt/2 and dt.
+  const CylinderOptions* cyl = o.cylinder.enabled ? &o.cylinder : nullptr;
+  const double per_alpha = double(CapacitanceStokes::estimate_bytes(g, cyl));
+  const double limit = o.memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
+  const int slots = int(std::min<double>(CapacitanceStokes::kCachedAlphas, std::floor(limit / per_alpha)));
+  if (slots < 2)
+    throw InputError("full3d.grid.cells_across",
+                     std::to_string(g.nx()) + " x " + std::to_string(g.ny()) + " x " + std::to_string(g.nz()) + " cells",
+                     "a grid whose Stokes factors for two time steps fit the memory limit (" + gib(2 * per_alpha) +
+                         " needed, " + gib(limit) +
+                         " allowed by full3d.memory_limit_gib): fewer cells across, a shorter swimmer, or a larger "
+                         "full3d.memory_limit_gib on a machine that has the memory");
+  return slots;
+}
+
 struct StokesSolver::Impl {
   MacGrid grid;
   FluidParams fluid;
@@ -62,16 +80,7 @@ struct StokesSolver::Impl {
                          "a cylinder at least half a cell inside the duct walls (the scenes build the duct one "
                          "cell wider than the cylinder on each side)");
     }
-    // The factors of as many dt values as fit the memory limit (up to kCachedAlphas); at least
-    // two, the midpoint scheme's dt/2 and dt.
-    const double per_alpha = double(CapacitanceStokes::estimate_bytes(g, cyl));
-    const double limit = o.memory_limit_gib * 1024.0 * 1024.0 * 1024.0;
-    const int slots = int(std::min<double>(CapacitanceStokes::kCachedAlphas, std::floor(limit / per_alpha)));
-    if (slots < 2)
-      throw InputError("full3d.grid.cells_across",
-                       std::to_string(nx) + " x " + std::to_string(ny) + " x " + std::to_string(nz) + " cells",
-                       "a grid whose Stokes factors for two time steps fit the memory limit (" + gib(2 * per_alpha) +
-                           " needed, " + gib(limit) + " allowed): fewer cells across or a shorter swimmer");
+    const int slots = factor_slots(g, o);
     const int thr = o.threads > 0 ? o.threads : std::max(1, o.fft.threads);
     capacitance = std::make_unique<CapacitanceStokes>(g, f.mu, cyl, thr, o.fft);
     capacitance->limit_cache(slots);

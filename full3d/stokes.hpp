@@ -78,6 +78,11 @@ struct StokesStats {
   double factorization_seconds = 0.0;  ///< duct and cylinder: time spent (re)factorising in this step (new dt), s
 };
 
+/// Duct and cylinder: how many time steps' capacitance factors o.memory_limit_gib holds (at
+/// most CapacitanceStokes::kCachedAlphas); swim::InputError naming full3d.grid.cells_across and
+/// full3d.memory_limit_gib when it holds fewer than two. Periodic box: kCachedAlphas (no factors).
+int factor_slots(const MacGrid& g, const StokesOptions& o);
+
 class StokesSolver {
  public:
   /// Throws swim::InputError for rho <= 0 or mu <= 0, a cylinder on a box grid, a cylinder

@@ -25,6 +25,16 @@ IbOptions ib_options(const Params3d& p) {
   return o;
 }
 
+void check_fluid_memory(const Params3d& p) {
+  StokesOptions o;
+  o.memory_limit_gib = p.memory_limit_gib;
+  if (p.container == "cylinder") {
+    o.cylinder.enabled = true;
+    o.cylinder.radius = p.container_radius;
+  }
+  (void)factor_slots(MacGrid(p.nx, p.ny, p.nz, p.h, p.grid_boundary()), o);
+}
+
 World3d::World3d(const Params3d& params)
     : p(params), mesh(make_mesh(params)), e_ref(uniform_contraction_energy(mesh, params.membrane, params.protocol.R_f)),
       options(ib_options(params)) {}

@@ -24,6 +24,10 @@ namespace swim::full3d {
 /// The coupled-step options a scene asks for: scheme, CFL bound, threads, container
 /// (cylinder wall kind), Navier-Stokes advection.
 IbOptions ib_options(const Params3d& p);
+/// The scene's fluid grid against full3d.memory_limit_gib, before anything is built or written:
+/// swim::InputError naming full3d.grid.cells_across and full3d.memory_limit_gib when the Stokes
+/// factors of two time steps do not fit (factor_slots).
+void check_fluid_memory(const Params3d& p);
 
 struct World3d {
   /// `p` must outlive the world.

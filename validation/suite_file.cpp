@@ -14,6 +14,7 @@
 #include "common/errors.hpp"
 #include "full3d/scene3d.hpp"
 #include "full3d/scene3d_keys.hpp"
+#include "full3d/world3d.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "validation/richardson.hpp"
 #include "validation/verdicts.hpp"
@@ -104,7 +105,7 @@ void number_list(const json& j, const std::string& at, Ok ok, const std::string&
 void check_3d(const json& s, const std::string& at, const std::string& what) {
   try {
     json resolved;
-    full3d::read_scene3d(s, resolved);
+    full3d::check_fluid_memory(full3d::read_scene3d(s, resolved));
   } catch (const InputError& e) {
     throw InputError(at, what, std::string("a scene the 3D tier runs; it refuses this one: ") + e.what());
   }
@@ -406,6 +407,13 @@ void check_suite(const json& s, const std::string& path, const std::string& data
         throw InputError(at + ".grids[" + std::to_string(g) + "]", grid_key + " = " + grids[g].dump(),
                          std::string("a scene the 3D tier runs; it refuses this one: ") + e.what());
       }
+    }
+    // the last grid (the finest in a suite's ascending series) read in full too: its fluid
+    // grid against the memory limit before any run starts
+    if (grids.size() > 1) {
+      json sl = base;
+      set_key(sl, grid_key, grids.back());
+      check_3d(sl, at + ".grids[" + std::to_string(grids.size() - 1) + "]", grid_key + " = " + grids.back().dump());
     }
     json resolved0;
     const double c1 = full3d::read_scene3d(s0, resolved0).c1_estimate();

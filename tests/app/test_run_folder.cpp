@@ -320,6 +320,23 @@ TEST(RunFolderCli, ARunWhoseOutputWouldExceedTheLimitIsRefused) {
   fs::remove_all(d);
 }
 
+// A fluid grid whose Stokes factors for two time steps exceed full3d.memory_limit_gib is refused
+// when the scene is read (exit 2 naming the grid key and the limit's key), before the folder
+// exists: the solver would otherwise refuse it only when built.
+TEST(RunFolderCli, AFluidGridBeyondTheMemoryLimitIsRefusedBeforeAnythingIsWritten) {
+  const fs::path d = tmpdir("memory");
+  const fs::path out = d / "run";
+  const Cli c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/paper_aspect_L0.2.json\" --tier 3d --out \"" +
+                             out.string() + "\" --set full3d.grid.cells_across=80 --set full3d.memory_limit_gib=0.125",
+                         d);
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("'full3d.grid.cells_across' = 320 x 84 x 84 cells"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("full3d.memory_limit_gib"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("0.125000 GiB allowed"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  fs::remove_all(d);
+}
+
 TEST(RunFolderCli, ARealFullFilesystemIsExitThreeAndNothingClaimsSuccess) {
   // A 600 kB tmpfs: the 1D demo's radius.csv (3.5 MB) cannot fit. Needs the right to mount
   // (root in a container that allows it); skipped otherwise -- the injected failure above

@@ -119,6 +119,21 @@ TEST(SuiteReference, BadValuesAreInputErrorsNamingTheKey) {
 // A case whose scene the axi tier refuses (here the paper's free wall, not held round; then an
 // odd cells_across) is an InputError at load time naming suite.cases[0].reference, with the
 // axi tier's own reason; the same scene made round loads.
+// The finest grid of a case is read in full at load: a fluid grid beyond the memory limit is
+// refused before any run, naming the grid, the key and the limit's key.
+TEST(SuiteReference, AFinestGridBeyondTheMemoryLimitIsRefusedAtLoad) {
+  const std::string path = testing::TempDir() + "/memory_suite_" + std::to_string(::getpid()) + ".json";
+  std::ofstream(path) << R"({"cases": [{"scene": "paper_aspect_L0.2.json", "grids": [32, 40, 80],
+      "set": {"full3d.memory_limit_gib": 0.125}}], )"
+                      << kRest << "}";
+  expect_refused(path, {"suite.cases[0].grids[2]", "full3d.grid.cells_across = 80", "full3d.memory_limit_gib",
+                        "0.125000 GiB allowed"});
+  std::ofstream(path) << R"({"cases": [{"scene": "paper_aspect_L0.2.json", "grids": [32, 40, 80],
+      "set": {"full3d.memory_limit_gib": 1}}], )"
+                      << kRest << "}";
+  EXPECT_NO_THROW(load_suite(path, SWIM_SOURCE_DIR "/data"));
+}
+
 TEST(SuiteReference, ASceneTheAxiTierRefusesIsRefusedAtLoad) {
   expect_refused(write_suite("paper_amplitude_0.82.json", R"({"tier": "axi", "grids": [16, 24, 32]})"),
                  {"suite.cases[0].reference", "paper_amplitude_0.82.json", "full3d.membrane.axisymmetric"});
