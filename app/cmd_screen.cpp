@@ -2,10 +2,10 @@
 #include <cstdlib>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <cmath>
 #include <limits>
 
 #include "app/app.hpp"
@@ -188,13 +188,12 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   return s;
 }
 
-// --grid-check: the sweep's design k on `factor` times its cells (numerics1d.cells), read from
-// its scene as a user's --set would give it.
-reduced1d::Params refined_design(const sweep::Sweep& sw, size_t k, const reduced1d::Params& at_n, int factor) {
+// --grid-check: the scene of the sweep's design k on `factor` times its cells (numerics1d.cells),
+// as a user's --set would give it.
+scene::json refined_scene(const sweep::Sweep& sw, size_t k, const reduced1d::Params& at_n, int factor) {
   scene::json sc = sw.design(k);
   scene::apply_override(sc, "numerics1d.cells=" + std::to_string(at_n.numerics.cells * factor));
-  scene::json resolved;
-  return reduced1d::read_scene(sc, resolved, sw.base_dir);
+  return sc;
 }
 
 // The grid check's summary (screen.json "grid_check"): per design the metric's relative change
@@ -309,10 +308,13 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     }
   }
   const size_t n_designs = designs.size();
+  std::vector<scene::json> refined_scenes;  // --grid-check: designs[n_designs + k]'s scene
   if (grid_check > 0) {
     for (size_t k = 0; k < n_designs; ++k) {
       try {
-        designs.push_back(refined_design(sw, k, designs[k], factor));
+        refined_scenes.push_back(refined_scene(sw, k, designs[k], factor));
+        scene::json resolved;
+        designs.push_back(reduced1d::read_scene(refined_scenes.back(), resolved, sw.base_dir));
       } catch (const InputError& e) {
         throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) +
                                           ") on " + std::to_string(factor) + " times its cells (--grid-check): " + e.what());
@@ -341,8 +343,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     const std::string base_dir = fs::absolute(sw.base_dir).string();
     for (size_t i = 0; i < designs.size(); ++i) {
       const size_t k = i % n_designs;
-      scene::json sc = sw.design(k);
-      if (i >= n_designs) scene::apply_override(sc, "numerics1d.cells=" + std::to_string(designs[i].numerics.cells));
+      const scene::json sc = i < n_designs ? sw.design(k) : refined_scenes[k];
       tasks.push_back({"1D run of design " + std::to_string(k) + (i >= n_designs ? " (grid check)" : ""),
                        {{"kind", "1d"}, {"scene", sc}, {"base_dir", base_dir}},
                        cost_1d(designs[i]),

@@ -26,13 +26,7 @@ IbOptions ib_options(const Params3d& p) {
 }
 
 void check_fluid_memory(const Params3d& p) {
-  StokesOptions o;
-  o.memory_limit_gib = p.memory_limit_gib;
-  if (p.container == "cylinder") {
-    o.cylinder.enabled = true;
-    o.cylinder.radius = p.container_radius;
-  }
-  (void)factor_slots(MacGrid(p.nx, p.ny, p.nz, p.h, p.grid_boundary()), o);
+  (void)factor_slots(MacGrid(p.nx, p.ny, p.nz, p.h, p.grid_boundary()), ib_options(p).stokes);
 }
 
 World3d::World3d(const Params3d& params)
