@@ -39,6 +39,23 @@ inline double resistance(double mu, double d, double a, double b) {
   return (8.0 * mu / pi) * d * mean_Rm4(a, b);
 }
 
+/// Resistance of an open end's half cell as a drainage layer: the quasi-steady flux through a
+/// length d whose pressure follows the wall, dp = C1 dR (the actuation uniform over the half
+/// cell), Q = -(pi / 8 mu) R^4 C1 R_z, integrates exactly to Q = -(pi / 8 mu d) mean(R^4) dp
+/// whatever the profile R(z) between a and b (docs/reduced1d.md, "The open ends").
+inline double drainage_resistance(double mu, double d, double a, double b) {
+  return (8.0 * mu / pi) * d / mean_R4(a, b);
+}
+/// d/da and d/db of drainage_resistance.
+inline void drainage_dresistance(double mu, double d, double a, double b, double& ra, double& rb) {
+  const double m = mean_R4(a, b), r = (8.0 * mu / pi) * d / m;
+  const double a2 = a * a, b2 = b * b;
+  const double ma = (4.0 * a2 * a + 3.0 * a2 * b + 2.0 * a * b2 + b2 * b) / 5.0;
+  const double mb = (4.0 * b2 * b + 3.0 * b2 * a + 2.0 * b * a2 + a2 * a) / 5.0;
+  ra = -r * ma / m;
+  rb = -r * mb / m;
+}
+
 /// Integrals I_n = int R^n p_z dz (n = 1, 2, 4) over the point set, exact for linear R and p
 /// between consecutive points: sum_k (p_{k+1} - p_k) mean_Rn(R_k, R_{k+1}).
 struct PressureIntegrals {

@@ -68,6 +68,7 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
       Rb0_static(R0),
       RbL_static(R0) {
   wall = wall_law(P);
+  drainage_ends = P.numerics.open_end_drainage && !bending && !junction;
   // Layout [V_rear, cell 0, ..., cell N-1, V_front, D, X]: V_rear/V_front sit next to the
   // end cells they depend on, so their couplings are inside the band of the Newton matrix
   // and BDF keeps the linear invariant h sum A_i - V_rear + V_front exactly.
@@ -142,6 +143,7 @@ ModelState ForceModel::make_state() const {
     s.Pipt.assign(N + 2, 0.0);
     if (confined) {
       s.sys = std::make_unique<outer::ConfinedSystem>(N + 2, d, mu, a_in, a_out, Rc_eff, period, L);
+      s.sys->drainage_ends = drainage_ends;
       if (junction) {
         s.sys->junction = &outer::kCalibratedJunction;
         s.Vpt.assign(N + 2, 0.0);
@@ -278,13 +280,16 @@ void ForceModel::fluxes(ModelState& s, bool derivatives, bool want_velocity) con
     s.U = sys.U;
     return;
   }
-  r[0] = disc::resistance(mu, 0.5 * h, s.Rb0 - a_in, R[0] - a_in);
+  auto end_r = [&](double a, double b) {
+    return drainage_ends ? disc::drainage_resistance(mu, 0.5 * h, a, b) : disc::resistance(mu, 0.5 * h, a, b);
+  };
+  r[0] = end_r(s.Rb0 - a_in, R[0] - a_in);
   Q[0] = -p[0] / r[0];
   for (int j = 1; j < N; ++j) {
     r[j] = disc::resistance(mu, h, R[j - 1] - a_in, R[j] - a_in);
     Q[j] = -(p[j] - p[j - 1]) / r[j];
   }
-  r[N] = disc::resistance(mu, 0.5 * h, R[N - 1] - a_in, s.RbL - a_in);
+  r[N] = end_r(R[N - 1] - a_in, s.RbL - a_in);
   Q[N] = p[N - 1] / r[N];
   for (int j = 0; j <= N; ++j) s.cond[j] = 1.0 / r[j];
   if (force_free && (!velocity_quadrature || want_velocity)) {  // unbounded: slender-body average
@@ -412,7 +417,10 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
       const auto& k = sys.k[j];
       const auto &da = sys.point_derivative(j), &db = sys.point_derivative(j + 1);
       double rla, rlb;
-      dresistance(d, a - a_in, b - a_in, rla, rlb);
+      if (drainage_ends && (j == 0 || j == N))
+        disc::drainage_dresistance(mu, d, a - a_in, b - a_in, rla, rlb);
+      else
+        dresistance(d, a - a_in, b - a_in, rla, rlb);
       // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
       const double w = sys.w[j], Qj = sys.Q_in[j];
       auto partial = [&](const outer::AnnulusPoint<double>& dp, double drl, double& dQ, double& d1, double& d2) {
@@ -468,7 +476,10 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
   for (int j = 0; j <= N; ++j) {
     const double a = Rp(j), b = Rp(j + 1), d = (j == 0 || j == N) ? 0.5 * h : h;
     double ra, rb;
-    dresistance(d, a - a_in, b - a_in, ra, rb);
+    if (drainage_ends && (j == 0 || j == N))
+      disc::drainage_dresistance(mu, d, a - a_in, b - a_in, ra, rb);
+    else
+      dresistance(d, a - a_in, b - a_in, ra, rb);
     s.QL[j] = dPi(j) / st.r[j] - st.Q[j] / st.r[j] * ra;
     s.QR[j] = -dPi(j + 1) / st.r[j] - st.Q[j] / st.r[j] * rb;
   }

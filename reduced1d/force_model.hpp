@@ -136,6 +136,8 @@ struct ForceModel {
   // pressures are closure unknowns and the rims' thrust follows the wall velocities, so it
   // runs on the IDA path (V an unknown) even without the traction.
   bool junction;
+  // The open ends' half cells conduct as drainage layers (disc::drainage_resistance).
+  bool drainage_ends = false;
   bool dae;            // IDA path: wall inertia, short-wave traction, axial bending or the junction
   // Unbounded: U does not feed back into the radii. With velocity_quadrature the right-hand
   // side leaves it out (X and the U parts of the lab-frame volumes are then integrated along

@@ -1,5 +1,7 @@
 #include "reduced1d/outer_flow.hpp"
 
+#include "reduced1d/discretisation.hpp"
+
 #include <algorithm>
 #include <Eigen/Dense>
 
@@ -251,6 +253,12 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
         last = j;
       }
   }
+  if (drainage_ends)  // the open ends' half cells: the drainage layer's lumen resistance
+    for (int j : {0, ni - 1}) {
+      const double M4 = disc::mean_R4(Rpt[j] - ain, Rpt[j + 1] - ain), kd = (8.0 * mu / pi) * dd[j];
+      kc[j].rl = kd / M4;
+      wj[j] = M4 / (kd + kc[j].ra * M4);
+    }
   interval_valid_ = !derivatives;
   return true;
 }

@@ -183,6 +183,9 @@ class ConfinedSystem {
   const EndJunction* junction = nullptr;  ///< the calibrated end junction
   JunctionClosure jc;                     ///< transmural() with a junction: its closure
   double M[2][2] = {{0, 0}, {0, 0}};     ///< transmural 2 x 2 (rows: periodicity, force; cols: W, U)
+  /// The two end intervals conduct as the open end's drainage layer (disc::drainage_resistance)
+  /// rather than as a lumen linear in R (set before geometry(); the force-driven wave only).
+  bool drainage_ends = false;
 
  private:
   std::vector<AnnulusPoint<double>> pts_, dpts_;

@@ -183,6 +183,11 @@ struct Numerics {
   double atol_scale = 1e-6;     ///< absolute tolerance as a fraction of each state's scale
   double output_interval = 1e-3;  ///< series/radius output interval [s]
   long max_steps = 2000000;     ///< integrator step budget for the whole run
+  /// Force-driven wave: the open ends' half cells conduct as drainage layers
+  /// (disc::drainage_resistance; numerics1d.open_end = "drainage"), else as a lumen linear in R
+  /// ("linear"). Not with the axial bending or the calibrated junction, whose end radii are not
+  /// the actuation's static ones.
+  bool open_end_drainage = true;
 };
 
 struct Params {

@@ -339,6 +339,17 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     p.numerics.rtol = n.number("rtol", 1e-6, Range::closed(1e-12, 1e-2));
     p.numerics.atol_scale = n.number("atol_scale", 1e-6, Range::closed(1e-14, 1e-2));
     p.numerics.max_steps = n.integer("max_steps", 2000000, 100, 1000000000);
+    // The open ends' half cells as drainage layers (docs/reduced1d.md, "The open ends"): where
+    // an end's radius is the static one of its actuation, the force-driven wave without the
+    // axial bending or the calibrated junction.
+    const bool static_ends = forced && !p.swimmer.end_junction && !(p.wall.D_axial > 0);
+    const std::string open_end = n.choice("open_end", static_ends ? "drainage" : "linear", {"drainage", "linear"});
+    if (open_end == "drainage" && !static_ends)
+      throw InputError(n.path("open_end"), "\"drainage\"",
+                       "the drainage layer is the half cell of an open end held at its actuation's static radius: "
+                       "wave.kind = \"force_driven\" without model1d.axial_bending or model1d.end_effects = "
+                       "\"junction\"; use \"linear\" here");
+    p.numerics.open_end_drainage = open_end == "drainage";
     n.finish();
     if (forced) {  // every protocol segment must span at least one cell
       if (p.numerics.cells < needed)

@@ -145,19 +145,24 @@ TEST(ForceFree, DisplacementIsIndependentOfTheViscosity) {
 // cells' radii and pressures, the end radii (held end segments) and the wall velocities near
 // the ends (the rims' thrust). The traction's fields are checked with mirror ends and with the
 // mixed end condition (model1d.short_wave_traction_end = 0.6: the end cells' ghost values).
+// The open ends' half cells are checked as drainage layers (the default) and as a lumen linear
+// in R (numerics1d.open_end = "linear"; the junction has its own ends).
 TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
   double worst_junction = 0;
+  for (bool drainage : {true, false})
   for (bool junction : {false, true})
   for (double traction_end : {-1.0, 0.0, 0.6})  // -1: no traction
   for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
     for (int N : {37, 60}) {
       if (junction && outer != OuterFlow::Confined) continue;  // the junction belongs to the confined closure
+      if (junction && !drainage) continue;                     // (its ends are never drainage layers)
       const bool traction = traction_end >= 0.0;
       Params p = force_free_cycle(N);
       p.swimmer.short_wave_traction = traction;
       p.swimmer.traction_end = traction ? traction_end : 0.0;
       p.swimmer.outer = outer;
       p.swimmer.end_junction = junction;
+      p.numerics.open_end_drainage = drainage;
       p.swimmer.a_in = 2e-9;
       p.swimmer.a_out = 3e-9;
       const int n = p.protocol.segments;
