@@ -14,6 +14,10 @@
 
 namespace swim::reduced1d {
 
+/// The screening grids: up to this many cells a scene's default `numerics1d.rtol` is 1e-4 (the
+/// grid's own error is far above the integration's), above it 1e-6.
+inline constexpr int kScreeningCells = 100;
+
 /// Throws swim::InputError naming the key, the value and what is allowed.
 /// `scene_dir` is used to find a calibration file given by a relative path.
 Params read_scene(const scene::json& scene, scene::json& resolved, const std::string& scene_dir = ".");
