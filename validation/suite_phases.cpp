@@ -76,6 +76,29 @@ Run1d run_1d(const json& sc, const std::string& label, const std::string& scene_
   return r;
 }
 
+/// The grid error of a 1D model's figures on case c: the model's scene again on twice its
+/// cells, each figure's error estimated as 2 |v_N - v_2N| (a first-order series; a second-order
+/// one would give 4/3 of the change), in the figure's unit. `status` says why there is none.
+json grid_error_1d(const json& scene, const Run1d& r, const std::string& label, const std::string& scene_dir) {
+  const long cells = r.record.value("cells", 0L);
+  json e = {{"cells", cells}, {"refined_cells", 2 * cells},
+            {"rule", "2 |v_N - v_2N|: the figure on twice the cells, read as a first-order series"}};
+  json s = scene;
+  set_key(s, "numerics1d.cells", 2 * cells);
+  const Run1d f = run_1d(s, label, scene_dir);
+  if (!f.cyc.has_cycle) {
+    e["status"] = "no error estimate: on " + std::to_string(2 * cells) + " cells the model " +
+                  (f.ok ? "completed no cycle" : f.record.value("status", std::string("failed")));
+    return e;
+  }
+  e["status"] = "ok";
+  e["displacement_per_cycle_m"] = 2.0 * std::abs(r.cyc.displacement_per_cycle_m - f.cyc.displacement_per_cycle_m);
+  e["cycle_time_s"] = 2.0 * std::abs(r.cyc.cycle_time_s - f.cyc.cycle_time_s);
+  e["mean_velocity_per_cycle_m_per_s"] =
+      2.0 * std::abs(r.cyc.mean_velocity_per_cycle_m_per_s - f.cyc.mean_velocity_per_cycle_m_per_s);
+  return e;
+}
+
 json relative(double value, double ref) {
   if (!(std::abs(ref) > 0)) return nullptr;
   return (value - ref) / std::abs(ref);
@@ -300,15 +323,23 @@ json judge_models(const SuiteCase& c, const json& suite, const std::string& cal_
   for (const json& m : suite["models1d"]) {
     const std::string label = m["label"];
     const bool calibrated = m.value("calibrated", false);
+    const bool first = models_j.empty();  // the suite's default 1D model
     Run1d r;
+    json scene;
     if (calibrated && cal_file.empty()) {
       r.record = {{"label", label}, {"status", "not run: the calibration failed"}};
     } else {
       say(c.tag + ": 1D " + label);
-      r = run_1d(model_scene_of(c, m, cal_file), label, c.scene_dir);
+      scene = model_scene_of(c, m, cal_file);
+      r = run_1d(scene, label, c.scene_dir);
     }
     json entry = r.record;
     entry["calibrated"] = calibrated;
+    // the error bar of the default model's figures in the trend claims (verdicts.cpp)
+    if (first && r.cyc.has_cycle) {
+      say(c.tag + ": 1D " + label + " on twice its cells (its grid error)");
+      entry["grid_error"] = grid_error_1d(scene, r, label, c.scene_dir);
+    }
     if (r.cyc.has_cycle) {
       json vs_cal = json::object();
       // against the case's reference: the axisymmetric one when the case has it, else the

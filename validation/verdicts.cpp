@@ -58,12 +58,9 @@ Valued reference_of(const json& c, const std::string& key) {
   return v;
 }
 
-/// The relative error given to a 1D value in a trend claim: the tier's grid error at its default
-/// grid (N = 50 within 0.5 % of N = 400, docs/outer-flow-1d.md §3b).
-constexpr double kOneDGridError = 5e-3;
-
 /// The suite's default 1D model's (the first of models1d) value of `key` on case c, with the
-/// error kOneDGridError |value|.
+/// error of its grid: 2 |v_N - v_2N| from its run on twice the cells (`grid_error`, written by
+/// the suite's 1D phase). Without that estimate the value has no error bar and is missing.
 Valued default_model_of(const json& c, const std::string& key) {
   Valued v;
   const json& models = c.contains("models1d") ? c["models1d"] : json::array();
@@ -72,14 +69,22 @@ Valued default_model_of(const json& c, const std::string& key) {
     return v;
   }
   const json& m = models[0];
-  if (m.value("status", std::string()) == "ok" && m.contains(key) && m[key].is_number()) {
-    v.value = m[key].get<double>();
-    v.error = kOneDGridError * std::abs(v.value);
-    if (std::isfinite(v.value)) return v;
+  const std::string label = m.value("label", std::string());
+  if (m.value("status", std::string()) == "ok" && m.contains(key) && m[key].is_number() &&
+      std::isfinite(m[key].get<double>())) {
+    const json& g = m.contains("grid_error") ? m["grid_error"] : json();
+    if (g.is_object() && g.value("status", std::string()) == "ok" && g.contains(key) && g[key].is_number()) {
+      v.value = m[key].get<double>();
+      v.error = g[key].get<double>();
+      return v;
+    }
+    v.value = v.error = kNaN;
+    v.missing = "the default 1D model (" + label + ") has a value without an error bar: " +
+                (g.is_object() ? g.value("status", std::string("no grid error")) : std::string("no grid error"));
+    return v;
   }
   v.value = v.error = kNaN;
-  v.missing = "the default 1D model (" + m.value("label", std::string()) + ") has no value: " +
-              m.value("status", std::string("no cycle"));
+  v.missing = "the default 1D model (" + label + ") has no value: " + m.value("status", std::string("no cycle"));
   return v;
 }
 
@@ -319,7 +324,7 @@ json findings(const json& cases, const json& th) {
   const auto aspect = group("aspect"), amplitude = group("amplitude");
 
   // The paper's trends, on the reference (the converged answer) and then on the suite's default
-  // 1D model with the same rule (each 1D value carries the tier's grid error, kOneDGridError).
+  // 1D model with the same rule (each 1D value carries its own grid error, default_model_of).
   const auto trends = [&](bool one_d) {
     const std::string on = one_d ? " (1D tier, the suite's default 1D model)" : "";
     const std::string settle_suffix = one_d ? ": a finer 1D grid (numerics1d.cells)" : kSettleSuffix;

@@ -64,6 +64,20 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
     for (const auto& [k, v] : m["verdicts"].items())
       EXPECT_TRUE(v == "pass" || v == "fail" || v == "inconclusive") << k << ": " << v;
   }
+  // the default model (the first) carries its grid error, from its run on twice its cells: the
+  // error bar of its figures in the trend claims; a small fraction of each figure on 100 cells
+  {
+    const auto& g = c["models1d"][0]["grid_error"];
+    ASSERT_EQ(g.value("status", ""), "ok") << g.dump();
+    EXPECT_EQ(g["cells"], 100);
+    EXPECT_EQ(g["refined_cells"], 200);
+    for (const char* k : {"displacement_per_cycle_m", "cycle_time_s", "mean_velocity_per_cycle_m_per_s"}) {
+      const double e = g[k].get<double>(), v = c["models1d"][0][k].get<double>();
+      EXPECT_GE(e, 0.0) << k;
+      EXPECT_LT(e, 0.05 * std::abs(v)) << k;
+    }
+    for (std::size_t i = 1; i < c["models1d"].size(); ++i) EXPECT_FALSE(c["models1d"][i].contains("grid_error")) << i;
+  }
   // the force-free models swim the way 3D does; the paper's reproduction overestimates the
   // displacement by orders of magnitude (its thrust has no opposing force but wall inertia)
   const double ref = c["reference3d"]["displacement_per_cycle_m"]["value"];

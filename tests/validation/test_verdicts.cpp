@@ -189,7 +189,9 @@ TEST(Findings, DistanceGrowsWithLengthHasThreeOutcomes) {
 }
 
 // The paper's trends on the 1D tier: the same claims judged on the suite's default 1D model
-// (the first of models1d), each 1D value carrying the tier's grid error (0.5 %). The 1D rows
+// (the first of models1d), each 1D value carrying its own grid error (`grid_error`, from its run
+// on twice the cells; here 0.5 %); a value whose grid error could not be estimated has no error
+// bar and counts as missing. The 1D rows
 // follow the 1D values, not the reference's: here the reference grows with L and the 1D tier
 // shrinks; two 1D values 0.2 % apart are within their error bars (inconclusive, settled by a
 // finer 1D grid); a case whose default model failed leaves the claim on the other cases: at best
@@ -199,7 +201,10 @@ TEST(Findings, TheTrendsAreAssessedOnTheDefault1DModelToo) {
   const std::string on1d = grows + " (1D tier, the suite's default 1D model)";
   auto with_1d = [](json cs, std::vector<double> d1d) {
     for (std::size_t i = 0; i < cs.size(); ++i) {
-      json m = {{"label", "default"}, {"status", "ok"}, {"displacement_per_cycle_m", d1d[i]}};
+      json m = {{"label", "default"},
+                {"status", "ok"},
+                {"displacement_per_cycle_m", d1d[i]},
+                {"grid_error", {{"status", "ok"}, {"displacement_per_cycle_m", 0.005 * d1d[i]}}}};
       if (d1d[i] < 0) m = {{"label", "default"}, {"status", "failed: collapsed"}};
       cs[i]["models1d"] = json::array({m, {{"label", "other"}, {"status", "ok"}, {"displacement_per_cycle_m", 1.0}}});
     }
@@ -227,6 +232,17 @@ TEST(Findings, TheTrendsAreAssessedOnTheDefault1DModelToo) {
   EXPECT_EQ(f["to_settle"].get<std::string>().rfind("values for L0.4", 0), 0u) << f["to_settle"];
   f = find(findings(with_1d(cs, {30 * nm, -1, 10 * nm}), kThresholds), on1d);
   EXPECT_EQ(f["status"], "refuted") << f.dump(1);  // a contradiction among the others stands
+  // a value without its grid error: no error bar, missing like a failed run, naming the cause
+  json no_bar = with_1d(cs, {30 * nm, 20 * nm, 10 * nm});
+  no_bar[1]["models1d"][0]["grid_error"] = {{"status", "no error estimate: on 100 cells the model failed: collapsed"}};
+  f = find(findings(no_bar, kThresholds), on1d);
+  EXPECT_EQ(f["status"], "refuted") << f.dump(1);  // L0.8 < L0.2 still contradicts the claim
+  EXPECT_NE(f["missing"].get<std::string>().find("has a value without an error bar: no error estimate"), std::string::npos)
+      << f["missing"];
+  no_bar = with_1d(cs, {30 * nm, 60 * nm, 90 * nm});
+  no_bar[2]["models1d"][0].erase("grid_error");
+  f = find(findings(no_bar, kThresholds), on1d);
+  EXPECT_EQ(f["status"], "inconclusive") << f.dump(1);  // supported where it has bars, L0.8 missing
   f = find(findings(with_1d(cs, {30 * nm, -1, -1}), kThresholds), on1d);
   EXPECT_EQ(f["status"], "not assessed") << f.dump(1);  // one value left: nothing to compare
   EXPECT_NE(f["reason"].get<std::string>().find("failed: collapsed"), std::string::npos) << f["reason"];
