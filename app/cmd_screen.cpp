@@ -130,7 +130,7 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
     const size_t i = chosen[c];
     const long rank = static_cast<long>(std::find(ranked.begin(), ranked.end(), i) - ranked.begin()) + 1;
     cands.push_back({i, describe(sw, i), c < chosen.size() - chosen.size() / 2 ? "best" : "spread", rank, sw.design(i),
-                     results[i].metrics});
+                     results[i].metrics, "", std::nullopt});  // the recovery end matched below
     design::match_recovery_end(cands.back(), sw.base_dir);  // the 1D cycle ends as the 3D run's
   }
   std::printf("confirming %zu of %zu designs in 3D (%zu best, %zu spread over the rest)%s\n", cands.size(),
