@@ -309,6 +309,13 @@ void ForceModel::dresistance(double d, double a, double b, double& ra, double& r
   rb = -c * (b2 + 2.0 * ab + 3.0 * a2) / (a3b3 * b);
 }
 
+void ForceModel::interval_dresistance(int j, double d, double a, double b, double& ra, double& rb) const {
+  if (drainage_ends && (j == 0 || j == N))
+    disc::drainage_dresistance(mu, d, a, b, ra, rb);
+  else
+    dresistance(d, a, b, ra, rb);
+}
+
 disc::PressureIntegrals ForceModel::integrals(const ModelState& st) const {
   disc::PressureIntegrals s;
   for (int j = 0; j <= N; ++j) {
@@ -417,10 +424,7 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
       const auto& k = sys.k[j];
       const auto &da = sys.point_derivative(j), &db = sys.point_derivative(j + 1);
       double rla, rlb;
-      if (drainage_ends && (j == 0 || j == N))
-        disc::drainage_dresistance(mu, d, a - a_in, b - a_in, rla, rlb);
-      else
-        dresistance(d, a - a_in, b - a_in, rla, rlb);
+      interval_dresistance(j, d, a - a_in, b - a_in, rla, rlb);
       // Q_in = (ra Qt + c U - dPi) / (rl + ra); t1 = rl Q_in; t2 = -S rl Q_in - S dPi + e U
       const double w = sys.w[j], Qj = sys.Q_in[j];
       auto partial = [&](const outer::AnnulusPoint<double>& dp, double drl, double& dQ, double& d1, double& d2) {
@@ -476,10 +480,7 @@ void ForceModel::flux_sensitivities(Linearisation& s, bool with_pressure) const 
   for (int j = 0; j <= N; ++j) {
     const double a = Rp(j), b = Rp(j + 1), d = (j == 0 || j == N) ? 0.5 * h : h;
     double ra, rb;
-    if (drainage_ends && (j == 0 || j == N))
-      disc::drainage_dresistance(mu, d, a - a_in, b - a_in, ra, rb);
-    else
-      dresistance(d, a - a_in, b - a_in, ra, rb);
+    interval_dresistance(j, d, a - a_in, b - a_in, ra, rb);
     s.QL[j] = dPi(j) / st.r[j] - st.Q[j] / st.r[j] * ra;
     s.QR[j] = -dPi(j + 1) / st.r[j] - st.Q[j] / st.r[j] * rb;
   }

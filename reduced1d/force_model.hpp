@@ -250,6 +250,9 @@ struct ForceModel {
  private:
   /// d r / d a and d r / d b for the resistance r(d, a, b) of disc::resistance.
   void dresistance(double d, double a, double b, double& ra, double& rb) const;
+  /// The same for interval j (0..N): the drainage layer's (disc::drainage_dresistance) at the
+  /// two open ends when drainage_ends, else dresistance.
+  void interval_dresistance(int j, double d, double a, double b, double& ra, double& rb) const;
   void flux_sensitivities(Linearisation& s, bool with_pressure) const;
 
   /// Row scalings of the IDA residual (scaled state): cu in F_a = a' - cu R V; cv, the
