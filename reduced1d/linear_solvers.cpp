@@ -499,29 +499,47 @@ struct BlockTri {
     for (int i = 0; i < nv; ++i) store4(y + 4 * i, y0[i] + y1[i]);
   }
 
+  /// y = a - A x for the column-major s x s matrix A (stride ld, padding rows zero), in four
+  /// independent chains: the sweeps' step from cell to cell, whose latency (x arrives, the
+  /// products, their sum) is the solve's critical path. y may alias a, not x.
+  template <int s>
+  static void matvec_sub(const double* A, const double* x, const double* a, double* y) {
+    constexpr int ld = lead(s);
+    constexpr int nv = ld / 4;
+    V4 y0[nv], y1[nv] = {}, y2[nv] = {}, y3[nv] = {};
+    for (int i = 0; i < nv; ++i) y0[i] = load4(a + 4 * i);
+    int c = 0;
+    for (; c + 3 < s; c += 4)
+      for (int i = 0; i < nv; ++i) {
+        y0[i] -= load4(A + c * ld + 4 * i) * x[c];
+        y1[i] -= load4(A + (c + 1) * ld + 4 * i) * x[c + 1];
+        y2[i] -= load4(A + (c + 2) * ld + 4 * i) * x[c + 2];
+        y3[i] -= load4(A + (c + 3) * ld + 4 * i) * x[c + 3];
+      }
+    for (; c < s; ++c)
+      for (int i = 0; i < nv; ++i) y1[i] -= load4(A + c * ld + 4 * i) * x[c];
+    for (int i = 0; i < nv; ++i) store4(y + 4 * i, (y0[i] + y1[i]) + (y2[i] + y3[i]));
+  }
+
   template <int s>
   void solve_cells(double* b) {
     constexpr int ld = lead(s);
     constexpr std::size_t SS = std::size_t(s) * ld;
     if constexpr (s == ld) {  // whole vectors in place, no copies (blocks of 4, 8, 12)
       constexpr int nv = ld / 4;
-      alignas(32) double T[ld] = {}, y[ld] = {}, Ly[ld] = {};
+      alignas(32) double Ly[ld] = {};
       for (long k = 0; k < N; ++k) {  // y_k = D_k^{-1} b_k - (D_k^{-1} L_k) y_{k-1}
         double* bk = b + o + k * s;
         matvec<s>(Dinv.data() + k * SS, bk, Ly);
-        if (k > 0) {
-          matvec<s>(DL.data() + k * SS, y, T);
-          for (int v = 0; v < nv; ++v) store4(y + 4 * v, load4(Ly + 4 * v) - load4(T + 4 * v));
-        } else {
-          for (int v = 0; v < nv; ++v) store4(y + 4 * v, load4(Ly + 4 * v));
-        }
-        for (int v = 0; v < nv; ++v) store4(bk + 4 * v, load4(y + 4 * v));
+        if (k > 0)
+          matvec_sub<s>(DL.data() + k * SS, bk - s, Ly, bk);
+        else
+          for (int v = 0; v < nv; ++v) store4(bk + 4 * v, load4(Ly + 4 * v));
       }
       const double* x = b + o + (N - 1) * s;
       for (long k = N - 2; k >= 0; --k) {  // x_k = y_k - Up_k x_{k+1}
         double* xk = b + o + k * s;
-        matvec<s>(Up.data() + k * SS, x, T);
-        for (int v = 0; v < nv; ++v) store4(xk + 4 * v, load4(xk + 4 * v) - load4(T + 4 * v));
+        matvec_sub<s>(Up.data() + k * SS, x, xk, xk);
         x = xk;
       }
       return;
