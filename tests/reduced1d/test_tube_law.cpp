@@ -320,7 +320,7 @@ TEST(TubeLaw, CalibrationFileRoundTripIsBitIdentical) {
 // R_f = 0.35 R0 on the measured law of the paper's free wall (docs/tube-law/calibration.json,
 // paper_amplitude_0.55 at 20 cells across): paper_amplitude_0.35 at its load factor 1.4 of the
 // law's static load completes its cycle at 50 cells, with the displacement measured there
-// (75.2 nm; 75.9 nm at 100 and 200 cells) within 2 %, and its radii stay on the measured
+// (74.3 nm; 75.5 and 75.6 nm at 100 and 200 cells) within 2 %, and its radii stay on the measured
 // knots (above the deepest, 0.258 R0). The linear law's static load at R_f is 15 times larger.
 TEST(TubeLaw, ContractedRatio035RunsOnTheMeasuredBuckledLaw) {
   scene::json sc = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.35.json");
@@ -339,7 +339,7 @@ TEST(TubeLaw, ContractedRatio035RunsOnTheMeasuredBuckledLaw) {
   ASSERT_EQ(m.cycles_completed, 1);
   std::printf("R_f = 0.35 R0 on the buckled law, 50 cells: %.4g nm per cycle, cycle %.4g s\n",
               m.displacement_m * 1e9, m.cycle_times_s[0]);
-  EXPECT_NEAR(m.displacement_m, 75.2e-9, 0.02 * 75.2e-9);
+  EXPECT_NEAR(m.displacement_m, 74.3e-9, 0.02 * 74.3e-9);
   double Rmin = 1e300;
   for (const auto& s : r.series) Rmin = std::min(Rmin, s.R_min);
   EXPECT_GT(Rmin, p.wall.law->knots_R().front());
