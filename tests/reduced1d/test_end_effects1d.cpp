@@ -16,6 +16,7 @@
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
+#include "scene_refusal.hpp"
 
 using namespace swim::reduced1d::outer;
 using swim::scene::json;
@@ -98,15 +99,7 @@ TEST(EndEffects, SceneKeyRefusesBadValuesAndOtherModels) {
       sc["wave"] = {{"kind", wave}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"width", "0.05 um"}};
     return sc;
   };
-  auto message = [](const json& sc) {
-    json resolved;
-    try {
-      (void)swim::reduced1d::read_scene(sc, resolved);
-    } catch (const swim::InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string();
-  };
+  auto message = [](const json& sc) { return swim::reduced1d::test::refusal_of(sc).message; };
   const std::string bad = message(scene({{"end_effects", "sampson"}}, "step"));
   EXPECT_NE(bad.find("model1d.end_effects"), std::string::npos) << bad;
   EXPECT_NE(bad.find("sampson"), std::string::npos) << bad;

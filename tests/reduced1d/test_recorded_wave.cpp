@@ -22,6 +22,7 @@
 #include "reduced1d/report.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
+#include "scene_refusal.hpp"
 
 namespace fs = std::filesystem;
 using swim::scene::json;
@@ -210,13 +211,8 @@ TEST(RecordedWave, BadFilesAreRefusedNamingTheKey) {
   const fs::path good = record_sine("none", &X);
   const Table tb = read_table(good);
   auto message = [](const json& sc) {
-    json resolved;
-    try {
-      (void)read_scene(sc, resolved);
-    } catch (const swim::InputError& e) {
-      return std::make_pair(e.key(), std::string(e.what()));
-    }
-    return std::make_pair(std::string(), std::string());
+    const test::Refusal r = test::refusal_of(sc);
+    return r.refused ? std::make_pair(r.key, r.message) : std::make_pair(std::string(), std::string());
   };
   struct Case {
     std::string name, text, allowed;

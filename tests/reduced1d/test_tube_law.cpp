@@ -29,6 +29,7 @@
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
 #include "reduced1d/tube_law.hpp"
+#include "scene_refusal.hpp"
 
 using namespace swim;
 using namespace swim::reduced1d;
@@ -288,14 +289,9 @@ TEST(TubeLaw, CalibrationFileRoundTripIsBitIdentical) {
   EXPECT_EQ(a.radius, b.radius);
   EXPECT_EQ(metrics(from_file, a).cycles_completed, 1);
   // bad values of the new key: exit 2 naming the key, the value and what is allowed
-  auto key_of = [&](scene::json sc) {
-    try {
-      scene::json r;
-      read_scene(sc, r);
-    } catch (const InputError& e) {
-      return std::pair{e.key(), std::string(e.what())};
-    }
-    return std::pair{std::string("(accepted)"), std::string()};
+  auto key_of = [&](const scene::json& sc) {
+    const swim::reduced1d::test::Refusal r = swim::reduced1d::test::refusal_of(sc);
+    return std::pair{r.key, r.message};
   };
   scene::json bad = law_scene(file);
   bad["wall"]["law"] = "cubic";
