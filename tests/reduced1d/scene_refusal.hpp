@@ -19,11 +19,11 @@ struct Refusal {
   std::string message;  ///< the whole message (empty when accepted)
 };
 
-/// Read `scene` (scene files relative to `scene_dir`) and report whether it was refused.
-inline Refusal refusal_of(const scene::json& scene, const std::string& scene_dir = ".") {
+/// Read `scene` and report whether it was refused.
+inline Refusal refusal_of(const scene::json& scene) {
   scene::json resolved;
   try {
-    (void)read_scene(scene, resolved, scene_dir);
+    (void)read_scene(scene, resolved);
   } catch (const swim::InputError& e) {
     return {true, e.key(), e.what()};
   }
