@@ -343,6 +343,8 @@ void EventLoop::check_end_radii(double t) const {
           t);
     return;
   }
+  // Continued open ends are the end cells: the cells' own collapse root watches them.
+  if (M_.ends_follow_cells) return;
   double lo0, loL;
   M_.end_radius_range(lo0, loL);
   if ((lo0 < collapse_ || loL < collapse_) && M_.wall.law) {

@@ -68,7 +68,9 @@ ForceModel::ForceModel(const Params& P, bool step_velocity)
       Rb0_static(R0),
       RbL_static(R0) {
   wall = wall_law(P);
-  drainage_ends = P.numerics.open_end_drainage && !bending && !junction;
+  drainage_ends = P.numerics.open_end == OpenEnd::Drainage && !bending && !junction;
+  ends_follow_cells = bending || (P.numerics.open_end == OpenEnd::Continued && !junction);
+  if (!bending) end_w0 = 1.0, end_w1 = 0.0;
   // Layout [V_rear, cell 0, ..., cell N-1, V_front, D, X]: V_rear/V_front sit next to the
   // end cells they depend on, so their couplings are inside the band of the Newton matrix
   // and BDF keeps the linear invariant h sum A_i - V_rear + V_front exactly.
@@ -215,9 +217,10 @@ bool ForceModel::unpack(const double* y, ModelState& s) const {
     s.Rbar[k] = sum / seg_w[k];
     s.qs[k] = seg_law[k]->eval(s.Rbar[k], s.dqs[k]);
   }
-  if (bending) {  // free ends of a bending wall: straight through the last two cells (no curvature)
-    s.Rb0 = 1.5 * R[0] - 0.5 * R[1];
-    s.RbL = 1.5 * R[N - 1] - 0.5 * R[N - 2];
+  if (ends_follow_cells) {  // a bending wall's free ends, straight through the last two cells (no
+                           // curvature), or the continued open ends, the end cells' radii
+    s.Rb0 = end_w0 * R[0] + end_w1 * R[1];
+    s.RbL = end_w0 * R[N - 1] + end_w1 * R[N - 2];
     if (!(s.Rb0 > 0) || !(s.RbL > 0)) ok = false;
   } else {
     s.Rb0 = end0_seg ? law[0].a->rest_radius(wall, s.qs[seg_a[0]]) : Rb0_static;
@@ -769,14 +772,16 @@ void ForceModel::ida_band(const Linearisation& s, const double* y, double cj, co
   band(iVf, iVf, cj);
   band(iVf, 1 + S * (N - 1), -s.QL[N] * dRda(N - 1) / V_s);
   band(iVf, 1 + S * (N - 1) + 2, -cond[N] * P_s / V_s);
-  if (bending) {  // Q_0 and Q_N through the free ends' radii Rb = 1.5 R_end - 0.5 R_next
+  if (ends_follow_cells) {  // Q_0 and Q_N through the ends' radii Rb = w0 R_end + w1 R_next
     const double c = cp / h;
-    for (auto [i, w] : {std::pair{0, 1.5}, std::pair{1, -0.5}}) {
+    for (auto [i, w] : {std::pair{0, end_w0}, std::pair{1, end_w1}}) {
+      if (w == 0.0) continue;  // (the continued end's neighbour; outside the band without bending)
       const double d0 = s.Qb0 * w * dRda(i);
       band(1 + 2, 1 + S * i, -c * d0);
       band(iVr, 1 + S * i, -d0 / V_s);
     }
-    for (auto [i, w] : {std::pair{N - 1, 1.5}, std::pair{N - 2, -0.5}}) {
+    for (auto [i, w] : {std::pair{N - 1, end_w0}, std::pair{N - 2, end_w1}}) {
+      if (w == 0.0) continue;
       const double dN = s.QbL * w * dRda(i);
       band(1 + S * (N - 1) + 2, 1 + S * i, c * dN);
       band(iVf, 1 + S * i, -dN / V_s);
@@ -820,8 +825,8 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
       Ul[off + 1 + S * i + 1] = cv * u;  // F_V = [V'] + cv (C1 (R - R0) + q + T - p)
       Vt[off + 1 + S * i] = st.dqs[k] * u / seg_w[k] * 0.5 * R0 * R0 / R[i];
     }
-    double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii (not a bending wall's)
-    if (endL_seg && seg_a[N - 1] == k && !bending) {  // Q_N depends on RbL (linear law: R0 - qs/C1)
+    double g1 = 0, g2 = 0;  // confined: d g / d qs_k through the end radii (static ends only)
+    if (endL_seg && seg_a[N - 1] == k && !ends_follow_cells) {  // Q_N depends on RbL (linear law: R0 - qs/C1)
       const double dQN = s.QbL * end_sensitivity(st, true);
       Ul[off + 1 + S * (N - 1) + 2] += cp * dQN / h;
       Ul[off + iVf] += -dQN / V_s;
@@ -830,7 +835,7 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
         else g1 -= s.g1b[N] / C1, g2 -= s.g2b[N] / C1;
       }
     }
-    if (end0_seg && seg_a[0] == k && !bending) {
+    if (end0_seg && seg_a[0] == k && !ends_follow_cells) {
       const double dQ0 = s.Qb0 * end_sensitivity(st, false);
       Ul[off + 1 + 2] += -cp * dQ0 / h;
       Ul[off + iVr] += -dQ0 / V_s;
@@ -841,8 +846,8 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
     }
     if (junction) {  // the end rows through the end radii too
       double g[4] = {g1, g2, 0.0, 0.0};
-      if (endL_seg && seg_a[N - 1] == k && !bending) g[3] += s.g4b[N] * end_sensitivity(st, true);
-      if (end0_seg && seg_a[0] == k && !bending) g[2] += s.g3a[0] * end_sensitivity(st, false);
+      if (endL_seg && seg_a[N - 1] == k && !ends_follow_cells) g[3] += s.g4b[N] * end_sensitivity(st, true);
+      if (end0_seg && seg_a[0] == k && !ends_follow_cells) g[2] += s.g3a[0] * end_sensitivity(st, false);
       if (g[0] != 0.0 || g[1] != 0.0 || g[2] != 0.0 || g[3] != 0.0) {
         JunctionChain jx{{}, off};
         for (int c = 0; c < 4; ++c)
@@ -892,9 +897,9 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
         d[1 + S * i] = (B[i] + A[i + 1]) * 0.5 * R0 * R0 / R[i];
         d[1 + S * i + 2] = (P[i] - P[i + 1]) * P_s;
       }
-      if (bending) {  // the end points' radii follow the cells beside them
-        for (auto [i, w] : {std::pair{0, 1.5}, std::pair{1, -0.5}}) d[1 + S * i] += A[0] * w * 0.5 * R0 * R0 / R[i];
-        for (auto [i, w] : {std::pair{N - 1, 1.5}, std::pair{N - 2, -0.5}})
+      if (ends_follow_cells) {  // the end points' radii follow the cells beside them
+        for (auto [i, w] : {std::pair{0, end_w0}, std::pair{1, end_w1}}) d[1 + S * i] += A[0] * w * 0.5 * R0 * R0 / R[i];
+        for (auto [i, w] : {std::pair{N - 1, end_w0}, std::pair{N - 2, end_w1}})
           d[1 + S * i] += B[N] * w * 0.5 * R0 * R0 / R[i];
       }
     }
@@ -941,16 +946,16 @@ int ForceModel::residual_low_rank(const Linearisation& s, std::vector<double>& U
       vw[1 + S * i + 2] = -(Gi[0][0] * g1p + Gi[0][1] * g2p);
       vu[1 + S * i + 2] = -(Gi[1][0] * g1p + Gi[1][1] * g2p);
     }
-    if (bending) {  // the end points' radii follow the cells beside them
+    if (ends_follow_cells) {  // the end points' radii follow the cells beside them
       auto add = [&](int i, double g1, double g2) {
         vw[1 + S * i] -= Gi[0][0] * g1 + Gi[0][1] * g2;
         vu[1 + S * i] -= Gi[1][0] * g1 + Gi[1][1] * g2;
       };
-      for (auto [i, w] : {std::pair{0, 1.5}, std::pair{1, -0.5}}) {
+      for (auto [i, w] : {std::pair{0, end_w0}, std::pair{1, end_w1}}) {
         const double f = w * 0.5 * R0 * R0 / R[i];
         add(i, s.g1a[0] * f, s.g2a[0] * f);
       }
-      for (auto [i, w] : {std::pair{N - 1, 1.5}, std::pair{N - 2, -0.5}}) {
+      for (auto [i, w] : {std::pair{N - 1, end_w0}, std::pair{N - 2, end_w1}}) {
         const double f = w * 0.5 * R0 * R0 / R[i];
         add(i, s.g1b[N] * f, s.g2b[N] * f);
       }

@@ -138,6 +138,11 @@ struct ForceModel {
   bool junction;
   // The open ends' half cells conduct as drainage layers (disc::drainage_resistance).
   bool drainage_ends = false;
+  // The end points' radii follow the cells beside them, Rb = end_w0 R_end + end_w1 R_next: the
+  // bending wall's straight continuation (1.5, -0.5) or the continued open end (1, 0); else they
+  // are the static radii of the end segments' actuation.
+  bool ends_follow_cells = false;
+  double end_w0 = 1.5, end_w1 = -0.5;
   bool dae;            // IDA path: wall inertia, short-wave traction, axial bending or the junction
   // Unbounded: U does not feed back into the radii. With velocity_quadrature the right-hand
   // side leaves it out (X and the U parts of the lab-frame volumes are then integrated along
@@ -182,7 +187,8 @@ struct ForceModel {
                      const std::vector<const ActuationLaw*>& seg_laws);
 
   /// Extreme end radii the current laws can produce (for the collapse check at a switch; a
-  /// bending wall's ends follow the wall, and EventLoop::check_end_radii checks its segments).
+  /// bending wall's ends and the continued open ends follow the wall, and
+  /// EventLoop::check_end_radii checks a bending wall's segments).
   void end_radius_range(double& lo0, double& loL) const;
 
   /// Radii (and V, p) from the scaled state; p from the tube law without inertia.

@@ -177,17 +177,23 @@ struct Swimmer {
   ExternalDrag drag = ExternalDrag::None;
 };
 
+/// The open ends of a force-driven wave.
+enum class OpenEnd {
+  Drainage,   ///< at the static radius of the end's actuation; the half cell a drainage layer
+  Linear,     ///< at the static radius of the end's actuation; R linear across the half cell
+  Continued,  ///< the end cell's radius continued to the mouth (with the short-wave traction only)
+};
+
 struct Numerics {
   int cells = 200;              ///< number of finite-volume cells along z
   double rtol = 1e-6;           ///< relative tolerance of CVODE/IDA
   double atol_scale = 1e-6;     ///< absolute tolerance as a fraction of each state's scale
   double output_interval = 1e-3;  ///< series/radius output interval [s]
   long max_steps = 2000000;     ///< integrator step budget for the whole run
-  /// Force-driven wave: the open ends' half cells conduct as drainage layers
-  /// (disc::drainage_resistance; numerics1d.open_end = "drainage"), else as a lumen linear in R
-  /// ("linear"). Not with the axial bending or the calibrated junction, whose end radii are not
-  /// the actuation's static ones.
-  bool open_end_drainage = true;
+  /// Force-driven wave without the axial bending or the calibrated junction (whose ends are
+  /// their own): the open ends (numerics1d.open_end; docs/reduced1d.md, "The open ends' half
+  /// cells").
+  OpenEnd open_end = OpenEnd::Drainage;
 };
 
 struct Params {

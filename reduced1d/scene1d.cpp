@@ -343,17 +343,27 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     p.numerics.rtol = n.number("rtol", p.numerics.cells <= kScreeningCells ? 1e-4 : 1e-6, Range::closed(1e-12, 1e-2));
     p.numerics.atol_scale = n.number("atol_scale", 1e-6, Range::closed(1e-14, 1e-2));
     p.numerics.max_steps = n.integer("max_steps", 2000000, 100, 1000000000);
-    // The open ends' half cells as drainage layers (docs/reduced1d.md, "The open ends"): where
-    // an end's radius is the static one of its actuation, the force-driven wave without the
-    // axial bending or the calibrated junction.
+    // The open ends (docs/reduced1d.md, "The open ends' half cells") of the force-driven wave
+    // without the axial bending or the calibrated junction, whose ends are their own: at the
+    // static radius of the end's actuation, its half cell a drainage layer (the default) or a
+    // lumen linear in R; or, with the short-wave traction, the end cell continued to the mouth.
     const bool static_ends = forced && !p.swimmer.end_junction && !(p.wall.D_axial > 0);
-    const std::string open_end = n.choice("open_end", static_ends ? "drainage" : "linear", {"drainage", "linear"});
+    const std::string open_end =
+        n.choice("open_end", static_ends ? "drainage" : "linear", {"drainage", "linear", "continued"});
     if (open_end == "drainage" && !static_ends)
       throw InputError(n.path("open_end"), "\"drainage\"",
                        "the drainage layer is the half cell of an open end held at its actuation's static radius: "
                        "wave.kind = \"force_driven\" without model1d.axial_bending or model1d.end_effects = "
                        "\"junction\"; use \"linear\" here");
-    p.numerics.open_end_drainage = open_end == "drainage";
+    if (open_end == "continued" && !(static_ends && p.swimmer.short_wave_traction))
+      throw InputError(n.path("open_end"), "\"continued\"",
+                       "an end continued from its cell is an open end of the short-wave traction's wall: "
+                       "wave.kind = \"force_driven\" with model1d.short_wave_traction = true, without "
+                       "model1d.axial_bending (whose ends follow the wall already) or model1d.end_effects = "
+                       "\"junction\"; use \"drainage\" or \"linear\" here");
+    p.numerics.open_end = open_end == "drainage"    ? OpenEnd::Drainage
+                          : open_end == "continued" ? OpenEnd::Continued
+                                                    : OpenEnd::Linear;
     n.finish();
     if (forced) {  // every protocol segment must span at least one cell
       if (p.numerics.cells < needed)

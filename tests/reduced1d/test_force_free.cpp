@@ -145,24 +145,27 @@ TEST(ForceFree, DisplacementIsIndependentOfTheViscosity) {
 // cells' radii and pressures, the end radii (held end segments) and the wall velocities near
 // the ends (the rims' thrust). The traction's fields are checked with mirror ends and with the
 // mixed end condition (model1d.short_wave_traction_end = 0.6: the end cells' ghost values).
-// The open ends' half cells are checked as drainage layers (the default) and as a lumen linear
-// in R (numerics1d.open_end = "linear"; the junction has its own ends).
+// The open ends are checked at their static radii with drainage layers (the default) and with a
+// lumen linear in R (numerics1d.open_end = "linear"), and, with the traction, continued from
+// the end cells ("continued": the end radii chain into the end cells, not the end segments'
+// loads); the junction has its own ends.
 TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
   double worst_junction = 0;
-  for (bool drainage : {true, false})
+  for (OpenEnd open_end : {OpenEnd::Drainage, OpenEnd::Linear, OpenEnd::Continued})
   for (bool junction : {false, true})
   for (double traction_end : {-1.0, 0.0, 0.6})  // -1: no traction
   for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded})
     for (int N : {37, 60}) {
       if (junction && outer != OuterFlow::Confined) continue;  // the junction belongs to the confined closure
-      if (junction && !drainage) continue;                     // (its ends are never drainage layers)
+      if (junction && open_end != OpenEnd::Drainage) continue;  // (the junction has its own ends)
       const bool traction = traction_end >= 0.0;
+      if (open_end == OpenEnd::Continued && !traction) continue;  // (the traction's wall only)
       Params p = force_free_cycle(N);
       p.swimmer.short_wave_traction = traction;
       p.swimmer.traction_end = traction ? traction_end : 0.0;
       p.swimmer.outer = outer;
       p.swimmer.end_junction = junction;
-      p.numerics.open_end_drainage = drainage;
+      p.numerics.open_end = open_end;
       p.swimmer.a_in = 2e-9;
       p.swimmer.a_out = 3e-9;
       const int n = p.protocol.segments;
@@ -172,7 +175,7 @@ TEST(ForceFree, AnalyticJacobianMatchesFiniteDifferences) {
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
           const auto c = test::check_jacobian(p, phase, active, seed);
-          EXPECT_LT(c.max_rel_error, 1e-6) << "junction=" << junction << " traction end=" << traction_end << " N=" << N
+          EXPECT_LT(c.max_rel_error, 1e-6) << "open end=" << int(open_end) << " junction=" << junction << " traction end=" << traction_end << " N=" << N
                                            << " phase=" << phase << " active=" << active;
           const int held = phase == 0 ? n - 1 - active : 0;
           EXPECT_EQ(c.rank, held + closure);
