@@ -347,6 +347,10 @@ void EventLoop::check_end_radii(double t) const {
   if (M_.ends_follow_cells) return;
   double lo0, loL;
   M_.end_radius_range(lo0, loL);
+  // With the short-wave traction the end may be continued from its cell instead, which needs no
+  // static end radius (docs/reduced1d.md, "The open ends' half cells").
+  const std::string or_continued =
+      M_.J > 0 && !M_.junction ? "; or set numerics1d.open_end = \"continued\" (the end cell carried to the mouth)" : "";
   if ((lo0 < collapse_ || loL < collapse_) && M_.wall.law) {
     const bool left = lo0 < collapse_;
     throw NumericalError(
@@ -354,16 +358,19 @@ void EventLoop::check_end_radii(double t) const {
             ": under its actuation the open end's static radius on the calibrated tube law, " +
             metres(left ? lo0 : loL) + ", is below the collapse radius " + metres(collapse_),
         "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) below the law's "
-        "static load at the collapse radius, " + fmt(-M_.wall(collapse_)) + " Pa",
+        "static load at the collapse radius, " + fmt(-M_.wall(collapse_)) + " Pa" + or_continued,
         t);
   }
   if (lo0 < collapse_ || loL < collapse_) {
     const bool left = lo0 < collapse_;
+    const double lo = left ? lo0 : loL;
     throw NumericalError(
         "tube radius collapsed to zero at z = " + metres(left ? 0.0 : M_.L) +
-            ": under its actuation the open end has no positive rest radius (R0 - q/C1 <= 0)",
+            (lo > 0 ? ": under its actuation the open end's static radius R0 - q/C1 = " + metres(lo) +
+                          " is below the collapse radius " + metres(collapse_)
+                    : std::string(": under its actuation the open end has no positive rest radius (R0 - q/C1 <= 0)")),
         "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) below C1 R0 = " +
-            fmt(M_.C1 * M_.R0) + " Pa or raise wall.C1",
+            fmt(M_.C1 * M_.R0) + " Pa or raise wall.C1" + or_continued,
         t);
   }
 }

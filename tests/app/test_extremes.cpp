@@ -147,6 +147,24 @@ TEST(Extremes, ForceDrivenWithoutTheShortWaveTraction) {
         {"ok", ""});
 }
 
+TEST(Extremes, ForceDrivenWithTheContinuedOpenEnds) {
+  // numerics1d.open_end = "continued": the end cells carried to the mouths need no static end
+  // radius, so the targets below R_f/R0 = 1/3 that stop the static ends at t = 0 run on; what
+  // remains is whether the cells stay open until the segment's mean radius reaches R_f. At
+  // R_f/R0 = 0.3 (q = 1.05 C1 R0) every length completes its cycle; at 0.1 (q = 1.35 C1 R0) the
+  // 0.4 and 6.25 um tubes close a cell first and stop naming the collapse, while the 0.125 um
+  // tube completes its cycle (its smallest radius 0.004 R0).
+  for (const char* ratio : {"0.1", "0.3"})
+    for (const char* length : {"6.25 um", "0.4 um", "0.125 um"}) {
+      const std::string r = ratio, l = length;
+      const bool collapses = r == "0.1" && l != "0.125 um";
+      check("force_driven continued ends, R_f/R0 = " + r + ", L = " + l,
+            {"protocol.load_factor=1.5", "numerics1d.open_end=continued", "wave.contracted_ratio=" + r,
+             "swimmer.length=" + l, "container.period=25 um"},
+            collapses ? Expect{"failed", "collapsed"} : Expect{"ok", ""});
+    }
+}
+
 TEST(Extremes, ForceDrivenWithThePapersFixedForce) {
   // The paper's fixed F_ext = 0.1 pN: deep targets and stiff walls are unreachable (exit 2),
   // a soft wall lets the open ends collapse (numerical failure, exit 3).
@@ -188,7 +206,9 @@ TEST(Extremes, ForceDrivenOnTheCalibratedWallAndWithAxialBending) {
   //  - everything else completes, beyond the buckling load (the paper's 0.32 Pa, 15 times the
   //    plateau) and with the viscosity over four decades (the cycle scales with mu);
   //  - 1 Pa exceeds the law's static load at the collapse radius (0.35 Pa): the open ends
-  //    collapse at t = 0 (numerical failure naming the load).
+  //    collapse at t = 0 (numerical failure naming the load); with the end cells continued to
+  //    the mouths (numerics1d.open_end = "continued") there is no static end, and both targets
+  //    complete their cycles.
   // The wall's bending along the axis (D = 2.1e-24 J, bending length 27 nm) on the linear
   // wall: at R_f = 0.1 R0 the active 75 nm segment's static radius at its middle (a beam on an
   // elastic foundation) is below the collapse radius, and the run stops at t = 0 naming the
@@ -218,6 +238,10 @@ TEST(Extremes, ForceDrivenOnTheCalibratedWallAndWithAxialBending) {
           {cal, buckled, "protocol.pressure=0.32 Pa", std::string("wave.contracted_ratio=") + ratio}, ok);
     check(std::string("force_driven buckled law, 1 Pa, R_f/R0 = ") + ratio,
           {cal, buckled, "protocol.pressure=1 Pa", std::string("wave.contracted_ratio=") + ratio}, collapse);
+    check(std::string("force_driven buckled law, 1 Pa, continued ends, R_f/R0 = ") + ratio,
+          {cal, buckled, "protocol.pressure=1 Pa", "numerics1d.open_end=continued",
+           std::string("wave.contracted_ratio=") + ratio},
+          ok);
   }
   for (const char* mu : {"1.2e-5 Pa*s", "1.2e-1 Pa*s"})
     check(std::string("force_driven buckled law, mu = ") + mu,

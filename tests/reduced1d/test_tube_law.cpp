@@ -178,14 +178,17 @@ TEST(TubeLaw, SmallLoadCycleMatchesTheLinearLaw) {
 }
 
 // The Newton matrices with the calibrated law (dw/dR in place of C1, the open ends' static
-// radii on the law) against central differences of the right-hand side / residual, at random
-// states spanning the law's soft and stiff parts (radii 0.45 .. 1.05 R0).
+// radii on the law, or with the traction the end cells continued to the mouths) against
+// central differences of the right-hand side / residual, at random states spanning the law's
+// soft and stiff parts (radii 0.45 .. 1.05 R0).
 TEST(TubeLaw, AnalyticJacobianMatchesFiniteDifferences) {
-  for (bool traction : {false, true})
+  for (int ends : {0, 1, 2})  // 0, 1: static ends without / with the traction; 2: continued ends
     for (OuterFlow outer : {OuterFlow::Confined, OuterFlow::Unbounded}) {
+      const bool traction = ends > 0;
       Params p = cycle(37);
       p.wall.law = law_from(collapsible);
       p.protocol.q = 0.12;  // Pa: the open ends' static radius stays on the knots (0.3 R0)
+      if (ends == 2) p.numerics.open_end = OpenEnd::Continued;
       p.swimmer.short_wave_traction = traction;
       p.swimmer.outer = outer;
       p.swimmer.a_in = 2e-9;
@@ -193,7 +196,7 @@ TEST(TubeLaw, AnalyticJacobianMatchesFiniteDifferences) {
       for (auto [phase, active] : {std::pair{0, 2}, std::pair{0, n - 1}, std::pair{1, 0}})
         for (unsigned seed : {1u, 2u}) {
           const auto c = reduced1d::test::check_jacobian(p, phase, active, seed);
-          EXPECT_LT(c.max_rel_error, 1e-6) << "traction=" << traction << " phase=" << phase << " active=" << active;
+          EXPECT_LT(c.max_rel_error, 1e-6) << "ends=" << ends << " phase=" << phase << " active=" << active;
           EXPECT_EQ(c.rank, (phase == 0 ? n - 1 - active : 0) + (outer == OuterFlow::Confined ? 2 : 0));
         }
     }
