@@ -308,11 +308,13 @@ void bench_1d(scene::json& report, bool quick, int reps, unsigned cores) {
   scene::json variants = scene::json::array();
   // the other models at N = 200, and the default model at N = 50 at the finer grids' tolerance
   // (the scene's default there is 1e-4: docs/performance-1d.md, "The tolerance against the
-  // grid's error")
+  // grid's error") and with the continued open ends (docs/reduced1d.md, "The open ends' half
+  // cells")
   for (const auto& [cells, v] : {std::pair{200, std::string("model1d.short_wave_traction=false")},
                                  std::pair{200, std::string("model1d.outer_flow=\"unbounded\"")},
                                  std::pair{200, std::string("model1d.model=\"paper\"")},
-                                 std::pair{50, std::string("numerics1d.rtol=1e-6")}}) {
+                                 std::pair{50, std::string("numerics1d.rtol=1e-6")},
+                                 std::pair{50, std::string("numerics1d.open_end=\"continued\"")}}) {
     std::vector<std::string> sets = {"numerics1d.cells=" + std::to_string(cells), "protocol.cycles=1",
                                      "time.duration=\"auto\"", v};
     if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");
