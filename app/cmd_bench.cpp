@@ -281,8 +281,8 @@ scene::json screening_json(const ScreeningTiming& t) {
 }
 
 /// The 1D part: one force-driven cycle at N = 50, 200, 800; at N = 200 the lubrication-only
-/// wall (no short-wave traction), the other outer flow and the paper's reproduction mode;
-/// screening throughput.
+/// wall (no short-wave traction), the other outer flow and the paper's reproduction mode; at
+/// N = 50 the finer grids' tolerance and the continued open ends; screening throughput.
 void bench_1d(scene::json& report, bool quick, int reps, unsigned cores) {
   std::printf("== 1D tier ==\n");
   std::printf("one force-driven cycle (demo scene, best of %d):\n", reps);
