@@ -349,7 +349,7 @@ void EventLoop::check_end_radii(double t) const {
   M_.end_radius_range(lo0, loL);
   // With the short-wave traction the end may be continued from its cell instead, which needs no
   // static end radius (docs/reduced1d.md, "The open ends' half cells").
-  const std::string or_continued =
+  const char* or_continued =
       M_.J > 0 && !M_.junction ? "; or set numerics1d.open_end = \"continued\" (the end cell carried to the mouth)" : "";
   if ((lo0 < collapse_ || loL < collapse_) && M_.wall.law) {
     const bool left = lo0 < collapse_;

@@ -65,21 +65,34 @@ TEST(OpenEnd, TheDrainageResistanceIsTheSteadyLayersOwn) {
 
 namespace {
 
-/// The L = 0.6 um tube driven at 1.4 times the static load of R_f = 0.35 R0 (a design of the
-/// screening benchmark's grid): its held open end closes to 0.09 R0.
-Metrics deep_cycle(int cells, const char* open_end) {
-  json sc = {{"swimmer", {{"length", "0.6 um"}}},
-             {"wave", {{"contracted_ratio", 0.35}}},
+/// One cycle of the `length` tube at R_f, driven at 1.4 times its static load, on `cells` cells
+/// with the given open end (the rest as the default scene; rtol > 0 sets numerics1d.rtol).
+Result deep_run(const char* length, double R_f, int cells, const char* open_end, Params* out = nullptr,
+                double rtol = 0.0) {
+  json sc = {{"swimmer", {{"length", length}}},
+             {"wave", {{"contracted_ratio", R_f}}},
              {"protocol", {{"load_factor", 1.4}}},
              {"numerics1d", {{"cells", cells}, {"open_end", open_end}}}};
+  if (rtol > 0) sc["numerics1d"]["rtol"] = rtol;
   json resolved;
   const Params p = read_scene(sc, resolved);
-  const Result r = solve(p);
+  if (out) *out = p;
+  return solve(p);
+}
+
+/// The metrics of one completed deep cycle (deep_run), the run asserted to complete.
+Metrics deep_metrics(const char* length, int cells, const char* open_end, double rtol = 0.0) {
+  Params p;
+  const Result r = deep_run(length, 0.35, cells, open_end, &p, rtol);
   EXPECT_FALSE(r.failure) << (r.failure ? r.failure->what() : "");
   const Metrics m = metrics(p, r);
-  EXPECT_EQ(m.cycles_completed, 1) << cells << " " << open_end;
+  EXPECT_EQ(m.cycles_completed, 1) << length << " " << cells << " " << open_end;
   return m;
 }
+
+/// The L = 0.6 um tube driven at 1.4 times the static load of R_f = 0.35 R0 (a design of the
+/// screening benchmark's grid): its held open end closes to 0.09 R0.
+Metrics deep_cycle(int cells, const char* open_end) { return deep_metrics("0.6 um", cells, open_end); }
 
 double rel(double a, double b) { return std::abs(a / b - 1.0); }
 
@@ -144,23 +157,6 @@ TEST(OpenEnd, TheSceneResolvesTheEndModelAndRefusesTheLayerWhereTheEndIsNotStati
   test::expect_refused(json{{"numerics1d", {{"open_end", "sharp"}}}}, "numerics1d.open_end");
 }
 
-namespace {
-
-/// One cycle of the L um tube at R_f, 1.4 times the static load, on `cells` cells with the
-/// given open end (the rest as the default scene; rtol 1e-7 so that the grid's error shows).
-Result deep_run(const char* length, double R_f, int cells, const char* open_end, Params* out = nullptr) {
-  json sc = {{"swimmer", {{"length", length}}},
-             {"wave", {{"contracted_ratio", R_f}}},
-             {"protocol", {{"load_factor", 1.4}}},
-             {"numerics1d", {{"cells", cells}, {"open_end", open_end}, {"rtol", 1e-7}}}};
-  json resolved;
-  const Params p = read_scene(sc, resolved);
-  if (out) *out = p;
-  return solve(p);
-}
-
-}  // namespace
-
 // The end cell continued to the mouth ("continued") against the static end with its drainage
 // layer, on the deep contraction whose 50-cell grid error is the largest of the screening
 // benchmark's static ends (L = 0.33 um, R_f = 0.35 R0; the default scene's container): the
@@ -169,14 +165,7 @@ Result deep_run(const char* length, double R_f, int cells, const char* open_end,
 // 5.4 % off; on 800 cells the two agree within 0.5 % (measured 0.19 % / 0.29 %: one model's
 // limit).
 TEST(OpenEnd, TheContinuedEndConvergesWhereTheStaticEndIsFirstOrder) {
-  auto figures = [](int cells, const char* end) {
-    Params p;
-    const Result r = deep_run("0.3333 um", 0.35, cells, end, &p);
-    EXPECT_FALSE(r.failure) << (r.failure ? r.failure->what() : "");
-    const Metrics m = metrics(p, r);
-    EXPECT_EQ(m.cycles_completed, 1) << cells << " " << end;
-    return m;
-  };
+  auto figures = [](int cells, const char* end) { return deep_metrics("0.3333 um", cells, end, 1e-7); };
   const Metrics c50 = figures(50, "continued"), c800 = figures(800, "continued");
   const Metrics d50 = figures(50, "drainage"), d800 = figures(800, "drainage");
   for (const auto& [label, m] : {std::pair{"continued 50", c50}, std::pair{"continued 800", c800},
@@ -200,13 +189,13 @@ TEST(OpenEnd, TheContinuedEndConvergesWhereTheStaticEndIsFirstOrder) {
 // tubes, docs/reduced1d.md), and the smallest radius is positive and below R_f.
 TEST(OpenEnd, TheContinuedEndRunsALoadBeyondTheStaticEndsRestRadius) {
   Params p;
-  const Result s = deep_run("0.4 um", 0.25, 50, "drainage", &p);
+  const Result s = deep_run("0.4 um", 0.25, 50, "drainage", &p, 1e-7);
   ASSERT_TRUE(s.failure);
   EXPECT_NE(std::string(s.failure->what()).find("no positive rest radius"), std::string::npos) << s.failure->what();
   EXPECT_NE(std::string(s.failure->what()).find("protocol.pressure"), std::string::npos);
   std::vector<Metrics> m;
   for (int cells : {50, 200}) {
-    const Result r = deep_run("0.4 um", 0.25, cells, "continued", &p);
+    const Result r = deep_run("0.4 um", 0.25, cells, "continued", &p, 1e-7);
     ASSERT_FALSE(r.failure) << cells << ": " << r.failure->what();
     m.push_back(metrics(p, r));
     EXPECT_EQ(m.back().cycles_completed, 1);
