@@ -174,7 +174,7 @@ struct FittedStokes::Geometry {
 void FittedStokes::element_geometry(int e, Geometry& g) const {
   const RefTables& T = ref();
   double cx[4], cr[4];
-  mesh_.corners(e, cx, cr);
+  mesh_->corners(e, cx, cr);
   pressure_scales(cx, cr, g.xc, g.rc, g.hx, g.hr);
   for (int q = 0; q < 9; ++q) {
     const double xi = T.xi[q], eta = T.eta[q];
@@ -193,37 +193,43 @@ void FittedStokes::element_geometry(int e, Geometry& g) const {
 }
 
 FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_nodes, Coupling coupling)
-    : mesh_(p, membrane_nodes), mu_(mu), coupling_(coupling) {
+    : FittedStokes(std::make_unique<FittedMesh>(p, membrane_nodes), mu, coupling) {}
+
+FittedStokes::FittedStokes(std::unique_ptr<MeridianMesh> mesh, double mu, Coupling coupling)
+    : mesh_(std::move(mesh)), mu_(mu), coupling_(coupling) {
   single_threaded_blas();
+  if (!mesh_) throw std::invalid_argument("FittedStokes: no mesh");
   if (!(std::isfinite(mu) && mu > 0))
     throw InputError("fluid.viscosity", significant(mu) + " Pa s", "must be a positive finite viscosity");
-  lref_ = p.Rc / (p.cells_inner + p.cells_outer);
+  lref_ = mesh_->length_scale();
   ps_ = mu_ / lref_;
+  const int membrane_nodes = mesh_->membrane_nodes();
+  const bool closed = mesh_->closed();
 
-  // Velocity DOFs, node-major: u_x except on the wall row, u_r except on the axis and wall rows.
-  const int nI = mesh_.node_columns(), nJ = mesh_.node_rows(), JW = nJ - 1;
-  dof_x_.assign(mesh_.nodes(), -1);
-  dof_r_.assign(mesh_.nodes(), -1);
+  // Velocity DOFs, node-major: u_x except on the container wall, u_r except on the axis and the
+  // container wall.
+  const int nodes = mesh_->nodes();
+  dof_x_.assign(nodes, -1);
+  dof_r_.assign(nodes, -1);
   int d = 0;
-  for (int I = 0; I < nI; ++I)
-    for (int J = 0; J < nJ; ++J) {
-      const int nd = mesh_.node(I, J);
-      if (J < JW) dof_x_[nd] = d++;
-      if (J > 0 && J < JW) dof_r_[nd] = d++;
-    }
+  for (int nd = 0; nd < nodes; ++nd) {
+    const NodeKind kind = mesh_->node_kind(nd);
+    if (kind != NodeKind::container) dof_x_[nd] = d++;
+    if (kind == NodeKind::interior) dof_r_[nd] = d++;
+  }
   n_vel_ = d;
-  const int E = mesh_.elements();
+  const int E = mesh_->elements();
   n_ = n_vel_ + 3 * E - 1;  // element 0's constant pressure is pinned
 
   loc_.assign(std::size_t(E) * kLoc, -1);
   for (int e = 0; e < E; ++e) {
     int* L = &loc_[std::size_t(e) * kLoc];
-    for (int b = 0; b < 3; ++b)
-      for (int i = 0; i < 3; ++i) {
-        const int a = 3 * b + i, nd = mesh_.element_node(e, i, b);
-        L[2 * a] = dof_x_[nd];
-        L[2 * a + 1] = dof_r_[nd];
-      }
+    for (int a = 0; a < 9; ++a) {
+      const int nd = mesh_->element_slot(e, a);
+      if (nd < 0) continue;  // a triangle's unused slots
+      L[2 * a] = dof_x_[nd];
+      L[2 * a + 1] = dof_r_[nd];
+    }
     for (int q = 0; q < 3; ++q) L[18 + q] = (e == 0 && q == 0) ? -1 : n_vel_ + 3 * e + q - 1;
   }
 
@@ -240,27 +246,28 @@ FittedStokes::FittedStokes(const FittedMeshParams& p, double mu, int membrane_no
     }
   }
   // Transfer stencils of the membrane vertices (slots V_{k-1}, M_{k-1/2}, V_k, M_{k+1/2}, V_{k+1}).
-  const int nm = membrane_nodes, ci2 = 2 * p.cells_inner;
+  const int nm = membrane_nodes;
   gnode_.assign(nm, {-1, -1, -1, -1, -1});
   gw_.assign(nm, {0, 0, 0, 0, 0});
   for (int k = 0; k < nm; ++k) {
     auto& g = gnode_[k];
-    g[2] = mesh_.membrane_node(k);
+    g[2] = mesh_->wall_node(k);
     if (coupling_ == Coupling::vertex) continue;
-    if (k > 0 || p.closed) {
-      g[0] = mesh_.node(2 * k - 2, ci2);
-      g[1] = mesh_.node(2 * k - 1, ci2);
+    if (k > 0 || closed) {
+      const int km = (k + nm - 1) % nm;
+      g[0] = mesh_->wall_node(km);
+      g[1] = mesh_->wall_midside_node(km);
     }
-    if (k < nm - 1 || p.closed) {
-      g[3] = mesh_.node(2 * k + 1, ci2);
-      g[4] = mesh_.node(2 * k + 2, ci2);
+    if (k < nm - 1 || closed) {
+      g[3] = mesh_->wall_midside_node(k);
+      g[4] = mesh_->wall_node((k + 1) % nm);
     }
   }
   // The stiffness couplings dt G K G^T: trace nodes of vertices up to 2 apart.
   for (int k = 0; k < nm; ++k)
     for (int dk = -2; dk <= 2; ++dk) {
       int l = k + dk;
-      if (p.closed)
+      if (closed)
         l = ((l % nm) + nm) % nm;
       else if (l < 0 || l >= nm)
         continue;
@@ -383,6 +390,12 @@ void FittedStokes::build_schur_pattern() {
   for (std::size_t k = 0; k < pen_pos.size(); ++k) up_pen_pos_[k] = up_of[std::size_t(pen_pos[k])];
 }
 
+const FittedMesh& FittedStokes::mesh() const {
+  const auto* m = dynamic_cast<const FittedMesh*>(mesh_.get());
+  if (!m) throw std::logic_error("FittedStokes::mesh: the solver's mesh is not the structured one");
+  return *m;
+}
+
 FittedStokes::~FittedStokes() {
   if (worker_.joinable()) worker_.join();
 }
@@ -396,7 +409,7 @@ int FittedStokes::find_position(int row, int col) const {
 }
 
 void FittedStokes::transfer_weights() {
-  const int nm = mesh_.membrane_nodes();
+  const int nm = mesh_->membrane_nodes();
   for (auto& w : gw_) w = {0, 0, 0, 0, 0};
   if (coupling_ == Coupling::vertex) {
     for (auto& w : gw_) w[2] = 1.0;
@@ -404,14 +417,15 @@ void FittedStokes::transfer_weights() {
   }
   // G_{a,k} = int phi_k N_a dA / A_k over the membrane edges (2 pi r ds; the integrand is a
   // polynomial of degree 4 in the edge parameter: 3-point Gauss is exact).
-  const bool closed = mesh_.params().closed;
+  const bool closed = mesh_->closed();
   std::vector<double> area(nm, 0.0);
   const int edges = closed ? nm : nm - 1;
   for (int k = 0; k < edges; ++k) {
     const int l = (k + 1) % nm;
-    const int ci = mesh_.params().cells_inner;  // the wall vertices (column k+1 = vertex l, +P when wrapped)
-    const double dx = mesh_.vertex_x(k + 1, ci) - mesh_.vertex_x(k, ci);
-    const double r0 = mesh_.vertex_r(k, ci), r1 = mesh_.vertex_r(k + 1, ci);
+    // the wall's rings in the fitted mesh (point k + 1 = ring l, + P when wrapped)
+    const Eigen::Vector2d wk = mesh_->wall_point(k), wl = mesh_->wall_point(k + 1);
+    const double dx = wl.x() - wk.x();
+    const double r0 = wk.y(), r1 = wl.y();
     const double len = std::hypot(dx, r1 - r0);
     for (int q = 0; q < 3; ++q) {
       const double t = kGp[q], r = 0.5 * (r0 * (1 - t) + r1 * (1 + t));
@@ -432,7 +446,7 @@ void FittedStokes::transfer_weights() {
 void FittedStokes::assemble(const Eigen::SparseMatrix<double>* K, double scale) {
   double* val = A_.valuePtr();
   std::fill(val, val + A_.nonZeros(), 0.0);
-  const int E = mesh_.elements();
+  const int E = mesh_->elements();
   Geometry g;
   Eigen::Matrix<double, 9, 9> Axx, Arr, Axr;
   Eigen::Matrix<double, 3, 9> Bx, Br;
@@ -486,13 +500,13 @@ void FittedStokes::assemble(const Eigen::SparseMatrix<double>* K, double scale) 
       }
   }
   if (K && scale != 0.0) {
-    const int nm = mesh_.membrane_nodes();
+    const int nm = mesh_->membrane_nodes();
     for (int c = 0; c < K->outerSize(); ++c)
       for (Eigen::SparseMatrix<double>::InnerIterator it(*K, c); it; ++it) {
         if (it.value() == 0.0) continue;
         const int i = int(it.row()), j = int(it.col()), k = i / 2, l = j / 2;
         int d = std::abs(k - l);
-        if (mesh_.params().closed) d = std::min(d, nm - d);
+        if (mesh_->closed()) d = std::min(d, nm - d);
         if (d > 2)
           throw std::invalid_argument("FittedStokes::factor: K couples membrane vertices " + std::to_string(k) +
                                       " and " + std::to_string(l) + " (more than 2 apart, n = " +
@@ -703,14 +717,14 @@ void FittedStokes::numeric_factor(bool regularised) {
 }
 
 void FittedStokes::factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<double>* K, double scale, bool force) {
-  const int nm = mesh_.membrane_nodes();
+  const int nm = mesh_->membrane_nodes();
   if (K && (K->rows() != 2 * nm || K->cols() != 2 * nm))
     throw std::invalid_argument("FittedStokes::factor: K must be " + std::to_string(2 * nm) + " x " +
                                 std::to_string(2 * nm));
   if (K && !std::isfinite(scale)) throw std::invalid_argument("FittedStokes::factor: non-finite scale");
   factored_ = solved_ = false;
   auto t0 = Clock::now();
-  mesh_.fit(X);
+  mesh_->fit(X);
   transfer_weights();
   // the previous system's background factorisation: the preconditioner from now on
   if (worker_.joinable()) {
@@ -865,7 +879,7 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
     throw std::invalid_argument("FittedStokes::solve: warm-start slot " + std::to_string(guess) + " not in [-1, " +
                                 std::to_string(kGuessSlots - 1) + "]");
   const Eigen::VectorXd* x0 = guess >= 0 ? &guess_[std::size_t(guess)] : nullptr;
-  const int nm = mesh_.membrane_nodes();
+  const int nm = mesh_->membrane_nodes();
   if (F.cols() != nm)
     throw std::invalid_argument("FittedStokes::solve: F has " + std::to_string(F.cols()) + " columns, expected " +
                                 std::to_string(nm));
@@ -879,7 +893,7 @@ void FittedStokes::solve(const Eigen::Matrix3Xd& F, Eigen::Matrix3Xd& U,
       rhs_[dof_x_[nd]] += gw_[k][s] * F(0, k);
       rhs_[dof_r_[nd]] += gw_[k][s] * F(1, k);
     }
-  const int E = mesh_.elements();
+  const int E = mesh_->elements();
   Geometry g;
   if (body && *body) {
     for (int e = 0; e < E; ++e) {
@@ -959,7 +973,7 @@ void FittedStokes::pressure_gauge() {
   p_mean_ = 0.0;
   Geometry g;
   double pv = 0.0, vol = 0.0;
-  for (int e = 0; e < mesh_.elements(); ++e) {
+  for (int e = 0; e < mesh_->elements(); ++e) {
     element_geometry(e, g);
     for (int q = 0; q < 9; ++q) {
       const double W = g.wdet[q] * g.r[q];
@@ -972,7 +986,7 @@ void FittedStokes::pressure_gauge() {
 
 FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen::Matrix3Xd& X,
                                                                     const Eigen::Matrix3Xd& V) {
-  const int nm = mesh_.membrane_nodes();
+  const int nm = mesh_->membrane_nodes();
   if (V.cols() != nm || !V.topRows(2).allFinite())
     throw std::invalid_argument("FittedStokes::prescribed_wall_velocity: V must be 3 x " + std::to_string(nm) +
                                 " and finite");
@@ -980,17 +994,19 @@ FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen:
   factored_ = solved_ = false;
   lu_valid_ = lu_current_ = false;  // the stored LU will be of the constrained system
   auto t0 = Clock::now();
-  mesh_.fit(X);
+  mesh_->fit(X);
   transfer_weights();
   assemble(nullptr, 0.0);
-  // The wall line's Q2 nodes: vertex columns 2k and midside columns 2k + 1 between the rims
-  // (closed test mode: the whole line). Their values: V interpolated linearly (a), 1 axial (b).
-  const bool closed = mesh_.params().closed;
-  const int ci2 = 2 * mesh_.params().cells_inner, last = closed ? 2 * nm - 1 : 2 * (nm - 1);
+  // The wall line's nodes: the rings (I = 2k) and the segments' midpoints (I = 2k + 1) between
+  // the rims (closed test mode: the whole line). Their values: V interpolated linearly (a), 1
+  // axial (b).
+  const bool closed = mesh_->closed();
+  const int last = closed ? 2 * nm - 1 : 2 * (nm - 1);
   std::vector<signed char> fixed(n_, 0);  // 1: axial, 2: radial wall unknown
   Eigen::VectorXd ga = Eigen::VectorXd::Zero(n_), gb = Eigen::VectorXd::Zero(n_);
   for (int I = 0; I <= last; ++I) {
-    const int nd = mesh_.node(I, ci2), k = I / 2, l = (k + 1) % nm;
+    const int k = I / 2, l = (k + 1) % nm;
+    const int nd = I % 2 == 0 ? mesh_->wall_node(k) : mesh_->wall_midside_node(k);
     const Eigen::Vector2d v = I % 2 == 0 ? Eigen::Vector2d(V(0, k), V(1, k))
                                          : Eigen::Vector2d(0.5 * (V(0, k) + V(0, l)), 0.5 * (V(1, k) + V(1, l)));
     fixed[dof_x_[nd]] = 1;
@@ -1075,7 +1091,7 @@ Eigen::Vector2d FittedStokes::eval_velocity(int e, double xi, double eta) const 
 
 double FittedStokes::eval_pressure(int e, double x, double r) const {
   double cx[4], cr[4];
-  mesh_.corners(e, cx, cr);
+  mesh_->corners(e, cx, cr);
   double xc, rc, hx, hr;
   pressure_scales(cx, cr, xc, rc, hx, hr);
   const int* L = &loc_[std::size_t(e) * kLoc];
@@ -1085,14 +1101,14 @@ double FittedStokes::eval_pressure(int e, double x, double r) const {
 Eigen::Vector2d FittedStokes::velocity(double x, double r) const {
   if (!solved_) throw std::logic_error("FittedStokes::velocity before solve()");
   double xi, eta;
-  const int e = mesh_.locate(x, r, xi, eta);
+  const int e = mesh_->locate(x, r, xi, eta);
   return eval_velocity(e, xi, eta);
 }
 
 double FittedStokes::pressure(double x, double r) const {
   if (!solved_) throw std::logic_error("FittedStokes::pressure before solve()");
   double xi, eta;
-  const int e = mesh_.locate(x, r, xi, eta);
+  const int e = mesh_->locate(x, r, xi, eta);
   return eval_pressure(e, x, r);
 }
 
@@ -1103,14 +1119,14 @@ double FittedStokes::end_disc_flux(int end, double frame_velocity) const {
   // int 2 pi r (u_x dr - u_r dx) along the line minus U pi r_rim^2 (the frame's flux through any
   // surface spanning the rim circle). Each edge is straight and u is quadratic along it: 3-point
   // Gauss is exact.
-  const int c = end == 0 ? 0 : mesh_.membrane_nodes() - 1;
+  mesh_->rim_path(end, path_);
   double s = 0.0;
-  for (int j = 0; j < mesh_.params().cells_inner; ++j) {
-    const double r0 = mesh_.vertex_r(c, j), r1 = mesh_.vertex_r(c, j + 1);
-    const double dx = mesh_.vertex_x(c, j + 1) - mesh_.vertex_x(c, j);
+  for (const RimPathEdge& edge : path_) {
+    const double r0 = edge.r0, r1 = edge.r1;
+    const double dx = edge.x1 - edge.x0;
     double ux[3], ur[3];
     for (int m = 0; m < 3; ++m) {
-      const int node = mesh_.node(2 * c, 2 * j + m);
+      const int node = edge.node[m];
       ux[m] = dof_value(dof_x_[node]);
       ur[m] = dx != 0.0 ? dof_value(dof_r_[node]) : 0.0;
     }
@@ -1121,7 +1137,7 @@ double FittedStokes::end_disc_flux(int end, double frame_velocity) const {
       s += kGw[q] * kTwoPi * r * (vx * 0.5 * (r1 - r0) - vr * 0.5 * dx);
     }
   }
-  const double rim = mesh_.vertex_r(c, mesh_.params().cells_inner);
+  const double rim = path_.back().r1;
   return s - frame_velocity * std::numbers::pi * rim * rim;
 }
 
@@ -1150,7 +1166,7 @@ double FittedStokes::lumen_divergence_residual() const {
   if (umax == 0.0) return 0.0;
   Geometry g;
   double worst = 0.0;
-  for (int e = 0; e < mesh_.elements(); ++e) {
+  for (int e = 0; e < mesh_->elements(); ++e) {
     element_geometry(e, g);
     double vol = 0.0, area = 0.0;
     for (int q = 0; q < 9; ++q) {
@@ -1166,7 +1182,7 @@ double FittedStokes::dissipation() const {
   if (!solved_) throw std::logic_error("FittedStokes::dissipation before solve()");
   Geometry g;
   double s = 0.0;
-  for (int e = 0; e < mesh_.elements(); ++e) {
+  for (int e = 0; e < mesh_->elements(); ++e) {
     element_geometry(e, g);
     const int* L = &loc_[std::size_t(e) * kLoc];
     for (int q = 0; q < 9; ++q) {

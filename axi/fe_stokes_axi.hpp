@@ -177,6 +177,11 @@ class FittedStokes {
   /// comment "Membrane coupling"); an addition to the original interface, defaulted.
   enum class Coupling { consistent, vertex };
   FittedStokes(const FittedMeshParams& p, double mu, int membrane_nodes, Coupling coupling = Coupling::consistent);
+  /// The same on any mesh of the meridian plane (axi/meridian_mesh.hpp): the structured
+  /// quadrilaterals above, or a triangulation moved with the wall (axi/tri_mesh.hpp, the P2+
+  /// element; see the header comment "Triangles"). Its topology fixes the pattern for the
+  /// solver's life.
+  FittedStokes(std::unique_ptr<MeridianMesh> mesh, double mu, Coupling coupling = Coupling::consistent);
   ~FittedStokes();
   FittedStokes(const FittedStokes&) = delete;
   FittedStokes& operator=(const FittedStokes&) = delete;
@@ -278,7 +283,9 @@ class FittedStokes {
   /// max over elements |int_e div u dV| / (vol_e max|u| / h_e), h_e = sqrt(area_e); a
   /// dimensionless mass-conservation residual (round-off for a correct solve).
   double lumen_divergence_residual() const;
-  const FittedMesh& mesh() const { return mesh_; }
+  /// The structured mesh (std::logic_error on a triangulation).
+  const FittedMesh& mesh() const;
+  const MeridianMesh& meridian_mesh() const { return *mesh_; }
   int unknowns() const { return n_; }
   std::size_t nonzeros() const { return std::size_t(A_.nonZeros()); }
 
@@ -350,7 +357,8 @@ class FittedStokes {
   bool gmres(int max_iterations, bool fresh, int& iters, double& relres, const Eigen::VectorXd* x0 = nullptr);
   void pressure_gauge();  ///< p_mean_ of the current sol_
 
-  FittedMesh mesh_;
+  std::unique_ptr<MeridianMesh> mesh_;
+  mutable std::vector<RimPathEdge> path_;  ///< end_disc_flux's path (work)
   double mu_, lref_, ps_;
   int n_ = 0, n_vel_ = 0;
   std::vector<int> dof_x_, dof_r_;  ///< per Q2 node, -1 = Dirichlet

@@ -591,6 +591,19 @@ void FittedMesh::corners(int e, double x[4], double r[4]) const {
   r[3] = vertex_r(c, j + 1);
 }
 
+void FittedMesh::rim_path(int end, std::vector<RimPathEdge>& path) const {
+  const int c = end == 0 ? 0 : n_ - 1;
+  path.resize(std::size_t(p_.cells_inner));
+  for (int j = 0; j < p_.cells_inner; ++j) {
+    RimPathEdge& s = path[std::size_t(j)];
+    for (int m = 0; m < 3; ++m) s.node[m] = node(2 * c, 2 * j + m);
+    s.x0 = vertex_x(c, j);
+    s.r0 = vertex_r(c, j);
+    s.x1 = vertex_x(c, j + 1);
+    s.r1 = vertex_r(c, j + 1);
+  }
+}
+
 Eigen::Vector2d FittedMesh::node_position(int I, int J) const {
   const int c = I / 2, j = J / 2;
   const bool mx = I % 2, mr = J % 2;

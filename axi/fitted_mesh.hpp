@@ -112,6 +112,8 @@
 
 #include <vector>
 
+#include "axi/meridian_mesh.hpp"
+
 namespace swim::axi {
 
 /// The bilinear map of a quadrilateral's corners (cx, cr) (in the order (xi, eta) = (-1,-1),
@@ -161,7 +163,7 @@ struct FittedMeshParams {
 /// membrane_nodes < 3.
 void check_fitted_mesh_params(const FittedMeshParams& p, int membrane_nodes);
 
-class FittedMesh {
+class FittedMesh final : public MeridianMesh {
  public:
   /// Topology only (positions unset until fit()). Checks the parameters (see above).
   FittedMesh(const FittedMeshParams& p, int membrane_nodes);
@@ -171,16 +173,16 @@ class FittedMesh {
   /// remedy) for a non-finite vertex, r outside (0, Rc), a tube that does not fit the period
   /// (not x_0 < x_{n-1} < x_0 + P) or a non-positive element Jacobian (the wall shape the mesh
   /// cannot follow, naming the element and the nearest wall vertex).
-  void fit(const Eigen::Matrix3Xd& X);
+  void fit(const Eigen::Matrix3Xd& X) override;
 
   const FittedMeshParams& params() const { return p_; }
-  int membrane_nodes() const { return n_; }
+  int membrane_nodes() const override { return n_; }
   int columns() const { return nc_; }            ///< element columns = vertex columns (periodic)
   int rows() const { return ny_; }               ///< element rows, cells_inner + cells_outer
-  int elements() const { return nc_ * ny_; }
+  int elements() const override { return nc_ * ny_; }
   int node_columns() const { return 2 * nc_; }
   int node_rows() const { return 2 * ny_ + 1; }
-  int nodes() const { return node_columns() * node_rows(); }
+  int nodes() const override { return node_columns() * node_rows(); }
   int element(int c, int j) const { return c * ny_ + j; }
   int element_column(int e) const { return e / ny_; }
   int element_row(int e) const { return e % ny_; }
@@ -215,7 +217,7 @@ class FittedMesh {
   /// Whether vertex column c's line is vertical (x = column_x(c) on every row).
   bool column_vertical(int c) const { return vertical_[c % nc_] != 0; }
   /// The four corners of element e: (x, r) of (xi, eta) = (-1,-1), (1,-1), (1,1), (-1,1).
-  void corners(int e, double x[4], double r[4]) const;
+  void corners(int e, double x[4], double r[4]) const override;
   /// Physical position of Q2 node (I, J) (I = 0..2NC-1; the periodic image is P further).
   Eigen::Vector2d node_position(int I, int J) const;
   /// The element containing (x, r) (x wrapped by P into [x(r), x(r) + P), x(r) the axial
@@ -223,7 +225,24 @@ class FittedMesh {
   /// and the reference coordinates there (the bilinear map inverted by Newton's method);
   /// returns the element index. x is returned wrapped. On a shared edge either neighbour may be
   /// returned.
-  int locate(double& x, double r, double& xi, double& eta) const;
+  int locate(double& x, double r, double& xi, double& eta) const override;
+  // ---- the solver's view (axi/meridian_mesh.hpp)
+  ElementShape element_shape() const override { return ElementShape::quadrilateral; }
+  int element_slot(int e, int a) const override { return element_node(e, a % 3, a / 3); }
+  NodeKind node_kind(int node) const override {
+    const int J = node % (2 * ny_ + 1);
+    return J == 0 ? NodeKind::axis : (J == 2 * ny_ ? NodeKind::container : NodeKind::interior);
+  }
+  int wall_node(int k) const override { return node(2 * k, 2 * p_.cells_inner); }
+  int wall_midside_node(int k) const override { return node(2 * k + 1, 2 * p_.cells_inner); }
+  Eigen::Vector2d wall_point(int k) const override {
+    return {vertex_x(k, p_.cells_inner), vertex_r(k, p_.cells_inner)};
+  }
+  bool closed() const override { return p_.closed; }
+  /// The vertex column's line of ring 0 or n - 1, from the axis to the wall.
+  void rim_path(int end, std::vector<RimPathEdge>& path) const override;
+  double length_scale() const override { return p_.Rc / (p_.cells_inner + p_.cells_outer); }
+
   /// Smallest element Jacobian x_xi r_eta - x_eta r_xi over the corners (for diagnostics).
   double min_jacobian() const { return min_jac_; }
 
