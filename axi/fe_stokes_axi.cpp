@@ -144,6 +144,64 @@ const RefTables& ref() {
   return t;
 }
 
+// The P2+ triangle (Crouzeix-Raviart): P2 enriched by the cubic bubble B = 27 l0 l1 l2, in its
+// nodal (Lagrange) basis on the vertices, the edges' midpoints and the centroid, at the 7 points
+// of Radon's degree-5 rule (slots 7, 8 and points 7, 8 unused: zero weight and zero functions).
+// With lambda = (1 - xi - eta, xi, eta): vertex i: l_i (2 l_i - 1) + 3 l0 l1 l2; edge (i, j):
+// 4 l_i l_j - 12 l0 l1 l2; centroid: 27 l0 l1 l2.
+void p2plus(double xi, double eta, double N[9], double Nxi[9], double Neta[9]) {
+  const double l[3] = {1.0 - xi - eta, xi, eta};
+  const double dxi[3] = {-1.0, 1.0, 0.0}, deta[3] = {-1.0, 0.0, 1.0};
+  const double b = l[0] * l[1] * l[2];
+  const double bxi = dxi[0] * l[1] * l[2] + l[0] * dxi[1] * l[2] + l[0] * l[1] * dxi[2];
+  const double beta = deta[0] * l[1] * l[2] + l[0] * deta[1] * l[2] + l[0] * l[1] * deta[2];
+  for (int i = 0; i < 3; ++i) {
+    N[i] = l[i] * (2.0 * l[i] - 1.0) + 3.0 * b;
+    Nxi[i] = (4.0 * l[i] - 1.0) * dxi[i] + 3.0 * bxi;
+    Neta[i] = (4.0 * l[i] - 1.0) * deta[i] + 3.0 * beta;
+    const int j = (i + 1) % 3;
+    N[3 + i] = 4.0 * l[i] * l[j] - 12.0 * b;
+    Nxi[3 + i] = 4.0 * (dxi[i] * l[j] + l[i] * dxi[j]) - 12.0 * bxi;
+    Neta[3 + i] = 4.0 * (deta[i] * l[j] + l[i] * deta[j]) - 12.0 * beta;
+  }
+  N[6] = 27.0 * b;
+  Nxi[6] = 27.0 * bxi;
+  Neta[6] = 27.0 * beta;
+  N[7] = N[8] = Nxi[7] = Nxi[8] = Neta[7] = Neta[8] = 0.0;
+}
+
+struct TriTables {
+  double N[9][9], Nxi[9][9], Neta[9][9], w[9], xi[9], eta[9];
+  TriTables() {
+    const double s = std::sqrt(15.0);
+    const double a1 = (6.0 - s) / 21.0, b1 = (9.0 + 2.0 * s) / 21.0, w1 = (155.0 - s) / 2400.0;
+    const double a2 = (6.0 + s) / 21.0, b2 = (9.0 - 2.0 * s) / 21.0, w2 = (155.0 + s) / 2400.0;
+    const double px[7] = {1.0 / 3.0, a1, b1, a1, a2, b2, a2}, pe[7] = {1.0 / 3.0, a1, a1, b1, a2, a2, b2};
+    const double pw[7] = {9.0 / 80.0, w1, w1, w1, w2, w2, w2};
+    for (int q = 0; q < 9; ++q) {
+      xi[q] = q < 7 ? px[q] : 1.0 / 3.0;
+      eta[q] = q < 7 ? pe[q] : 1.0 / 3.0;
+      w[q] = q < 7 ? pw[q] : 0.0;
+      p2plus(xi[q], eta[q], N[q], Nxi[q], Neta[q]);
+      if (q >= 7)
+        for (int a = 0; a < 9; ++a) N[q][a] = Nxi[q][a] = Neta[q][a] = 0.0;
+    }
+  }
+};
+const TriTables& tri_ref() {
+  static const TriTables t;
+  return t;
+}
+
+// The pressure basis's centre and scales on a triangle: its centroid and sqrt(2 area), about
+// its edges' length on a shape-regular triangle.
+void triangle_pressure_scales(const double cx[4], const double cr[4], double& xc, double& rc, double& hx,
+                              double& hr) {
+  xc = (cx[0] + cx[1] + cx[2]) / 3.0;
+  rc = (cr[0] + cr[1] + cr[2]) / 3.0;
+  hx = hr = std::sqrt(std::abs((cx[1] - cx[0]) * (cr[2] - cr[0]) - (cx[2] - cx[0]) * (cr[1] - cr[0])));
+}
+
 // Centre and scales of an element's pressure basis {1, (x - xc)/hx, (r - rc)/hr}: the mean of
 // its corners, the mean length of its two xi-edges and its mean eta-extent. Positive for any
 // valid element, whatever the tilt of its sides; on an element with vertical sides hx is its
@@ -172,9 +230,27 @@ struct FittedStokes::Geometry {
 };
 
 void FittedStokes::element_geometry(int e, Geometry& g) const {
-  const RefTables& T = ref();
   double cx[4], cr[4];
   mesh_->corners(e, cx, cr);
+  if (triangles_) {  // the affine map of the reference triangle (0,0), (1,0), (0,1)
+    const TriTables& T = tri_ref();
+    triangle_pressure_scales(cx, cr, g.xc, g.rc, g.hx, g.hr);
+    const double xx = cx[1] - cx[0], xe = cx[2] - cx[0], rx = cr[1] - cr[0], re = cr[2] - cr[0];
+    const double det = xx * re - xe * rx, inv = 1.0 / det;
+    for (int q = 0; q < 9; ++q) {
+      const double xi = T.xi[q], eta = T.eta[q];
+      g.x[q] = cx[0] + xx * xi + xe * eta;
+      g.r[q] = cr[0] + rx * xi + re * eta;
+      g.wdet[q] = kTwoPi * T.w[q] * det;
+      for (int a = 0; a < 9; ++a) {
+        g.N(q, a) = T.N[q][a];
+        g.gx(q, a) = (re * T.Nxi[q][a] - rx * T.Neta[q][a]) * inv;
+        g.gr(q, a) = (-xe * T.Nxi[q][a] + xx * T.Neta[q][a]) * inv;
+      }
+    }
+    return;
+  }
+  const RefTables& T = ref();
   pressure_scales(cx, cr, g.xc, g.rc, g.hx, g.hr);
   for (int q = 0; q < 9; ++q) {
     const double xi = T.xi[q], eta = T.eta[q];
@@ -202,6 +278,7 @@ FittedStokes::FittedStokes(std::unique_ptr<MeridianMesh> mesh, double mu, Coupli
   if (!(std::isfinite(mu) && mu > 0))
     throw InputError("fluid.viscosity", significant(mu) + " Pa s", "must be a positive finite viscosity");
   lref_ = mesh_->length_scale();
+  triangles_ = mesh_->element_shape() == ElementShape::triangle;
   ps_ = mu_ / lref_;
   const int membrane_nodes = mesh_->membrane_nodes();
   const bool closed = mesh_->closed();
@@ -1079,6 +1156,15 @@ FittedStokes::PrescribedWall FittedStokes::prescribed_wall_velocity(const Eigen:
 Eigen::Vector2d FittedStokes::eval_velocity(int e, double xi, double eta) const {
   const int* L = &loc_[std::size_t(e) * kLoc];
   Eigen::Vector2d u(0.0, 0.0);
+  if (triangles_) {
+    double N[9], Nxi[9], Neta[9];
+    p2plus(xi, eta, N, Nxi, Neta);
+    for (int a = 0; a < 7; ++a) {
+      u[0] += N[a] * dof_value(L[2 * a]);
+      u[1] += N[a] * dof_value(L[2 * a + 1]);
+    }
+    return u;
+  }
   for (int b = 0; b < 3; ++b)
     for (int i = 0; i < 3; ++i) {
       const int a = 3 * b + i;
@@ -1093,7 +1179,10 @@ double FittedStokes::eval_pressure(int e, double x, double r) const {
   double cx[4], cr[4];
   mesh_->corners(e, cx, cr);
   double xc, rc, hx, hr;
-  pressure_scales(cx, cr, xc, rc, hx, hr);
+  if (triangles_)
+    triangle_pressure_scales(cx, cr, xc, rc, hx, hr);
+  else
+    pressure_scales(cx, cr, xc, rc, hx, hr);
   const int* L = &loc_[std::size_t(e) * kLoc];
   return ps_ * (dof_value(L[18]) + dof_value(L[19]) * (x - xc) / hx + dof_value(L[20]) * (r - rc) / hr) - p_mean_;
 }

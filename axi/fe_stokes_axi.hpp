@@ -359,6 +359,7 @@ class FittedStokes {
 
   std::unique_ptr<MeridianMesh> mesh_;
   mutable std::vector<RimPathEdge> path_;  ///< end_disc_flux's path (work)
+  bool triangles_ = false;                 ///< the mesh's elements are P2+ triangles
   double mu_, lref_, ps_;
   int n_ = 0, n_vel_ = 0;
   std::vector<int> dof_x_, dof_r_;  ///< per Q2 node, -1 = Dirichlet
