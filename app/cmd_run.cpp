@@ -298,11 +298,14 @@ int run_axi(const RunOptions& o, const scene::json& sc) {
     per_cycle = si(s["displacement_per_cycle_m"].get<double>(), "m") + (is_transit(s) ? " per wave transit in " : " per cycle in ") +
                 si(s["cycle_time_s"].get<double>(), "s") + ", " +
                 si(s["mean_velocity_per_cycle_m_per_s"].get<double>(), "m/s");
-  std::printf("%s (axi): displacement %s; %s; %s; pumped %s; %ld steps on %d x %d cells (h = %s); wall time %s\n"
+  const std::string grid = p.method == axi::AxiMethod::ImmersedBoundary
+                               ? std::to_string(p.nr) + " x " + std::to_string(p.nx) + " cells"
+                               : std::string(p.triangles ? "the fitted triangles" : "the fitted quadrilaterals");
+  std::printf("%s (axi): displacement %s; %s; %s; pumped %s; %ld steps on %s (h = %s); wall time %s\n"
               "  -> %s/summary.json\n",
               p.name().c_str(), si(s["displacement_m"].get<double>(), "m").c_str(), per_cycle.c_str(),
-              cycles_text(s).c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps, p.nr,
-              p.nx, si(p.h, "m").c_str(), si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
+              cycles_text(s).c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps, grid.c_str(),
+              si(p.h, "m").c_str(), si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
   std::fflush(stdout);
   for (const auto& w : s["implausible_because"])
     std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());

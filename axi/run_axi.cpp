@@ -13,6 +13,7 @@
 #include "axi/ib_axi.hpp"
 #include "axi/run_folder_axi.hpp"
 #include "axi/stokes_axi.hpp"
+#include "axi/tri_mesh.hpp"
 #include "axi/wall_axi.hpp"
 #include "common/errors.hpp"
 #include "common/progress.hpp"
@@ -72,18 +73,8 @@ class Runner {
              series_columns(), wall_.reference_positions()) {
     rec_.keep(ctl.keep_rows);
     if (fitted_) {
-      const FittedMeshParams mp = fitted_mesh_params();
-      stage_ = std::make_unique<FittedStokes>(mp, b_.fluid.mu, wall_.nodes());
-      flow_ = std::make_unique<FittedStokes>(mp, b_.fluid.mu, wall_.nodes());
-      // The steps' linear solves stop at a relative residual of 1e-7 (FittedStokes's own default,
-      // 1e-12, is for its tests): the stage velocity's error is then 4-5 orders below the step's
-      // error tolerance, and an old factorisation preconditions for longer. On paper_amplitude_0.82
-      // (16 cells) the displacement per cycle moved by 1.3e-8 and the cycle time by 1e-7 (relative),
-      // with 114 factorisations instead of 431 (docs/performance.md, "Axisymmetric tier").
-      stage_->set_reuse(true, FittedStokes::kRefactorAfter, kStepSolveTolerance);
-      flow_->set_reuse(true, FittedStokes::kRefactorAfter, kStepSolveTolerance);
-      stage_->set_background_factorisation(p_.threads > 1);
-      flow_->set_background_factorisation(p_.threads > 1);
+      if (p_.triangles) tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), mesh_.X0);
+      make_solvers();
     } else {
       stokes_ = std::make_unique<AxiStokes>(grid_, b_.fluid.mu);
     }
@@ -154,6 +145,56 @@ class Runner {
   }
 
  private:
+  /// The fitted method's two solvers on the structured mesh, or on the current triangulation
+  /// (their statistics continued from the solvers they replace).
+  void make_solvers() {
+    const FittedStokes::Timing ts = stage_ ? stage_->timing() : FittedStokes::Timing{};
+    const FittedStokes::Timing tf = flow_ ? flow_->timing() : FittedStokes::Timing{};
+    stage_.reset();
+    flow_.reset();
+    if (tri_) {
+      stage_ = std::make_unique<FittedStokes>(std::make_unique<TriMesh>(*tri_), b_.fluid.mu);
+      flow_ = std::make_unique<FittedStokes>(std::make_unique<TriMesh>(*tri_), b_.fluid.mu);
+    } else {
+      const FittedMeshParams mp = fitted_mesh_params();
+      stage_ = std::make_unique<FittedStokes>(mp, b_.fluid.mu, wall_.nodes());
+      flow_ = std::make_unique<FittedStokes>(mp, b_.fluid.mu, wall_.nodes());
+    }
+    // The steps' linear solves stop at a relative residual of 1e-7 (FittedStokes's own default,
+    // 1e-12, is for its tests): the stage velocity's error is then 4-5 orders below the step's
+    // error tolerance, and an old factorisation preconditions for longer. On paper_amplitude_0.82
+    // (16 cells) the displacement per cycle moved by 1.3e-8 and the cycle time by 1e-7 (relative),
+    // with 114 factorisations instead of 431 (docs/performance.md, "Axisymmetric tier").
+    for (FittedStokes* f : {stage_.get(), flow_.get()}) {
+      f->set_reuse(true, FittedStokes::kRefactorAfter, kStepSolveTolerance);
+      f->set_background_factorisation(p_.threads > 1);
+    }
+    stage_->set_timing(ts);
+    flow_->set_timing(tf);
+  }
+
+  /// The triangulation made again on the wall X (axi.mesh = triangles), and the solvers on it.
+  void remesh(const Eigen::Matrix3Xd& X) {
+    const auto t = std::chrono::steady_clock::now();
+    tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), X);
+    make_solvers();
+    ++remeshes_;
+    split_remesh_ += seconds_since(t);
+  }
+
+  /// Whether the triangulation fitted to the accepted shape X_ has degraded (its smallest angle
+  /// below kRemeshAngle): then it is made again on X_.
+  void keep_triangles_fit() {
+    TriMesh probe(*tri_);
+    try {
+      probe.fit(X_);
+    } catch (const NumericalError&) {
+      remesh(X_);
+      return;
+    }
+    if (probe.min_angle() < kRemeshAngle) remesh(X_);
+  }
+
   // ---- checkpoints ----------------------------------------------------------------------
   /// The run's state between steps, listed once for writing and reading (full3d/checkpoint.hpp).
   template <class Self, class F>
@@ -216,6 +257,11 @@ class Runner {
       w.put("stage_timing", timing_record(stage_->timing()));
       w.put("flow_timing", timing_record(flow_->timing()));
     }
+    if (tri_) {  // the triangulation is made again on its reference shape when the run resumes
+      const Eigen::Matrix3Xd& R = tri_->reference();
+      w.put("mesh_reference", std::vector<double>(R.data(), R.data() + R.size()));
+      w.put("remeshes", std::vector<double>{double(remeshes_), split_remesh_});
+    }
     w.put(full3d::kOutputMarks, marks);
     w.put("wall_time_s", wall);
     w.save(out_ + "/checkpoint.bin");
@@ -232,6 +278,14 @@ class Runner {
     const full3d::CheckpointReader r = open_checkpoint(p_, resolved_, out_);
     records(*this, full3d::CheckpointIn(r));
     rec_.load([&](const std::string& name) { return r.get_vector(name); });
+    if (tri_) {
+      const std::vector<double> R = r.get_vector("mesh_reference");
+      tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), Eigen::Map<const Eigen::Matrix3Xd>(R.data(), 3, wall_.nodes()));
+      make_solvers();
+      const std::vector<double> m = r.get_vector("remeshes");
+      remeshes_ = long(m.at(0));
+      split_remesh_ = m.at(1);
+    }
     if (fitted_) {
       stage_->set_timing(timing_of(r.get_vector("stage_timing")));
       flow_->set_timing(timing_of(r.get_vector("flow_timing")));
@@ -353,6 +407,10 @@ class Runner {
       if (!(X(1, k) > 0.0 && X(1, k) < b_.container_radius))
         return "ring " + std::to_string(k) + " at radius " + significant(X(1, k), 4) + " m, outside (0, Rc)";
     if (!fitted_) return {};
+    if (tri_) {
+      std::string cause;
+      return tri_->follows(X, &cause) ? std::string() : cause;
+    }
     try {
       FittedMesh probe(fitted_mesh_params(), n);
       probe.fit(X);
@@ -421,6 +479,7 @@ class Runner {
     const Eigen::Matrix3Xd F0 = total_force(X_);
     const int n = wall_.nodes();
     const EventValue g0 = event_value(X_);  // X_ is an accepted shape: the mesh follows it
+    if (tri_) keep_triangles_fit();
     for (;;) {
       check_dt_min();
       bool valid = true;
@@ -456,9 +515,15 @@ class Runner {
         Xn_ = X_ + dt_ * (1.5 * k1_ + 0.5 * k2_);
         if (const std::string bad = fold(Xn_); !bad.empty()) throw NumericalError(bad, "", t_);
       } catch (const NumericalError& e) {
-        // a shape the fitted mesh cannot follow (folded or outside the container): retry smaller
+        // a shape the fitted mesh cannot follow (folded or outside the container): retry smaller;
+        // a triangulation made on an earlier shape is first made again on this step's start
         valid = false;
         last_rejection_ = e.cause();
+        if (tri_ && tri_->reference() != X_ && e.cause().find("non-positive Jacobian") != std::string::npos) {
+          ++rejected_;
+          remesh(X_);
+          continue;
+        }
       }
       if (valid && err <= tol) {
         // Protocol events are located, not just detected: a step that carries the event
@@ -655,11 +720,13 @@ class Runner {
                     {"recovery_end_energy_J", protocol_.end_threshold()},
                     {"cell_size_m", p_.h},
                     {"method", p_.method_name()},
-                    {"grid", fitted_ ? json{p_.cells_inner, p_.cells_outer, wall_.nodes() - 1, p_.gap_columns}
-                                     : json{p_.nr, p_.nx}},
-                    {"grid_is", fitted_ ? "element rows inside and outside the wall, element columns along the tube and "
-                                          "across the gap"
-                                        : "cells across the radius and along the axis"},
+                    {"grid", tri_ ? json{tri_->elements(), tri_->vertices()}
+                                  : fitted_ ? json{p_.cells_inner, p_.cells_outer, wall_.nodes() - 1, p_.gap_columns}
+                                            : json{p_.nr, p_.nx}},
+                    {"grid_is", tri_ ? "triangles and vertices of the last triangulation (axi.mesh = triangles)"
+                                : fitted_ ? "element rows inside and outside the wall, element columns along the tube and "
+                                            "across the gap"
+                                          : "cells across the radius and along the axis"},
                     {"wall_nodes", wall_.nodes()},
                     {"wall_node_spacing_m", wall_.ds0()},
                     {"wall_end_spacing_m", wall_.min_ds0()},
@@ -698,6 +765,8 @@ class Runner {
           fallbacks == 0 ? "Cholesky of the regularised system (CHOLMOD)"
                          : "Cholesky of the regularised system (CHOLMOD), then LU (UMFPACK) after a failure";
       rec_.stats["factorisation_fallbacks"] = fallbacks;
+      rec_.stats["mesh"] = tri_ ? "triangles" : "quadrilaterals";
+      if (tri_) rec_.stats["remeshes"] = remeshes_;
     }
   }
 
@@ -708,6 +777,7 @@ class Runner {
     const FittedStokes::Timing& b = flow_->timing();
     return {{"wall_forces", split_forces_},
             {"wall_stiffness", split_stiffness_},
+            {"meshing", split_remesh_},
             {"assembly", a.assemble + b.assemble},
             {"factorisation", a.factor + b.factor},
             {"factorisation_in_background", a.factor_background + b.factor_background},
@@ -731,6 +801,11 @@ class Runner {
   std::unique_ptr<AxiStokes> stokes_;       ///< immersed boundary: the MAC solver
   std::unique_ptr<FittedStokes> stage_;     ///< fitted: the Rosenbrock stages' system (with gamma dt K)
   std::unique_ptr<FittedStokes> flow_;      ///< fitted: the plain fluid solve (velocities, end fluxes)
+  std::shared_ptr<const TriMesh> tri_;      ///< fitted, axi.mesh = triangles: the current triangulation
+  long remeshes_ = 0;                       ///< triangulations made after the first
+  double split_remesh_ = 0;                 ///< s spent making them and their solvers
+  /// A triangulation whose smallest angle falls below this on the accepted shape is made again.
+  static constexpr double kRemeshAngle = 12.0 * 3.14159265358979323846 / 180.0;
   AxiWall wall_;
   full3d::CylinderMesh mesh_;
   double e_ref_;
@@ -793,6 +868,10 @@ full3d::CheckpointReader Runner::open_checkpoint(const ParamsAxi& p, const json&
   if (p.method == AxiMethod::Fitted) {
     expect_size("stage_timing", 8, "solver statistics");
     expect_size("flow_timing", 8, "solver statistics");
+  }
+  if (p.method == AxiMethod::Fitted && p.triangles) {
+    expect_size("mesh_reference", 3 * std::size_t(p.wall_nodes), "triangulation's reference shape");
+    expect_size("remeshes", 2, "triangulation statistics");
   }
   expect_size(full3d::kOutputMarks, 6, "output streams (size and checksum of series.csv.part and radius.csv.part)");
   const std::vector<double> X = r.get_vector("X");

@@ -29,6 +29,7 @@ const json& section_or_empty(const json& sc, const char* key) {
 const json& section_keys() {
   static const json keys = {{"axi",
                              {{"method", "choice:fitted|immersed_boundary"},
+                              {"mesh", "choice:quadrilaterals|triangles"},
                               {"grid", {{"cells_across", "integer@[8,8192]"}, {"cell_size", "quantity:m@positive"}}},
                               {"spacing_factor", "number@(0,2]"},  // (0, 1) for the immersed boundary
                               {"rim_refinement", "number@positive"},
@@ -53,6 +54,14 @@ FittedMeshParams fitted_mesh_params(const ParamsAxi& p) {
   mp.wall_row_aspect = p.wall_row_aspect;
   mp.gap_growth = 4.0;  // the column count is chosen for a ratio near 1 + 5 ds / Rc (read_scene_axi)
   return mp;
+}
+
+TriMeshParams tri_mesh_params(const ParamsAxi& p) {
+  TriMeshParams t;
+  t.Rc = p.base.container_radius;
+  t.period = p.base.period;
+  t.size = kTriangleSize * p.h;
+  return t;
 }
 
 ParamsAxi read_scene_axi(const json& sc, json& resolved) {
@@ -106,6 +115,17 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
     throw InputError("wave.kind", "\"" + b.wave.kind + "\"",
                      "axi.method = \"immersed_boundary\" runs \"force_driven\" only; the prescribed waves (step, "
                      "sine) run with axi.method = \"fitted\"");
+  // fitted: the structured quadrilaterals (rebuilt on every shape) or a triangulation moved with
+  // the wall and made again where it degrades (rims that hook, docs/axi.md "Triangles")
+  p.triangles = a.choice("mesh", "quadrilaterals", {"quadrilaterals", "triangles"}) == "triangles";
+  if (p.triangles && ib)
+    throw InputError(a.path("mesh"), "\"triangles\"",
+                     "\"quadrilaterals\" (the default, unused) with axi.method = \"immersed_boundary\": the mesh is the "
+                     "fitted method's");
+  if (p.triangles && b.wave.prescribed())
+    throw InputError(a.path("mesh"), "\"triangles\"",
+                     "\"quadrilaterals\" with a prescribed wave (wave.kind = " + b.wave.kind +
+                         "): the triangulation runs the force-driven protocol");
   {
     Reader g = a.child("grid");
     if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {

@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "axi/fitted_mesh.hpp"
+#include "axi/tri_mesh.hpp"
 #include "common/scene.hpp"
 #include "full3d/scene3d.hpp"
 
@@ -41,6 +42,7 @@ struct ParamsAxi {
   AxiMethod method = AxiMethod::Fitted;
   // fitted mesh (method Fitted): element rows and gap columns from h (docs/axi.md)
   int cells_inner = 0, cells_outer = 0, gap_columns = 0;
+  bool triangles = false;      ///< axi.mesh = triangles: the moved triangulation (axi/tri_mesh.hpp) instead
   // grid
   int nr = 32, nx = 256;       ///< radial and axial cells
   double h = 0.0;              ///< m
@@ -69,6 +71,11 @@ struct ParamsAxi {
 
 /// The fitted mesh's parameters (method Fitted; read_scene_axi derives them from h).
 FittedMeshParams fitted_mesh_params(const ParamsAxi& p);
+
+/// The triangulation's parameters (axi.mesh = triangles): triangles' longest edge
+/// kTriangleSize h away from the wall.
+inline constexpr double kTriangleSize = 1.0;
+TriMeshParams tri_mesh_params(const ParamsAxi& p);
 
 /// Throws swim::InputError naming the key, the value and what is allowed.
 ParamsAxi read_scene_axi(const scene::json& scene, scene::json& resolved);

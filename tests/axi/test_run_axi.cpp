@@ -120,6 +120,18 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
     s["axi"]["rim_refinement"] = bad;
     EXPECT_EQ(input_error_key(s), "axi.rim_refinement") << bad;
   }
+  // the triangulation is the fitted method's mesh, for the force-driven protocol
+  s = base;
+  s["axi"]["mesh"] = "triangles";
+  EXPECT_EQ(input_error_key(s), "axi.mesh");
+  s["axi"]["method"] = "fitted";
+  EXPECT_EQ(input_error_key(s), "(accepted)");
+  s["axi"]["mesh"] = "hexagons";
+  EXPECT_EQ(input_error_key(s), "axi.mesh");
+  s["axi"]["mesh"] = "triangles";
+  s["wave"] = {{"kind", "step"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"width", "0.05 um"}};
+  s.erase("protocol");
+  EXPECT_EQ(input_error_key(s), "axi.mesh");
   // the diagnostic wall without the Poisson coupling: a boolean, default true, resolved
   s = base;
   json resolved;
