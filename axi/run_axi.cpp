@@ -183,7 +183,7 @@ class Runner {
   }
 
   /// Whether the triangulation fitted to the accepted shape X_ has degraded (its smallest angle
-  /// below kRemeshAngle): then it is made again on X_.
+  /// below axi.remesh_angle): then it is made again on X_.
   void keep_triangles_fit() {
     TriMesh probe(*tri_);
     try {
@@ -192,7 +192,7 @@ class Runner {
       remesh(X_);
       return;
     }
-    if (probe.min_angle() < kRemeshAngle) remesh(X_);
+    if (probe.min_angle() < p_.remesh_angle) remesh(X_);
   }
 
   // ---- checkpoints ----------------------------------------------------------------------
@@ -804,8 +804,6 @@ class Runner {
   std::shared_ptr<const TriMesh> tri_;      ///< fitted, axi.mesh = triangles: the current triangulation
   long remeshes_ = 0;                       ///< triangulations made after the first
   double split_remesh_ = 0;                 ///< s spent making them and their solvers
-  /// A triangulation whose smallest angle falls below this on the accepted shape is made again.
-  static constexpr double kRemeshAngle = 12.0 * 3.14159265358979323846 / 180.0;
   AxiWall wall_;
   full3d::CylinderMesh mesh_;
   double e_ref_;

@@ -1,6 +1,7 @@
 #include "axi/scene_axi.hpp"
 
 #include <cmath>
+#include <numbers>
 
 #include "common/errors.hpp"
 #include "common/scene_shared.hpp"
@@ -30,6 +31,7 @@ const json& section_keys() {
   static const json keys = {{"axi",
                              {{"method", "choice:fitted|immersed_boundary"},
                               {"mesh", "choice:quadrilaterals|triangles"},
+                              {"remesh_angle", "quantity:rad@(0,0.3490658503988659)"},
                               {"grid", {{"cells_across", "integer@[8,8192]"}, {"cell_size", "quantity:m@positive"}}},
                               {"spacing_factor", "number@(0,2]"},  // (0, 1) for the immersed boundary
                               {"rim_refinement", "number@positive"},
@@ -126,6 +128,12 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
     throw InputError(a.path("mesh"), "\"triangles\"",
                      "\"quadrilaterals\" with a prescribed wave (wave.kind = " + b.wave.kind +
                          "): the triangulation runs the force-driven protocol");
+  // triangles: the smallest angle below which the moved triangulation is made again (the mesher
+  // keeps its angles above 20.7 degrees where the wall lets it)
+  p.remesh_angle = a.quantity("remesh_angle", "rad", "12 degree", Range::open(0.0, 20.0 * std::numbers::pi / 180.0));
+  if (!p.triangles && std::abs(p.remesh_angle - 12.0 * std::numbers::pi / 180.0) > 1e-12)
+    throw InputError(a.path("remesh_angle"), fmt(p.remesh_angle, "rad"),
+                     "12 degree (the default, unused) unless axi.mesh = \"triangles\"");
   {
     Reader g = a.child("grid");
     if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {

@@ -43,6 +43,7 @@ struct ParamsAxi {
   // fitted mesh (method Fitted): element rows and gap columns from h (docs/axi.md)
   int cells_inner = 0, cells_outer = 0, gap_columns = 0;
   bool triangles = false;      ///< axi.mesh = triangles: the moved triangulation (axi/tri_mesh.hpp) instead
+  double remesh_angle = 0.0;   ///< rad: triangles, the smallest angle below which the mesh is made again
   // grid
   int nr = 32, nx = 256;       ///< radial and axial cells
   double h = 0.0;              ///< m

@@ -129,6 +129,16 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
   s["axi"]["mesh"] = "hexagons";
   EXPECT_EQ(input_error_key(s), "axi.mesh");
   s["axi"]["mesh"] = "triangles";
+  for (const char* bad : {"0 degree", "25 degree", "0.5 m"}) {
+    s["axi"]["remesh_angle"] = bad;
+    EXPECT_EQ(input_error_key(s), "axi.remesh_angle") << bad;
+  }
+  s["axi"]["remesh_angle"] = "8 degree";
+  EXPECT_EQ(input_error_key(s), "(accepted)");
+  s["axi"]["mesh"] = "quadrilaterals";  // the angle is the triangulation's
+  EXPECT_EQ(input_error_key(s), "axi.remesh_angle");
+  s["axi"].erase("remesh_angle");
+  s["axi"]["mesh"] = "triangles";
   s["wave"] = {{"kind", "step"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"width", "0.05 um"}};
   s.erase("protocol");
   EXPECT_EQ(input_error_key(s), "axi.mesh");
