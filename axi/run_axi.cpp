@@ -553,8 +553,10 @@ class Runner {
     if (dt_ < p_.dt_min && (b_.duration <= 0 || b_.duration - t_ > p_.dt_min))
       throw NumericalError("the step size fell below axi.dt_min = " + significant(p_.dt_min, 4) + " s" +
                                (last_rejection_.empty() ? "" : " (last rejection: " + last_rejection_ + ")"),
-                           fitted_ ? "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid"
-                                   : "loosen axi.tolerance or lower axi.dt_min",
+                           !fitted_ ? "loosen axi.tolerance or lower axi.dt_min"
+                           : tri_   ? "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid"
+                                    : "loosen axi.tolerance or lower axi.dt_min; a folding wall needs a finer axi.grid, "
+                                      "and a rim that hooks back over the lumen axi.mesh = \"triangles\"",
                            t_);
   }
 
