@@ -182,8 +182,9 @@ struct TriTables {
       xi[q] = q < 7 ? px[q] : 1.0 / 3.0;
       eta[q] = q < 7 ? pe[q] : 1.0 / 3.0;
       w[q] = q < 7 ? pw[q] : 0.0;
-      p2plus(xi[q], eta[q], N[q], Nxi[q], Neta[q]);
-      if (q >= 7)
+      if (q < 7)
+        p2plus(xi[q], eta[q], N[q], Nxi[q], Neta[q]);
+      else
         for (int a = 0; a < 9; ++a) N[q][a] = Nxi[q][a] = Neta[q][a] = 0.0;
     }
   }
