@@ -129,15 +129,21 @@ TriMesh::TriMesh(const TriMeshParams& p, const Eigen::Matrix3Xd& X_ref) {
     throw std::invalid_argument("TriMesh: Rc, period, size and angle_bound must be positive and finite");
   const int n = int(X_ref.cols());
   if (n < 3) throw std::invalid_argument("TriMesh: at least 3 rings");
-  if (!X_ref.topRows(2).allFinite()) throw std::invalid_argument("TriMesh: non-finite ring");
+  // The shape is the wall's, taken from a run: a shape the strip cannot hold is a numerical
+  // failure of that run (it keeps its partial results), not a programming error.
+  const std::string remedy = "lower the load (protocol.pressure) or widen the container (container.radius)";
+  if (!X_ref.topRows(2).allFinite()) throw NumericalError("a wall ring is not finite where the mesh is made", remedy);
   double xmin = X_ref(0, 0), xmax = X_ref(0, 0);
   for (int k = 0; k < n; ++k) {
     if (!(X_ref(1, k) > 0 && X_ref(1, k) < p.Rc))
-      throw std::invalid_argument("TriMesh: ring " + std::to_string(k) + " outside (0, Rc)");
+      throw NumericalError("wall ring " + std::to_string(k) + " at r = " + significant(X_ref(1, k), 4) +
+                               " m lies outside (0, Rc) where the mesh is made",
+                           remedy);
     xmin = std::min(xmin, X_ref(0, k));
     xmax = std::max(xmax, X_ref(0, k));
   }
-  if (!(xmax - xmin < p.period)) throw std::invalid_argument("TriMesh: the tube is longer than the period");
+  if (!(xmax - xmin < p.period))
+    throw NumericalError("the wall spans " + significant(xmax - xmin, 4) + " m, not less than the period", remedy);
   auto t = std::make_shared<Topology>();
   t->p = p;
   t->X_ref = X_ref;

@@ -238,6 +238,25 @@ TEST(TriMesh, RefusesAShapeItCannotFollow) {
   EXPECT_NO_THROW(m.fit(X));
 }
 
+// A mesh made on a shape the strip cannot hold (a ring on the container, a tube as long as the
+// period) is a numerical failure of the run that asked for it, naming the ring and a scene key.
+TEST(TriMesh, RefusesToMeshAShapeTheStripCannotHold) {
+  const double h = kRc / 8;
+  const int n = int(kL / (0.5 * h)) + 1;
+  Eigen::Matrix3Xd X = tube(n);
+  X(1, 5) = kRc;
+  try {
+    TriMesh m(tri_params(h), X);
+    ADD_FAILURE() << "a ring on the container was meshed";
+  } catch (const swim::NumericalError& e) {
+    EXPECT_NE(std::string(e.what()).find("wall ring 5"), std::string::npos) << e.what();
+    EXPECT_NE(e.remedy().find("protocol.pressure"), std::string::npos) << e.remedy();
+  }
+  X = tube(n);
+  X(0, n - 1) = X(0, 0) + kP;
+  EXPECT_THROW(TriMesh(tri_params(h), X), swim::NumericalError);
+}
+
 // The hook the structured mesh cannot follow (docs/axi.md, "What the mesh cannot follow"): a rim
 // curled through 200 degrees, inwards over a wedge of lumen and outwards over the tube. The
 // structured mesh refuses both; the triangulation meshes them and its solve conserves mass and
