@@ -322,24 +322,33 @@ void EventLoop::install_laws() {
 
 void EventLoop::check_end_radii(double t) const {
   if (M_.bending) {
-    // A bending wall's ends follow the wall. Its active segment, of length l under the whole
-    // actuation q, deflects at its middle by f q / C1 with f = 1 - exp(-x) cos(x),
-    // x = l / (2 sqrt(2) l_b), l_b = (D / C1)^(1/4) (a uniform load on a length l of a beam on
-    // an elastic foundation): the static radius there must stay above the collapse radius.
+    // A bending wall's ends follow the wall. Its active segment, of length l under the load P,
+    // deflects like a beam on an elastic foundation (wavenumber beta = 1 / (sqrt 2 l_b),
+    // l_b = (D / C1)^(1/4)): at its middle by f P / C1, on its mean by g P / C1, with
+    // f = 1 - exp(-x) cos x, x = beta l / 2, and g = 1 - (1 + exp(-2x)(sin 2x - cos 2x)) / (4x).
+    // The protocol holds the segment once its mean reaches R_f, so the segment passes that
+    // shape on the way to its static one: what must stay open is its middle there, the static
+    // radius under (f / g) times the load that holds R_f (or under f q when q cannot bring the
+    // mean to R_f: a stall, which the run reports). A middle that closes first would grind the
+    // integrator to the step budget against the lubrication's R^-4 resistance.
     // (Held segments are controlled to R_f, not loaded by q.)
     const double ell_b = std::pow(M_.D_axial / M_.C1, 0.25);
     double longest = 0;
     for (double w : machine_.seg_weight()) longest = std::max(longest, w * M_.h);
     const double x = longest / (2.0 * std::sqrt(2.0) * ell_b);
     const double f = 1.0 - std::exp(-x) * std::cos(x);
-    const double q = f * P_.protocol.q;
-    const double Rs = M_.wall.law ? M_.wall.static_radius(q) : M_.R0 - q / M_.C1;
+    const double g = 1.0 - (1.0 + std::exp(-2.0 * x) * (std::sin(2.0 * x) - std::cos(2.0 * x))) / (4.0 * x);
+    const double q = P_.protocol.q, hold = -M_.wall(P_.protocol.R_f);
+    const double P_mid = f * std::min(hold / g, q);
+    const double Rs = M_.wall.static_radius(P_mid);
     if (Rs < collapse_)
       throw NumericalError(
-          "tube radius collapsed to zero: under the actuation " + fmt(P_.protocol.q) + " Pa a protocol segment of " +
-              metres(longest) + " (bending length " + metres(ell_b) + ") has the static radius " + metres(Rs) +
-              " at its middle, below the collapse radius " + metres(collapse_),
-          "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) or raise wall.C1",
+          "tube radius collapsed to zero: under the actuation " + fmt(q) + " Pa a protocol segment of " +
+              metres(longest) + " (bending length " + metres(ell_b) + ") closes at its middle (static radius " +
+              metres(Rs) + ", below the collapse radius " + metres(collapse_) + ") before its mean reaches R_f = " +
+              metres(P_.protocol.R_f),
+          "raise wave.contracted_ratio, lower the actuation (protocol.pressure, protocol.total_force or "
+          "protocol.load_factor) or raise wall.C1",
           t);
     return;
   }

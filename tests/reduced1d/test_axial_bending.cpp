@@ -173,6 +173,33 @@ TEST(AxialBending, VanishingRigidityGivesTheLocalLawsCycle) {
   EXPECT_GT(wall.cycle_times_s[0] / T0, 1.1);
 }
 
+// A load beyond what the wall can hold at rest (q > C1 R0: a segment under the whole load has no
+// static radius) still runs a bending wall's cycle when its segments reach R_f on the way: the
+// protocol holds each segment there. The paper's R_f = 0.35 R0 tube under 0.8 Pa (C1 R0 about
+// 0.5 Pa) with the round wall's bending: every segment reaches R_f, in order from the front, and
+// no cell closes (smallest radius measured 23 nm, 0.19 R0). R_f = 0.1 R0, whose segments' middles
+// close before their mean reaches R_f, is refused at t = 0 (Extremes, docs/stability-1d.md).
+TEST(AxialBending, ALoadTheWallCannotHoldAtRestRunsWhenTheSegmentsReachTheirTarget) {
+  scene::json s = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.35.json");
+  s["protocol"].erase("load_factor");
+  s["protocol"]["pressure"] = "0.8 Pa";
+  s["model1d"]["axial_bending"] = {{"source", "scene"}, {"rigidity", "2.1e-24 J"}};
+  scene::json resolved;
+  const Params p = read_scene(s, resolved);
+  ASSERT_GT(p.protocol.q, 1.4 * p.wall.C1 * p.geometry.R0);
+  const Result r = solve(p);
+  ASSERT_FALSE(r.failure) << r.failure->what();
+  const auto m = metrics(p, r);
+  ASSERT_EQ(m.cycle_times_s.size(), 1u);
+  ASSERT_EQ(r.segment_reached.size(), std::size_t(p.protocol.segments));
+  for (std::size_t k = 1; k < r.segment_reached.size(); ++k) {
+    EXPECT_GT(r.segment_reached[k], 0.0);
+    EXPECT_LT(r.segment_reached[k], r.segment_reached[k - 1]) << "segment " << k;
+  }
+  EXPECT_GT(m.min_radius_m, 0.1 * p.geometry.R0);
+  EXPECT_GT(m.displacement_per_cycle_m, 0.0);
+}
+
 // Scene guards: the term belongs to the force-free force-driven model; the calibration source
 // needs a calibration file that holds the measured rigidity; a rigidity must be positive and
 // is only read with source = "scene". Each refusal names its key.
