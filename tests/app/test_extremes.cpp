@@ -212,8 +212,9 @@ TEST(Extremes, ForceDrivenOnTheCalibratedWallAndWithAxialBending) {
   // The wall's bending along the axis (D = 2.1e-24 J, bending length 27 nm) on the linear
   // wall: at R_f = 0.1 R0 the active 75 nm segment's middle closes (a beam on an elastic
   // foundation) before its mean reaches R_f, and the run stops at t = 0 naming the collapse
-  // (without the check it grinds to the step budget); on the shortest tube (segments of 20 to 40 nm, shorter than the bending length)
-  // the active segment cannot bend down to R_f and the run stalls (numerical failure); the
+  // (without the check it grinds to the step budget); on the shortest tube (segments of 20 to
+  // 40 nm, shorter than the bending length) the active segment cannot bend down to R_f and the
+  // run stalls (numerical failure); the
   // longer tubes complete. On the buckled law the bending, 30 times stiffer than the plateau
   // at the segments' scale, holds the segment above R_f: stall.
   const std::string cal = std::string("wall.calibration=") + SWIM_SOURCE_DIR "/docs/tube-law/calibration.json";

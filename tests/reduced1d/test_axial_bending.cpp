@@ -176,7 +176,7 @@ TEST(AxialBending, VanishingRigidityGivesTheLocalLawsCycle) {
 // A load beyond what the wall can hold at rest (q > C1 R0: a segment under the whole load has no
 // static radius) still runs a bending wall's cycle when its segments reach R_f on the way: the
 // protocol holds each segment there. The paper's R_f = 0.35 R0 tube under 0.8 Pa (C1 R0 about
-// 0.5 Pa) with the round wall's bending: every segment reaches R_f, in order from the front, and
+// 0.5 Pa) with the round wall's bending: every segment reaches R_f, from the last to the first, and
 // no cell closes (smallest radius measured 23 nm, 0.19 R0). R_f = 0.1 R0, whose segments' middles
 // close before their mean reaches R_f, is refused at t = 0 (Extremes, docs/stability-1d.md).
 TEST(AxialBending, ALoadTheWallCannotHoldAtRestRunsWhenTheSegmentsReachTheirTarget) {
