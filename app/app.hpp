@@ -39,7 +39,7 @@ int screen(const std::string& sweep, const std::string& out, int jobs, int progr
 /// the best design also runs in 3D with `threads` threads.
 int optimize(const std::string& spec, const std::string& out, int progress, bool overwrite, bool confirm, int threads);
 /// fine_cycles: cells across of one cycle each of the paper's buckling wall (paper_aspect_L0.2,
-/// seeded as the converged suite's paper_aspect_L0.2_seeded), `--fine-cycle N`; fine_sets: scene
+/// seeded as the buckling suite's paper_aspect_L0.2_seeded), `--fine-cycle N`; fine_sets: scene
 /// overrides of those cycles (`--fine-cycle-set KEY=VALUE`, e.g. full3d.wall_stabilization).
 int bench(const std::string& out, bool quick, bool paper_cycle, const std::string& tier = "all",
           const std::vector<int>& fine_cycles = {}, const std::vector<std::string>& fine_sets = {});

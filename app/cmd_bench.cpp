@@ -546,7 +546,7 @@ PaperCycle run_paper_cycle(const std::string& out, unsigned cores) {
 
 /// The paper's buckling wall on a fine grid: paper_aspect_L0.2 at `cells` across, seeded with the
 /// mode its buckling estimate grows fastest (seed_mode = "auto": m = 8 lobes of 1e-2 R0, as the
-/// converged suite's paper_aspect_L0.2_seeded), into out/fine_cycle_N. Targets: 4 min at 96
+/// buckling suite's paper_aspect_L0.2_seeded), into out/fine_cycle_N. Targets: 4 min at 96
 /// cells, 12 min at 128 (none on other grids).
 PaperCycle run_fine_cycle(const std::string& out, unsigned cores, int cells, const std::vector<std::string>& sets) {
   const double target = cells == 96 ? 240.0 : cells == 128 ? 720.0 : 0.0;

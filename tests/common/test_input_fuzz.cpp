@@ -171,7 +171,8 @@ TEST(StrictSuite, UnknownKeysWrongTypesAndBadValuesAreRejectedNamingTheKey) {
   EXPECT_EQ(suite_key(with([](json& s) { s["rtol1d"] = {1e-4, 2.0}; }), false), "suite.rtol1d");
 }
 
-// (default.json and converged.json: SuiteReference.TheShippedConvergedSuiteLoads, SuiteFile.ShippedSuitesLoad)
+// (default.json, converged.json and buckling.json: SuiteReference.TheShippedConvergedSuiteLoads,
+// SuiteReference.TheShippedBucklingSuiteLoads, SuiteFile.ShippedSuitesLoad)
 TEST(StrictSuite, TheShippedSuitesAreAccepted) {
   for (const char* name : {"quick.json", "resolution.json"})
     EXPECT_NO_THROW(swim::validation::load_suite(kSuites + "/" + name, kData)) << name;
