@@ -18,6 +18,7 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 import numpy as np  # noqa: E402  (a dependency of matplotlib)
 
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
@@ -167,6 +168,22 @@ def cell(text):
 def legend_right(ax):
     """Legend beside the axes, off the data."""
     ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
+
+
+def legend_below(fig, ax, width=9.0, height=4.6, ncol=2, wrap=58):
+    """Legend under the axes, off the data, its long labels wrapped: the axes keep the figure's
+    width (beside them, a legend of long model labels squeezed the plot to a strip). Lays the
+    figure out with room for the legend's rows."""
+    handles, labels = ax.get_legend_handles_labels()
+    labels = [textwrap.fill(l, wrap, subsequent_indent="  ") for l in labels]
+    fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize="small", frameon=False)
+    # about 0.18 inch per line; the columns are filled one after the other, so row r holds the
+    # labels r, r + rows, ...
+    rows = math.ceil(len(labels) / ncol)
+    lines = sum(max(labels[i].count("\n") + 1 for i in range(r, len(labels), rows)) for r in range(rows))
+    below = 0.18 * lines + 0.15
+    fig.set_size_inches(width, height + below)
+    fig.tight_layout(rect=(0, below / (height + below), 1, 1))
 
 
 def save(fig, path):
@@ -333,8 +350,20 @@ def reference_convergence_figure(case, path):
     paper = (case.get("paper") or {}).get("max_displacement_m")
     panels = [p for p in FIGURE_PANELS if p[0] != "max_displacement_m" or paper]
     fig, axes = plt.subplots(1, len(panels), figsize=(5.4 * len(panels), 6.0))
-    hmax = max([r["cell_size_m"] * 1e9 for r in r3 + ra] or [1.0])
+    # the grids whose run completed no cycle (a failure, a time limit): marked, not left out silently
+    def without_cycle(runs):
+        bad = [r for r in runs if not r.get("has_cycle") and r.get("cell_size_m")]
+        why = " (time limit)" if bad and all("time_limit" in r.get("status", "") for r in bad) else ""
+        return [r["cell_size_m"] * 1e9 for r in bad], why
+
+    (no3, why3), (noa, whya) = without_cycle(case["runs3d"]), without_cycle(ref.get("runs", []))
+    hmax = max([r["cell_size_m"] * 1e9 for r in r3 + ra] + no3 + noa or [1.0])
     for ax, (key, ylabel, scale) in zip(axes, panels):
+        for hs, why, colour, tier in ((no3, why3, "k", "3D"), (noa, whya, "tab:blue", "axisymmetric")):
+            for j, h in enumerate(hs):
+                ax.axvline(h, color=colour, ls=":", lw=1.0, alpha=0.6,
+                           label=None if j else f"{tier} runs without a cycle{why}: h = "
+                           + ", ".join(f"{v:.3g}" for v in sorted(hs)) + " nm")
         p3 = [(r["cell_size_m"] * 1e9, r[key] * scale) for r in r3 if r.get(key) is not None]
         pa = [(r["cell_size_m"] * 1e9, r[key] * scale) for r in ra if r.get(key) is not None]
         e3 = case["reference3d"].get(key)
@@ -475,6 +504,11 @@ def pareto_figure(report, path):
                                          fontsize=7, xytext=(4, -10) if below else (-4, 4),
                                          textcoords="offset points", ha="left" if below else "right"))
     ax.set(xlabel="wall time [s] (log scale)", ylabel="error in displacement per cycle [%] (log scale)")
+    # plain numbers on the error axis (1, 2, 5, 10, 20, ...), not 4×10¹
+    fmt = matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}")
+    ax.yaxis.set_major_formatter(fmt)
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.FuncFormatter(
+        lambda v, _: f"{v:g}" if f"{v:.1e}"[0] in "25" else ""))
     # each case's error is taken against its judged reference: the axisymmetric one where the
     # case has it, else the 3D extrapolation
     axi = [bool(c.get("reference")) for c in cases]
@@ -514,23 +548,36 @@ def sweep_figure(report, group, xlabel, key, ylabel, scale, path, title, logx=Fa
             e3.append(ref["error"] * scale if ref and ref.get("error") is not None else 0)
         ax.errorbar(x, y3, yerr=e3, fmt="o--", color="0.5", mfc="white", capsize=3, label="3D extrapolation (h → 0)")
     labels = [m["label"] for m in cases[0]["models1d"]]
+    ref_max = max((abs(b) for b in y if math.isfinite(b)), default=0.0)
+    unit = "m/s" if key.endswith("_per_s") else "m"
+    off = []
     for k, lab in enumerate(labels):
         v = []
         for c in cases:
             m = next((m for m in c["models1d"] if m["label"] == lab), None)
             v.append(m[key] * scale if m and key in m else float("nan"))
-        if all(not math.isfinite(a) or abs(a) > 50 * max(abs(b) for b in y if math.isfinite(b)) for a in v):
+        if all(not math.isfinite(a) for a in v):
+            continue
+        # a model more than 50 times the references anywhere (the paper's reproduction mode)
+        # would flatten every other line: named in the title instead
+        big = [a for a in v if math.isfinite(a) and abs(a) > 50 * ref_max]
+        if big:
+            off.append(f"1D: {lab} (up to {si(max(abs(a) for a in big) / scale, unit)})")
             continue
         ax.plot(x, v, MODEL_STYLES[k % len(MODEL_STYLES)] + "o", label=f"1D: {lab}")
     ax.set(xlabel=xlabel, ylabel=ylabel)
-    fig.suptitle(f"{report['suite']} suite: {title}")
+    sup = f"{report['suite']} suite: {title}"
+    if off:
+        sup += "\n" + textwrap.fill("off scale, not drawn: " + "; ".join(off), 110)
+    fig.suptitle(sup)
     if logx:
         ax.set_xscale("log")
         ax.set_xticks(x)
         ax.set_xticklabels([f"{v:g}" for v in x])
         ax.minorticks_off()
-    legend_right(ax)
-    save(fig, path)
+    legend_below(fig, ax)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
     return True
 
 
@@ -1029,6 +1076,10 @@ def main(d):
                     "mean velocity per cycle [nm/s]", 1e9, f"{d}/fig_velocity_vs_length.png",
                     "Mean velocity per cycle against swimmer length (Figure 13)"):
         glob.append("fig_velocity_vs_length.png")
+    if sweep_figure(report, "amplitude", "contracted radius R_f / R₀", "mean_velocity_per_cycle_m_per_s",
+                    "mean velocity per cycle [nm/s]", 1e9, f"{d}/fig_velocity_vs_amplitude.png",
+                    "Mean velocity per cycle against contraction (Figure 13)"):
+        glob.append("fig_velocity_vs_amplitude.png")
     if sweep_figure(report, "container", "container radius Rc / R₀", "displacement_per_cycle_m",
                     "displacement per cycle [nm]", 1e9, f"{d}/fig_distance_vs_container.png",
                     "Distance per cycle against the container radius, L = 0.2 µm", logx=True):

@@ -375,6 +375,46 @@ class ValidationFigures(unittest.TestCase):
         self.assertEqual(axes[1].get_ylim()[0], 0.0)
         self.assertGreater(axes[1].get_ylim()[1], 1.28)
 
+    def test_sweep_names_an_off_scale_model_and_keeps_the_legend_off_the_axes(self):
+        # a model 50 times the references at one case (the paper's reproduction: 175 um against
+        # 74 nm) is named in the title, not drawn; the others are drawn, the legend below the axes
+        def case(v, ref, paper):
+            return {"group": "amplitude", "sweep_value": v,
+                    "reference3d": {"displacement_per_cycle_m": {"value": 0.9 * ref, "error": 1e-9}},
+                    "reference": {"displacement_per_cycle_m": {"value": ref, "error": 1e-10}},
+                    "models1d": [{"label": "default", "displacement_per_cycle_m": 0.8 * ref},
+                                 {"label": "paper's", "displacement_per_cycle_m": paper}]}
+        report = {"suite": "s", "cases": [case(0.55, 7.4e-8, 1.75e-4), case(0.82, 1.9e-8, 4.6e-8)]}
+        self.assertTrue(self.mod.sweep_figure(report, "amplitude", "R_f / R0", "displacement_per_cycle_m",
+                                              "displacement per cycle [nm]", 1e9, f"{self.d}/s.png", "t"))
+        fig = self.closed[-1]
+        ax = fig.axes[0]
+        drawn = [ln.get_label() for ln in ax.get_lines()]
+        self.assertIn("1D: default", drawn)
+        self.assertNotIn("1D: paper's", drawn)
+        self.assertIn("off scale, not drawn: 1D: paper's (up to 175 µm)", fig._suptitle.get_text())
+        self.assertLess(ax.get_ylim()[1], 100)  # nm: the drawn lines set the scale
+        self.assertTrue(legend_outside(fig, ax, fig.legends[0]))
+        self.assertGreater(ax.get_position().width, 0.7)  # the axes keep the figure's width
+
+    def test_reference_convergence_marks_the_grids_without_a_cycle(self):
+        ok = [{"has_cycle": True, "cell_size_m": h, "displacement_per_cycle_m": d, "cycle_time_s": t}
+              for h, d, t in ((1.25e-8, 7.8e-8, 3.6), (1.04e-8, 7.5e-8, 3.4))]
+        stuck = [{"has_cycle": False, "cell_size_m": h, "status": "failed: numerical failure: the protocol did "
+                  "not complete 1 cycle(s) within full3d.time_limit = 5 s"} for h in (1.56e-8, 7.81e-9)]
+        val = {"value": 1.0e-7, "error": 1e-9, "converged": False}
+        case = {"name": "c", "runs3d": stuck[:1] + ok + stuck[1:], "models1d": [],
+                "reference3d": {"displacement_per_cycle_m": val, "cycle_time_s": dict(val, value=2.7)},
+                "reference": {"runs": [dict(r, cell_size_m=2 * r["cell_size_m"]) for r in ok],
+                              "displacement_per_cycle_m": val, "cycle_time_s": dict(val, value=2.7)}}
+        self.assertTrue(self.mod.reference_convergence_figure(case, f"{self.d}/r.png"))
+        ax = self.closed[-1].axes[0]
+        marks = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
+        self.assertEqual(sorted(round(ln.get_xdata()[0], 2) for ln in marks), [7.81, 15.6])
+        legend = " ".join(t.get_text() for t in ax.get_legend().get_texts())
+        self.assertIn("3D runs without a cycle (time limit): h = 7.81, 15.6 nm", legend)
+        self.assertNotIn("axisymmetric runs without a cycle", legend)
+
     def test_pareto_labels_do_not_overlap(self):
         import matplotlib.pyplot as plt
         fig, ax = plt.subplots()
