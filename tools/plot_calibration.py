@@ -145,6 +145,7 @@ def figure(d):
 def main(d):
     fig, _ = figure(d)
     fig.savefig(f"{d}/calibration.png", dpi=110)
+    plt.close(fig)  # plot_validation draws one per case in one process
     with open(f"{d}/calibration.json") as f:
         c = json.load(f)
     if "tube_law" in c:
@@ -222,6 +223,7 @@ def plot_tube_law(d, c):
     ax[1].legend(fontsize="small", frameon=False)
     fig.tight_layout()
     fig.savefig(f"{d}/tube_law.png", dpi=110)
+    plt.close(fig)
 
 
 def plot_axial_stiffness(d, c):
@@ -270,6 +272,7 @@ def plot_axial_stiffness(d, c):
         a_.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     fig.tight_layout()
     fig.savefig(f"{d}/axial_stiffness.png", dpi=110)
+    plt.close(fig)
 
 
 if __name__ == "__main__":
