@@ -193,7 +193,7 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
     const reduced1d::Params p = reduced1d::read_scene(best_scene, resolved, spec.base_dir);
     const auto one = reduced1d::run_designs({p}, 1);
     design::ConfirmOptions o{spec.objective, spec.maximize, spec.confirm, threads, progress, out + "/confirm-runs", {}};
-    std::vector<design::Candidate> optimum = {{0, best_text, "optimum", 1, best_scene, one[0].metrics}};
+    std::vector<design::Candidate> optimum = {{0, best_text, "optimum", 1, best_scene, one[0].metrics, {}, {}}};
     design::match_recovery_end(optimum[0], spec.base_dir);  // the 1D cycle ends as the 3D run's
     scene::json report = design::confirm_candidates(optimum, o);
     report["agreement_absent_because"] = "one design (the optimum) is confirmed: the agreement is its relative differences";

@@ -438,10 +438,14 @@ void wall_times(const SuiteCase& c, const std::vector<Run3d>& runs, json& cr) {
   for (const auto& r : runs) w3 += r.wall;
   for (const auto& m : models_j) w1 += m.value("wall_time_s", 0.0);
   const double w1_first = models_j.empty() ? 0.0 : models_j[0].value("wall_time_s", 0.0);
+  const bool cycle_1d = !models_j.empty() && models_j[0].value("has_cycle", false);
   cr["wall_time_3d_s"] = w3;
   cr["wall_time_1d_s"] = w1;
+  // the cost of one cycle in each tier: a run that stopped before its cycle (a time limit, a
+  // failure) has no such cost, so there is no ratio
   const Run3d& at_cal = runs[c.calibration_grid];
-  if (at_cal.wall > 0 && w1_first > 0) cr["wall_time_ratio_3d_over_1d"] = at_cal.wall / w1_first;
+  if (at_cal.cyc.has_cycle && cycle_1d && at_cal.wall > 0 && w1_first > 0)
+    cr["wall_time_ratio_3d_over_1d"] = at_cal.wall / w1_first;
 }
 
 json extremes_3d(const json& suite, const std::string& suite_dir, const std::string& data_dir, RunCache& cache,

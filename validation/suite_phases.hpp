@@ -96,7 +96,8 @@ json judge_models(const SuiteCase& c, const json& suite, const std::string& cal_
 json speed_accuracy(const SuiteCase& c, const json& suite, const std::string& cal_file, const std::vector<Run3d>& runs,
                     const json& cr, RunCache& cache, const Say& say, int progress);
 
-/// The wall times of the case's 3D study and 1D models, and their ratio at the calibration grid.
+/// The wall times of the case's 3D study and 1D models, and their ratio at the calibration grid
+/// (the 3D run there against the first 1D model, when both completed a cycle).
 void wall_times(const SuiteCase& c, const std::vector<Run3d>& runs, json& cr);
 
 /// 3D at the extremes: each of the suite's extremes3d against the outcome it states.

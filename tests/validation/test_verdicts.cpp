@@ -445,3 +445,31 @@ TEST(Targets1d, ACaseStatesItsOwnTargetsElseTheSuitesAndTheyJudgeByTheSameRules)
   for (const char* k : {"displacement_per_cycle", "cycle_time", "mean_velocity_per_cycle", "velocity_phase_correlation"})
     EXPECT_EQ(b[k], "pass") << k;
 }
+
+// The report's speed ratio is the cost of one cycle in each tier: the 3D run at the calibration
+// grid against the first 1D model. A 3D run that stopped before its cycle (R_f = 0.35 R0's
+// 32-cell run at its 5-s time limit) or a 1D model without a cycle gives no ratio; the wall
+// times are summed either way.
+TEST(WallTimes, TheRatioNeedsACycleInBothTiers) {
+  SuiteCase c;
+  c.calibration_grid = 0;
+  std::vector<Run3d> runs(2);
+  runs[0].wall = 66.0;
+  runs[1].wall = 148.0;
+  runs[1].cyc.has_cycle = true;
+  auto with_model = [](bool cycle) {
+    return json{{"models1d", json::array({{{"wall_time_s", 0.154}, {"has_cycle", cycle}}})}};
+  };
+  json cr = with_model(true);
+  wall_times(c, runs, cr);
+  EXPECT_FALSE(cr.contains("wall_time_ratio_3d_over_1d")) << "the 3D run at the calibration grid has no cycle";
+  EXPECT_DOUBLE_EQ(cr["wall_time_3d_s"].get<double>(), 214.0);
+  EXPECT_DOUBLE_EQ(cr["wall_time_1d_s"].get<double>(), 0.154);
+  c.calibration_grid = 1;
+  cr = with_model(true);
+  wall_times(c, runs, cr);
+  EXPECT_NEAR(cr["wall_time_ratio_3d_over_1d"].get<double>(), 148.0 / 0.154, 1e-9);
+  cr = with_model(false);
+  wall_times(c, runs, cr);
+  EXPECT_FALSE(cr.contains("wall_time_ratio_3d_over_1d")) << "the 1D model has no cycle";
+}
