@@ -12,6 +12,7 @@
 #include "common/scene_shared.hpp"
 #include "common/units.hpp"
 #include "reduced1d/outer_flow.hpp"
+#include "reduced1d/protocol.hpp"
 #include "reduced1d/recorded_wave.hpp"
 #include "reduced1d/tube_law.hpp"
 
@@ -348,8 +349,16 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     // static radius of the end's actuation, its half cell a drainage layer (the default) or a
     // lumen linear in R; or, with the short-wave traction, the end cell continued to the mouth.
     const bool static_ends = forced && !p.swimmer.end_junction && !(p.wall.D_axial > 0);
-    const std::string open_end =
-        n.choice("open_end", static_ends ? "drainage" : "linear", {"drainage", "linear", "continued"});
+    // A static end needs a static radius under the actuation: at or below the collapse radius
+    // (q near or above C1 R0, or above the calibrated law's load there) it has none, and a run
+    // would stop at t = 0. The short-wave traction's wall then takes the end cell continued to
+    // the mouth instead, the same limit, which needs no static end (docs/reduced1d.md, "The open
+    // ends' half cells").
+    const bool no_static_end =
+        static_ends && detail::wall_law(p).static_radius(p.protocol.q) < detail::collapse_radius(p);
+    const char* end_default =
+        !static_ends ? "linear" : no_static_end && p.swimmer.short_wave_traction ? "continued" : "drainage";
+    const std::string open_end = n.choice("open_end", end_default, {"drainage", "linear", "continued"});
     if (open_end == "drainage" && !static_ends)
       throw InputError(n.path("open_end"), "\"drainage\"",
                        "the drainage layer is the half cell of an open end held at its actuation's static radius: "

@@ -157,6 +157,38 @@ TEST(OpenEnd, TheSceneResolvesTheEndModelAndRefusesTheLayerWhereTheEndIsNotStati
   test::expect_refused(json{{"numerics1d", {{"open_end", "sharp"}}}}, "numerics1d.open_end");
 }
 
+// A load the static end cannot hold: at load factor 1.5 and R_f = 0.3 R0 the actuation is
+// 1.05 C1 R0, above which an open end has no positive rest radius (and with a calibrated
+// hydraulic offset the end closes sooner: R0 - q/C1 below a_in). The default end is then the
+// end cell continued to the mouth, which needs no static end; on the lubrication-only wall,
+// which has no continued end, it stays "drainage" (the run stops at t = 0 naming the collapse).
+// Given explicitly, "drainage" is kept.
+TEST(OpenEnd, ALoadTheStaticEndCannotHoldDefaultsToTheContinuedEnd) {
+  const json deep = {{"protocol", {{"load_factor", 1.5}}}, {"wave", {{"contracted_ratio", 0.3}}}};
+  json resolved;
+  Params p = read_scene(deep, resolved);
+  EXPECT_EQ(p.numerics.open_end, OpenEnd::Continued);
+  EXPECT_EQ(resolved["numerics1d"]["open_end"], "continued");
+  // R_f = 0.4 R0: q = 0.9 C1 R0, the end at 0.1 R0: static, and open without an offset ...
+  json shallow = deep;
+  shallow["wave"]["contracted_ratio"] = 0.4;
+  p = read_scene(shallow, resolved);
+  EXPECT_EQ(p.numerics.open_end, OpenEnd::Drainage);
+  // ... closed by an inner hydraulic offset of 0.12 R0 (the calibration's is about 0.11 R0)
+  shallow["model1d"] = {{"hydraulic_offsets", {{"source", "scene"}, {"inner", "15 nm"}, {"outer", "11 nm"}}}};
+  p = read_scene(shallow, resolved);
+  EXPECT_EQ(p.numerics.open_end, OpenEnd::Continued);
+  json lubrication = deep;
+  lubrication["model1d"] = {{"short_wave_traction", false}};
+  p = read_scene(lubrication, resolved);
+  EXPECT_EQ(p.numerics.open_end, OpenEnd::Drainage);
+  json asked = deep;
+  asked["numerics1d"] = {{"open_end", "drainage"}};
+  p = read_scene(asked, resolved);
+  EXPECT_EQ(p.numerics.open_end, OpenEnd::Drainage);
+  EXPECT_EQ(resolved["numerics1d"]["open_end"], "drainage");
+}
+
 // The end cell continued to the mouth ("continued") against the static end with its drainage
 // layer, on the deep contraction whose 50-cell grid error is the largest of the screening
 // benchmark's static ends (L = 0.33 um, R_f = 0.35 R0; the default scene's container): the
