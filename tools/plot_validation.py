@@ -170,10 +170,11 @@ def legend_right(ax):
     ax.legend(loc="center left", bbox_to_anchor=(1.0, 0.5), fontsize="small", frameon=False)
 
 
-def legend_below(fig, ax, width=9.0, height=4.6, ncol=2, wrap=58):
-    """Legend under the axes, off the data, its long labels wrapped: the axes keep the figure's
-    width (beside them, a legend of long model labels squeezed the plot to a strip). Lays the
-    figure out with room for the legend's rows."""
+def legend_below(fig, ax, width=9.0, height=4.6, ncol=2, wrap=58, gap=0.15):
+    """Legend under the axes (of ax's entries, for the whole figure), off the data, its long
+    labels wrapped: the axes keep the figure's width (beside them, a legend of long model labels
+    squeezed the plot to a strip). Lays the figure out, width x height inches of axes and below
+    them room for the legend's rows and a gap."""
     handles, labels = ax.get_legend_handles_labels()
     labels = [textwrap.fill(l, wrap, subsequent_indent="  ") for l in labels]
     fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize="small", frameon=False)
@@ -181,7 +182,7 @@ def legend_below(fig, ax, width=9.0, height=4.6, ncol=2, wrap=58):
     # labels r, r + rows, ...
     rows = math.ceil(len(labels) / ncol)
     lines = sum(max(labels[i].count("\n") + 1 for i in range(r, len(labels), rows)) for r in range(rows))
-    below = 0.18 * lines + 0.15
+    below = 0.18 * lines + gap
     fig.set_size_inches(width, height + below)
     fig.tight_layout(rect=(0, below / (height + below), 1, 1))
 
@@ -276,17 +277,8 @@ def velocity_figure(case, path):
     if off:
         title += "\noff scale, not drawn: " + "; ".join(off)
     fig.suptitle(title)
-    handles, labels = ax[0].get_legend_handles_labels()
     # long model labels wrapped, so that three columns fit the figure's width
-    labels = [textwrap.fill(l, 62, subsequent_indent="  ") for l in labels]
-    fig.legend(handles, labels, loc="lower center", ncol=3, fontsize="small", frameon=False)
-    # room below the panels for the legend's rows (about 0.18 inch per line; the columns are
-    # filled one after the other, so row r holds the labels r, r + rows and r + 2 rows) and a gap
-    rows = math.ceil(len(labels) / 3)
-    lines = sum(max(labels[i].count("\n") + 1 for i in range(r, len(labels), rows)) for r in range(rows))
-    below = 0.18 * lines + 0.12
-    fig.set_size_inches(12, 4.0 + below)
-    fig.tight_layout(rect=(0, below / (4.0 + below), 1, 1))
+    legend_below(fig, ax[0], width=12, height=4.0, ncol=3, wrap=62, gap=0.12)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 
