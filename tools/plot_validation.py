@@ -312,6 +312,8 @@ def order_text(e):
         return "not asymptotic: f0 + a h + b h² fitted" + (f" (three finest: order {obs:.2f})" if obs is not None else "")
     if e.get("method") == "lumen_fit":
         return "smeared lumen T0 (1 − a h)⁻⁴ fitted" + (f" (three finest: order {obs:.2f})" if obs is not None else "")
+    if e.get("within_time_error"):
+        return "grids within the time integration's error: finest grid, bounded at the lowest order"
     return "not asymptotic" + (f", observed order {obs:.2f}" if obs is not None else "")
 
 
@@ -947,14 +949,26 @@ def reference_markdown(c):
                    f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
                    f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {si(r.get('max_displacement_m'), 'm')} | "
                    f"{r.get('steps', '')} | {si(r.get('wall_time_s'), 's')}{' (cached)' if r.get('cached') else ''} |")
+    tc = ref.get("time_check")
+    if tc and tc.get("run"):
+        r = tc["run"]
+        out.append(f"| {json.dumps(r.get('grid_value'))}, axi.tolerance × {tc.get('factor', 0):g} (time check) | "
+                   f"{si(r['cell_size_m'], 'm')} | {r['status'][:60]} | "
+                   f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
+                   f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {si(r.get('max_displacement_m'), 'm')} | "
+                   f"{r.get('steps', '')} | {si(r.get('wall_time_s'), 's')}{' (cached)' if r.get('cached') else ''} |")
     out.append("")
+    if tc:
+        out.append(f"- time integration's error, inside each error bar below: {tc.get('note', '')}")
     for key, words, unit in FIGURE_WORDS:
         e = ref.get(key)
         if not e:
             continue
         rel = e.get("relative_error")
+        te = e.get("time_error")
         out.append(f"- {words}: {si(e['value'], unit)} ± {si(e['error'], unit)}"
-                   f"{'' if rel is None else f' (± {100 * rel:.2g} %)'}; {order_text(e)}; "
+                   f"{'' if rel is None else f' (± {100 * rel:.2g} %)'}"
+                   f"{'' if te is None else f', of which the time integration ± {si(te, unit)}'}; {order_text(e)}; "
                    f"{'converged' if e.get('converged') else 'not converged'}; {e.get('note', '')}")
         for q in e.get("phases", []):
             out.append(f"  - {q['phase']}: {si(q['value'], unit)} ± {si(q['error'], unit)}; {order_text(q)}")

@@ -20,6 +20,7 @@ json extrapolation_json(const Extrapolation& e) {
          {"order", num(e.order)},         {"observed_order", num(e.observed_order)},
          {"asymptotic", e.asymptotic},    {"method", e.method},
          {"note", e.note}};
+  if (e.within_time_error) j["within_time_error"] = true;
   // the fitted expansion f0 + a h + b h^2, in the figure's unit per m and per m^2 of h
   if (e.method == "expansion_fit") j["expansion"] = {{"f0", num(e.value)}, {"a_per_m", num(e.expansion_a)}, {"b_per_m2", num(e.expansion_b)}};
   // the fitted lumen model T0 (1 - a h)^-4, a per m of h
@@ -36,7 +37,15 @@ std::string percent_text(double x) {
 /// A figure of the reference converged: asymptotic, with an observed order (three grids),
 /// its relative error at most `target`.
 bool figure_converged(const Extrapolation& e, double rel, double target) {
-  return e.asymptotic && std::isfinite(e.observed_order) && std::isfinite(rel) && rel <= target;
+  return ((e.asymptotic && std::isfinite(e.observed_order)) || e.within_time_error) && std::isfinite(rel) &&
+         rel <= target;
+}
+
+/// A figure's time integration error from a time check's entry (NaN when it has none).
+double time_error_of(const json& tc, const char* key) {
+  if (!tc.is_object() || !tc.contains("errors") || !tc["errors"].contains(key) || !tc["errors"][key].is_number())
+    return std::numeric_limits<double>::quiet_NaN();
+  return tc["errors"][key].get<double>();
 }
 
 /// The cycle time as the sum of the protocol's phases (CycleFigures::phase_times_s), each
@@ -117,7 +126,45 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
   return ref;
 }
 
-json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target) {
+json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double factor) {
+  json tc = {{"factor", factor}, {"exponent", kAxiToleranceExponent}, {"errors", json::object()}};
+  char b[96];
+  std::snprintf(b, sizeof b, "axi.tolerance x %g", factor);
+  const std::string run = std::string("the coarsest grid again at ") + b;
+  if (!at_tolerance.cyc.has_cycle || !tighter.cyc.has_cycle) {
+    tc["note"] = run + ": " + (tighter.cyc.has_cycle ? "the reference's run" : "that run") +
+                 " completed no cycle, so the time integration's error is not estimated";
+    return tc;
+  }
+  const double scale = 1.0 / (1.0 - std::pow(factor, kAxiToleranceExponent));
+  json& e = tc["errors"];
+  auto put = [&](const char* key, double a, double t) {
+    if (std::isfinite(a) && std::isfinite(t)) e[key] = std::abs(a - t) * scale;
+  };
+  const record::CycleFigures &a = at_tolerance.cyc, &t = tighter.cyc;
+  put("displacement_per_cycle_m", a.displacement_per_cycle_m, t.displacement_per_cycle_m);
+  put("cycle_time_s", a.cycle_time_s, t.cycle_time_s);
+  put("mean_velocity_per_cycle_m_per_s", a.mean_velocity_per_cycle_m_per_s, t.mean_velocity_per_cycle_m_per_s);
+  put("max_displacement_m", at_tolerance.max_displacement, tighter.max_displacement);
+  if (!a.phase_times_s.empty() && a.phase_times_s.size() == t.phase_times_s.size()) {
+    json p = json::array();
+    for (std::size_t k = 0; k < a.phase_times_s.size(); ++k)
+      p.push_back(std::abs(a.phase_times_s[k] - t.phase_times_s[k]) * scale);
+    e["phase_times_s"] = p;
+  }
+  auto rel = [&](const char* key, double v) {
+    return e.contains(key) && v != 0 ? percent_text(e[key].get<double>() / std::abs(v)) : std::string("—");
+  };
+  std::snprintf(b, sizeof b, "%g", kAxiToleranceExponent);
+  tc["note"] = run + ": displacement per cycle ± " + rel("displacement_per_cycle_m", a.displacement_per_cycle_m) +
+               ", cycle time ± " + rel("cycle_time_s", a.cycle_time_s) + ", mean velocity per cycle ± " +
+               rel("mean_velocity_per_cycle_m_per_s", a.mean_velocity_per_cycle_m_per_s) +
+               " (each change over 1 - factor^" + b + ", the error at the reference's tolerance)";
+  return tc;
+}
+
+json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target,
+                   const json& time_check) {
   std::vector<double> h, d, T, v, hm, m;
   std::vector<std::vector<double>> phases;
   for (const auto& r : runs)
@@ -153,8 +200,18 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
                            {"mean_velocity_per_cycle_m_per_s", "mean velocity per cycle", &h, &v}};
   if (with_max && hm.size() >= 2) figs.push_back({"max_displacement_m", "maximum displacement", &hm, &m});
   for (const Fig& f : figs) {
-    const Extrapolation e = richardson(*f.hh, *f.f, assumed, orders);
+    Extrapolation e = richardson(*f.hh, *f.f, assumed, orders);
+    // the time integration's error: inside every figure's error; where the grids' differences
+    // lie within it they show no order, and the grid error is bounded at the lowest order instead
+    const double et = time_error_of(time_check, f.key);
+    if (std::isfinite(et)) {
+      if (auto b = bound_within_time_error(*f.hh, *f.f, et, orders))
+        e = *b;
+      else
+        e.error += et;
+    }
     json j = extrapolation_json(e);
+    if (std::isfinite(et)) j["time_error"] = et;
     const double rel = std::abs(e.value) > 0 ? std::abs(e.error / e.value) : std::numeric_limits<double>::quiet_NaN();
     j["relative_error"] = num(rel);
     j["converged"] = figure_converged(e, rel, target);
@@ -163,6 +220,23 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
   // three grids or more: the cycle time phase by phase when the whole cycle's series does not converge
   if (h.size() >= 3 && !ref["cycle_time_s"]["converged"].get<bool>()) {
     json ps = phase_sum_cycle_time(h, phases, assumed, orders, target);
+    if (!ps.is_null() && time_check.is_object()) {
+      // the phases' time errors add (the whole cycle's where the check has no phases)
+      double et = time_error_of(time_check, "cycle_time_s");
+      const json& tp = time_check["errors"].value("phase_times_s", json());
+      if (tp.is_array() && tp.size() == ps["phases"].size()) {
+        et = 0;
+        for (const json& x : tp) et += x.get<double>();
+      }
+      if (std::isfinite(et)) {
+        const double sum = ps["value"].get<double>(), err = ps["error"].get<double>() + et;
+        const double rel = std::abs(err / sum);
+        ps["error"] = num(err);
+        ps["relative_error"] = num(rel);
+        ps["time_error"] = et;
+        ps["converged"] = ps["converged"].get<bool>() && std::isfinite(rel) && rel <= target;
+      }
+    }
     if (!ps.is_null()) {
       ps["whole_cycle"] = ref["cycle_time_s"];
       ref["cycle_time_s"] = ps;
@@ -184,6 +258,9 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
                  {"converged", jd["converged"].get<bool>() && ps["converged"].get<bool>() && std::isfinite(rv) &&
                                    rv <= target},
                  {"direct", ref["mean_velocity_per_cycle_m_per_s"]}};
+      if (jd.contains("time_error") && ps.contains("time_error"))  // inside rv, as the errors are
+        jv["time_error"] = num(std::abs(vv) * (jd["time_error"].get<double>() / std::abs(dv) +
+                                               ps["time_error"].get<double>() / std::abs(tv)));
       ref["mean_velocity_per_cycle_m_per_s"] = jv;
     }
   }
@@ -196,6 +273,7 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
     std::string why;
     if (j.contains("phases")) why = " (the sum of its phases)";
     else if (j.contains("direct")) why = " (displacement over the phases' cycle time)";
+    else if (j.value("within_time_error", false)) why = " (grids within the time integration's error)";
     else if (!j["asymptotic"].get<bool>()) why = " (not in the asymptotic range)";
     else if (j["observed_order"].is_null()) why = " (two grids: no observed order)";
     const bool has_rel = j["relative_error"].is_number();
@@ -204,6 +282,16 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
   }
   ref["converged"] = all;
   ref["statement"] = std::string(all ? "converged to " : "not converged to ") + target_text + ": " + parts;
+  if (time_check.is_object()) {
+    ref["time_check"] = time_check;
+    const bool measured = !time_check["errors"].empty();
+    char b[64];
+    std::snprintf(b, sizeof b, "axi.tolerance x %g", time_check.value("factor", 0.0));
+    ref["statement"] = ref["statement"].get<std::string>() +
+                       (measured ? std::string("; the time integration's error included (the coarsest grid at ") + b + ")"
+                                 : std::string("; the time integration's error not estimated (its check at ") + b +
+                                       " completed no cycle)");
+  }
   return ref;
 }
 

@@ -29,8 +29,28 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
 /// converged when every figure is. When the whole cycle's time is not converged, it is taken
 /// as the sum of its phases, each extrapolated on its own, and the mean velocity per cycle as
 /// the displacement over that time (relative errors added); the whole cycle's extrapolation is
-/// kept beside it. `statement` says so with the figures reached.
-json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target);
+/// kept beside it. `statement` says so with the figures reached. With a `time_check`
+/// (axi_time_check's entry) each figure's error includes the time integration's.
+json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target,
+                   const json& time_check = nullptr);
+
+/// The lowest power of the step tolerance at which the axi tier's time integration error falls:
+/// its step control keeps the local error below tolerance x h with steps that scale as
+/// sqrt(tolerance), so the error over a cycle falls at least as tolerance^(1/2).
+constexpr double kAxiToleranceExponent = 0.5;
+
+/// The time integration's share of a reference's error, measured by running one reference grid
+/// again at a tighter step tolerance (axi.tolerance x `factor`, 0 < factor < 1): each figure's
+/// change between the two runs, |f(tol) - f(factor tol)|, is (1 - factor^q) times the error at
+/// the reference's tolerance when that error falls as tol^q, so the error at the reference's
+/// tolerance is taken as the change / (1 - factor^q) with q = kAxiToleranceExponent (the
+/// slowest fall; a faster one makes the error smaller). The entry (report.json
+/// "reference"."time_check"): the factor, the grid, each figure's time error ("errors": keys as
+/// the reference's figures, plus "phase_times_s", one per protocol phase) and a note; when
+/// either run has no cycle, "errors" is empty and the note says why. axi_reference adds each
+/// figure's time error to its error and, where the grids' differences lie within it, bounds the
+/// figure at the scheme's lowest order (bound_within_time_error).
+json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double factor);
 
 /// The 3D extrapolation (reference_3d's entry) against the axisymmetric reference, figure by
 /// figure: both values with their errors, the difference, e_3d + e_ref, agree / disagree

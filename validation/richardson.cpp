@@ -176,6 +176,36 @@ Extrapolation richardson(std::vector<double> h, std::vector<double> f, double as
   return e;
 }
 
+std::optional<Extrapolation> bound_within_time_error(std::vector<double> h, std::vector<double> f, double time_error,
+                                                     OrderRange range) {
+  if (h.size() != f.size())
+    throw InputError("validation grids", std::to_string(h.size()), "one value per grid");
+  if (h.size() < 3 || !(time_error > 0) || !std::isfinite(time_error)) return std::nullopt;
+  std::vector<double> hs, fs;
+  coarse_to_fine(h, f, hs, fs);
+  const std::size_t n = hs.size();
+  double bound = 0;
+  for (std::size_t k = n - 3; k + 1 < n; ++k) {
+    const double d = std::abs(fs[k] - fs[k + 1]);
+    if (!(d <= 2.0 * time_error)) return std::nullopt;
+    bound = std::max(bound, (d + 2.0 * time_error) / (std::pow(hs[k] / hs[k + 1], range.lo) - 1.0));
+  }
+  Extrapolation e;
+  e.value = fs.back();
+  e.error = bound + time_error;
+  e.order = 0;
+  e.asymptotic = false;
+  e.within_time_error = true;
+  e.method = "time_error_bound";
+  char b[200];
+  std::snprintf(b, sizeof b,
+                "the grids' differences lie within the time integration's error (2 x %.3g): finest grid, its grid error "
+                "bounded at the scheme's lowest order %g, plus the time integration's error",
+                time_error, range.lo);
+  e.note = b;
+  return e;
+}
+
 namespace {
 
 /// The least-squares fit f = f0 + a h + b h^2: (f0, a, b), with h in units of h_unit for the

@@ -16,6 +16,7 @@
 
 #include <functional>
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -50,7 +51,11 @@ struct Extrapolation {
   /// differences of opposite sign, or an order beyond the search bracket)
   double observed_order = std::numeric_limits<double>::quiet_NaN();
   bool asymptotic = false;
-  /// "richardson" (or two grids with the assumed order), "expansion_fit", "lumen_fit", "finest_grid"
+  /// the grid differences lie within the time integration's error, so no order is observed, and
+  /// the error is bounded at the scheme's lowest order instead (bound_within_time_error)
+  bool within_time_error = false;
+  /// "richardson" (or two grids with the assumed order), "expansion_fit", "lumen_fit",
+  /// "time_error_bound", "finest_grid"
   std::string method = "finest_grid";
   std::string note;      ///< how the value was obtained
   /// method "expansion_fit": the fitted a (per m of h) and b (per m^2) of f0 + a h + b h^2;
@@ -131,6 +136,21 @@ struct SumExtrapolation {
   bool converged = false;
   std::vector<Extrapolation> parts;
 };
+
+/// A series whose grid-to-grid differences are within the noise of its time integration. Each
+/// value carries up to `time_error` from the integrator's step tolerance, so when every
+/// difference between neighbouring grids among the finest three is at most 2 time_error, the
+/// differences say nothing about the order. The finest value's grid error is then bounded with
+/// the scheme's lowest order instead: with f(h) = f0 + C h^p and p >= range.lo, the finest
+/// value's error is d / ((h_a / h_b)^p - 1) for a pair of grids h_a > h_b whose true difference
+/// is d, at most (|f_a - f_b| + 2 time_error) / ((h_a / h_b)^range.lo - 1); the larger of the two
+/// pairs' bounds is kept. The result: the finest value, error = that bound + time_error,
+/// method "time_error_bound", `within_time_error` true, `asymptotic` false and `order` 0 (no
+/// order is observed). Nothing (std::nullopt) with fewer than three grids, a time_error that is
+/// not positive and finite, or a difference beyond 2 time_error. Throws InputError as
+/// richardson() for repeated spacings and mismatched sizes.
+std::optional<Extrapolation> bound_within_time_error(std::vector<double> h, std::vector<double> f, double time_error,
+                                                     OrderRange range);
 
 /// h: grid spacings; parts[g]: the parts on grid g (the same number on every grid, two or
 /// more), target: the relative error the sum must reach. Throws InputError as richardson(),

@@ -38,8 +38,9 @@ void check_reference(const json& ref, const std::string& at) {
                      "an object {\"tier\": \"axi\", \"grid_key\": \"axi.grid.cells_across\", \"grids\": [64, 128, 256], "
                      "\"order_range\": ..., \"set\": {...}}: the converged reference of the case");
   for (const auto& [k, v] : ref.items())
-    if (k != "tier" && k != "grid_key" && k != "grids" && k != "order_range" && k != "set")
-      throw InputError(at + "." + k, scene::show(v), "not a key of a reference: tier, grid_key, grids, order_range, set");
+    if (k != "tier" && k != "grid_key" && k != "grids" && k != "order_range" && k != "set" && k != "tolerance_check")
+      throw InputError(at + "." + k, scene::show(v),
+                       "not a key of a reference: tier, grid_key, grids, order_range, set, tolerance_check");
   const json& tier = member(ref, "tier", at);
   if (tier != "axi")
     throw InputError(at + ".tier", scene::show(tier),
@@ -61,6 +62,13 @@ void check_reference(const json& ref, const std::string& at) {
   if (ref.contains("order_range")) parse_order_range(ref["order_range"], at + ".order_range");
   if (ref.contains("set") && !ref["set"].is_object())
     throw InputError(at + ".set", scene::show(ref["set"]), "an object {\"dotted.key\": value} applied to the axi runs");
+  if (ref.contains("tolerance_check")) {
+    const json& f = ref["tolerance_check"];
+    if (!f.is_number() || !(f.get<double>() > 0 && f.get<double>() < 1))
+      throw InputError(at + ".tolerance_check", scene::show(f),
+                       "a number between 0 and 1 (exclusive): the factor on axi.tolerance of the run that measures the "
+                       "time integration's error on the coarsest grid (0.25: four times tighter)");
+  }
 }
 
 std::string key_list(std::initializer_list<const char*> keys) {
@@ -220,6 +228,15 @@ json reference_scene(const json& base, const json& ref, const json& grid) {
   json s = base;
   apply_sets(s, ref.value("set", json()));
   set_key(s, ref.value("grid_key", std::string("axi.grid.cells_across")), grid);
+  return s;
+}
+
+json tolerance_check_scene(const json& base, const json& ref) {
+  if (!ref.contains("tolerance_check")) return nullptr;
+  json s = reference_scene(base, ref, ref["grids"][0]);
+  json resolved;
+  const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
+  set_key(s, "axi.tolerance", ref["tolerance_check"].get<double>() * p.tolerance);
   return s;
 }
 
@@ -467,6 +484,8 @@ void check_suite(const json& s, const std::string& path, const std::string& data
       try {
         json resolved;
         axi::read_scene_axi(reference_scene(base, ref, g), resolved);
+        if (&g == &ref["grids"][0] && ref.contains("tolerance_check"))
+          axi::read_scene_axi(tolerance_check_scene(base, ref), resolved);
       } catch (const InputError& e) {
         throw InputError(at, scene_name + " at " + ref.value("grid_key", std::string("axi.grid.cells_across")) + " = " +
                                  g.dump(),

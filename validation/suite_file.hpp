@@ -52,6 +52,11 @@ std::vector<json> selected_cases(const json& suite, const std::vector<std::strin
 /// set, the grid.
 json reference_scene(const json& base, const json& ref, const json& grid);
 
+/// The scene of a reference's time check (its `tolerance_check` factor f): the coarsest grid's
+/// reference scene with axi.tolerance at f times the tolerance it resolves to. Null when the
+/// reference has no `tolerance_check`.
+json tolerance_check_scene(const json& base, const json& ref);
+
 /// The 3D tier's full3d.recovery_end when a scene does not set it (full3d/scene3d.cpp; a test
 /// checks the two agree).
 inline constexpr const char* kRecoveryEndDefault3d = "dead_band";

@@ -15,6 +15,7 @@
 #include "common/scene.hpp"
 #include "axi/scene_axi.hpp"
 #include "full3d/scene3d.hpp"
+#include "validation/extrapolated_reference.hpp"
 #include "validation/run_cache.hpp"
 #include "validation/suite.hpp"
 #include "validation/suite_file.hpp"
@@ -113,6 +114,9 @@ TEST(SuiteReference, BadValuesAreInputErrorsNamingTheKey) {
   expect_refused(write_suite("x.json", R"({"tier": "axi", "grids": [64, 128, 256], "set": 2})"),
                  {"suite.cases[0].reference.set", "an object"});
   expect_refused(write_suite("x.json", R"("axi")"), {"suite.cases[0].reference", "an object"});
+  for (const char* f : {"1.5", "0", "\"quarter\""})
+    expect_refused(write_suite("x.json", std::string(R"({"tier": "axi", "grids": [64, 128, 256], "tolerance_check": )") + f + "}"),
+                   {"suite.cases[0].reference.tolerance_check", "between 0 and 1"});
   expect_refused(write_suite("paper_amplitude_0.82.json", R"({"tier": "axi", "grids": [16, 24, 32]})",
                              R"("reference_target_relative": 2, )", kRound),
                  {"suite.reference_target_relative", "2", "between 0 and 1"});
@@ -265,6 +269,78 @@ TEST(SuiteReference, FindingsAreJudgedAgainstTheAxisymmetricReference) {
 // (round, geometric recovery end, fixed bending rigidity) on both tiers, and the 1D tier's design
 // targets for round walls, 10 / 15 / 15 % and 0.8. The paper's buckling wall is not in it: its
 // 3D series has not converged to a few percent (SuiteReference.TheShippedBucklingSuiteLoads).
+namespace {
+/// An axi run with a cycle on a grid of cell size h: its displacement, cycle time and two phases.
+RunAxi axi_run(double h, double d, double T, double first_phase) {
+  RunAxi r;
+  r.h = h;
+  r.ok = true;
+  r.cyc.has_cycle = true;
+  r.cyc.cycles_completed = 1;
+  r.cyc.displacement_per_cycle_m = d;
+  r.cyc.cycle_time_s = T;
+  r.cyc.mean_velocity_per_cycle_m_per_s = d / T;
+  r.cyc.phase_times_s = {first_phase, T - first_phase};
+  return r;
+}
+}  // namespace
+
+// The time integration's share of a reference's error (the coarsest grid again at axi.tolerance
+// x 0.25). The displacement's grid differences (6 and 8 pm on 40 nm) lie within its time error
+// (2 x 4 pm): without the check it is "not in the asymptotic range" and the reference not
+// converged; with it, the finest value with the lowest order's bound plus the time error,
+// converged to 1 %. The cycle time, an exact order-2 series, keeps its Richardson value and
+// gains exactly its time error. A check whose run completed no cycle changes no error bar.
+TEST(SuiteReference, TheReferencesErrorIncludesTheTimeIntegrations) {
+  const double h1 = 31.25 * nm, h2 = 20.8333 * nm, h3 = 15.625 * nm;
+  auto T = [&](double h) { return 0.3 + 0.0009 * (h / h3) * (h / h3); };
+  const std::vector<RunAxi> runs = {axi_run(h1, 40.170 * nm, T(h1), 0.1), axi_run(h2, 40.176 * nm, T(h2), 0.1),
+                                    axi_run(h3, 40.168 * nm, T(h3), 0.1)};
+  RunAxi tight = runs[0];
+  tight.cyc.displacement_per_cycle_m = 40.166 * nm;  // 4 pm: the error at the reference's tolerance 8 pm
+  tight.cyc.cycle_time_s += 1e-4;
+  tight.cyc.mean_velocity_per_cycle_m_per_s = tight.cyc.displacement_per_cycle_m / tight.cyc.cycle_time_s;
+  tight.cyc.phase_times_s = {0.1, tight.cyc.cycle_time_s - 0.1};
+
+  const json tc = axi_time_check(runs[0], tight, 0.25);
+  EXPECT_NEAR(tc["errors"]["displacement_per_cycle_m"].get<double>(), 8e-12, 1e-17);  // 4 pm / (1 - 0.25^0.5)
+  EXPECT_NEAR(tc["errors"]["cycle_time_s"].get<double>(), 2e-4, 1e-12);
+  ASSERT_EQ(tc["errors"]["phase_times_s"].size(), 2u);
+  EXPECT_NEAR(tc["errors"]["phase_times_s"][1].get<double>(), 2e-4, 1e-12);
+
+  const json plain = axi_reference(runs, kSharpInterfaceOrders, false, 0.01);
+  const json with = axi_reference(runs, kSharpInterfaceOrders, false, 0.01, tc);
+  EXPECT_FALSE(plain["displacement_per_cycle_m"]["asymptotic"].get<bool>());
+  EXPECT_FALSE(plain["displacement_per_cycle_m"]["converged"].get<bool>());
+  EXPECT_FALSE(plain["converged"].get<bool>());
+  const json& d = with["displacement_per_cycle_m"];
+  EXPECT_TRUE(d["within_time_error"].get<bool>());
+  EXPECT_TRUE(d["converged"].get<bool>());
+  EXPECT_DOUBLE_EQ(d["value"].get<double>(), 40.168 * nm);
+  // pairs: (6 + 16) pm / (1.5 - 1) = 44 pm, (8 + 16) pm / (1.3333 - 1) = 72 pm; plus 8 pm
+  EXPECT_NEAR(d["error"].get<double>(), 80e-12, 0.1e-12);
+  EXPECT_TRUE(with["converged"].get<bool>());
+  EXPECT_NE(with["statement"].get<std::string>().find("the time integration's error included"), std::string::npos);
+  EXPECT_NE(with["statement"].get<std::string>().find("within the time integration's error"), std::string::npos);
+  const json &cp = plain["cycle_time_s"], &cw = with["cycle_time_s"];
+  EXPECT_TRUE(cw["asymptotic"].get<bool>());
+  EXPECT_NEAR(cw["observed_order"].get<double>(), 2.0, 1e-6);
+  EXPECT_DOUBLE_EQ(cw["value"].get<double>(), cp["value"].get<double>());
+  EXPECT_NEAR(cw["error"].get<double>(), cp["error"].get<double>() + 2e-4, 1e-12);
+  EXPECT_EQ(with["time_check"]["factor"], 0.25);
+
+  RunAxi none = tight;
+  none.cyc.has_cycle = false;
+  const json tn = axi_time_check(runs[0], none, 0.25);
+  EXPECT_TRUE(tn["errors"].empty());
+  EXPECT_NE(tn["note"].get<std::string>().find("completed no cycle"), std::string::npos);
+  const json wn = axi_reference(runs, kSharpInterfaceOrders, false, 0.01, tn);
+  EXPECT_EQ(wn["displacement_per_cycle_m"]["error"], plain["displacement_per_cycle_m"]["error"]);
+  EXPECT_EQ(wn["cycle_time_s"]["error"], plain["cycle_time_s"]["error"]);
+  EXPECT_FALSE(wn["converged"].get<bool>());
+  EXPECT_NE(wn["statement"].get<std::string>().find("the time integration's error not estimated"), std::string::npos);
+}
+
 TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
   const json s = load_suite(SWIM_SOURCE_DIR "/data/validation/converged.json", SWIM_SOURCE_DIR "/data");
   ASSERT_EQ(s["cases"].size(), 6u);

@@ -11,7 +11,9 @@
 #include <fstream>
 
 #include "common/scene.hpp"
+#include "axi/scene_axi.hpp"
 #include "validation/suite.hpp"
+#include "validation/suite_file.hpp"
 #include "validation/verdicts.hpp"
 
 using namespace swim;
@@ -22,10 +24,10 @@ namespace {
 
 /// The suite: the round-wall scene, 3D on 12, 14, 16 cells across, the axi reference on 16, 24,
 /// 32 cells across (the immersed-boundary method: seconds per grid), one 1D model.
-json make_suite(const json& axi_set) {
+json make_suite(const json& axi_set, double tolerance_check = 0) {
   json set = {{"axi.method", "immersed_boundary"}};
   set.update(axi_set);
-  return {{"name", "reference_e2e"},
+  json s = {{"name", "reference_e2e"},
           {"thresholds",
            {{"displacement_per_cycle_relative", 0.25},
             {"cycle_time_relative", 0.5},
@@ -50,6 +52,8 @@ json make_suite(const json& axi_set) {
            {{{"label", "force-free, confined, sharp wall"},
              {"calibrated", false},
              {"set", {{"model1d.model", "force_free"}, {"model1d.outer_flow", "confined"}}}}}}};
+  if (tolerance_check > 0) s["cases"][0]["reference"]["tolerance_check"] = tolerance_check;
+  return s;
 }
 
 }  // namespace
@@ -168,6 +172,44 @@ TEST(ReferenceSuite, TheAxiSeriesIsTheReferenceOfTheCase) {
     EXPECT_FALSE(r3["cases"][0]["reference"]["runs"][g]["cached"].get<bool>()) << g;
     EXPECT_TRUE(r3["cases"][0]["runs3d"][g]["cached"].get<bool>()) << g;
   }
+
+  // the time check: the coarsest grid again at half its step tolerance, a run of its own (the
+  // three grids come from the cache of the first run); its change, over 1 - 0.5^0.5, is each
+  // figure's time error, inside the figure's error
+  std::ofstream(out + "/suite.json") << make_suite(json::object(), 0.5).dump(2);
+  const json r4 = validation::run_suite(o);
+  const json& ref4 = r4["cases"][0]["reference"];
+  for (std::size_t g = 0; g < 3; ++g) EXPECT_TRUE(ref4["runs"][g]["cached"].get<bool>()) << g;
+  ASSERT_TRUE(ref4.contains("time_check")) << ref4.dump().substr(0, 1000);
+  const json& tc = ref4["time_check"];
+  EXPECT_FALSE(tc["run"]["cached"].get<bool>());
+  EXPECT_EQ(tc["grid_value"], 16);
+  ASSERT_TRUE(tc["run"]["has_cycle"].get<bool>()) << tc.dump().substr(0, 1000);
+  const double change = std::abs(tc["run"]["displacement_per_cycle_m"].get<double>() -
+                                 ref4["runs"][0]["displacement_per_cycle_m"].get<double>());
+  EXPECT_NEAR(tc["errors"]["displacement_per_cycle_m"].get<double>(), change / (1.0 - std::sqrt(0.5)), 1e-6 * change + 1e-18);
+  for (const char* k : {"displacement_per_cycle_m", "cycle_time_s", "mean_velocity_per_cycle_m_per_s"}) {
+    ASSERT_TRUE(ref4[k]["time_error"].is_number()) << k;
+    EXPECT_GE(ref4[k]["error"].get<double>(), ref4[k]["time_error"].get<double>()) << k;
+  }
+  EXPECT_NE(ref4["statement"].get<std::string>().find("the time integration's error included"), std::string::npos);
+  // the check run's scene: the coarsest grid's with half the tolerance the axi tier resolves
+  const json cs = validation::tolerance_check_scene(scene::load_file(out + "/round_0.82.json"),
+                                                    make_suite(json::object(), 0.5)["cases"][0]["reference"]);
+  json resolved;
+  const axi::ParamsAxi p = axi::read_scene_axi(cs, resolved);
+  json base_resolved;
+  const axi::ParamsAxi p0 = axi::read_scene_axi(
+      validation::reference_scene(scene::load_file(out + "/round_0.82.json"),
+                                  make_suite(json::object())["cases"][0]["reference"], 16),
+      base_resolved);
+  EXPECT_DOUBLE_EQ(p.tolerance, 0.5 * p0.tolerance);
+  EXPECT_EQ(p.nr, p0.nr);
+  // planned as a job of its own under MPI
+  const json plan = validation::plan_runs(o);
+  int axi_jobs = 0;
+  for (const json& j : plan) axi_jobs += j["job"]["type"] == "axi";
+  EXPECT_EQ(axi_jobs, 4);
 }
 
 // `swim validate --case NAME`: a name selects the cases of that scene file (with or without

@@ -264,6 +264,61 @@ void sample(double T, double sign, std::vector<double>& t, std::vector<double>& 
 
 // A velocity history and the same history on a cycle 4x longer: identical against phase,
 // different against time. A mirrored history anticorrelates.
+// Grids whose differences lie within the time integration's noise: f(h) = f0 + C h^p with p in
+// the scheme's range, each value off by up to e_t (the step tolerance's error). Wherever the
+// bound applies, the finest value's distance to f0 is within the error it states; over draws
+// of noise and orders it applies in some and is refused in others (differences beyond 2 e_t).
+// The bound is the lowest order's: with the highest order's in its place the error bars miss f0.
+TEST(TimeErrorBound, CoversTheLimitWhereTheGridsDifferencesAreNoise) {
+  const std::vector<double> h = {31.25, 20.8333, 15.625};
+  const double f0 = 40.0, et = 0.01;
+  unsigned state = 12345;
+  auto uniform = [&] {  // [-1, 1), a fixed sequence
+    state = state * 1664525u + 1013904223u;
+    return 2.0 * (state >> 8) / double(1u << 24) - 1.0;
+  };
+  int applied = 0, refused = 0, missed_at_hi = 0;
+  for (int draw = 0; draw < 2000; ++draw) {
+    const double p = kSharpInterfaceOrders.lo + (uniform() + 1.0) / 2.0 * (kSharpInterfaceOrders.hi - kSharpInterfaceOrders.lo);
+    const double E3 = (uniform() + 1.0) * 4.0 * et;  // the finest grid's error, 0 to 8 e_t
+    std::vector<double> f;
+    for (double x : h) f.push_back(f0 + E3 * std::pow(x / h.back(), p) + et * uniform());
+    const auto b = bound_within_time_error(h, f, et, kSharpInterfaceOrders);
+    if (!b) {
+      ++refused;
+      continue;
+    }
+    ++applied;
+    EXPECT_TRUE(b->within_time_error);
+    EXPECT_FALSE(b->asymptotic);
+    EXPECT_EQ(b->method, "time_error_bound");
+    EXPECT_DOUBLE_EQ(b->value, f.back());
+    EXPECT_LE(std::abs(b->value - f0), b->error) << "p = " << p << ", E3 = " << E3;
+    // the same bound with the highest order would claim too little
+    const auto hi = bound_within_time_error(h, f, et, OrderRange{kSharpInterfaceOrders.hi - 1e-9, kSharpInterfaceOrders.hi});
+    if (hi && std::abs(hi->value - f0) > hi->error) ++missed_at_hi;
+  }
+  EXPECT_GT(applied, 100);
+  EXPECT_GT(refused, 100);
+  EXPECT_GT(missed_at_hi, 0);
+}
+
+// The bound's arithmetic on one series, and where it is refused: a difference beyond 2 e_t, two
+// grids, a time error that is zero or not finite.
+TEST(TimeErrorBound, IsTheLowestOrdersBoundAndIsRefusedBeyondTheNoise) {
+  // grids 3, 2, 1 (ratios 1.5 and 2), differences 0.01 and 0.015, e_t = 0.01, order range [1, 3.5]
+  const auto b = bound_within_time_error({3, 2, 1}, {10.0, 10.01, 9.995}, 0.01, kSharpInterfaceOrders);
+  ASSERT_TRUE(b.has_value());
+  // pairs: (0.01 + 0.02) / (1.5 - 1) = 0.06 and (0.015 + 0.02) / (2 - 1) = 0.035; the larger, plus e_t
+  EXPECT_NEAR(b->error, 0.06 + 0.01, 1e-12);
+  EXPECT_DOUBLE_EQ(b->value, 9.995);
+  EXPECT_FALSE(bound_within_time_error({3, 2, 1}, {10.0, 10.03, 10.02}, 0.01, kSharpInterfaceOrders).has_value());
+  EXPECT_FALSE(bound_within_time_error({2, 1}, {10.0, 10.001}, 0.01, kSharpInterfaceOrders).has_value());
+  EXPECT_FALSE(bound_within_time_error({3, 2, 1}, {10.0, 10.0, 10.0}, 0.0, kSharpInterfaceOrders).has_value());
+  EXPECT_FALSE(bound_within_time_error({3, 2, 1}, {10.0, 10.0, 10.0}, std::nan(""), kSharpInterfaceOrders).has_value());
+  EXPECT_THROW(bound_within_time_error({3, 2}, {10.0, 10.0, 10.0}, 0.01, kSharpInterfaceOrders), InputError);
+}
+
 TEST(CompareSeries, PhaseNormalisationAndCorrelation) {
   std::vector<double> t1, u1, t2, u2, t3, u3;
   sample(1.0, 1.0, t1, u1);
