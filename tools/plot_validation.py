@@ -313,7 +313,7 @@ def order_text(e):
     if e.get("method") == "lumen_fit":
         return "smeared lumen T0 (1 − a h)⁻⁴ fitted" + (f" (three finest: order {obs:.2f})" if obs is not None else "")
     if e.get("within_time_error"):
-        return "grids within the time integration's error: finest grid, bounded at the lowest order"
+        return "within the time integration's error: bounded"
     return "not asymptotic" + (f", observed order {obs:.2f}" if obs is not None else "")
 
 
@@ -385,7 +385,8 @@ def reference_convergence_figure(case, path):
         ax.grid(alpha=0.3)
         # each panel's legend below it, off the data: the orders differ from figure to figure
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize="small", frameon=False)
-    statement = "\n".join(textwrap.wrap(ref.get("statement", ""), 150))
+    # the statement wrapped to the figure's width (about 9 characters per inch at this size)
+    statement = "\n".join(textwrap.wrap(ref.get("statement", ""), int(9 * 5.4 * len(panels))))
     fig.suptitle(f"{case['name']}: grid convergence of the 3D tier and the axisymmetric reference\n{statement}",
                  fontsize=10)
     fig.tight_layout()

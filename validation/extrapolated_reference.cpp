@@ -129,7 +129,7 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
 json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double factor) {
   json tc = {{"factor", factor}, {"exponent", kAxiToleranceExponent}, {"errors", json::object()}};
   char b[96];
-  std::snprintf(b, sizeof b, "axi.tolerance x %g", factor);
+  std::snprintf(b, sizeof b, "axi.tolerance × %g", factor);
   const std::string run = std::string("the coarsest grid again at ") + b;
   if (!at_tolerance.cyc.has_cycle || !tighter.cyc.has_cycle) {
     tc["note"] = run + ": " + (tighter.cyc.has_cycle ? "the reference's run" : "that run") +
@@ -155,11 +155,11 @@ json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double fa
   auto rel = [&](const char* key, double v) {
     return e.contains(key) && v != 0 ? percent_text(e[key].get<double>() / std::abs(v)) : std::string("—");
   };
-  std::snprintf(b, sizeof b, "%g", kAxiToleranceExponent);
+  std::snprintf(b, sizeof b, "%g^%g", factor, kAxiToleranceExponent);
   tc["note"] = run + ": displacement per cycle ± " + rel("displacement_per_cycle_m", a.displacement_per_cycle_m) +
                ", cycle time ± " + rel("cycle_time_s", a.cycle_time_s) + ", mean velocity per cycle ± " +
                rel("mean_velocity_per_cycle_m_per_s", a.mean_velocity_per_cycle_m_per_s) +
-               " (each change over 1 - factor^" + b + ", the error at the reference's tolerance)";
+               " (each change / (1 − " + b + "): the error at the reference's tolerance)";
   return tc;
 }
 
@@ -286,7 +286,7 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
     ref["time_check"] = time_check;
     const bool measured = !time_check["errors"].empty();
     char b[64];
-    std::snprintf(b, sizeof b, "axi.tolerance x %g", time_check.value("factor", 0.0));
+    std::snprintf(b, sizeof b, "axi.tolerance × %g", time_check.value("factor", 0.0));
     ref["statement"] = ref["statement"].get<std::string>() +
                        (measured ? std::string("; the time integration's error included (the coarsest grid at ") + b + ")"
                                  : std::string("; the time integration's error not estimated (its check at ") + b +

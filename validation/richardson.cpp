@@ -199,7 +199,7 @@ std::optional<Extrapolation> bound_within_time_error(std::vector<double> h, std:
   e.method = "time_error_bound";
   char b[200];
   std::snprintf(b, sizeof b,
-                "the grids' differences lie within the time integration's error (2 x %.3g): finest grid, its grid error "
+                "the grids' differences lie within the time integration's error (2 × %.3g): finest grid, its grid error "
                 "bounded at the scheme's lowest order %g, plus the time integration's error",
                 time_error, range.lo);
   e.note = b;

@@ -282,7 +282,7 @@ std::vector<RunAxi> axi_reference_study(const SuiteCase& c, const json& suite, c
   // the time integration's share of the error: the coarsest grid again at a tighter step tolerance
   json time_check = nullptr;
   if (const json ts = tolerance_check_scene(c.base, rs); !ts.is_null()) {
-    say(c.tag + ": axi reference time check (" + rkey + " = " + rgrids[0].dump() + " at axi.tolerance x " +
+    say(c.tag + ": axi reference time check (" + rkey + " = " + rgrids[0].dump() + " at axi.tolerance × " +
         rs["tolerance_check"].dump() + ")");
     RunAxi r = cache.run_axi(ts, progress);
     r.record["grid_value"] = rgrids[0];
