@@ -231,9 +231,20 @@ json reference_scene(const json& base, const json& ref, const json& grid) {
   return s;
 }
 
+std::size_t coarsest_reference_grid(const json& base, const json& ref) {
+  std::size_t best = 0;
+  double h = 0;
+  for (std::size_t g = 0; g < ref["grids"].size(); ++g) {
+    json resolved;
+    const double hg = axi::read_scene_axi(reference_scene(base, ref, ref["grids"][g]), resolved).h;
+    if (hg > h) h = hg, best = g;
+  }
+  return best;
+}
+
 json tolerance_check_scene(const json& base, const json& ref) {
   if (!ref.contains("tolerance_check")) return nullptr;
-  json s = reference_scene(base, ref, ref["grids"][0]);
+  json s = reference_scene(base, ref, ref["grids"][coarsest_reference_grid(base, ref)]);
   json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
   set_key(s, "axi.tolerance", ref["tolerance_check"].get<double>() * p.tolerance);

@@ -52,6 +52,10 @@ std::vector<json> selected_cases(const json& suite, const std::vector<std::strin
 /// set, the grid.
 json reference_scene(const json& base, const json& ref, const json& grid);
 
+/// The index in `grids` of a reference's coarsest grid (the largest cell size the axi tier
+/// resolves), whatever the order the grids are listed in.
+std::size_t coarsest_reference_grid(const json& base, const json& ref);
+
 /// The scene of a reference's time check (its `tolerance_check` factor f): the coarsest grid's
 /// reference scene with axi.tolerance at f times the tolerance it resolves to. Null when the
 /// reference has no `tolerance_check`.

@@ -282,12 +282,13 @@ std::vector<RunAxi> axi_reference_study(const SuiteCase& c, const json& suite, c
   // the time integration's share of the error: the coarsest grid again at a tighter step tolerance
   json time_check = nullptr;
   if (const json ts = tolerance_check_scene(c.base, rs); !ts.is_null()) {
-    say(c.tag + ": axi reference time check (" + rkey + " = " + rgrids[0].dump() + " at axi.tolerance × " +
+    const std::size_t g0 = coarsest_reference_grid(c.base, rs);
+    say(c.tag + ": axi reference time check (" + rkey + " = " + rgrids[g0].dump() + " at axi.tolerance × " +
         rs["tolerance_check"].dump() + ")");
     RunAxi r = cache.run_axi(ts, progress);
-    r.record["grid_value"] = rgrids[0];
-    time_check = axi_time_check(aruns.front(), r, rs["tolerance_check"].get<double>());
-    time_check["grid_value"] = rgrids[0];
+    r.record["grid_value"] = rgrids[g0];
+    time_check = axi_time_check(aruns[g0], r, rs["tolerance_check"].get<double>());
+    time_check["grid_value"] = rgrids[g0];
     time_check["run"] = r.record;
   }
   cr["reference"] = axi_reference(aruns, rorders, c.paper_max, target, time_check);
