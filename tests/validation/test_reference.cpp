@@ -341,6 +341,22 @@ TEST(SuiteReference, TheReferencesErrorIncludesTheTimeIntegrations) {
   EXPECT_NE(wn["statement"].get<std::string>().find("the time integration's error not estimated"), std::string::npos);
 }
 
+// The time check runs the reference's coarsest grid, whatever the order the grids are listed in,
+// at the factor times the step tolerance that grid resolves to; a reference without the key has none.
+TEST(SuiteReference, TheTimeCheckRunsTheCoarsestGrid) {
+  json base = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");
+  apply_sets(base, json::parse(kRound));
+  const json ref = {{"tier", "axi"}, {"grids", {24, 16, 32}}, {"tolerance_check", 0.25}};
+  EXPECT_EQ(coarsest_reference_grid(base, ref), 1u);
+  json r16, rc;
+  const axi::ParamsAxi p16 = axi::read_scene_axi(reference_scene(base, ref, 16), r16);
+  const axi::ParamsAxi pc = axi::read_scene_axi(tolerance_check_scene(base, ref), rc);
+  EXPECT_DOUBLE_EQ(pc.h, p16.h);
+  EXPECT_DOUBLE_EQ(pc.tolerance, 0.25 * p16.tolerance);
+  EXPECT_NE(run_key_axi(rc), run_key_axi(r16));
+  EXPECT_TRUE(tolerance_check_scene(base, json{{"tier", "axi"}, {"grids", {16, 24, 32}}}).is_null());
+}
+
 TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
   const json s = load_suite(SWIM_SOURCE_DIR "/data/validation/converged.json", SWIM_SOURCE_DIR "/data");
   ASSERT_EQ(s["cases"].size(), 6u);
@@ -351,6 +367,11 @@ TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
     EXPECT_EQ(ref["tier"], "axi");
     EXPECT_EQ(ref["grids"], json::array({16, 24, 32}));
     EXPECT_EQ(ref["order_range"], "sharp_interface");
+    EXPECT_EQ(ref["tolerance_check"], 0.25);  // its error bars hold the time integration's error
+    // the L = 0.2 um reference at a quarter of the default step tolerance, which it needs to
+    // reach 1 % with that error inside its bars
+    if (c["set"]["name"] == "paper_aspect_L0.2_round_wall") EXPECT_EQ(ref["set"]["axi.tolerance"], 5e-4);
+    else EXPECT_FALSE(ref["set"].contains("axi.tolerance"));
     for (const json* set : {&c["set"], &ref["set"]}) {
       EXPECT_EQ((*set)["full3d.membrane.axisymmetric"], true);
       EXPECT_EQ((*set)["full3d.recovery_end"], "shape");
