@@ -314,7 +314,8 @@ void bench_1d(scene::json& report, bool quick, int reps, unsigned cores) {
                                  std::pair{200, std::string("model1d.outer_flow=\"unbounded\"")},
                                  std::pair{200, std::string("model1d.model=\"paper\"")},
                                  std::pair{50, std::string("numerics1d.rtol=1e-6")},
-                                 std::pair{50, std::string("numerics1d.open_end=\"continued\"")}}) {
+                                 std::pair{50, std::string("numerics1d.open_end=\"continued\"")},
+                                 std::pair{50, std::string("numerics1d.threads=2")}}) {
     std::vector<std::string> sets = {"numerics1d.cells=" + std::to_string(cells), "protocol.cycles=1",
                                      "time.duration=\"auto\"", v};
     if (v.find("paper") != std::string::npos) sets.push_back("model1d.outer_flow=null");

@@ -334,9 +334,11 @@ int run(const RunOptions& o) {
                          "1 or 2 with --tier axi (axi.threads: the second thread factors the systems the first solves)");
       scene::apply_override(sc, "axi.threads=" + std::to_string(o.threads));
     } else if (o.tier != "3d") {
-      throw InputError("--threads", std::to_string(o.threads),
-                       "only the 3D and axisymmetric tiers run on several threads (full3d.threads, axi.threads); add "
-                       "--tier 3d or --tier axi, or leave --threads out");
+      if (o.threads > 2)
+        throw InputError("--threads", std::to_string(o.threads),
+                         "1 or 2 with the 1D tier (numerics1d.threads: the second thread evaluates the force-driven "
+                         "run's output samples while the first integrates); more with --tier 3d");
+      scene::apply_override(sc, "numerics1d.threads=" + std::to_string(o.threads));
     } else {
       scene::apply_override(sc, "full3d.threads=" + std::to_string(o.threads));
     }

@@ -18,6 +18,7 @@
 #include "reduced1d/integrator.hpp"
 #include "reduced1d/internal.hpp"
 #include "reduced1d/protocol.hpp"
+#include "reduced1d/sample_pipe.hpp"
 #include "reduced1d/sundials.hpp"
 
 namespace swim::reduced1d::detail {
@@ -130,7 +131,18 @@ class EventLoop {
   bool switch_protocol();
   void install_laws();
   void check_end_radii(double t) const;
+  /// The output sample at time t of state y: evaluated here, or handed to the sample thread
+  /// (false: a non-finite sample, here or, found now, on the sample thread earlier).
   bool record(double t, const double* y);
+  /// Evaluates and emits the sample into the scratch state st (the velocity quadrature's
+  /// integrals qv and the protocol's phase taken at t).
+  bool sample(double t, const double* y, const VelocityQuadrature::V3& qv, int phase, ModelState& st);
+  /// Waits for the sample thread; false when one of its samples was not finite.
+  bool sync_samples();
+  /// The failure a run with its samples on this thread would have stopped on first: the
+  /// sample thread's non-finite sample, when there is one before e's time.
+  NumericalError first_failure(const NumericalError& e);
+  NumericalError non_finite_state(double t) const;
   const double* cell_radii(const double* y);
   NumericalError integrator_failure(const sun::SundialsError& e) const;
 
@@ -153,6 +165,13 @@ class EventLoop {
   std::unique_ptr<Integrator> be_;
   VelocityQuadrature vq_;
   Result res_;
+  // The sample thread (numerics1d.threads = 2) and its scratch state; declared last, so that
+  // it stops before anything its samples use is destroyed.
+  ModelState sample_state_;
+  std::vector<double> sample_y_;  // the sample thread's state (the unknowns it reads in place)
+  int sample_unknowns_ = 0;       // leading unknowns of a cell that a sample reads
+  double sample_failed_at_ = 0;  // time of the sample thread's non-finite sample
+  std::unique_ptr<SamplePipe> samples_;
 };
 
 EventLoop::EventLoop(const Params& P, std::vector<double> fixed_q, double t_fixed_end, const Output& out,
@@ -170,6 +189,28 @@ EventLoop::EventLoop(const Params& P, std::vector<double> fixed_q, double t_fixe
     res_.stats[k] = 0;
   res_.z.resize(M_.N);
   for (int i = 0; i < M_.N; ++i) res_.z[i] = (i + 0.5) * M_.h;
+  if (P.numerics.threads >= 2) {
+    // A record: the unknowns a sample reads, then t, the quadrature's three integrals and the
+    // phase. The sample thread puts the unknowns back in place in a state of its own.
+    sample_state_ = M_.make_state();
+    sample_y_.assign(M_.n, 0.0);
+    sample_unknowns_ = M_.dae ? 3 : 1;
+    const int width = 1 + sample_unknowns_ * M_.N + (M_.n - M_.iVf);
+    samples_ = std::make_unique<SamplePipe>(std::size_t(width + 5), [this, width](const double* r) {
+      const int S = M_.stride, w = sample_unknowns_, N = M_.N;
+      double* y = sample_y_.data();
+      const double* c = r;
+      y[M_.iVr] = *c++;
+      for (int i = 0; i < N; ++i)
+        for (int j = 0; j < w; ++j) y[1 + S * i + j] = *c++;
+      for (int k = M_.iVf; k < M_.n; ++k) y[k] = *c++;
+      const double* h = r + width;
+      const VelocityQuadrature::V3 qv = {h[1], h[2], h[3]};
+      if (sample(h[0], y, qv, int(h[4]), sample_state_)) return true;
+      sample_failed_at_ = h[0];
+      return false;
+    });
+  }
   if (fixed_) {
     t_stop_ = t_fixed_end;
   } else if (P.duration > 0) {
@@ -191,12 +232,9 @@ Result EventLoop::run() {
         if (switch_protocol()) break;
         continue;
       }
-      if (!record(t_, be_->y()))
-        throw NumericalError("non-finite state", P_.numerics.cells < 100000
-                                                     ? "tighten numerics1d.rtol or refine numerics1d.cells"
-                                                     : "tighten numerics1d.rtol",
-                             t_);
+      if (!record(t_, be_->y())) throw non_finite_state(t_);
       if (tout >= t_stop_) {
+        if (!sync_samples()) throw non_finite_state(t_);
         if (stop_fails_)
           throw NumericalError(
               "the protocol did not complete " + std::to_string(P_.protocol.cycles) +
@@ -207,10 +245,11 @@ Result EventLoop::run() {
       }
       ++k;
     }
+    if (!sync_samples()) throw non_finite_state(t_);
   } catch (const NumericalError& e) {
-    res_.failure = e;
+    res_.failure = first_failure(e);
   } catch (const sun::SundialsError& e) {
-    res_.failure = integrator_failure(e);
+    res_.failure = first_failure(integrator_failure(e));
   }
   // harvest adds only the counters since the last restart, and every restart is preceded
   // by a harvest: nothing is counted twice.
@@ -235,7 +274,9 @@ void EventLoop::start() {
     vq_.restart(0.0, vq_.integrand(M_, pb_->state, be_->y()));
     be_->on_step = [this](double tn, const double* y) { vq_.step(tn, vq_.integrand(M_, pb_->state, y)); };
   }
-  if (!record(0.0, be_->y())) {
+  // (the first sample on this thread: its failure is the initial state's)
+  if (!sample(0.0, be_->y(), M_.velocity_quadrature ? vq_.at(0.0) : VelocityQuadrature::V3{}, machine_.phase(),
+              pb_->state)) {
     check_end_radii(0.0);  // an open end without a positive rest radius is the usual cause
     throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
   }
@@ -278,6 +319,9 @@ int EventLoop::advance(double tout) {
 
 bool EventLoop::switch_protocol() {
   const double t = t_;
+  // The switch changes the laws the samples are evaluated with, and its events follow the
+  // samples before it.
+  if (!sync_samples()) throw non_finite_state(t);
   // the partial step up to the root, with the laws in force before the switch
   if (M_.velocity_quadrature) vq_.step(t, vq_.integrand(M_, pb_->state, be_->y()));
   found_.assign(std::max(machine_.root_count(), 2), 0);
@@ -385,7 +429,53 @@ void EventLoop::check_end_radii(double t) const {
 }
 
 bool EventLoop::record(double tt, const double* y) {
-  ModelState& st = pb_->state;
+  const VelocityQuadrature::V3 qv = M_.velocity_quadrature ? vq_.at(tt) : VelocityQuadrature::V3{};
+  if (!samples_) return sample(tt, y, qv, machine_.phase(), pb_->state);
+  if (samples_->failed()) return sync_samples();
+  // The unknowns a sample reads (sample_unknowns_): a cell's cross-section, and its velocity
+  // and pressure where they are unknowns, not its traction fields or curvature; a third of
+  // the state to carry to the other core.
+  double* r = samples_->slot();
+  const int S = M_.stride, w = sample_unknowns_, N = M_.N;
+  double* c = r;
+  *c++ = y[M_.iVr];
+  for (int i = 0; i < N; ++i)
+    for (int j = 0; j < w; ++j) *c++ = y[1 + S * i + j];
+  for (int k = M_.iVf; k < M_.n; ++k) *c++ = y[k];
+  double* h = c;
+  h[0] = tt;
+  h[1] = qv[0], h[2] = qv[1], h[3] = qv[2];
+  h[4] = machine_.phase();
+  samples_->commit();
+  return true;
+}
+
+bool EventLoop::sync_samples() {
+  if (!samples_) return true;
+  samples_->drain();
+  if (!samples_->failed()) return true;
+  t_ = sample_failed_at_;
+  return false;
+}
+
+NumericalError EventLoop::non_finite_state(double t) const {
+  return NumericalError("non-finite state",
+                        P_.numerics.cells < 100000 ? "tighten numerics1d.rtol or refine numerics1d.cells"
+                                                   : "tighten numerics1d.rtol",
+                        t);
+}
+
+NumericalError EventLoop::first_failure(const NumericalError& e) {
+  if (!samples_) return e;
+  try {
+    if (!sync_samples() && (e.time() < 0 || sample_failed_at_ <= e.time())) return non_finite_state(sample_failed_at_);
+  } catch (const NumericalError& s) {
+    return s;
+  }
+  return e;
+}
+
+bool EventLoop::sample(double tt, const double* y, const VelocityQuadrature::V3& qv, int phase, ModelState& st) {
   const int N = M_.N;
   const bool ok = M_.unpack(y, st);
   M_.fluxes(st);
@@ -394,7 +484,6 @@ bool EventLoop::record(double tt, const double* y) {
   M_.extras(st, y, d, &W);
   Sample s;
   M_.end_state(st, s);
-  const VelocityQuadrature::V3 qv = M_.velocity_quadrature ? vq_.at(tt) : VelocityQuadrature::V3{};
   s.V_rear_lab = (y[M_.iVrl] + qv[1]) * M_.V_s;
   s.V_front_lab = (y[M_.iVfl] + qv[2]) * M_.V_s;
   s.t = tt;
@@ -410,7 +499,7 @@ bool EventLoop::record(double tt, const double* y) {
   double vol = 0;
   for (int i = 0; i < N; ++i) vol += st.R[i] * st.R[i];
   s.tube_volume = pi * vol * M_.h;
-  s.phase = machine_.phase();
+  s.phase = phase;
   if (!ok) return false;
   if (!finite(s)) return false;
   emit(res_, out_, s, st.R.data(), N, t_stop_);

@@ -190,6 +190,9 @@ struct Numerics {
   double atol_scale = 1e-6;     ///< absolute tolerance as a fraction of each state's scale
   double output_interval = 1e-3;  ///< series/radius output interval [s]
   long max_steps = 2000000;     ///< integrator step budget for the whole run
+  /// Threads of a force-driven run: 2 evaluates the output samples on a second thread while
+  /// the first integrates (the same results bit for bit).
+  int threads = 1;
   /// Force-driven wave without the axial bending or the calibrated junction (whose ends are
   /// their own): the open ends (numerics1d.open_end; docs/reduced1d.md, "The open ends' half
   /// cells").

@@ -344,6 +344,9 @@ Params read_scene(const json& scene, json& resolved, const std::string& scene_di
     p.numerics.rtol = n.number("rtol", p.numerics.cells <= kScreeningCells ? 1e-4 : 1e-6, Range::closed(1e-12, 1e-2));
     p.numerics.atol_scale = n.number("atol_scale", 1e-6, Range::closed(1e-14, 1e-2));
     p.numerics.max_steps = n.integer("max_steps", 2000000, 100, 1000000000);
+    // A second thread evaluates the output samples of a force-driven run (docs/performance-1d.md,
+    // "The output samples on a second thread"); a screen runs its designs one per thread instead.
+    p.numerics.threads = static_cast<int>(n.integer("threads", 1, 1, 2));
     // The open ends (docs/reduced1d.md, "The open ends' half cells") of the force-driven wave
     // without the axial bending or the calibrated junction, whose ends are their own: at the
     // static radius of the end's actuation, its half cell a drainage layer (the default) or a

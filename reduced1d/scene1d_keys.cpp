@@ -19,7 +19,7 @@ const scene::json& section_keys() {
         {"end_effects", "choice:none|open_ends|junction"},
         {"recovery_end", "choice:energy|dead_band|shape"},
         {"axial_bending", {{"source", "choice:none|scene|calibration"}, {"rigidity", "quantity:J@positive"}}}}},
-      {"numerics1d", {{"cells", "integer"}, {"rtol", "number"}, {"atol_scale", "number"}, {"max_steps", "integer"}, {"open_end", "choice:drainage|linear|continued"}}}};
+      {"numerics1d", {{"cells", "integer"}, {"rtol", "number"}, {"atol_scale", "number"}, {"max_steps", "integer"}, {"threads", "integer"}, {"open_end", "choice:drainage|linear|continued"}}}};
   return keys;
 }
 

@@ -271,8 +271,8 @@ TEST(CommandLine, BenchRefusesAFineCycleItCannotRun) {
   fs::remove_all(d);
 }
 
-// --threads sets the 3D run's threads (full3d.threads, in the resolved scene); the 1D tier
-// runs on one thread and refuses it naming the flag; swim calibrate takes it too.
+// --threads sets the 3D run's threads (full3d.threads, in the resolved scene) and the 1D run's
+// (numerics1d.threads, 1 or 2: more is refused naming the flag); swim calibrate takes it too.
 TEST(CommandLine, RunAndCalibrateAcceptThreads) {
   const fs::path d = swim::test::scratch_dir("swim_first_hour_threads");
   const fs::path out = d / "run3d";
@@ -282,9 +282,12 @@ TEST(CommandLine, RunAndCalibrateAcceptThreads) {
   EXPECT_EQ(c.code, 0) << c.err;
   EXPECT_EQ(summary_of(out)["scene"]["full3d"]["threads"], 2);
   c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 2 --out \"" + (d / "run1d").string() + "\"", d);
+  EXPECT_EQ(c.code, 0) << c.err;
+  EXPECT_EQ(summary_of(d / "run1d")["scene"]["numerics1d"]["threads"], 2);
+  c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 3 --out \"" + (d / "run1d3").string() + "\"", d);
   EXPECT_EQ(c.code, 2);
   EXPECT_NE(c.err.find("--threads"), std::string::npos) << c.err;
-  EXPECT_FALSE(fs::exists(d / "run1d"));
+  EXPECT_FALSE(fs::exists(d / "run1d3"));
   // a calibration takes minutes: its --threads is parsed, then the missing scene is the refusal
   c = swim_cli("calibrate \"" + (d / "missing.json").string() + "\" --threads 2", d);
   EXPECT_EQ(c.code, 2);

@@ -1,0 +1,152 @@
+// The output samples of a force-driven run on a second thread (numerics1d.threads = 2): the
+// pipe that carries them keeps their order, stops at a failed one and hands the consumer's
+// exception back; a run with the second thread gives the same result bit for bit as one
+// without it, on every path of the event loop (IDA and CVODE, the confined and the unbounded
+// outer flow, the junction and the axial bending, several cycles, a run stopped midway).
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "common/errors.hpp"
+#include "reduced1d/sample_pipe.hpp"
+#include "reduced1d/scene1d.hpp"
+#include "reduced1d/solver.hpp"
+
+using namespace swim::reduced1d;
+using swim::reduced1d::detail::SamplePipe;
+using json = swim::scene::json;
+
+TEST(SamplePipe, DeliversEveryRecordInOrderThroughAFullRing) {
+  // Two slots for 5 000 records: the producer waits for the consumer most of the time.
+  std::vector<double> seen;
+  {
+    SamplePipe pipe(3, [&](const double* r) {
+      seen.push_back(r[0]);
+      EXPECT_EQ(r[1], 2.0 * r[0]);
+      EXPECT_EQ(r[2], -r[0]);
+      return true;
+    }, 2);
+    for (int k = 0; k < 5000; ++k) {
+      double* r = pipe.slot();
+      r[0] = k, r[1] = 2.0 * k, r[2] = -k;
+      pipe.commit();
+      if (k == 2500) {
+        pipe.drain();
+        EXPECT_EQ(seen.size(), 2501u);
+      }
+    }
+    pipe.drain();
+    EXPECT_FALSE(pipe.failed());
+  }
+  ASSERT_EQ(seen.size(), 5000u);
+  for (int k = 0; k < 5000; ++k) ASSERT_EQ(seen[k], double(k)) << k;
+}
+
+TEST(SamplePipe, AFailedRecordStopsTheRestAndAnExceptionReachesTheProducer) {
+  std::vector<double> seen;
+  SamplePipe pipe(1, [&](const double* r) {
+    seen.push_back(r[0]);
+    return r[0] != 7.0;
+  });
+  for (int k = 0; k < 20; ++k) {
+    *pipe.slot() = k;
+    pipe.commit();
+  }
+  pipe.drain();
+  EXPECT_TRUE(pipe.failed());
+  EXPECT_EQ(seen.size(), 8u);  // 0 ... 7; 8 ... 19 skipped
+
+  SamplePipe throwing(1, [](const double* r) -> bool {
+    if (r[0] == 3.0) throw std::runtime_error("sample 3");
+    return true;
+  });
+  for (int k = 0; k < 10; ++k) {
+    *throwing.slot() = k;
+    throwing.commit();
+  }
+  try {
+    throwing.drain();
+    ADD_FAILURE() << "drain() did not rethrow the consumer's exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_STREQ(e.what(), "sample 3");
+  }
+  EXPECT_TRUE(throwing.failed());
+}
+
+namespace {
+
+Result run(json scene, int threads) {
+  scene["numerics1d"]["threads"] = threads;
+  json resolved;
+  const Params p = read_scene(scene, resolved);
+  EXPECT_EQ(p.numerics.threads, threads);
+  return solve(p);
+}
+
+// Every figure of the two results, bit for bit.
+void expect_identical(const Result& a, const Result& b, const std::string& what) {
+  ASSERT_EQ(a.series.size(), b.series.size()) << what;
+  EXPECT_GT(a.series.size(), 10u) << what;
+  for (std::size_t k = 0; k < a.series.size(); ++k) {
+    const std::vector<double> ra = series_row(a.series[k]), rb = series_row(b.series[k]);
+    ASSERT_EQ(0, std::memcmp(ra.data(), rb.data(), ra.size() * sizeof(double))) << what << ": sample " << k;
+  }
+  EXPECT_EQ(a.radius, b.radius) << what;
+  EXPECT_EQ(a.radius_times, b.radius_times) << what;
+  EXPECT_EQ(a.cycle_start, b.cycle_start) << what;
+  EXPECT_EQ(a.cycle_end, b.cycle_end) << what;
+  EXPECT_EQ(a.switches, b.switches) << what;
+  EXPECT_EQ(a.stats, b.stats) << what;  // the integration itself is the same
+  EXPECT_EQ(a.record.series.rows(), b.record.series.rows()) << what;
+  ASSERT_EQ(bool(a.failure), bool(b.failure)) << what;
+  if (a.failure) {
+    EXPECT_STREQ(a.failure->what(), b.failure->what()) << what;
+    EXPECT_EQ(a.failure->time(), b.failure->time()) << what;
+  }
+}
+
+}  // namespace
+
+TEST(SampleThread, GivesTheSameRunBitForBitOnEveryPath) {
+  const std::vector<std::pair<std::string, json>> scenes = {
+      {"default (IDA, short-wave traction, confined)", json::object()},
+      {"lubrication-only wall (CVODE, one unknown per cell)", {{"model1d", {{"short_wave_traction", false}}}}},
+      {"unbounded outer flow (velocity quadrature)", {{"model1d", {{"outer_flow", "unbounded"}}}}},
+      {"calibrated junction", {{"model1d", {{"end_effects", "junction"}}}}},
+      {"axial bending (curvature unknowns)",
+       {{"model1d", {{"axial_bending", {{"source", "scene"}, {"rigidity", "5e-25 J"}}}}}}},
+      {"two cycles", {{"protocol", {{"cycles", 2}}}}},
+  };
+  for (const auto& [what, scene] : scenes) {
+    const Result one = run(scene, 1), two = run(scene, 2);
+    EXPECT_FALSE(one.failure) << what << ": " << (one.failure ? one.failure->what() : "");
+    EXPECT_FALSE(one.cycle_end.empty()) << what;
+    expect_identical(one, two, what);
+  }
+}
+
+TEST(SampleThread, KeepsTheSamplesAndTheFailureOfARunStoppedMidway) {
+  // The step budget runs out in the first contraction: the samples up to there and the same
+  // failure, at the same time.
+  const json scene = {{"numerics1d", {{"max_steps", 150}}}};
+  const Result one = run(scene, 1), two = run(scene, 2);
+  ASSERT_TRUE(one.failure);
+  EXPECT_NE(std::string(one.failure->what()).find("numerics1d.max_steps"), std::string::npos) << one.failure->what();
+  EXPECT_GT(one.failure->time(), 0.0);
+  expect_identical(one, two, "stopped by the step budget");
+}
+
+TEST(SampleThread, ThreadsOtherThanOneOrTwoAreRefusedNamingTheKey) {
+  for (const json v : {json(0), json(3), json("two")}) {
+    json resolved;
+    try {
+      read_scene(json{{"numerics1d", {{"threads", v}}}}, resolved);
+      ADD_FAILURE() << "numerics1d.threads = " << v.dump() << " was accepted";
+    } catch (const swim::InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("numerics1d.threads"), std::string::npos) << e.what();
+    }
+  }
+}
