@@ -57,7 +57,11 @@ void SamplePipe::wake(std::atomic<bool>& sleeping) {
 
 double* SamplePipe::slot() {
   const long c = committed_.load(std::memory_order_relaxed);
-  wait_until([&] { return c - consumed_.load(std::memory_order_seq_cst) < long(slots_); }, producer_sleeps_);
+  // A full ring waits until half of it is free: where the consumer is the slower side (a run
+  // streaming its rows to disk), the producer then sleeps once per half ring, not once per
+  // record.
+  if (c - consumed_.load(std::memory_order_seq_cst) >= long(slots_))
+    wait_until([&] { return c - consumed_.load(std::memory_order_seq_cst) <= long(slots_ / 2); }, producer_sleeps_);
   return ring_ + std::size_t(c % long(slots_)) * stride_;
 }
 
