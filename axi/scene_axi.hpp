@@ -33,6 +33,8 @@ enum class AxiMethod {
 /// Default axi.tolerance of a prescribed wave: the time quadrature's error in the displacement
 /// over the run, in cells h (docs/axi.md "Prescribed waves").
 inline constexpr double kPrescribedTolerance = 1e-4;
+/// The smallest axi.tolerance a scene may ask for (cells per step).
+inline constexpr double kMinTolerance = 1e-6;
 
 /// Growth ratio of the ring spacing from the rims inwards (axi.rim_refinement < 1).
 inline constexpr double kRimGrowth = 1.5;

@@ -108,8 +108,12 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
   s["full3d"]["membrane"]["secondary_seed_amplitude"] = 0.001;
   EXPECT_EQ(input_error_key(s), "full3d.membrane.secondary_seed_amplitude");
   s = base;
-  s["axi"]["tolerance"] = 0.0;
-  EXPECT_EQ(input_error_key(s), "axi.tolerance");
+  for (double bad : {0.0, 1e-7, 1.0}) {  // [1e-6, 1): smaller would run for days
+    s["axi"]["tolerance"] = bad;
+    EXPECT_EQ(input_error_key(s), "axi.tolerance") << bad;
+  }
+  s["axi"]["tolerance"] = 1e-6;
+  EXPECT_EQ(input_error_key(s), "(accepted)");
   // the rims' refinement is the fitted method's: the immersed boundary keeps uniform rings
   s = base;
   s["axi"]["rim_refinement"] = 0.25;

@@ -117,6 +117,10 @@ TEST(SuiteReference, BadValuesAreInputErrorsNamingTheKey) {
   for (const char* f : {"1.5", "0", "\"quarter\""})
     expect_refused(write_suite("x.json", std::string(R"({"tier": "axi", "grids": [64, 128, 256], "tolerance_check": )") + f + "}"),
                    {"suite.cases[0].reference.tolerance_check", "between 0 and 1"});
+  // a factor that takes the check below the axi tier's smallest tolerance (2e-3 x 1e-4 = 2e-7)
+  expect_refused(write_suite("paper_amplitude_0.82.json",
+                             R"({"tier": "axi", "grids": [16, 24, 32], "tolerance_check": 1e-4})", "", kRound),
+                 {"suite.cases[0].reference.tolerance_check", "axi.tolerance", "1e-06"});
   expect_refused(write_suite("paper_amplitude_0.82.json", R"({"tier": "axi", "grids": [16, 24, 32]})",
                              R"("reference_target_relative": 2, )", kRound),
                  {"suite.reference_target_relative", "2", "between 0 and 1"});
