@@ -57,7 +57,7 @@ int main(int argc, char** argv) {
   run->add_option("--resume", ro.resume, "3D and axi: continue an interrupted run from the checkpoint in this output folder");
   run->add_flag("--overwrite", ro.overwrite,
                 "Replace the results of another run in the output folder (its files are removed first)");
-  run->add_option("--threads", ro.threads, "3D and axi: threads of the run (sets full3d.threads, default the scene's, 1; or axi.threads, 1 or 2, default 2)")
+  run->add_option("--threads", ro.threads, "Threads of the run: 3D sets full3d.threads (default the scene's, 1); axi sets axi.threads (1 or 2, default 2); 1D sets numerics1d.threads (1 or 2, default 1: the second evaluates the output samples)")
       ->check(CLI::Range(1, 256));
   run->add_flag("--error-estimate", ro.error_estimate,
                 "3D: also run the scene on a coarser grid (3/4 of the cells across, in OUT/error_estimate/coarse) and "

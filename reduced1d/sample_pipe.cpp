@@ -10,8 +10,9 @@
 namespace swim::reduced1d::detail {
 
 namespace {
-// Spins before a side sleeps: tens of microseconds to half a millisecond, by the processor's
-// pause (longer than the integration between two samples, short against a sleep's wake-up).
+// Spins before a side sleeps: about a millisecond where a pause takes 49 ns (the AMD EPYC of
+// docs/performance-1d.md); longer than the integration between two samples, short against a
+// run.
 constexpr int kSpins = 20000;
 
 inline void relax() {
