@@ -272,7 +272,8 @@ TEST(CommandLine, BenchRefusesAFineCycleItCannotRun) {
 }
 
 // --threads sets the 3D run's threads (full3d.threads, in the resolved scene) and the 1D run's
-// (numerics1d.threads, 1 or 2: more is refused naming the flag); swim calibrate takes it too.
+// (numerics1d.threads, 1 or 2: the same files either way; more is refused naming the flag);
+// swim calibrate takes it too.
 TEST(CommandLine, RunAndCalibrateAcceptThreads) {
   const fs::path d = swim::test::scratch_dir("swim_first_hour_threads");
   const fs::path out = d / "run3d";
@@ -284,6 +285,14 @@ TEST(CommandLine, RunAndCalibrateAcceptThreads) {
   c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 2 --out \"" + (d / "run1d").string() + "\"", d);
   EXPECT_EQ(c.code, 0) << c.err;
   EXPECT_EQ(summary_of(d / "run1d")["scene"]["numerics1d"]["threads"], 2);
+  // the files the second thread streamed are the one-thread run's, byte for byte
+  c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 1 --out \"" + (d / "run1d1").string() + "\"", d);
+  EXPECT_EQ(c.code, 0) << c.err;
+  for (const char* f : {"series.csv", "radius.csv"}) {
+    const std::string one = slurp(d / "run1d1" / f), two = slurp(d / "run1d" / f);
+    EXPECT_GT(one.size(), 10000u) << f;
+    EXPECT_TRUE(one == two) << f << " differs between --threads 1 and 2";
+  }
   c = swim_cli("run \"" SWIM_SOURCE_DIR "/data/scenes/demo.json\" --quiet --threads 3 --out \"" + (d / "run1d3").string() + "\"", d);
   EXPECT_EQ(c.code, 2);
   EXPECT_NE(c.err.find("--threads"), std::string::npos) << c.err;
