@@ -9,7 +9,9 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -130,14 +132,23 @@ class EventLoop {
   /// Apply the located root at t_. Returns true when the run is complete.
   bool switch_protocol();
   void install_laws();
+  /// A cycle's start or end for the run record: now, or after the samples before it.
+  void cycle_event(bool start, double t);
   void check_end_radii(double t) const;
   /// The output sample at time t of state y: evaluated here, or handed to the sample thread
   /// (false: a non-finite sample, here or, found now, on the sample thread earlier).
   bool record(double t, const double* y);
+  /// The sample at a collapse or at the last cycle's end, on this thread once the sample
+  /// thread has caught up (after the switch's events); a non-finite one is left out, and is
+  /// not the run's failure.
+  void record_here(double t);
   /// Evaluates and emits the sample into the scratch state st (the velocity quadrature's
   /// integrals qv and the protocol's phase taken at t).
-  bool sample(double t, const double* y, const VelocityQuadrature::V3& qv, int phase, ModelState& st);
-  /// Waits for the sample thread; false when one of its samples was not finite.
+  bool sample(const ForceModel& M, double t, const double* y, const VelocityQuadrature::V3& qv, int phase,
+              ModelState& st);
+  /// Waits for the sample thread; false when one of its samples was not finite (a switch in
+  /// progress is then taken back). Otherwise hands the switch's events to the run record and
+  /// its laws to the sample thread's model.
   bool sync_samples();
   /// The failure a run with its samples on this thread would have stopped on first: the
   /// sample thread's non-finite sample, when there is one before e's time.
@@ -167,7 +178,22 @@ class EventLoop {
   Result res_;
   // The sample thread (numerics1d.threads = 2) and its scratch state; declared last, so that
   // it stops before anything its samples use is destroyed.
+  std::unique_ptr<ForceModel> sample_model_;  // the sample thread's model (its own laws)
   ModelState sample_state_;
+  // A switch whose samples before it the sample thread has not yet evaluated: its events for
+  // the run record, and what it changed, to be taken back if one of those samples fails.
+  struct PendingSwitch {
+    bool open = false;
+    std::vector<std::pair<bool, double>> events;  // (cycle start, t) in order; false: cycle end
+    ProtocolMachine machine;
+    long switches = 0;
+    std::size_t cycle_start = 0, cycle_end = 0;
+    int cycles_done = 0;
+    std::map<std::string, long> stats;  // after the switch's harvest
+    explicit PendingSwitch(const ProtocolMachine& m) : machine(m) {}
+  };
+  std::optional<PendingSwitch> pending_;
+  bool harvested_ = false;  // a switch was taken back: the counters stop at its root
   std::vector<double> sample_y_;  // the sample thread's state (the unknowns it reads in place)
   int sample_unknowns_ = 0;       // leading unknowns of a cell that a sample reads
   double sample_failed_at_ = 0;  // time of the sample thread's non-finite sample
@@ -192,7 +218,8 @@ EventLoop::EventLoop(const Params& P, std::vector<double> fixed_q, double t_fixe
   if (P.numerics.threads >= 2) {
     // A record: the unknowns a sample reads, then t, the quadrature's three integrals and the
     // phase. The sample thread puts the unknowns back in place in a state of its own.
-    sample_state_ = M_.make_state();
+    sample_model_ = std::make_unique<ForceModel>(P, !velocity_in_rhs);
+    sample_state_ = sample_model_->make_state();
     sample_y_.assign(M_.n, 0.0);
     sample_unknowns_ = M_.dae ? 3 : 1;
     const int width = 1 + sample_unknowns_ * M_.N + (M_.n - M_.iVf);
@@ -206,7 +233,7 @@ EventLoop::EventLoop(const Params& P, std::vector<double> fixed_q, double t_fixe
       for (int k = M_.iVf; k < M_.n; ++k) y[k] = *c++;
       const double* h = r + width;
       const VelocityQuadrature::V3 qv = {h[1], h[2], h[3]};
-      if (sample(h[0], y, qv, int(h[4]), sample_state_)) return true;
+      if (sample(*sample_model_, h[0], y, qv, int(h[4]), sample_state_)) return true;
       sample_failed_at_ = h[0];
       return false;
     });
@@ -253,7 +280,7 @@ Result EventLoop::run() {
   }
   // harvest adds only the counters since the last restart, and every restart is preceded
   // by a harvest: nothing is counted twice.
-  if (be_) be_->harvest(res_.stats);
+  if (be_ && !harvested_) be_->harvest(res_.stats);
   res_.segment_reached = machine_.reached();
   if (fixed_) res_.segment_reached.clear();
   return std::move(res_);
@@ -267,6 +294,7 @@ void EventLoop::start() {
   }
   machine_.laws(lawbuf_, seglawbuf_);
   M_.set_actuation(machine_, lawbuf_, seglawbuf_);
+  if (sample_model_) sample_model_->set_actuation(machine_, lawbuf_, seglawbuf_);
   be_ = make_integrator(*pb_, P_);
   be_->set_roots(machine_.root_count());
   be_->set_stop_time(t_stop_);
@@ -275,7 +303,7 @@ void EventLoop::start() {
     be_->on_step = [this](double tn, const double* y) { vq_.step(tn, vq_.integrand(M_, pb_->state, y)); };
   }
   // (the first sample on this thread: its failure is the initial state's)
-  if (!sample(0.0, be_->y(), M_.velocity_quadrature ? vq_.at(0.0) : VelocityQuadrature::V3{}, machine_.phase(),
+  if (!sample(M_, 0.0, be_->y(), M_.velocity_quadrature ? vq_.at(0.0) : VelocityQuadrature::V3{}, machine_.phase(),
               pb_->state)) {
     check_end_radii(0.0);  // an open end without a positive rest radius is the usual cause
     throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
@@ -319,9 +347,19 @@ int EventLoop::advance(double tout) {
 
 bool EventLoop::switch_protocol() {
   const double t = t_;
-  // The switch changes the laws the samples are evaluated with, and its events follow the
-  // samples before it.
-  if (!sync_samples()) throw non_finite_state(t);
+  // With a sample thread the samples before the switch may still be in its hands. It
+  // evaluates them with a model of its own, so the switch and the restart go on meanwhile;
+  // the switch's events reach the run record, and its laws that model, once it has caught up
+  // (sync_samples, at the end of the switch), and the switch is taken back if one of those
+  // samples fails, where a run on one thread would have stopped.
+  if (samples_) {
+    if (samples_->failed() && !sync_samples()) throw non_finite_state(t_);
+    pending_.emplace(machine_);
+    pending_->switches = res_.switches;
+    pending_->cycle_start = res_.cycle_start.size();
+    pending_->cycle_end = res_.cycle_end.size();
+    pending_->cycles_done = cycles_done_;
+  }
   // the partial step up to the root, with the laws in force before the switch
   if (M_.velocity_quadrature) vq_.step(t, vq_.integrand(M_, pb_->state, be_->y()));
   found_.assign(std::max(machine_.root_count(), 2), 0);
@@ -330,33 +368,45 @@ bool EventLoop::switch_protocol() {
   res_.switches += machine_.apply(t, found_.data(), R);
   if (machine_.collapsed()) {
     const int imin = int(std::min_element(Rcells_.begin(), Rcells_.end()) - Rcells_.begin());
-    record(t, be_->y());
+    record_here(t);
     throw NumericalError("tube radius collapsed to zero at z = " + metres(res_.z[imin]),
                          "lower the actuation (protocol.pressure, protocol.total_force or protocol.load_factor) or raise wave.contracted_ratio", t);
   }
   if (machine_.cycle_completed()) {
     res_.cycle_end.push_back(t);
-    if (out_.record) out_.record->cycle_ended(t);
+    cycle_event(false, t);
     ++cycles_done_;
     if (fixed_ || (P_.duration <= 0 && cycles_done_ >= P_.protocol.cycles)) {
       machine_.finish();
-      record(t, be_->y());
+      record_here(t);
       return true;
     }
     machine_.start_cycle(t, R);
     res_.cycle_start.push_back(t);
-    if (out_.record) out_.record->cycle_started(t);
+    cycle_event(true, t);
   }
   install_laws();
   check_end_radii(t);
   if (M_.velocity_quadrature) vq_.restart(t, vq_.integrand(M_, pb_->state, be_->y()));  // right-hand value
   be_->harvest(res_.stats);
   steps_before_ = res_.stats["steps"];
+  if (pending_) {
+    pending_->stats = res_.stats;
+    pending_->open = true;
+  }
   be_->restart(t);
   be_->set_roots(machine_.root_count());
   be_->set_stop_time(t_stop_);
   ++res_.stats["reinits"];
+  if (!sync_samples()) throw non_finite_state(t_);
   return false;
+}
+
+void EventLoop::cycle_event(bool start, double t) {
+  if (pending_)
+    pending_->events.emplace_back(start, t);
+  else if (out_.record)
+    start ? out_.record->cycle_started(t) : out_.record->cycle_ended(t);
 }
 
 void EventLoop::install_laws() {
@@ -430,7 +480,7 @@ void EventLoop::check_end_radii(double t) const {
 
 bool EventLoop::record(double tt, const double* y) {
   const VelocityQuadrature::V3 qv = M_.velocity_quadrature ? vq_.at(tt) : VelocityQuadrature::V3{};
-  if (!samples_) return sample(tt, y, qv, machine_.phase(), pb_->state);
+  if (!samples_) return sample(M_, tt, y, qv, machine_.phase(), pb_->state);
   if (samples_->failed()) return sync_samples();
   // The unknowns a sample reads (sample_unknowns_): a cell's cross-section, and its velocity
   // and pressure where they are unknowns, not its traction fields or curvature; a third of
@@ -450,12 +500,38 @@ bool EventLoop::record(double tt, const double* y) {
   return true;
 }
 
+void EventLoop::record_here(double t) {
+  if (samples_ && !sync_samples()) throw non_finite_state(t_);
+  const VelocityQuadrature::V3 qv = M_.velocity_quadrature ? vq_.at(t) : VelocityQuadrature::V3{};
+  sample(M_, t, be_->y(), qv, machine_.phase(), pb_->state);
+}
+
 bool EventLoop::sync_samples() {
   if (!samples_) return true;
   samples_->drain();
-  if (!samples_->failed()) return true;
-  t_ = sample_failed_at_;
-  return false;
+  std::optional<PendingSwitch> sw = std::move(pending_);
+  pending_.reset();
+  if (samples_->failed()) {
+    if (sw) {  // a sample before the switch failed: a run on one thread stopped there
+      machine_ = std::move(sw->machine);
+      res_.switches = sw->switches;
+      res_.cycle_start.resize(sw->cycle_start);
+      res_.cycle_end.resize(sw->cycle_end);
+      cycles_done_ = sw->cycles_done;
+      if (sw->open) {
+        res_.stats = std::move(sw->stats);
+        harvested_ = true;
+      }
+    }
+    t_ = sample_failed_at_;
+    return false;
+  }
+  if (sw) {
+    if (out_.record)
+      for (const auto& [start, t] : sw->events) start ? out_.record->cycle_started(t) : out_.record->cycle_ended(t);
+    sample_model_->set_actuation(machine_, lawbuf_, seglawbuf_);
+  }
+  return true;
 }
 
 NumericalError EventLoop::non_finite_state(double t) const {
@@ -475,32 +551,33 @@ NumericalError EventLoop::first_failure(const NumericalError& e) {
   return e;
 }
 
-bool EventLoop::sample(double tt, const double* y, const VelocityQuadrature::V3& qv, int phase, ModelState& st) {
-  const int N = M_.N;
-  const bool ok = M_.unpack(y, st);
-  M_.fluxes(st);
+bool EventLoop::sample(const ForceModel& M, double tt, const double* y, const VelocityQuadrature::V3& qv, int phase,
+                       ModelState& st) {
+  const int N = M.N;
+  const bool ok = M.unpack(y, st);
+  M.fluxes(st);
   if (!st.geometry_ok) return false;
   double d[6], W = 0;
-  M_.extras(st, y, d, &W);
+  M.extras(st, y, d, &W);
   Sample s;
-  M_.end_state(st, s);
-  s.V_rear_lab = (y[M_.iVrl] + qv[1]) * M_.V_s;
-  s.V_front_lab = (y[M_.iVfl] + qv[2]) * M_.V_s;
+  M.end_state(st, s);
+  s.V_rear_lab = (y[M.iVrl] + qv[1]) * M.V_s;
+  s.V_front_lab = (y[M.iVfl] + qv[2]) * M.V_s;
   s.t = tt;
-  s.X = (y[M_.iX] + qv[0]) * M_.X_s;
+  s.X = (y[M.iX] + qv[0]) * M.X_s;
   s.W = W;
-  s.energy = M_.energy(st);
+  s.energy = M.energy(st);
   s.R_min = *std::min_element(st.R.begin(), st.R.end());
   s.R_max = *std::max_element(st.R.begin(), st.R.end());
   s.Q_rear = st.Q[0];
   s.Q_front = st.Q[N];
-  s.V_rear = y[M_.iVr] * M_.V_s;
-  s.V_front = y[M_.iVf] * M_.V_s;
+  s.V_rear = y[M.iVr] * M.V_s;
+  s.V_front = y[M.iVf] * M.V_s;
   double vol = 0;
   for (int i = 0; i < N; ++i) vol += st.R[i] * st.R[i];
-  s.tube_volume = pi * vol * M_.h;
+  s.tube_volume = pi * vol * M.h;
   s.phase = phase;
-  if (!ok) return false;
+  if (!ok || (out_.reject_sample && out_.reject_sample(tt))) return false;
   if (!finite(s)) return false;
   emit(res_, out_, s, st.R.data(), N, t_stop_);
   return true;

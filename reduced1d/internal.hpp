@@ -2,6 +2,7 @@
 // Not part of the product interface (reduced1d/solver.hpp is).
 #pragma once
 
+#include <functional>
 #include <vector>
 
 #include "reduced1d/solver.hpp"
@@ -17,6 +18,9 @@ struct Output {
   bool keep_samples = true;
   /// Also into this record (running figures, events; its stream writes them to disk).
   record::RunRecord* record = nullptr;
+  /// Fault injection for the tests: a force-driven sample at a time for which this returns
+  /// true counts as not finite (it may be called from the sample thread).
+  std::function<bool(double t)> reject_sample;
 };
 
 /// Throws swim::InputError for parameters the solver cannot run with (the scene layer is

@@ -5,12 +5,14 @@
 // outer flow, the junction and the axial bending, several cycles, a run stopped midway).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cstring>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "common/errors.hpp"
+#include "reduced1d/internal.hpp"
 #include "reduced1d/sample_pipe.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/solver.hpp"
@@ -148,5 +150,53 @@ TEST(SampleThread, ThreadsOtherThanOneOrTwoAreRefusedNamingTheKey) {
     } catch (const swim::InputError& e) {
       EXPECT_NE(std::string(e.what()).find("numerics1d.threads"), std::string::npos) << e.what();
     }
+  }
+}
+
+// A sample that fails just before a protocol switch: one thread stops there; two threads have
+// gone through the switch (its events, the machine's state, the restart) while the sample was
+// on the second, and take the switch back. Both give the same samples, events, segment times and
+// failure (fault injected by detail::Output::reject_sample, at the last sample before the
+// second switch; then at the cycle's end, where the switch also ends the cycle).
+TEST(SampleThread, AFailedSampleBeforeASwitchStopsTheRunThere) {
+  json sc = json::object();
+  json resolved;
+  Params p = read_scene(sc, resolved);
+  p.numerics.threads = 1;
+  const Result plain = solve(p);
+  ASSERT_FALSE(plain.failure);
+  ASSERT_GE(plain.segment_reached.size(), 3u);
+  // the segments are reached from the last to the first: the second switch is the one before last
+  std::vector<double> reached = plain.segment_reached;
+  std::sort(reached.begin(), reached.end());
+  const double second_switch = reached[1];
+  const double cycle_end = plain.cycle_end.at(0);
+  for (const double at : {second_switch, cycle_end}) {
+    double last = -1;  // the last sample strictly before the switch
+    for (const auto& smp : plain.series)
+      if (smp.t < at) last = smp.t;
+    ASSERT_GT(last, 0.0);
+    Result r[2];
+    for (int threads : {1, 2}) {
+      p.numerics.threads = threads;
+      detail::Output out;
+      out.reject_sample = [last](double t) { return t == last; };
+      r[threads - 1] = detail::solve_force_driven(p, out);
+    }
+    const Result &one = r[0], &two = r[1];
+    ASSERT_TRUE(one.failure) << at;
+    EXPECT_NE(std::string(one.failure->what()).find("non-finite state"), std::string::npos) << one.failure->what();
+    EXPECT_EQ(one.failure->time(), last);
+    ASSERT_TRUE(two.failure) << at;
+    EXPECT_STREQ(one.failure->what(), two.failure->what());
+    ASSERT_EQ(one.series.size(), two.series.size()) << at;
+    EXPECT_EQ(one.series.back().t, two.series.back().t);
+    EXPECT_LT(one.series.back().t, last);
+    EXPECT_EQ(one.radius, two.radius) << at;
+    EXPECT_EQ(one.cycle_start, two.cycle_start) << at;
+    EXPECT_EQ(one.cycle_end, two.cycle_end) << at;
+    EXPECT_TRUE(one.cycle_end.empty()) << at;
+    EXPECT_EQ(one.switches, two.switches) << at;
+    EXPECT_EQ(one.segment_reached, two.segment_reached) << at;
   }
 }
