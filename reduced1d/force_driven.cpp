@@ -183,7 +183,7 @@ class EventLoop {
   // A switch whose samples before it the sample thread has not yet evaluated: its events for
   // the run record, and what it changed, to be taken back if one of those samples fails.
   struct PendingSwitch {
-    bool open = false;
+    bool harvested = false;  // the switch has added the integrator's counters to the run's
     std::vector<std::pair<bool, double>> events;  // (cycle start, t) in order; false: cycle end
     ProtocolMachine machine;
     long switches = 0;
@@ -193,7 +193,7 @@ class EventLoop {
     explicit PendingSwitch(const ProtocolMachine& m) : machine(m) {}
   };
   std::optional<PendingSwitch> pending_;
-  bool harvested_ = false;  // a switch was taken back: the counters stop at its root
+  bool taken_back_ = false;  // a switch was taken back after its harvest: the counters stop at its root
   std::vector<double> sample_y_;  // the sample thread's state (the unknowns it reads in place)
   int sample_unknowns_ = 0;       // leading unknowns of a cell that a sample reads
   double sample_failed_at_ = 0;  // time of the sample thread's non-finite sample
@@ -280,7 +280,7 @@ Result EventLoop::run() {
   }
   // harvest adds only the counters since the last restart, and every restart is preceded
   // by a harvest: nothing is counted twice.
-  if (be_ && !harvested_) be_->harvest(res_.stats);
+  if (be_ && !taken_back_) be_->harvest(res_.stats);
   res_.segment_reached = machine_.reached();
   if (fixed_) res_.segment_reached.clear();
   return std::move(res_);
@@ -392,7 +392,7 @@ bool EventLoop::switch_protocol() {
   steps_before_ = res_.stats["steps"];
   if (pending_) {
     pending_->stats = res_.stats;
-    pending_->open = true;
+    pending_->harvested = true;
   }
   be_->restart(t);
   be_->set_roots(machine_.root_count());
@@ -518,9 +518,9 @@ bool EventLoop::sync_samples() {
       res_.cycle_start.resize(sw->cycle_start);
       res_.cycle_end.resize(sw->cycle_end);
       cycles_done_ = sw->cycles_done;
-      if (sw->open) {
+      if (sw->harvested) {
         res_.stats = std::move(sw->stats);
-        harvested_ = true;
+        taken_back_ = true;
       }
     }
     t_ = sample_failed_at_;
