@@ -9,6 +9,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <exception>
 #include <map>
 #include <memory>
 #include <optional>
@@ -151,7 +152,8 @@ class EventLoop {
   /// its laws to the sample thread's model.
   bool sync_samples();
   /// The failure a run with its samples on this thread would have stopped on first: the
-  /// sample thread's non-finite sample, when there is one before e's time.
+  /// sample thread's non-finite sample, or what a sample's evaluation or output threw (the
+  /// output limit), when it came before e.
   NumericalError first_failure(const NumericalError& e);
   NumericalError non_finite_state(double t) const;
   const double* cell_radii(const double* y);
@@ -196,7 +198,8 @@ class EventLoop {
   bool taken_back_ = false;  // a switch was taken back after its harvest: the counters stop at its root
   std::vector<double> sample_y_;  // the sample thread's state (the unknowns it reads in place)
   int sample_unknowns_ = 0;       // leading unknowns of a cell that a sample reads
-  double sample_failed_at_ = 0;  // time of the sample thread's non-finite sample
+  double sample_failed_at_ = 0;     // time of the sample thread's non-finite sample
+  bool sample_not_finite_ = false;  // the sample thread stopped on a non-finite sample (not on an exception)
   std::unique_ptr<SamplePipe> samples_;
 };
 
@@ -235,6 +238,7 @@ EventLoop::EventLoop(const Params& P, std::vector<double> fixed_q, double t_fixe
       const VelocityQuadrature::V3 qv = {h[1], h[2], h[3]};
       if (sample(*sample_model_, h[0], y, qv, int(h[4]), sample_state_)) return true;
       sample_failed_at_ = h[0];
+      sample_not_finite_ = true;
       return false;
     });
   }
@@ -508,11 +512,16 @@ void EventLoop::record_here(double t) {
 
 bool EventLoop::sync_samples() {
   if (!samples_) return true;
-  samples_->drain();
+  std::exception_ptr error;  // what a sample's evaluation or output threw (the output limit)
+  try {
+    samples_->drain();
+  } catch (...) {
+    error = std::current_exception();
+  }
   std::optional<PendingSwitch> sw = std::move(pending_);
   pending_.reset();
   if (samples_->failed()) {
-    if (sw) {  // a sample before the switch failed: a run on one thread stopped there
+    if (sw) {  // a sample before the switch failed or threw: a run on one thread stopped there
       machine_ = std::move(sw->machine);
       res_.switches = sw->switches;
       res_.cycle_start.resize(sw->cycle_start);
@@ -523,6 +532,7 @@ bool EventLoop::sync_samples() {
         taken_back_ = true;
       }
     }
+    if (error) std::rethrow_exception(error);
     t_ = sample_failed_at_;
     return false;
   }
@@ -544,7 +554,8 @@ NumericalError EventLoop::non_finite_state(double t) const {
 NumericalError EventLoop::first_failure(const NumericalError& e) {
   if (!samples_) return e;
   try {
-    if (!sync_samples() && (e.time() < 0 || sample_failed_at_ <= e.time())) return non_finite_state(sample_failed_at_);
+    if (!sync_samples() && sample_not_finite_ && (e.time() < 0 || sample_failed_at_ <= e.time()))
+      return non_finite_state(sample_failed_at_);
   } catch (const NumericalError& s) {
     return s;
   }

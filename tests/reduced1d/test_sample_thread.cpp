@@ -7,11 +7,13 @@
 
 #include <algorithm>
 #include <cstring>
+#include <filesystem>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "common/errors.hpp"
+#include "common/run_record.hpp"
 #include "reduced1d/internal.hpp"
 #include "reduced1d/sample_pipe.hpp"
 #include "reduced1d/scene1d.hpp"
@@ -198,5 +200,40 @@ TEST(SampleThread, AFailedSampleBeforeASwitchStopsTheRunThere) {
     EXPECT_TRUE(one.cycle_end.empty()) << at;
     EXPECT_EQ(one.switches, two.switches) << at;
     EXPECT_EQ(one.segment_reached, two.segment_reached) << at;
+  }
+}
+
+// The output limit is checked as the second thread writes the rows: the run stops at the same
+// row with the same failure as on one thread (the limit's, not a non-finite state), and a
+// switch made meanwhile is taken back (a limit that falls after the first switch).
+TEST(SampleThread, TheOutputLimitStopsTheRunAtTheSameRow) {
+  json sc = json::object();
+  json resolved;
+  Params p = read_scene(sc, resolved);
+  for (const std::uintmax_t limit : {30000u, 1500000u}) {
+    Result r[2];
+    for (int threads : {1, 2}) {
+      p.numerics.threads = threads;
+      const std::string dir = testing::TempDir() + "/sample_thread_limit_" + std::to_string(threads);
+      std::filesystem::remove_all(dir);
+      std::filesystem::create_directories(dir);
+      swim::record::RunStream stream(dir, series_columns());
+      stream.limit(limit);
+      SolveOptions so;
+      so.stream = &stream;
+      r[threads - 1] = solve(p, so);
+      std::filesystem::remove_all(dir);
+    }
+    const Result &one = r[0], &two = r[1];
+    ASSERT_TRUE(one.failure) << limit;
+    EXPECT_NE(std::string(one.failure->what()).find("output.max_bytes"), std::string::npos) << one.failure->what();
+    ASSERT_TRUE(two.failure) << limit;
+    EXPECT_STREQ(one.failure->what(), two.failure->what()) << limit;
+    EXPECT_EQ(one.failure->time(), two.failure->time()) << limit;
+    EXPECT_EQ(one.series.size(), two.series.size()) << limit;
+    EXPECT_EQ(one.cycle_start, two.cycle_start) << limit;
+    EXPECT_EQ(one.switches, two.switches) << limit;
+    EXPECT_EQ(one.segment_reached, two.segment_reached) << limit;
+    if (limit > 100000u) EXPECT_GT(one.switches, 0) << "the larger limit falls after a switch";
   }
 }
