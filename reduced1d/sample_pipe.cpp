@@ -10,8 +10,8 @@
 namespace swim::reduced1d::detail {
 
 namespace {
-// Spins before a side sleeps: about a millisecond where a pause takes 49 ns (the AMD EPYC of
-// docs/performance-1d.md); longer than the integration between two samples, short against a
+// Spins before a side sleeps: 0.5 to 1 ms on the AMD EPYC of docs/performance-1d.md (a pause
+// measured at 25 and 49 ns); longer than the integration between two samples, short against a
 // run.
 constexpr int kSpins = 20000;
 
