@@ -139,6 +139,10 @@ class EventLoop {
   /// The output sample at time t of state y: evaluated here, or handed to the sample thread
   /// (false: a non-finite sample, here or, found now, on the sample thread earlier).
   bool record(double t, const double* y);
+  /// The velocity quadrature's integrals at t (zero without the quadrature).
+  VelocityQuadrature::V3 quadrature_at(double t) const {
+    return M_.velocity_quadrature ? vq_.at(t) : VelocityQuadrature::V3{};
+  }
   /// The sample at a collapse or at the last cycle's end, on this thread once the sample
   /// thread has caught up (after the switch's events); a non-finite one is left out, and is
   /// not the run's failure.
@@ -307,7 +311,7 @@ void EventLoop::start() {
     be_->on_step = [this](double tn, const double* y) { vq_.step(tn, vq_.integrand(M_, pb_->state, y)); };
   }
   // (the first sample on this thread: its failure is the initial state's)
-  if (!sample(M_, 0.0, be_->y(), M_.velocity_quadrature ? vq_.at(0.0) : VelocityQuadrature::V3{}, machine_.phase(),
+  if (!sample(M_, 0.0, be_->y(), quadrature_at(0.0), machine_.phase(),
               pb_->state)) {
     check_end_radii(0.0);  // an open end without a positive rest radius is the usual cause
     throw NumericalError("non-finite initial state", "check the wall and fluid parameters", 0.0);
@@ -483,7 +487,7 @@ void EventLoop::check_end_radii(double t) const {
 }
 
 bool EventLoop::record(double tt, const double* y) {
-  const VelocityQuadrature::V3 qv = M_.velocity_quadrature ? vq_.at(tt) : VelocityQuadrature::V3{};
+  const VelocityQuadrature::V3 qv = quadrature_at(tt);
   if (!samples_) return sample(M_, tt, y, qv, machine_.phase(), pb_->state);
   if (samples_->failed()) return sync_samples();
   // The unknowns a sample reads (sample_unknowns_): a cell's cross-section, and its velocity
@@ -506,7 +510,7 @@ bool EventLoop::record(double tt, const double* y) {
 
 void EventLoop::record_here(double t) {
   if (samples_ && !sync_samples()) throw non_finite_state(t_);
-  const VelocityQuadrature::V3 qv = M_.velocity_quadrature ? vq_.at(t) : VelocityQuadrature::V3{};
+  const VelocityQuadrature::V3 qv = quadrature_at(t);
   sample(M_, t, be_->y(), qv, machine_.phase(), pb_->state);
 }
 
