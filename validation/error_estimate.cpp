@@ -159,7 +159,7 @@ scene::json error_estimate_json(const scene::json& fine, const scene::json& coar
                    {"coarse_cells_across", coarse_cells_across},
                    {"coarse_cell_size_m", h_coarse},
                    {"fine_cell_size_m", h_fine},
-                   {"order_range", {kImmersedBoundaryOrders.lo, kImmersedBoundaryOrders.hi}}};
+                   {"order_range", {kEstimateOrders[0], kEstimateOrders[2]}}};
   const auto value = [](const scene::json& s, const char* k) { return s[k].get<double>(); };
   const TwoGridEstimate d = two_grid_estimate(value(fine, kEstimatedFigures[0]), value(coarse, kEstimatedFigures[0]),
                                               h_fine, h_coarse, false);

@@ -100,7 +100,7 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
   // round walls' 3D series to their axisymmetric references where a power series in h misses
   // them, even with an order in range (docs/validation.md); the power series' statement stays in
   // the note, and it is kept where the lumen fit is refused
-  if (hs.size() >= 3 && orders.hi <= kImmersedBoundaryOrders.hi) {
+  if (hs.size() >= 3 && orders.hi <= kFirstOrderHighest) {
     Extrapolation lf = lumen_fit(hs, fT);
     if (lf.method == "lumen_fit") {
       lf.observed_order = eT.observed_order;

@@ -240,7 +240,7 @@ Extrapolation expansion_fit(std::vector<double> h, std::vector<double> f, OrderR
     return e;
   };
   if (n < 4) return refuse("fewer than four grids");
-  if (!(range.lo <= 1.0 && 1.0 <= range.hi && range.hi <= kImmersedBoundaryOrders.hi))
+  if (!(range.lo <= 1.0 && 1.0 <= range.hi && range.hi <= kFirstOrderHighest))
     return refuse("the scheme's order range " + range.text() + " is not that of a first-order method");
   const double unit = hs.back();
   const Eigen::Vector3d coef = expansion_coefficients(hs, fs, unit);

@@ -220,8 +220,9 @@ OrderRange parse_order_range(const json& v, const std::string& key) {
     if (r.lo > 0 && r.hi > r.lo && r.hi <= kOrderSearchMax) return r;
   }
   throw InputError(key, scene::show(v),
-                   "\"immersed_boundary\" (orders [0.5, 2]), \"sharp_interface\" ([1, 3.5]) or [lo, hi] with "
-                   "0 < lo < hi <= 20: the observed orders the 3D scheme can show");
+                   "\"immersed_boundary\" (orders " + kImmersedBoundaryOrders.text() + "), \"sharp_interface\" (" +
+                       kSharpInterfaceOrders.text() + ") or [lo, hi] with 0 < lo < hi <= 20: the observed orders the "
+                       "3D scheme can show");
 }
 
 std::string tolerance_verdict(double rel, double rel_error, double tolerance) {

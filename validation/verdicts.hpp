@@ -35,7 +35,7 @@
 namespace swim::validation {
 
 /// The order range of a suite file's `order_range` key (at the top, or per case): a name,
-/// "immersed_boundary" ([0.5, 2]) or "sharp_interface" ([1, 3.5]), or [lo, hi] with
+/// "immersed_boundary" ([0.5, 1.5]) or "sharp_interface" ([1, 3.5]), or [lo, hi] with
 /// 0 < lo < hi <= 20. Throws InputError naming `key`, the value and what is allowed.
 OrderRange parse_order_range(const scene::json& value, const std::string& key);
 

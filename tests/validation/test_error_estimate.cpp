@@ -11,9 +11,9 @@
 using namespace swim;
 using namespace swim::validation;
 
-// f(h) = f0 + C h^p exactly, p anywhere in the immersed boundary's range [0.5, 2]: the
-// extrapolation at the true order gives f0, and the interval [min, max] of E_0.5, E_1, E_2
-// holds f0 (E_p is monotone in p); at p = 1 the order-1 value is f0 itself.
+// f(h) = f0 + C h^p exactly, p anywhere in the span of the immersed boundary's pre-asymptotic
+// orders [0.5, 2]: the extrapolation at the true order gives f0, and the interval [min, max] of
+// E_0.5, E_1, E_2 holds f0 (E_p is monotone in p); at p = 1 the order-1 value is f0 itself.
 TEST(ErrorEstimate, ExactPowerLawsRecoverTheLimitAndTheIntervalHoldsIt) {
   const double f0 = 40.2, h = 7.8125, H = 10.4167;
   for (double p : {0.5, 0.75, 1.0, 1.3, 1.7, 2.0}) {
