@@ -318,21 +318,41 @@ std::vector<double> segment_aligned_ring_positions(double L, double spacing, dou
 AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double tol_force, int max_iterations) {
   if (!(P != 0.0) || !std::isfinite(P))
     throw InputError("pressure", significant(P), "a non-zero finite pressure in Pa (C1 = P / (R0 - R_mid))");
+  const int n = wall.nodes();
+  AxiPressureResponse out =
+      relax_under_ring_pressures(wall, std::vector<double>(std::size_t(n), P), wall.reference(), tol_force, max_iterations);
+  out.mid_radius = 0.5 * (out.X(1, (n - 1) / 2) + out.X(1, n / 2));
+  out.c1 = P / (wall.params().R0 - out.mid_radius);
+  return out;
+}
+
+AxiPressureResponse relax_under_ring_pressures(const AxiWall& wall, const std::vector<double>& P,
+                                               const Eigen::Matrix3Xd& start, double tol_force, int max_iterations) {
+  const int n = wall.nodes(), nu = 2 * n - 1;
+  if (int(P.size()) != n)
+    throw InputError("ring pressures", std::to_string(P.size()), "one pressure per ring (" + std::to_string(n) + ")");
+  double p_max = 0.0;
+  for (double p : P) {
+    if (!std::isfinite(p)) throw InputError("ring pressure", significant(p), "a finite pressure in Pa");
+    p_max = std::max(p_max, std::abs(p));
+  }
+  if (!(p_max > 0.0)) throw InputError("ring pressures", "all zero", "a non-zero pressure on some ring");
   if (max_iterations < 1)
     throw InputError("max_iterations", std::to_string(max_iterations), "an integer >= 1");
-  const int n = wall.nodes(), nu = 2 * n - 1;
+  if (start.cols() != n || start.rows() != 3 || !start.topRows(2).allFinite())
+    throw InputError("start shape", std::to_string(start.cols()) + " columns", "3 x nodes, finite");
   const Eigen::VectorXd& A = wall.node_area();
   const double R0 = wall.params().R0;
   // (plain loops for the reductions here: see sum_sq)
   const double a_max = *std::max_element(A.data(), A.data() + n);
-  if (!(tol_force > 0.0)) tol_force = 1e-9 * std::abs(P) * a_max;
+  if (!(tol_force > 0.0)) tol_force = 1e-9 * p_max * a_max;
   // unknowns: r_k -> 2k, x_k -> 2k - 1 (k >= 1); x_0 held
   auto dof = [](int k, int comp) { return comp == 1 ? 2 * k : 2 * k - 1; };
 
-  // gradient g = -F + P A e_r of E + P sum A r (3 x n; row 2 unused)
+  // gradient g = -F + P_k A_k e_r of E + sum P_k A_k r_k (3 x n; row 2 unused)
   auto gradient = [&](const Eigen::Matrix3Xd& X) {
     Eigen::Matrix3Xd g = -wall.forces(X);
-    g.row(1) += P * A.transpose();
+    for (int k = 0; k < n; ++k) g(1, k) += P[std::size_t(k)] * A[k];
     return g;
   };
   auto reduced = [&](const Eigen::Matrix3Xd& g) {
@@ -352,7 +372,7 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
     return m;
   };
 
-  Eigen::Matrix3Xd X = wall.reference();
+  Eigen::Matrix3Xd X = start;
   Eigen::Matrix3Xd g = gradient(X);
   Eigen::VectorXd res = reduced(g);
   const double eps = 1e-6 * R0;
@@ -416,8 +436,6 @@ AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double t
                              significant(out.max_residual_force) + " N (tolerance " + significant(tol_force) + " N) after " +
                              std::to_string(it) + " Newton iterations",
                          "reduce the applied pressure (protocol.pressure sets the scale of the calibration loads)");
-  out.mid_radius = 0.5 * (X(1, (n - 1) / 2) + X(1, n / 2));
-  out.c1 = P / (R0 - out.mid_radius);
   return out;
 }
 

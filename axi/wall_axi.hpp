@@ -182,4 +182,14 @@ struct AxiPressureResponse {
 AxiPressureResponse relax_under_pressure(const AxiWall& wall, double P, double tol_force = 0.0,
                                          int max_iterations = 50);
 
+/// The same for a pressure P_k on each ring (load -P_k A_k e_r; P has one value per ring, some
+/// non-zero), from the shape `start` (the reference, or the equilibrium of a nearby load: Newton
+/// from the reference does not reach a deep contraction of a short segment); tol_force <= 0
+/// selects 1e-9 max |P_k| max A_k. mid_radius and c1 are left 0 (they are a uniform load's).
+/// Throws swim::InputError for a profile of the wrong length, non-finite or all zero, a start
+/// shape that is not 3 x nodes and finite, max_iterations < 1; swim::NumericalError as above.
+AxiPressureResponse relax_under_ring_pressures(const AxiWall& wall, const std::vector<double>& P,
+                                               const Eigen::Matrix3Xd& start, double tol_force = 0.0,
+                                               int max_iterations = 50);
+
 }  // namespace swim::axi
