@@ -383,8 +383,12 @@ def reference_convergence_figure(case, path):
         ax.set(xlabel="cell size h [nm]", ylabel=ylabel)
         nonnegative_axis(ax, key)
         ax.grid(alpha=0.3)
-        # each panel's legend below it, off the data: the orders differ from figure to figure
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.16), fontsize="small", frameon=False)
+        # each panel's legend below it, off the data: the orders differ from figure to figure; the
+        # labels wrapped to the panel's width (about 10 characters per inch), so that neighbouring
+        # legends neither overlap nor run off the figure
+        handles, labels = ax.get_legend_handles_labels()
+        ax.legend(handles, [textwrap.fill(t, 52) for t in labels], loc="upper center", bbox_to_anchor=(0.5, -0.16),
+                  fontsize="small", frameon=False)
     # the statement wrapped to the figure's width (about 9 characters per inch at this size)
     statement = "\n".join(textwrap.wrap(ref.get("statement", ""), int(9 * 5.4 * len(panels))))
     fig.suptitle(f"{case['name']}: grid convergence of the 3D tier and the axisymmetric reference\n{statement}",
