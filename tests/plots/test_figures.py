@@ -403,17 +403,29 @@ class ValidationFigures(unittest.TestCase):
         stuck = [{"has_cycle": False, "cell_size_m": h, "status": "failed: numerical failure: the protocol did "
                   "not complete 1 cycle(s) within full3d.time_limit = 5 s"} for h in (1.56e-8, 7.81e-9)]
         val = {"value": 1.0e-7, "error": 1e-9, "converged": False}
+        # the long legend entries of the converged suite's two-panel cases: an expansion fit's
+        # with the three finest grids' order, and a cycle time summed from seven phases
+        phases = [{"observed_order": p} for p in (2.63, 5.56, None, 0.95, 5.13, 4.31, 1.56)]
         case = {"name": "c", "runs3d": stuck[:1] + ok + stuck[1:], "models1d": [],
-                "reference3d": {"displacement_per_cycle_m": val, "cycle_time_s": dict(val, value=2.7)},
+                "reference3d": {"displacement_per_cycle_m": dict(val, method="expansion_fit", observed_order=1.98),
+                                "cycle_time_s": dict(val, value=2.7)},
                 "reference": {"runs": [dict(r, cell_size_m=2 * r["cell_size_m"]) for r in ok],
-                              "displacement_per_cycle_m": val, "cycle_time_s": dict(val, value=2.7)}}
+                              "displacement_per_cycle_m": val, "cycle_time_s": dict(val, value=2.7, phases=phases)}}
         self.assertTrue(self.mod.reference_convergence_figure(case, f"{self.d}/r.png"))
         ax = self.closed[-1].axes[0]
         marks = [ln for ln in ax.get_lines() if ln.get_linestyle() == ":"]
         self.assertEqual(sorted(round(ln.get_xdata()[0], 2) for ln in marks), [7.81, 15.6])
-        legend = " ".join(t.get_text() for t in ax.get_legend().get_texts())
+        # the labels are wrapped to the panel's width: read them with the line breaks as spaces
+        legend = " ".join(" ".join(t.get_text().split()) for t in ax.get_legend().get_texts())
         self.assertIn("3D runs without a cycle (time limit): h = 7.81, 15.6 nm", legend)
         self.assertNotIn("axisymmetric runs without a cycle", legend)
+        # the two panels' legends neither overlap nor leave the figure
+        fig = self.closed[-1]
+        fig.canvas.draw()
+        boxes = [a.get_legend().get_window_extent(fig.canvas.get_renderer()) for a in fig.axes[:2]]
+        self.assertLess(boxes[0].x1, boxes[1].x0)
+        self.assertGreaterEqual(boxes[0].x0, fig.bbox.x0)
+        self.assertLessEqual(boxes[1].x1, fig.bbox.x1)
 
     def test_pareto_labels_do_not_overlap(self):
         import matplotlib.pyplot as plt
