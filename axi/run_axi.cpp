@@ -73,8 +73,11 @@ class Runner {
              series_columns(), wall_.reference_positions()) {
     rec_.keep(ctl.keep_rows);
     if (fitted_) {
-      if (p_.triangles) tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), mesh_.X0);
-      make_solvers();
+      // a resumed run's triangulation is the checkpoint's (restore), made once there
+      if (!(p_.triangles && ctl.resume)) {
+        if (p_.triangles) tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), mesh_.X0);
+        make_solvers();
+      }
     } else {
       stokes_ = std::make_unique<AxiStokes>(grid_, b_.fluid.mu);
     }
@@ -278,7 +281,7 @@ class Runner {
     const full3d::CheckpointReader r = open_checkpoint(p_, resolved_, out_);
     records(*this, full3d::CheckpointIn(r));
     rec_.load([&](const std::string& name) { return r.get_vector(name); });
-    if (tri_) {
+    if (fitted_ && p_.triangles) {
       const std::vector<double> R = r.get_vector("mesh_reference");
       tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), Eigen::Map<const Eigen::Matrix3Xd>(R.data(), 3, wall_.nodes()));
       make_solvers();
