@@ -171,11 +171,18 @@ def legend_right(ax):
 
 
 def legend_below(fig, ax, width=9.0, height=4.6, ncol=2, wrap=58, gap=0.15):
-    """Legend under the axes (of ax's entries, for the whole figure), off the data, its long
+    """Legend under the axes (of ax's entries, or of a list of axes' entries with each label
+    once, for the whole figure), off the data, its long
     labels wrapped: the axes keep the figure's width (beside them, a legend of long model labels
     squeezed the plot to a strip). Lays the figure out, width x height inches of axes and below
     them room for the legend's rows and a gap."""
-    handles, labels = ax.get_legend_handles_labels()
+    handles, labels, seen = [], [], set()
+    for a in (ax if isinstance(ax, (list, tuple)) else [ax]):  # entries of several axes, each label once
+        for h, l in zip(*a.get_legend_handles_labels()):
+            if l not in seen:
+                seen.add(l)
+                handles.append(h)
+                labels.append(l)
     labels = [textwrap.fill(l, wrap, subsequent_indent="  ") for l in labels]
     fig.legend(handles, labels, loc="lower center", ncol=ncol, fontsize="small", frameon=False)
     # about 0.18 inch per line; the columns are filled one after the other, so row r holds the
@@ -199,7 +206,8 @@ def pct(v):
 
 
 # the coarser 3D grids, next-finest first: each its own grey and dash, so they can be told apart
-COARSE_STYLES = (dict(color="0.35", ls="--"), dict(color="0.6", ls=":"), dict(color="0.75", ls="-."))
+COARSE_STYLES = (dict(color="0.35", ls="--"), dict(color="0.6", ls=":"), dict(color="0.75", ls="-."),
+                 dict(color="0.5", ls=(0, (6, 2, 1, 2, 1, 2))))
 
 
 def declutter(fig, labels, step=9):
@@ -230,55 +238,79 @@ def finest_axi_run(case):
 
 
 def velocity_figure(case, path):
-    fig, ax = plt.subplots(1, 2, figsize=(12, 4.4))
+    """U(t) and U against the cycle phase. With 1D models, two rows: the 3D grids and the
+    axisymmetric reference above, the 1D models against the reference (the finest axisymmetric
+    run, else the finest 3D run) below, so that neither set hides the other."""
     runs = [r for r in case["runs3d"] if r.get("has_cycle")]
-    ref_scale = 0.0
-    for k, r in enumerate(runs):
-        s = r["series"]
-        finest = k == len(runs) - 1
-        T = r["cycle_time_s"]
-        u = [v * 1e9 for v in s["velocity_m_per_s"]]
-        ref_scale = max(ref_scale, max(abs(v) for v in u) if u else 0.0)
-        kw = dict(color="k", lw=2, label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm (finest)") if finest else \
-            dict(COARSE_STYLES[(len(runs) - 2 - k) % len(COARSE_STYLES)], lw=1.0,
-                 label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm")
-        ax[0].plot(s["t_s"], u, **kw)
-        ax[1].plot([t / T for t in s["t_s"]], u, **kw)
-    # the converged reference of U(t) when the case has one: its finest axisymmetric run
     axi = finest_axi_run(case)
-    if axi is not None:
-        s = axi["series"]
-        T = axi["cycle_time_s"]
-        u = [v * 1e9 for v in s["velocity_m_per_s"]]
-        ref_scale = max(ref_scale, max(abs(v) for v in u) if u else 0.0)
-        kw = dict(color="C0", lw=2.4, alpha=0.8,
-                  label=f"axisymmetric reference, h = {axi['cell_size_m'] * 1e9:.3g} nm (finest; the U(t) verdict's reference)")
-        ax[0].plot(s["t_s"], u, **kw)
-        ax[1].plot([t / T for t in s["t_s"]], u, **kw)
-    off = []
+    scale = 0.0
+    for r in runs + ([axi] if axi is not None else []):
+        u = r["series"]["velocity_m_per_s"]
+        scale = max(scale, max(abs(v) for v in u) * 1e9 if u else 0.0)
+    models, off = [], []
     for k, m in enumerate(case["models1d"]):
         if "series" not in m or not m.get("has_cycle"):
             continue
-        s = m["series"]
-        u = [v * 1e9 for v in s["velocity_m_per_s"]]
-        if ref_scale > 0 and max(abs(v) for v in u) > 50 * ref_scale:
+        u = [v * 1e9 for v in m["series"]["velocity_m_per_s"]]
+        if scale > 0 and max(abs(v) for v in u) > 50 * scale:
             off.append(f"{m['label']} (peak {si(max(abs(v) for v in u) * 1e-9, 'm/s')})")
-            continue
-        T = m["cycle_time_s"]
-        st = MODEL_STYLES[k % len(MODEL_STYLES)]
-        ax[0].plot(s["t_s"], u, st, lw=1.4, label=f"1D: {m['label']}")
-        ax[1].plot([t / T for t in s["t_s"]], u, st, lw=1.4, label=f"1D: {m['label']}")
-    ax[0].set(xlabel="time t [s]", ylabel="swimmer velocity U [nm/s]", title="U(t) over the cycle")
-    ax[1].set(xlabel="cycle phase t / T_cycle (each tier on its own cycle time)", ylabel="U [nm/s]",
-              title="U against cycle phase")
-    for a in ax:
-        a.axhline(0, color="0.6", lw=0.6)
+        else:
+            models.append((k, m))
+    rows = 2 if models else 1
+    fig, axs = plt.subplots(rows, 2, figsize=(12, 4.4 * rows), squeeze=False)
+
+    def draw(ax_pair, s, T, **kw):
+        u = [v * 1e9 for v in s["velocity_m_per_s"]]
+        ax_pair[0].plot(s["t_s"], u, **kw)
+        ax_pair[1].plot([t / T for t in s["t_s"]], u, **kw)
+
+    finest_kw = None
+    for k, r in enumerate(runs):
+        finest = k == len(runs) - 1
+        kw = dict(color="k", lw=2, label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm (finest)") if finest else \
+            dict(COARSE_STYLES[(len(runs) - 2 - k) % len(COARSE_STYLES)], lw=1.0,
+                 label=f"3D, h = {r['cell_size_m'] * 1e9:.3g} nm")
+        draw(axs[0], r["series"], r["cycle_time_s"], **kw)
+        if finest:
+            finest_kw = kw
+    # the converged reference of U(t) when the case has one: its finest axisymmetric run
+    axi_kw = None
+    if axi is not None:
+        axi_kw = dict(color="C0", lw=2.4, alpha=0.8,
+                      label=f"axisymmetric reference, h = {axi['cell_size_m'] * 1e9:.3g} nm (finest; the U(t) verdict's reference)")
+        draw(axs[0], axi["series"], axi["cycle_time_s"], **axi_kw)
+    if rows == 2:
+        if axi is not None:
+            draw(axs[1], axi["series"], axi["cycle_time_s"], **axi_kw)
+        elif runs:
+            draw(axs[1], runs[-1]["series"], runs[-1]["cycle_time_s"], **finest_kw)
+        for k, m in models:
+            st = MODEL_STYLES[k % len(MODEL_STYLES)]
+            u = [v * 1e9 for v in m["series"]["velocity_m_per_s"]]
+            T = m["cycle_time_s"]
+            axs[1][0].plot(m["series"]["t_s"], u, st, lw=1.4, label=f"1D: {m['label']}")
+            axs[1][1].plot([t / T for t in m["series"]["t_s"]], u, st, lw=1.4, label=f"1D: {m['label']}")
+    against = "the axisymmetric reference" if axi is not None else "the finest 3D run"
+    for i in range(rows):
+        what = "3D grids" + (" and the axisymmetric reference" if axi is not None else "") if i == 0 else \
+            f"1D models against {against}"
+        axs[i][0].set(xlabel="time t [s]", ylabel="swimmer velocity U [nm/s]", title=f"U(t) over the cycle: {what}")
+        axs[i][1].set(xlabel="cycle phase t / T_cycle (each tier on its own cycle time)", ylabel="U [nm/s]",
+                      title="U against cycle phase")
+        for a in axs[i]:
+            a.axhline(0, color="0.6", lw=0.6)
+    if rows == 2:  # the same velocity scale in both rows
+        for j in range(2):
+            lo = min(axs[0][j].get_ylim()[0], axs[1][j].get_ylim()[0])
+            hi = max(axs[0][j].get_ylim()[1], axs[1][j].get_ylim()[1])
+            for i in range(2):
+                axs[i][j].set_ylim(lo, hi)
     title = f"{case['name']}: swimmer velocity, 1D against 3D" + (" and the axisymmetric reference" if axi else "")
     if off:
         title += "\noff scale, not drawn: " + "; ".join(off)
     fig.suptitle(title)
     # long model labels wrapped, so that three columns fit the figure's width
-    legend_below(fig, ax[0], width=12, height=4.0, ncol=3, wrap=62, gap=0.12)
+    legend_below(fig, [axs[i][0] for i in range(rows)], width=12, height=4.0 * rows, ncol=3, wrap=62, gap=0.12)
     fig.savefig(path, dpi=110)
     plt.close(fig)
 

@@ -335,6 +335,47 @@ class ValidationFigures(unittest.TestCase):
         self.mod.velocity_figure(case, f"{self.d}/v.png")
         self.assertFalse([ln for ln in self.closed[-1].axes[0].get_lines() if "axisymmetric" in ln.get_label()])
 
+    def test_velocity_figure_puts_the_1d_models_in_a_row_of_their_own(self):
+        # with 1D models: the 3D grids and the axi reference above, the 1D models against the
+        # reference below (the finest 3D run when there is no reference), the same U scale in
+        # both rows, every label once in the legend; an off-scale model is not drawn
+        s = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-8, 0]}
+        big = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-3, 0]}
+        fast = {"t_s": [0, 0.25, 0.5], "velocity_m_per_s": [0, 3e-8, 0]}
+        models = [{"label": "a", "has_cycle": True, "series": fast, "cycle_time_s": 0.5},
+                  {"label": "b", "has_cycle": True, "series": s, "cycle_time_s": 1.0},
+                  {"label": "paper", "has_cycle": True, "series": big, "cycle_time_s": 1.0},
+                  {"label": "stops", "has_cycle": False}]
+        runs = [{"has_cycle": True, "series": s, "cycle_time_s": 1.0, "cell_size_m": h} for h in (4e-8, 3e-8)]
+        case = {"name": "c", "models1d": models, "runs3d": runs,
+                "reference": {"runs": [{"has_cycle": True, "series": s, "cycle_time_s": 2.0, "cell_size_m": 2e-8}]}}
+        self.mod.velocity_figure(case, f"{self.d}/v.png")
+        fig = self.closed[-1]
+        plots = [a for a in fig.axes if a.get_lines()]
+        self.assertEqual(len(plots), 4)
+        labels = [[ln.get_label() for ln in a.get_lines() if not ln.get_label().startswith("_")] for a in plots]
+        for top in labels[:2]:
+            self.assertEqual(sum(l.startswith("3D") for l in top), 2)
+            self.assertEqual(sum(l.startswith("axisymmetric reference") for l in top), 1)
+            self.assertFalse([l for l in top if l.startswith("1D")])
+        for bottom in labels[2:]:
+            self.assertEqual([l for l in bottom if l.startswith("1D")], ["1D: a", "1D: b"])
+            self.assertEqual(sum(l.startswith("axisymmetric reference") for l in bottom), 1)
+            self.assertFalse([l for l in bottom if l.startswith("3D")])
+        for j in range(2):
+            self.assertEqual(plots[j].get_ylim(), plots[2 + j].get_ylim())
+        self.assertGreaterEqual(plots[0].get_ylim()[1], 30.0)  # the fastest 1D model's 30 nm/s fits the top row
+        legend = [t.get_text().replace("\n", " ") for t in fig.legends[0].get_texts()]
+        self.assertEqual(len(legend), len(set(legend)))
+        self.assertEqual(sum(t.startswith("axisymmetric reference") for t in legend), 1)
+        self.assertIn("paper (peak", fig._suptitle.get_text())
+        # no reference: the finest 3D run is the bottom row's
+        del case["reference"]
+        self.mod.velocity_figure(case, f"{self.d}/v.png")
+        plots = [a for a in self.closed[-1].axes if a.get_lines()]
+        bottom = [ln.get_label() for ln in plots[2].get_lines() if not ln.get_label().startswith("_")]
+        self.assertEqual([l for l in bottom if l.startswith("3D")], ["3D, h = 30 nm (finest)"])
+
     def test_convergence_grids_apart_and_not_asymptotic_said(self):
         runs = [{"has_cycle": True, "cell_size_m": h, "displacement_per_cycle_m": d}
                 for h, d in ((4e-8, 7e-10), (3.2e-8, 2.7e-9), (2.67e-8, 3.7e-9))]
