@@ -53,6 +53,7 @@ struct Options {
   double D = 2.1184615504e-24;  // J
   double mu = 1.2e-3;          // Pa s
   double ratio = 0.55, tol = 0.02;
+  std::string record;  // radius.csv of the cycle (t_s, z_m at the ring's reference position, radius_m)
 };
 
 [[noreturn]] void usage(const char* msg) {
@@ -60,7 +61,7 @@ struct Options {
                "swim_axial_wall_study: %s\n"
                "usage: swim_axial_wall_study [--wall linear|shell-fixed|shell-free] [--fluid-axial]\n"
                "  [--ends mirror|rest] [--rings N] [--dt-ms X] [--length-um X] [--first-nm X] [--segments N]\n"
-               "  [--pressure-pa X] [--ratio X]\n",
+               "  [--pressure-pa X] [--ratio X] [--record radius.csv]\n",
                msg);
   std::exit(2);
 }
@@ -109,6 +110,7 @@ int main(int argc, char** argv) {
     else if (a == "--segments") o.segments = std::atoi(next());
     else if (a == "--pressure-pa") o.pressure = std::atof(next());
     else if (a == "--ratio") o.ratio = std::atof(next());
+    else if (a == "--record") o.record = next();
     else usage(("unknown option " + a).c_str());
   }
   if (o.wall != "linear" && o.wall != "shell-fixed" && o.wall != "shell-free")
@@ -231,6 +233,25 @@ int main(int argc, char** argv) {
               o.fluid_axial ? " with the fluid's axial force" : "", o.rest_ends ? "rest" : "mirror", n, o.dt * 1e3,
               L * 1e9, o.pressure, o.ratio);
   double t = 0, t_event = 0;
+  // the record every 0.5 ms: what `swim run` replays as wave.kind = "recorded" (its flow model on
+  // this wall motion, the rings at their reference positions)
+  FILE* rec = nullptr;
+  if (!o.record.empty()) {
+    rec = std::fopen(o.record.c_str(), "w");
+    if (!rec) usage(("cannot write " + o.record).c_str());
+    std::fprintf(rec, "t_s,z_m,radius_m\n");
+  }
+  double next_record = 0.0, last_written = -1.0;
+  auto write_state = [&]() {
+    for (int k = 0; k < n; ++k) std::fprintf(rec, "%.9g,%.9g,%.12g\n", t, X0(0, k), y(k));
+    last_written = t;
+  };
+  auto record = [&]() {
+    if (!rec || t < next_record - 1e-12) return;
+    write_state();
+    next_record += 5e-4;
+  };
+  record();
   const double reach = o.ratio * (1 + o.tol);
   int last_back = -1;
   while (true) {
@@ -265,6 +286,7 @@ int main(int argc, char** argv) {
       }
     }
     t += o.dt;
+    record();
     if (recovering) {
       int worst = 0;
       for (int k = 0; k < n; ++k)
@@ -274,6 +296,10 @@ int main(int argc, char** argv) {
         std::printf("recovery: every ring within %.3g R0 of R0 after %.1f ms (cycle %.1f ms); the last to come back: the ring "
                     "%.1f nm from the front end; length %.1f nm\n",
                     o.tol, (t - t_event) * 1e3, t * 1e3, (L - X0(0, last_back)) * 1e9, len);
+        if (rec) {
+          if (t > last_written) write_state();  // the cycle's last state
+          std::fclose(rec);
+        }
         return 0;
       }
       last_back = worst;
