@@ -259,10 +259,10 @@ def velocity_figure(case, path):
     rows = 2 if models else 1
     fig, axs = plt.subplots(rows, 2, figsize=(12, 4.4 * rows), squeeze=False)
 
-    def draw(ax_pair, s, T, **kw):
+    def draw(ax_pair, s, T, *fmt, **kw):
         u = [v * 1e9 for v in s["velocity_m_per_s"]]
-        ax_pair[0].plot(s["t_s"], u, **kw)
-        ax_pair[1].plot([t / T for t in s["t_s"]], u, **kw)
+        ax_pair[0].plot(s["t_s"], u, *fmt, **kw)
+        ax_pair[1].plot([t / T for t in s["t_s"]], u, *fmt, **kw)
 
     finest_kw = None
     for k, r in enumerate(runs):
@@ -285,11 +285,8 @@ def velocity_figure(case, path):
         elif runs:
             draw(axs[1], runs[-1]["series"], runs[-1]["cycle_time_s"], **finest_kw)
         for k, m in models:
-            st = MODEL_STYLES[k % len(MODEL_STYLES)]
-            u = [v * 1e9 for v in m["series"]["velocity_m_per_s"]]
-            T = m["cycle_time_s"]
-            axs[1][0].plot(m["series"]["t_s"], u, st, lw=1.4, label=f"1D: {m['label']}")
-            axs[1][1].plot([t / T for t in m["series"]["t_s"]], u, st, lw=1.4, label=f"1D: {m['label']}")
+            draw(axs[1], m["series"], m["cycle_time_s"], MODEL_STYLES[k % len(MODEL_STYLES)], lw=1.4,
+                 label=f"1D: {m['label']}")
     against = "the axisymmetric reference" if axi is not None else "the finest 3D run"
     for i in range(rows):
         what = "3D grids" + (" and the axisymmetric reference" if axi is not None else "") if i == 0 else \
