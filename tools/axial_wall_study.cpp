@@ -283,6 +283,14 @@ int main(int argc, char** argv) {
       if (it >= 20 && step < 1e-6) break;
       if (it == 100) {
         std::printf("Newton did not converge at t = %.2f ms (largest update %.3g)\n", t * 1e3, step);
+        int worst = 0;
+        for (int c = 0; c < m; ++c)
+          if (std::abs(d(c)) / (c < m0 ? R0 : 1.0) > std::abs(d(worst)) / (worst < m0 ? R0 : 1.0)) worst = c;
+        if (worst < m0) {
+          const int k = worst % n;
+          std::printf("  the largest update: the %s of the ring %.1f nm from the front end (r %.4f R0)\n",
+                      worst < n ? "radius" : "axial position", (L - X0(0, k)) * 1e9, y(k) / R0);
+        }
         return 3;
       }
     }
