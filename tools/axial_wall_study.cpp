@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "axi/wall_axi.hpp"
+#include "reduced1d/outer_flow.hpp"
 
 namespace {
 
@@ -152,12 +153,10 @@ int main(int argc, char** argv) {
       if (seg[k] == s) num += A(k) * y(k), den += A(k);
     return num / den / R0;
   };
-  // lumen and annulus resistances per unit length (wall and container at rest)
+  // lumen and annulus resistances per unit length (wall and container at rest; the annulus's
+  // as the 1D tier's, reduced1d/outer_flow.hpp)
   auto r_in = [&](double r) { return 8 * mu / (kPi * r * r * r * r); };
-  auto k_out = [&](double r) {
-    const double g = Rc * Rc - r * r;
-    return kPi / (8 * mu) * (Rc * Rc * Rc * Rc - r * r * r * r - g * g / std::log(Rc / r));
-  };
+  auto annulus = [&](double r) { return swim::reduced1d::outer::annulus_point(r, Rc, mu); };
 
   int active = 0;
   bool recovering = false;  // every load released
@@ -190,7 +189,7 @@ int main(int argc, char** argv) {
     Pi += 4 * mu * (H * ((y.head(n) - y_old.head(n)) / o.dt));
     std::vector<double> Q(n + 1), rr(n + 1);
     for (int j = 0; j <= n; ++j) rr[j] = j == 0 ? y(0) : (j == n ? y(n - 1) : 0.5 * (y(j - 1) + y(j)));
-    auto cond = [&](double r) { return 1.0 / (r_in(r) + 1.0 / k_out(r)); };
+    auto cond = [&](double r) { return 1.0 / (r_in(r) + annulus(r).rho); };
     Q[0] = -cond(rr[0]) * Pi(0) / (0.5 * h);
     Q[n] = cond(rr[n]) * Pi(n - 1) / (0.5 * h);
     for (int j = 1; j < n; ++j) Q[j] = -cond(rr[j]) * (Pi(j) - Pi(j - 1)) / h;
@@ -198,21 +197,22 @@ int main(int argc, char** argv) {
     for (int k = 0; k < n; ++k)
       res(k) = (kPi * hb[k] * (y(k) * y(k) - y_old(k) * y_old(k)) - o.dt * (Q[k] - Q[k + 1])) / (kPi * R0 * h);
     if (free_rings) {
+      // the fluid's axial force: the lumen's and the annulus's pressure gradients at each face
+      // from its flux (Q = -p_in' / r_in = p_out' G_a), their mean over a ring's patch; per unit
+      // length -pi R^2 p_in' from the lumen, (pi R^2 - S) p_out' from the annulus's shear
+      std::vector<double> gin(n + 1, 0.0), gout(n + 1, 0.0);
+      if (o.fluid_axial)
+        for (int j = 0; j <= n; ++j) {
+          gin[j] = -Q[j] * r_in(rr[j]);
+          gout[j] = Q[j] * annulus(rr[j]).rho;
+        }
       for (int k = 0; k < n; ++k) {
         double fx = 0;
         if (o.fluid_axial) {
-          // pressure gradients from the flux at the two faces of the ring's patch
-          auto grads = [&](int j, double& gi, double& go) {
-            gi = -Q[j] * r_in(rr[j]);
-            go = Q[j] / k_out(rr[j]);
-          };
-          double gi0, go0, gi1, go1;
-          grads(k, gi0, go0);
-          grads(k + 1, gi1, go1);
-          const double gi = 0.5 * (gi0 + gi1), go = 0.5 * (go0 + go1), rk = y(k);
+          const double gi = 0.5 * (gin[k] + gin[k + 1]), go = 0.5 * (gout[k] + gout[k + 1]), rk = y(k);
           const int kl = k > 0 ? k - 1 : k, kr = k < n - 1 ? k + 1 : k;
           const double patch = 0.5 * (y(n + kr) - y(n + kl));
-          fx = patch * (-kPi * rk * rk * gi + 0.5 * kPi * go * (2 * rk * rk - (Rc * Rc - rk * rk) / std::log(Rc / rk))) -
+          fx = patch * (-kPi * rk * rk * gi + (kPi * rk * rk - annulus(rk).S) * go) -
                Pi(k) * kPi * (y(kr) * y(kr) - y(kl) * y(kl)) / 2;
         }
         res(n + k) = (F(0, k) + fx) / (Y * 2 * kPi * R0);
