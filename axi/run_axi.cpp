@@ -185,8 +185,11 @@ class Runner {
     split_remesh_ += seconds_since(t);
   }
 
-  /// Whether the triangulation fitted to the accepted shape X_ has degraded (its smallest angle
-  /// below axi.remesh_angle): then it is made again on X_.
+  /// Whether the triangulation fitted to the accepted shape X_ has degraded: then it is made
+  /// again on X_. Degraded means a triangle inverted, or the smallest angle fell below
+  /// axi.remesh_angle scaled by how far the mesh, when made, fell short of the mesher's bound
+  /// (TriMesh::remesh_threshold): a shape whose own corners cap every triangulation's smallest
+  /// angle below axi.remesh_angle is not meshed again at every step.
   void keep_triangles_fit() {
     TriMesh probe(*tri_);
     try {
@@ -195,7 +198,7 @@ class Runner {
       remesh(X_);
       return;
     }
-    if (probe.min_angle() < p_.remesh_angle) remesh(X_);
+    if (probe.min_angle() < tri_->remesh_threshold(p_.remesh_angle)) remesh(X_);
   }
 
   // ---- checkpoints ----------------------------------------------------------------------

@@ -323,6 +323,12 @@ const TriMeshParams& TriMesh::params() const { return t_->p; }
 const Eigen::Matrix3Xd& TriMesh::reference() const { return t_->X_ref; }
 double TriMesh::length_scale() const { return t_->p.size; }
 
+double TriMesh::bound_angle() const { return std::asin(std::sqrt(t_->p.angle_bound)); }
+
+double TriMesh::remesh_threshold(double angle) const {
+  return angle * std::min(1.0, min_angle_ / bound_angle());
+}
+
 int TriMesh::element_slot(int e, int a) const {
   if (a < 3) return t_->tri[3 * e + a];
   if (a < 6) return t_->V + t_->tedge[3 * e + (a - 3)];

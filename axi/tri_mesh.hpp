@@ -14,7 +14,7 @@
 // ceil(Rc / size)) and, since no constrained edge is split, keep them: the two cuts' vertices are
 // identified (the mesh is periodic), and every ring is a vertex and every wall segment an edge.
 // Triangles are refined until their longest edge is below `size` and their smallest angle above
-// asin(1 / (2 sqrt(angle_bound))) (20.7 deg for the default 0.125) wherever a new vertex does not
+// asin(sqrt(angle_bound)) (20.7 deg for the default 0.125) wherever a new vertex does not
 // encroach on a constraint; near the wall the rings' spacing sets the elements' size, which then
 // grows away from it.
 //
@@ -46,7 +46,7 @@ namespace swim::axi {
 struct TriMeshParams {
   double Rc = 0, period = 0;  ///< container radius and period, m
   double size = 0;            ///< longest edge of a triangle (where the rings do not set a finer one), m
-  double angle_bound = 0.125; ///< CGAL's shape bound B = 1 / (4 sin^2 theta_min)
+  double angle_bound = 0.125; ///< CGAL's shape criterion b = sin^2 theta_min (circumradius over shortest edge <= 1 / (2 sqrt(b)))
 };
 
 class TriMesh final : public MeridianMesh {
@@ -82,6 +82,15 @@ class TriMesh final : public MeridianMesh {
   bool follows(const Eigen::Matrix3Xd& X, std::string* cause = nullptr) const;
   /// The smallest angle of a triangle of the current fit, radians (0 before a fit).
   double min_angle() const { return min_angle_; }
+  /// The smallest angle the mesher aims for, asin(sqrt(angle_bound)), radians.
+  double bound_angle() const;
+  /// The smallest angle below which a fit of this mesh counts as degraded, for a nominal
+  /// threshold `angle` (radians): `angle` times min(1, the made mesh's smallest angle over
+  /// bound_angle()). Where the wall's own shape keeps the made mesh's smallest angle below the
+  /// bound (constrained segments meeting at a sharp corner, rings closer than the gap between
+  /// them), a new mesh cannot do better, and the threshold falls with it. Call on the mesh as
+  /// made (fitted to its reference shape).
+  double remesh_threshold(double angle) const;
   /// Position of node `node` in element e (its slot's point; the element's periodic image).
   Eigen::Vector2d slot_position(int e, int a) const;
 

@@ -984,25 +984,32 @@ def reference_markdown(c):
                    f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {si(r.get('max_displacement_m'), 'm')} | "
                    f"{r.get('steps', '')} | {si(r.get('wall_time_s'), 's')}{' (cached)' if r.get('cached') else ''} |")
     tc = ref.get("time_check")
-    if tc and tc.get("run"):
-        r = tc["run"]
-        out.append(f"| {json.dumps(r.get('grid_value'))}, axi.tolerance × {tc.get('factor', 0):g} (time check) | "
-                   f"{si(r['cell_size_m'], 'm')} | {r['status'][:60]} | "
-                   f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
-                   f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {si(r.get('max_displacement_m'), 'm')} | "
-                   f"{r.get('steps', '')} | {si(r.get('wall_time_s'), 's')}{' (cached)' if r.get('cached') else ''} |")
+    wc = ref.get("wall_check")
+    for chk, what in ((tc, "axi.tolerance × {:g} (time check)"), (wc, "axi.spacing_factor × {:g} (wall check)")):
+        if chk and chk.get("run"):
+            r = chk["run"]
+            out.append(f"| {json.dumps(r.get('grid_value'))}, {what.format(chk.get('factor', 0))} | "
+                       f"{si(r['cell_size_m'], 'm')} | {r['status'][:60]} | "
+                       f"{si(r.get('displacement_per_cycle_m'), 'm')} | {si(r.get('cycle_time_s'), 's')} | "
+                       f"{si(r.get('mean_velocity_per_cycle_m_per_s'), 'm/s')} | {si(r.get('max_displacement_m'), 'm')} | "
+                       f"{r.get('steps', '')} | {si(r.get('wall_time_s'), 's')}{' (cached)' if r.get('cached') else ''} |")
     out.append("")
     if tc:
         out.append(f"- time integration's error, inside each error bar below: {tc.get('note', '')}")
+    if wc:
+        out.append(f"- the wall's resolution error, inside each error bar below: {wc.get('note', '')}")
     for key, words, unit in FIGURE_WORDS:
         e = ref.get(key)
         if not e:
             continue
         rel = e.get("relative_error")
         te = e.get("time_error")
+        we = e.get("wall_error")
+        wall_text = "" if we is None else ", the wall's resolution ± " + si(we, unit)
         out.append(f"- {words}: {si(e['value'], unit)} ± {si(e['error'], unit)}"
                    f"{'' if rel is None else f' (± {100 * rel:.2g} %)'}"
-                   f"{'' if te is None else f', of which the time integration ± {si(te, unit)}'}; {order_text(e)}; "
+                   f"{'' if te is None else f', of which the time integration ± {si(te, unit)}'}"
+                   f"{wall_text}; {order_text(e)}; "
                    f"{'converged' if e.get('converged') else 'not converged'}; {e.get('note', '')}")
         for q in e.get("phases", []):
             out.append(f"  - {q['phase']}: {si(q['value'], unit)} ± {si(q['error'], unit)}; {order_text(q)}")

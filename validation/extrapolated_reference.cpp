@@ -126,26 +126,30 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
   return ref;
 }
 
-json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double factor) {
-  json tc = {{"factor", factor}, {"exponent", kAxiToleranceExponent}, {"errors", json::object()}};
-  char b[96];
-  std::snprintf(b, sizeof b, "axi.tolerance × %g", factor);
-  const std::string run = std::string("the coarsest grid again at ") + b;
-  if (!at_tolerance.cyc.has_cycle || !tighter.cyc.has_cycle) {
-    tc["note"] = run + ": " + (tighter.cyc.has_cycle ? "the reference's run" : "that run") +
-                 " completed no cycle, so the time integration's error is not estimated";
+namespace {
+
+/// One reference grid run again at a finer setting (a factor on one of its numerical
+/// parameters): each figure's change, scaled by 1 / (1 - factor^exponent), is the error at the
+/// reference's setting when that error falls as the parameter^exponent. `run` names the check's
+/// run, `of` whose error it measures ("the time integration's").
+json resolution_check(const RunAxi& at_setting, const RunAxi& finer, double factor, double exponent,
+                      const std::string& run, const std::string& of) {
+  json tc = {{"factor", factor}, {"exponent", exponent}, {"errors", json::object()}};
+  if (!at_setting.cyc.has_cycle || !finer.cyc.has_cycle) {
+    tc["note"] = run + ": " + (finer.cyc.has_cycle ? "the reference's run" : "that run") +
+                 " completed no cycle, so " + of + " error is not estimated";
     return tc;
   }
-  const double scale = 1.0 / (1.0 - std::pow(factor, kAxiToleranceExponent));
+  const double scale = 1.0 / (1.0 - std::pow(factor, exponent));
   json& e = tc["errors"];
   auto put = [&](const char* key, double a, double t) {
     if (std::isfinite(a) && std::isfinite(t)) e[key] = std::abs(a - t) * scale;
   };
-  const record::CycleFigures &a = at_tolerance.cyc, &t = tighter.cyc;
+  const record::CycleFigures &a = at_setting.cyc, &t = finer.cyc;
   put("displacement_per_cycle_m", a.displacement_per_cycle_m, t.displacement_per_cycle_m);
   put("cycle_time_s", a.cycle_time_s, t.cycle_time_s);
   put("mean_velocity_per_cycle_m_per_s", a.mean_velocity_per_cycle_m_per_s, t.mean_velocity_per_cycle_m_per_s);
-  put("max_displacement_m", at_tolerance.max_displacement, tighter.max_displacement);
+  put("max_displacement_m", at_setting.max_displacement, finer.max_displacement);
   if (!a.phase_times_s.empty() && a.phase_times_s.size() == t.phase_times_s.size()) {
     json p = json::array();
     for (std::size_t k = 0; k < a.phase_times_s.size(); ++k)
@@ -155,16 +159,46 @@ json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double fa
   auto rel = [&](const char* key, double v) {
     return e.contains(key) && v != 0 ? percent_text(e[key].get<double>() / std::abs(v)) : std::string("—");
   };
-  std::snprintf(b, sizeof b, "%g^%g", factor, kAxiToleranceExponent);
+  char b[96];
+  std::snprintf(b, sizeof b, "%g^%g", factor, exponent);
   tc["note"] = run + ": displacement per cycle ± " + rel("displacement_per_cycle_m", a.displacement_per_cycle_m) +
                ", cycle time ± " + rel("cycle_time_s", a.cycle_time_s) + ", mean velocity per cycle ± " +
                rel("mean_velocity_per_cycle_m_per_s", a.mean_velocity_per_cycle_m_per_s) +
-               " (each change / (1 − " + b + "): the error at the reference's tolerance)";
+               " (each change / (1 − " + b + "): the error at the reference's setting)";
   return tc;
 }
 
+/// The sum of a check's phase errors (its whole cycle's where it has no phases of that
+/// number); NaN without a check.
+double phase_error_of(const json& check, std::size_t phases) {
+  if (!check.is_object()) return std::numeric_limits<double>::quiet_NaN();
+  double e = time_error_of(check, "cycle_time_s");
+  const json& tp = check["errors"].value("phase_times_s", json());
+  if (tp.is_array() && tp.size() == phases) {
+    e = 0;
+    for (const json& x : tp) e += x.get<double>();
+  }
+  return e;
+}
+
+}  // namespace
+
+json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double factor) {
+  char b[96];
+  std::snprintf(b, sizeof b, "axi.tolerance × %g", factor);
+  return resolution_check(at_tolerance, tighter, factor, kAxiToleranceExponent,
+                          std::string("the coarsest grid again at ") + b, "the time integration's");
+}
+
+json axi_wall_check(const RunAxi& at_spacing, const RunAxi& finer, double factor) {
+  char b[96];
+  std::snprintf(b, sizeof b, "axi.spacing_factor × %g", factor);
+  return resolution_check(at_spacing, finer, factor, kAxiSpacingExponent,
+                          std::string("the coarsest grid again with its rings at ") + b, "the wall's resolution");
+}
+
 json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target,
-                   const json& time_check) {
+                   const json& time_check, const json& wall_check) {
   std::vector<double> h, d, T, v, hm, m;
   std::vector<std::vector<double>> phases;
   for (const auto& r : runs)
@@ -210,8 +244,13 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
       else
         e.error += et;
     }
+    // the wall's resolution error: inside every figure's error (the grids refine the rings
+    // with h, so it is not noise between them to bound the grids' differences by)
+    const double ew = time_error_of(wall_check, f.key);
+    if (std::isfinite(ew)) e.error += ew;
     json j = extrapolation_json(e);
     if (std::isfinite(et)) j["time_error"] = et;
+    if (std::isfinite(ew)) j["wall_error"] = ew;
     const double rel = std::abs(e.value) > 0 ? std::abs(e.error / e.value) : std::numeric_limits<double>::quiet_NaN();
     j["relative_error"] = num(rel);
     j["converged"] = figure_converged(e, rel, target);
@@ -220,20 +259,18 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
   // three grids or more: the cycle time phase by phase when the whole cycle's series does not converge
   if (h.size() >= 3 && !ref["cycle_time_s"]["converged"].get<bool>()) {
     json ps = phase_sum_cycle_time(h, phases, assumed, orders, target);
-    if (!ps.is_null() && time_check.is_object()) {
-      // the phases' time errors add (the whole cycle's where the check has no phases)
-      double et = time_error_of(time_check, "cycle_time_s");
-      const json& tp = time_check["errors"].value("phase_times_s", json());
-      if (tp.is_array() && tp.size() == ps["phases"].size()) {
-        et = 0;
-        for (const json& x : tp) et += x.get<double>();
-      }
-      if (std::isfinite(et)) {
-        const double sum = ps["value"].get<double>(), err = ps["error"].get<double>() + et;
+    if (!ps.is_null()) {
+      // the phases' time and wall errors add (the whole cycle's where a check has no phases)
+      const double et = phase_error_of(time_check, ps["phases"].size());
+      const double ew = phase_error_of(wall_check, ps["phases"].size());
+      if (std::isfinite(et) || std::isfinite(ew)) {
+        const double sum = ps["value"].get<double>();
+        const double err = ps["error"].get<double>() + (std::isfinite(et) ? et : 0.0) + (std::isfinite(ew) ? ew : 0.0);
         const double rel = std::abs(err / sum);
         ps["error"] = num(err);
         ps["relative_error"] = num(rel);
-        ps["time_error"] = et;
+        if (std::isfinite(et)) ps["time_error"] = et;
+        if (std::isfinite(ew)) ps["wall_error"] = ew;
         ps["converged"] = ps["converged"].get<bool>() && std::isfinite(rel) && rel <= target;
       }
     }
@@ -258,9 +295,9 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
                  {"converged", jd["converged"].get<bool>() && ps["converged"].get<bool>() && std::isfinite(rv) &&
                                    rv <= target},
                  {"direct", ref["mean_velocity_per_cycle_m_per_s"]}};
-      if (jd.contains("time_error") && ps.contains("time_error"))  // inside rv, as the errors are
-        jv["time_error"] = num(std::abs(vv) * (jd["time_error"].get<double>() / std::abs(dv) +
-                                               ps["time_error"].get<double>() / std::abs(tv)));
+      for (const char* k : {"time_error", "wall_error"})  // inside rv, as the errors are
+        if (jd.contains(k) && ps.contains(k))
+          jv[k] = num(std::abs(vv) * (jd[k].get<double>() / std::abs(dv) + ps[k].get<double>() / std::abs(tv)));
       ref["mean_velocity_per_cycle_m_per_s"] = jv;
     }
   }
@@ -282,6 +319,16 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
   }
   ref["converged"] = all;
   ref["statement"] = std::string(all ? "converged to " : "not converged to ") + target_text + ": " + parts;
+  if (wall_check.is_object()) {
+    ref["wall_check"] = wall_check;
+    char b[64];
+    std::snprintf(b, sizeof b, "axi.spacing_factor × %g", wall_check.value("factor", 0.0));
+    ref["statement"] = ref["statement"].get<std::string>() +
+                       (!wall_check["errors"].empty()
+                            ? std::string("; the wall's resolution error included (the coarsest grid with its rings at ") + b + ")"
+                            : std::string("; the wall's resolution error not estimated (its check at ") + b +
+                                  " completed no cycle)");
+  }
   if (time_check.is_object()) {
     ref["time_check"] = time_check;
     const bool measured = !time_check["errors"].empty();

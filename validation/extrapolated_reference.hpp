@@ -31,8 +31,11 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
 /// the displacement over that time (relative errors added); the whole cycle's extrapolation is
 /// kept beside it. `statement` says so with the figures reached. With a `time_check`
 /// (axi_time_check's entry) each figure's error includes the time integration's.
+/// With a `wall_check` (axi_wall_check's entry) each figure's error includes the wall's
+/// resolution error as well (added, never used to bound the grids' differences: the grids
+/// refine the rings with h).
 json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target,
-                   const json& time_check = nullptr);
+                   const json& time_check = nullptr, const json& wall_check = nullptr);
 
 /// The lowest power of the step tolerance at which the axi tier's time integration error falls:
 /// its step control keeps the local error below tolerance x h with steps that scale as
@@ -51,6 +54,18 @@ constexpr double kAxiToleranceExponent = 0.5;
 /// figure's time error to its error and, where the grids' differences lie within it, bounds the
 /// figure at the scheme's lowest order (bound_within_time_error).
 json axi_time_check(const RunAxi& at_tolerance, const RunAxi& tighter, double factor);
+
+/// The lowest order at which the wall's discretisation error falls with the rings' spacing:
+/// second order on a smooth wall, first where it folds (a kink between two rings).
+constexpr double kAxiSpacingExponent = 1.0;
+
+/// The wall's resolution share of a reference's error, measured by running the coarsest grid
+/// again with its rings closer (axi.spacing_factor x `factor`, 0 < factor < 1), the fluid's grid
+/// unchanged: each figure's change / (1 - factor^kAxiSpacingExponent), as axi_time_check. The
+/// grid series refines the rings with h too, but a wall whose shape the rings resolve poorly (a
+/// folded rim whose two layers close on a film of fluid) can move with the rings far more than
+/// the grids' spread shows (docs/axi.md). Entry: report.json "reference"."wall_check".
+json axi_wall_check(const RunAxi& at_spacing, const RunAxi& finer, double factor);
 
 /// The 3D extrapolation (reference_3d's entry) against the axisymmetric reference, figure by
 /// figure: both values with their errors, the difference, e_3d + e_ref, agree / disagree

@@ -127,13 +127,14 @@ json plan_runs(const SuiteOptions& o) {
         add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
             double(p.nr) * p.nx * (p.time_limit / p.dt_max));
       }
-      if (const json s = tolerance_check_scene(base, rs); !s.is_null()) {
-        json resolved;
-        const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
-        key = run_key_axi(resolved);
-        add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
-            double(p.nr) * p.nx * (p.time_limit / p.dt_max));
-      }
+      for (const json& s : {tolerance_check_scene(base, rs), spacing_check_scene(base, rs)})
+        if (!s.is_null()) {
+          json resolved;
+          const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
+          key = run_key_axi(resolved);
+          add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
+              double(p.nr) * p.nx * (p.time_limit / p.dt_max));
+        }
     }
     const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
     {

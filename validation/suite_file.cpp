@@ -7,6 +7,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <tuple>
 
 #include <unistd.h>
 
@@ -38,9 +39,10 @@ void check_reference(const json& ref, const std::string& at) {
                      "an object {\"tier\": \"axi\", \"grid_key\": \"axi.grid.cells_across\", \"grids\": [64, 128, 256], "
                      "\"order_range\": ..., \"set\": {...}}: the converged reference of the case");
   for (const auto& [k, v] : ref.items())
-    if (k != "tier" && k != "grid_key" && k != "grids" && k != "order_range" && k != "set" && k != "tolerance_check")
+    if (k != "tier" && k != "grid_key" && k != "grids" && k != "order_range" && k != "set" && k != "tolerance_check" &&
+        k != "spacing_check")
       throw InputError(at + "." + k, scene::show(v),
-                       "not a key of a reference: tier, grid_key, grids, order_range, set, tolerance_check");
+                       "not a key of a reference: tier, grid_key, grids, order_range, set, tolerance_check, spacing_check");
   const json& tier = member(ref, "tier", at);
   if (tier != "axi")
     throw InputError(at + ".tier", scene::show(tier),
@@ -68,6 +70,13 @@ void check_reference(const json& ref, const std::string& at) {
       throw InputError(at + ".tolerance_check", scene::show(f),
                        "a number between 0 and 1 (exclusive): the factor on axi.tolerance of the run that measures the "
                        "time integration's error on the coarsest grid (0.25: four times tighter)");
+  }
+  if (ref.contains("spacing_check")) {
+    const json& f = ref["spacing_check"];
+    if (!f.is_number() || !(f.get<double>() > 0 && f.get<double>() < 1))
+      throw InputError(at + ".spacing_check", scene::show(f),
+                       "a number between 0 and 1 (exclusive): the factor on axi.spacing_factor of the run that measures "
+                       "the wall's resolution error on the coarsest grid (0.5: twice the rings)");
   }
 }
 
@@ -242,13 +251,28 @@ std::size_t coarsest_reference_grid(const json& base, const json& ref) {
   return best;
 }
 
-json tolerance_check_scene(const json& base, const json& ref) {
-  if (!ref.contains("tolerance_check")) return nullptr;
+namespace {
+
+/// The coarsest reference grid's scene with one axi parameter at the check's factor (the
+/// reference's `key`) times the value that grid resolves to; null without the key.
+json check_scene(const json& base, const json& ref, const char* key, const char* parameter,
+                 double axi::ParamsAxi::*value) {
+  if (!ref.contains(key)) return nullptr;
   json s = reference_scene(base, ref, ref["grids"][coarsest_reference_grid(base, ref)]);
   json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
-  set_key(s, "axi.tolerance", ref["tolerance_check"].get<double>() * p.tolerance);
+  set_key(s, parameter, ref[key].get<double>() * (p.*value));
   return s;
+}
+
+}  // namespace
+
+json tolerance_check_scene(const json& base, const json& ref) {
+  return check_scene(base, ref, "tolerance_check", "axi.tolerance", &axi::ParamsAxi::tolerance);
+}
+
+json spacing_check_scene(const json& base, const json& ref) {
+  return check_scene(base, ref, "spacing_check", "axi.spacing_factor", &axi::ParamsAxi::spacing_factor);
 }
 
 std::string recovery_end_3d(const json& s) {
@@ -501,16 +525,18 @@ void check_suite(const json& s, const std::string& path, const std::string& data
                          std::string("a scene the axisymmetric tier (--tier axi) runs; it refuses this one: ") + e.what());
       }
     }
-    // the time check's scene: the coarsest grid at its tighter step tolerance
-    if (ref.contains("tolerance_check")) {
-      try {
-        json resolved;
-        axi::read_scene_axi(tolerance_check_scene(base, ref), resolved);
-      } catch (const InputError& e) {
-        throw InputError(at + ".tolerance_check", scene::show(ref["tolerance_check"]),
-                         std::string("a factor whose time check the axisymmetric tier runs; it refuses it: ") + e.what());
+    // the checks' scenes: the coarsest grid at its tighter step tolerance, and with its rings closer
+    for (const auto& [key, what, scene_of] : {std::tuple{"tolerance_check", "time check", &tolerance_check_scene},
+                                              std::tuple{"spacing_check", "wall check", &spacing_check_scene}})
+      if (ref.contains(key)) {
+        try {
+          json resolved;
+          axi::read_scene_axi(scene_of(base, ref), resolved);
+        } catch (const InputError& e) {
+          throw InputError(at + "." + key, scene::show(ref[key]),
+                           std::string("a factor whose ") + what + " the axisymmetric tier runs; it refuses it: " + e.what());
+        }
       }
-    }
   }
 }
 

@@ -61,6 +61,11 @@ std::size_t coarsest_reference_grid(const json& base, const json& ref);
 /// reference has no `tolerance_check`.
 json tolerance_check_scene(const json& base, const json& ref);
 
+/// The scene of a reference's wall check (its `spacing_check` factor f): the coarsest grid's
+/// reference scene with axi.spacing_factor at f times the factor it resolves to (the rings
+/// closer, the fluid's grid the same). Null when the reference has no `spacing_check`.
+json spacing_check_scene(const json& base, const json& ref);
+
 /// The 3D tier's full3d.recovery_end when a scene does not set it (full3d/scene3d.cpp; a test
 /// checks the two agree).
 inline constexpr const char* kRecoveryEndDefault3d = "dead_band";

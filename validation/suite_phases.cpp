@@ -279,19 +279,24 @@ std::vector<RunAxi> axi_reference_study(const SuiteCase& c, const json& suite, c
     axi_runs.push_back(r.record);
     aruns.push_back(std::move(r));
   }
-  // the time integration's share of the error: the coarsest grid again at a tighter step tolerance
-  json time_check = nullptr;
-  if (const json ts = tolerance_check_scene(c.base, rs); !ts.is_null()) {
+  // the time integration's and the wall's shares of the error: the coarsest grid again at a
+  // tighter step tolerance, and again with its rings closer
+  auto check = [&](const json& scene, const char* key, const std::string& what,
+                   json (*judge)(const RunAxi&, const RunAxi&, double)) -> json {
+    if (scene.is_null()) return nullptr;
     const std::size_t g0 = coarsest_reference_grid(c.base, rs);
-    say(c.tag + ": axi reference time check (" + rkey + " = " + rgrids[g0].dump() + " at axi.tolerance × " +
-        rs["tolerance_check"].dump() + ")");
-    RunAxi r = cache.run_axi(ts, progress);
+    say(c.tag + ": axi reference " + what + " (" + rkey + " = " + rgrids[g0].dump() + ", " + key + " " +
+        rs[key].dump() + ")");
+    RunAxi r = cache.run_axi(scene, progress);
     r.record["grid_value"] = rgrids[g0];
-    time_check = axi_time_check(aruns[g0], r, rs["tolerance_check"].get<double>());
-    time_check["grid_value"] = rgrids[g0];
-    time_check["run"] = r.record;
-  }
-  cr["reference"] = axi_reference(aruns, rorders, c.paper_max, target, time_check);
+    json j = judge(aruns[g0], r, rs[key].get<double>());
+    j["grid_value"] = rgrids[g0];
+    j["run"] = r.record;
+    return j;
+  };
+  const json time_check = check(tolerance_check_scene(c.base, rs), "tolerance_check", "time check", axi_time_check);
+  const json wall_check = check(spacing_check_scene(c.base, rs), "spacing_check", "wall check", axi_wall_check);
+  cr["reference"] = axi_reference(aruns, rorders, c.paper_max, target, time_check, wall_check);
   cr["reference"]["tier"] = "axi";
   cr["reference"]["method"] = method;
   cr["reference"]["grid_key"] = rkey;

@@ -217,6 +217,34 @@ TEST(TriMesh, MovesWithTheWall) {
   EXPECT_GT(m.min_angle(), 5.0 * kPi / 180);
 }
 
+// The degradation threshold of a run's remeshing (TriMesh::remesh_threshold). The mesher's bound
+// is asin(sqrt(0.125)) = 20.705 degrees. A smooth tube is meshed above it, so the nominal
+// threshold (12 degrees) stands. A wall with a spike whose two segments meet at about 9.5 degrees
+// caps the smallest angle of any triangulation that keeps the rings at that apex angle: the made
+// mesh falls short of the bound, and the threshold falls with it (12 degrees times the made
+// mesh's smallest angle over the bound), so a fit of the mesh as made does not count as
+// degraded. Fails if the bound is computed from the wrong relation (NaN or 90 degrees for the
+// default b), or the threshold does not scale, which makes a run mesh again at every step while
+// the wall keeps such a corner.
+TEST(TriMesh, ScalesItsRemeshThresholdByTheAngleTheMadeMeshReached) {
+  const double h = kRc / 16, deg = kPi / 180;
+  const int n = int(kL / (0.5 * h)) + 1;
+  const TriMesh smooth(tri_params(h), tube(n, 0.2));
+  EXPECT_NEAR(smooth.bound_angle() / deg, 20.7048, 1e-3);
+  ASSERT_GE(smooth.min_angle(), smooth.bound_angle());
+  EXPECT_EQ(smooth.remesh_threshold(12 * deg), 12 * deg);
+  Eigen::Matrix3Xd X = tube(n);
+  const double ds = kL / (n - 1);
+  X(1, n / 2) += 12 * ds;  // its neighbours ds either side: apex angle 2 atan(1 / 12) = 9.53 degrees
+  const TriMesh spiked(tri_params(h), X);
+  std::printf("  spike of apex angle 9.53 deg: the made mesh's smallest angle %.2f deg, threshold %.2f deg\n",
+              spiked.min_angle() / deg, spiked.remesh_threshold(12 * deg) / deg);
+  EXPECT_LE(spiked.min_angle(), 9.54 * deg);
+  EXPECT_GT(spiked.min_angle(), 1 * deg);
+  EXPECT_NEAR(spiked.remesh_threshold(12 * deg), 12 * deg * spiked.min_angle() / spiked.bound_angle(), 1e-15);
+  EXPECT_LT(spiked.remesh_threshold(12 * deg), spiked.min_angle());
+}
+
 // A ring pushed through its neighbours' triangles inverts them: fit refuses the shape with a
 // swim::NumericalError naming the triangle and the ring, follows() says so without changing the
 // mesh, and the mesh still fits the good shape afterwards.

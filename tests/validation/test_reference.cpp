@@ -345,6 +345,85 @@ TEST(SuiteReference, TheReferencesErrorIncludesTheTimeIntegrations) {
   EXPECT_NE(wn["statement"].get<std::string>().find("the time integration's error not estimated"), std::string::npos);
 }
 
+// The wall's resolution share of a reference's error (the coarsest grid again with its rings at
+// axi.spacing_factor x 0.5): each figure's change / (1 - 0.5^1) is added to its error, after the
+// time integration's, and never used to bound the grids' differences (the grid series refines
+// the rings with h). The hooked round wall's case: its recovery waits on a film between the
+// folded rim's two layers, which closer rings let close further: 1.26 s on the coarsest grid,
+// 3.86 s with twice the rings (docs/axi.md). Its cycle time then carries an error of 2 x 2.6 s on
+// top of the grids' and the time integration's, and its mean velocity per cycle the relative
+// errors of both; the statement says the error is included. A check whose run completed no cycle
+// changes no error bar and the statement says so.
+TEST(SuiteReference, TheReferencesErrorIncludesTheWallsResolution) {
+  const double h1 = 31.25 * nm, h2 = 20.8333 * nm, h3 = 15.625 * nm;
+  const std::vector<RunAxi> runs = {axi_run(h1, 109.4 * nm, 1.26, 0.2), axi_run(h2, 108.9 * nm, 3.05, 0.2),
+                                    axi_run(h3, 108.1 * nm, 2.66, 0.2)};
+  RunAxi fine = runs[0];
+  fine.cyc.displacement_per_cycle_m = 108.4 * nm;
+  fine.cyc.cycle_time_s = 3.86;
+  fine.cyc.mean_velocity_per_cycle_m_per_s = fine.cyc.displacement_per_cycle_m / fine.cyc.cycle_time_s;
+  fine.cyc.phase_times_s = {0.2, 3.66};
+
+  const json wc = axi_wall_check(runs[0], fine, 0.5);
+  EXPECT_EQ(wc["exponent"].get<double>(), kAxiSpacingExponent);
+  EXPECT_NEAR(wc["errors"]["displacement_per_cycle_m"].get<double>(), 2e-9, 1e-15);  // 1 nm / (1 - 0.5)
+  EXPECT_NEAR(wc["errors"]["cycle_time_s"].get<double>(), 5.2, 1e-12);
+  ASSERT_EQ(wc["errors"]["phase_times_s"].size(), 2u);
+  EXPECT_NEAR(wc["errors"]["phase_times_s"][0].get<double>(), 0.0, 1e-15);
+  EXPECT_NEAR(wc["errors"]["phase_times_s"][1].get<double>(), 5.2, 1e-12);
+  EXPECT_NE(wc["note"].get<std::string>().find("axi.spacing_factor × 0.5"), std::string::npos) << wc["note"];
+
+  const json plain = axi_reference(runs, kSharpInterfaceOrders, false, 0.01);
+  const json with = axi_reference(runs, kSharpInterfaceOrders, false, 0.01, nullptr, wc);
+  const json &dp = plain["displacement_per_cycle_m"], &dw = with["displacement_per_cycle_m"];
+  EXPECT_DOUBLE_EQ(dw["value"].get<double>(), dp["value"].get<double>());
+  EXPECT_NEAR(dw["error"].get<double>(), dp["error"].get<double>() + 2e-9, 1e-18);
+  EXPECT_NEAR(dw["wall_error"].get<double>(), 2e-9, 1e-15);
+  EXPECT_FALSE(dw.contains("within_time_error") && dw["within_time_error"].get<bool>());
+  // the cycle time: the sum of its phases, each phase's wall error added
+  const json &cp = plain["cycle_time_s"], &cw = with["cycle_time_s"];
+  ASSERT_TRUE(cw.contains("phases"));
+  EXPECT_NEAR(cw["error"].get<double>(), cp["error"].get<double>() + 5.2, 1e-9);
+  EXPECT_NEAR(cw["wall_error"].get<double>(), 5.2, 1e-12);
+  const json& vw = with["mean_velocity_per_cycle_m_per_s"];
+  EXPECT_NEAR(vw["relative_error"].get<double>(),
+              dw["relative_error"].get<double>() + cw["relative_error"].get<double>(), 1e-12);
+  EXPECT_GT(cw["relative_error"].get<double>(), 1.0);  // no cycle time to speak of
+  EXPECT_FALSE(with["converged"].get<bool>());
+  EXPECT_NE(with["statement"].get<std::string>().find("the wall's resolution error included"), std::string::npos);
+  EXPECT_EQ(with["wall_check"]["factor"], 0.5);
+
+  RunAxi none = fine;
+  none.cyc.has_cycle = false;
+  const json wn = axi_wall_check(runs[0], none, 0.5);
+  EXPECT_TRUE(wn["errors"].empty());
+  EXPECT_NE(wn["note"].get<std::string>().find("the wall's resolution error is not estimated"), std::string::npos);
+  const json rn = axi_reference(runs, kSharpInterfaceOrders, false, 0.01, nullptr, wn);
+  EXPECT_EQ(rn["displacement_per_cycle_m"]["error"], dp["error"]);
+  EXPECT_EQ(rn["cycle_time_s"]["error"], cp["error"]);
+  EXPECT_NE(rn["statement"].get<std::string>().find("the wall's resolution error not estimated"), std::string::npos);
+}
+
+// The wall check runs the reference's coarsest grid with its rings at the factor times the
+// spacing factor that grid resolves to, the fluid's grid (h) the same; a reference without the
+// key has none; a factor outside (0, 1) is refused naming the key.
+TEST(SuiteReference, TheWallCheckRunsTheCoarsestGridWithCloserRings) {
+  json base = scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");
+  apply_sets(base, json::parse(kRound));
+  const json ref = {{"tier", "axi"}, {"grids", {24, 16, 32}}, {"spacing_check", 0.5}};
+  json r16, rc;
+  const axi::ParamsAxi p16 = axi::read_scene_axi(reference_scene(base, ref, 16), r16);
+  const axi::ParamsAxi pc = axi::read_scene_axi(spacing_check_scene(base, ref), rc);
+  EXPECT_DOUBLE_EQ(pc.h, p16.h);
+  EXPECT_DOUBLE_EQ(pc.spacing_factor, 0.5 * p16.spacing_factor);
+  EXPECT_GT(pc.wall_nodes, p16.wall_nodes + p16.wall_nodes / 2);
+  EXPECT_NE(run_key_axi(rc), run_key_axi(r16));
+  EXPECT_TRUE(spacing_check_scene(base, json{{"tier", "axi"}, {"grids", {16, 24, 32}}}).is_null());
+  for (const char* f : {"1", "0", "-0.5", "\"half\""})
+    expect_refused(write_suite("x.json", std::string(R"({"tier": "axi", "grids": [64, 128, 256], "spacing_check": )") + f + "}"),
+                   {"suite.cases[0].reference.spacing_check", "between 0 and 1"});
+}
+
 // The time check runs the reference's coarsest grid, whatever the order the grids are listed in,
 // at the factor times the step tolerance that grid resolves to; a reference without the key has none.
 TEST(SuiteReference, TheTimeCheckRunsTheCoarsestGrid) {
@@ -372,6 +451,7 @@ TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
     EXPECT_EQ(ref["grids"], json::array({16, 24, 32}));
     EXPECT_EQ(ref["order_range"], "sharp_interface");
     EXPECT_EQ(ref["tolerance_check"], 0.25);  // its error bars hold the time integration's error
+    EXPECT_EQ(ref["spacing_check"], 0.5);     // and the wall's resolution error
     // the L = 0.2 um reference at a quarter of the default step tolerance, which it needs to
     // reach 1 % with that error inside its bars
     if (c["set"]["name"] == "paper_aspect_L0.2_round_wall") EXPECT_EQ(ref["set"]["axi.tolerance"], 5e-4);
