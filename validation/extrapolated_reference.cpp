@@ -223,6 +223,14 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
     return ref;
   }
   const double assumed = std::clamp(1.0, orders.lo, orders.hi);
+  // The wall check measures the wall's error on the coarsest grid's rings. The grids refine the
+  // rings with h, so an asymptotic series carries that error to h -> 0 with the rest (the ring
+  // spacing's own order is near 2 on a smooth wall, inside the scheme's range). A figure the
+  // series does not extrapolate (not asymptotic: the finest grid's value) keeps the wall's
+  // error on the finest grid's rings, taken from the check at the lowest order:
+  // e_w (h_finest / h_coarsest)^kAxiSpacingExponent, added to its error.
+  const double wall_scale =
+      std::pow(*std::min_element(h.begin(), h.end()) / *std::max_element(h.begin(), h.end()), kAxiSpacingExponent);
   struct Fig {
     const char* key;
     const char* words;
@@ -244,9 +252,9 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
       else
         e.error += et;
     }
-    // the wall's resolution error: inside every figure's error (the grids refine the rings
-    // with h, so it is not noise between them to bound the grids' differences by)
-    const double ew = time_error_of(wall_check, f.key);
+    // the wall's resolution error, where the grid series does not carry it (below)
+    const double ew = e.asymptotic ? std::numeric_limits<double>::quiet_NaN()
+                                   : wall_scale * time_error_of(wall_check, f.key);
     if (std::isfinite(ew)) e.error += ew;
     json j = extrapolation_json(e);
     if (std::isfinite(et)) j["time_error"] = et;
@@ -260,9 +268,26 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
   if (h.size() >= 3 && !ref["cycle_time_s"]["converged"].get<bool>()) {
     json ps = phase_sum_cycle_time(h, phases, assumed, orders, target);
     if (!ps.is_null()) {
-      // the phases' time and wall errors add (the whole cycle's where a check has no phases)
+      // the phases' time errors add (the whole cycle's where the check has no phases), and the
+      // wall errors of the phases the grids do not extrapolate (as for the whole figures above)
       const double et = phase_error_of(time_check, ps["phases"].size());
-      const double ew = phase_error_of(wall_check, ps["phases"].size());
+      double ew = std::numeric_limits<double>::quiet_NaN();
+      if (wall_check.is_object()) {
+        const json& wp = wall_check["errors"].value("phase_times_s", json());
+        if (wp.is_array() && wp.size() == ps["phases"].size()) {
+          ew = 0;
+          for (std::size_t k = 0; k < wp.size(); ++k) {
+            json& q = ps["phases"][k];
+            if (q["asymptotic"].get<bool>()) continue;
+            const double w = wall_scale * wp[k].get<double>();
+            q["wall_error"] = w;
+            q["error"] = num(q["error"].get<double>() + w);
+            ew += w;
+          }
+        } else if (!ps["asymptotic"].get<bool>()) {
+          ew = wall_scale * time_error_of(wall_check, "cycle_time_s");
+        }
+      }
       if (std::isfinite(et) || std::isfinite(ew)) {
         const double sum = ps["value"].get<double>();
         const double err = ps["error"].get<double>() + (std::isfinite(et) ? et : 0.0) + (std::isfinite(ew) ? ew : 0.0);
@@ -296,8 +321,8 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
                                    rv <= target},
                  {"direct", ref["mean_velocity_per_cycle_m_per_s"]}};
       for (const char* k : {"time_error", "wall_error"})  // inside rv, as the errors are
-        if (jd.contains(k) && ps.contains(k))
-          jv[k] = num(std::abs(vv) * (jd[k].get<double>() / std::abs(dv) + ps[k].get<double>() / std::abs(tv)));
+        if (jd.contains(k) || ps.contains(k))
+          jv[k] = num(std::abs(vv) * (jd.value(k, 0.0) / std::abs(dv) + ps.value(k, 0.0) / std::abs(tv)));
       ref["mean_velocity_per_cycle_m_per_s"] = jv;
     }
   }

@@ -31,9 +31,10 @@ json reference_3d(const std::vector<Run3d>& runs, const OrderRange& orders, bool
 /// the displacement over that time (relative errors added); the whole cycle's extrapolation is
 /// kept beside it. `statement` says so with the figures reached. With a `time_check`
 /// (axi_time_check's entry) each figure's error includes the time integration's.
-/// With a `wall_check` (axi_wall_check's entry) each figure's error includes the wall's
-/// resolution error as well (added, never used to bound the grids' differences: the grids
-/// refine the rings with h).
+/// With a `wall_check` (axi_wall_check's entry) a figure the grids do not extrapolate (not
+/// asymptotic; each such phase of the cycle time) adds the wall's resolution error on the finest
+/// grid's rings, the check's error times (h_finest / h_coarsest)^kAxiSpacingExponent: the grids
+/// refine the rings with h, so an asymptotic series carries the wall's error with the rest.
 json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bool with_max, double target,
                    const json& time_check = nullptr, const json& wall_check = nullptr);
 
