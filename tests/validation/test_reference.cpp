@@ -468,7 +468,10 @@ TEST(SuiteReference, TheShippedConvergedSuiteLoads) {
     EXPECT_EQ(c["grids"], json::array({32, 40, 48, 56, 64}));
     const json& ref = c["reference"];
     EXPECT_EQ(ref["tier"], "axi");
-    EXPECT_EQ(ref["grids"], json::array({16, 24, 32}));
+    // R_f = 0.35 R0's hooked recovery rises over 16-32 cells; a fourth grid brings its three
+    // finest into the range the rules extrapolate (docs/axi.md, "What holds the hooked rim")
+    if (c["set"]["name"] == "paper_amplitude_0.35_round_wall") EXPECT_EQ(ref["grids"], json::array({16, 24, 32, 48}));
+    else EXPECT_EQ(ref["grids"], json::array({16, 24, 32}));
     EXPECT_EQ(ref["order_range"], "sharp_interface");
     EXPECT_EQ(ref["tolerance_check"], 0.25);  // its error bars hold the time integration's error
     EXPECT_EQ(ref["spacing_check"], 0.5);     // and the wall's resolution error
