@@ -20,13 +20,13 @@
 //    every ring is within 1 nm of R0. A wall that unfolds in microseconds under a drag of this
 //    size holds no fold of its own: what holds it in the run is the fluid. A study, not a solver.
 #include <Eigen/Dense>
-#include <Eigen/SparseCholesky>
-#include <Eigen/SparseLU>
+#include <gsl/gsl_spline.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -77,29 +77,19 @@ double fold_gap(const Shape& s, int* ring, int* segment) {
   return best;
 }
 
-// natural cubic spline through (t_k, y_k), evaluated at u
-struct Spline {
-  std::vector<double> t, y, m;
-  Spline(std::vector<double> tt, std::vector<double> yy) : t(std::move(tt)), y(std::move(yy)), m(t.size(), 0.0) {
-    const int n = int(t.size());
-    std::vector<double> a(n, 0.0), b(n, 1.0), c(n, 0.0), d(n, 0.0);
-    for (int i = 1; i < n - 1; ++i) {
-      const double h0 = t[i] - t[i - 1], h1 = t[i + 1] - t[i];
-      a[i] = h0 / 6, b[i] = (h0 + h1) / 3, c[i] = h1 / 6;
-      d[i] = (y[i + 1] - y[i]) / h1 - (y[i] - y[i - 1]) / h0;
-    }
-    for (int i = 1; i < n; ++i) {
-      const double w = a[i] / b[i - 1];
-      b[i] -= w * c[i - 1], d[i] -= w * d[i - 1];
-    }
-    m[n - 1] = d[n - 1] / b[n - 1];
-    for (int i = n - 2; i >= 0; --i) m[i] = (d[i] - c[i] * m[i + 1]) / b[i];
+// natural cubic spline through (t_k, y_k) (GSL's cspline)
+class Spline {
+ public:
+  Spline(const std::vector<double>& t, const std::vector<double>& y)
+      : s_(gsl_spline_alloc(gsl_interp_cspline, t.size()), gsl_spline_free),
+        acc_(gsl_interp_accel_alloc(), gsl_interp_accel_free) {
+    gsl_spline_init(s_.get(), t.data(), y.data(), t.size());
   }
-  double operator()(double u) const {
-    const int i = std::clamp(int(std::upper_bound(t.begin(), t.end(), u) - t.begin()) - 1, 0, int(t.size()) - 2);
-    const double h = t[i + 1] - t[i], A = (t[i + 1] - u) / h, B = (u - t[i]) / h;
-    return A * y[i] + B * y[i + 1] + ((A * A * A - A) * m[i] + (B * B * B - B) * m[i + 1]) * h * h / 6;
-  }
+  double operator()(double u) const { return gsl_spline_eval(s_.get(), u, acc_.get()); }
+
+ private:
+  std::unique_ptr<gsl_spline, void (*)(gsl_spline*)> s_;
+  std::unique_ptr<gsl_interp_accel, void (*)(gsl_interp_accel*)> acc_;
 };
 
 Shape refine(const Shape& s, int m) {

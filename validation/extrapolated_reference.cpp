@@ -41,8 +41,9 @@ bool figure_converged(const Extrapolation& e, double rel, double target) {
          rel <= target;
 }
 
-/// A figure's time integration error from a time check's entry (NaN when it has none).
-double time_error_of(const json& tc, const char* key) {
+/// A figure's error from a check's entry (axi_time_check's or axi_wall_check's; NaN when it
+/// has none).
+double check_error_of(const json& tc, const char* key) {
   if (!tc.is_object() || !tc.contains("errors") || !tc["errors"].contains(key) || !tc["errors"][key].is_number())
     return std::numeric_limits<double>::quiet_NaN();
   return tc["errors"][key].get<double>();
@@ -172,7 +173,7 @@ json resolution_check(const RunAxi& at_setting, const RunAxi& finer, double fact
 /// number); NaN without a check.
 double phase_error_of(const json& check, std::size_t phases) {
   if (!check.is_object()) return std::numeric_limits<double>::quiet_NaN();
-  double e = time_error_of(check, "cycle_time_s");
+  double e = check_error_of(check, "cycle_time_s");
   const json& tp = check["errors"].value("phase_times_s", json());
   if (tp.is_array() && tp.size() == phases) {
     e = 0;
@@ -245,7 +246,7 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
     Extrapolation e = richardson(*f.hh, *f.f, assumed, orders);
     // the time integration's error: inside every figure's error; where the grids' differences
     // lie within it they show no order, and the grid error is bounded at the lowest order instead
-    const double et = time_error_of(time_check, f.key);
+    const double et = check_error_of(time_check, f.key);
     if (std::isfinite(et)) {
       if (auto b = bound_within_time_error(*f.hh, *f.f, et, orders))
         e = *b;
@@ -254,7 +255,7 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
     }
     // the wall's resolution error, where the grid series does not carry it (below)
     const double ew = e.asymptotic ? std::numeric_limits<double>::quiet_NaN()
-                                   : wall_scale * time_error_of(wall_check, f.key);
+                                   : wall_scale * check_error_of(wall_check, f.key);
     if (std::isfinite(ew)) e.error += ew;
     json j = extrapolation_json(e);
     if (std::isfinite(et)) j["time_error"] = et;
@@ -285,7 +286,7 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
             ew += w;
           }
         } else if (!ps["asymptotic"].get<bool>()) {
-          ew = wall_scale * time_error_of(wall_check, "cycle_time_s");
+          ew = wall_scale * check_error_of(wall_check, "cycle_time_s");
         }
       }
       if (std::isfinite(et) || std::isfinite(ew)) {
@@ -344,26 +345,19 @@ json axi_reference(const std::vector<RunAxi>& runs, const OrderRange& orders, bo
   }
   ref["converged"] = all;
   ref["statement"] = std::string(all ? "converged to " : "not converged to ") + target_text + ": " + parts;
-  if (wall_check.is_object()) {
-    ref["wall_check"] = wall_check;
+  // each check's entry, and what the statement says of it
+  auto state = [&](const char* name, const json& check, const char* error, const char* run, const char* parameter) {
+    if (!check.is_object()) return;
+    ref[name] = check;
     char b[64];
-    std::snprintf(b, sizeof b, "axi.spacing_factor × %g", wall_check.value("factor", 0.0));
-    ref["statement"] = ref["statement"].get<std::string>() +
-                       (!wall_check["errors"].empty()
-                            ? std::string("; the wall's resolution error included (the coarsest grid with its rings at ") + b + ")"
-                            : std::string("; the wall's resolution error not estimated (its check at ") + b +
-                                  " completed no cycle)");
-  }
-  if (time_check.is_object()) {
-    ref["time_check"] = time_check;
-    const bool measured = !time_check["errors"].empty();
-    char b[64];
-    std::snprintf(b, sizeof b, "axi.tolerance × %g", time_check.value("factor", 0.0));
-    ref["statement"] = ref["statement"].get<std::string>() +
-                       (measured ? std::string("; the time integration's error included (the coarsest grid at ") + b + ")"
-                                 : std::string("; the time integration's error not estimated (its check at ") + b +
-                                       " completed no cycle)");
-  }
+    std::snprintf(b, sizeof b, "%s × %g", parameter, check.value("factor", 0.0));
+    ref["statement"] = ref["statement"].get<std::string>() + "; " + error +
+                       (!check["errors"].empty() ? std::string(" included (") + run + b + ")"
+                                                 : std::string(" not estimated (its check at ") + b + " completed no cycle)");
+  };
+  state("wall_check", wall_check, "the wall's resolution error", "the coarsest grid with its rings at ",
+        "axi.spacing_factor");
+  state("time_check", time_check, "the time integration's error", "the coarsest grid at ", "axi.tolerance");
   return ref;
 }
 

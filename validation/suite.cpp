@@ -1,5 +1,6 @@
 #include "validation/suite.hpp"
 
+#include <vector>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -119,22 +120,17 @@ json plan_runs(const SuiteOptions& o) {
     }
     if (cs.contains("reference")) {
       const json& rs = cs["reference"];
-      for (const json& g : rs["grids"]) {
-        const json s = reference_scene(base, rs, g);
+      std::vector<json> scenes;  // its grids, then its checks' runs
+      for (const json& g : rs["grids"]) scenes.push_back(reference_scene(base, rs, g));
+      for (json s : {tolerance_check_scene(base, rs), spacing_check_scene(base, rs)})
+        if (!s.is_null()) scenes.push_back(std::move(s));
+      for (const json& s : scenes) {
         json resolved;
         const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
         key = run_key_axi(resolved);
         add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
             double(p.nr) * p.nx * (p.time_limit / p.dt_max));
       }
-      for (const json& s : {tolerance_check_scene(base, rs), spacing_check_scene(base, rs)})
-        if (!s.is_null()) {
-          json resolved;
-          const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
-          key = run_key_axi(resolved);
-          add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
-              double(p.nr) * p.nx * (p.time_limit / p.dt_max));
-        }
     }
     const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
     {

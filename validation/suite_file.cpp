@@ -8,6 +8,7 @@
 #include <fstream>
 #include <sstream>
 #include <tuple>
+#include <utility>
 
 #include <unistd.h>
 
@@ -64,20 +65,17 @@ void check_reference(const json& ref, const std::string& at) {
   if (ref.contains("order_range")) parse_order_range(ref["order_range"], at + ".order_range");
   if (ref.contains("set") && !ref["set"].is_object())
     throw InputError(at + ".set", scene::show(ref["set"]), "an object {\"dotted.key\": value} applied to the axi runs");
-  if (ref.contains("tolerance_check")) {
-    const json& f = ref["tolerance_check"];
-    if (!f.is_number() || !(f.get<double>() > 0 && f.get<double>() < 1))
-      throw InputError(at + ".tolerance_check", scene::show(f),
-                       "a number between 0 and 1 (exclusive): the factor on axi.tolerance of the run that measures the "
-                       "time integration's error on the coarsest grid (0.25: four times tighter)");
-  }
-  if (ref.contains("spacing_check")) {
-    const json& f = ref["spacing_check"];
-    if (!f.is_number() || !(f.get<double>() > 0 && f.get<double>() < 1))
-      throw InputError(at + ".spacing_check", scene::show(f),
-                       "a number between 0 and 1 (exclusive): the factor on axi.spacing_factor of the run that measures "
-                       "the wall's resolution error on the coarsest grid (0.5: twice the rings)");
-  }
+  // the checks' factors: one run each on the coarsest grid, a parameter times the factor
+  for (const auto& [key, what] :
+       {std::pair{"tolerance_check", "the factor on axi.tolerance of the run that measures the time integration's "
+                                     "error on the coarsest grid (0.25: four times tighter)"},
+        std::pair{"spacing_check", "the factor on axi.spacing_factor of the run that measures the wall's "
+                                   "resolution error on the coarsest grid (0.5: twice the rings)"}})
+    if (ref.contains(key)) {
+      const json& f = ref[key];
+      if (!f.is_number() || !(f.get<double>() > 0 && f.get<double>() < 1))
+        throw InputError(at + "." + key, scene::show(f), std::string("a number between 0 and 1 (exclusive): ") + what);
+    }
 }
 
 std::string key_list(std::initializer_list<const char*> keys) {
