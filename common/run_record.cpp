@@ -244,18 +244,36 @@ CycleFigures cycle_figures(const RunRecord& r) {
     c.cycle_times_s.push_back(e.cycle_end_s[k] - e.cycle_start_s[k]);
     c.cycle_displacements_m.push_back(x_at(e.x_at_cycle_end_m, k) - x_at(e.x_at_cycle_start_m, k));
   }
+  // the centre's position at time t from the kept rows (linear between the rows around t)
+  const bool rows = r.series.rows() >= 2 && r.series.has("t_s") && r.series.has("x_center_m");
+  const std::vector<double> ts = rows ? r.series.column("t_s") : std::vector<double>();
+  const std::vector<double> xs = rows ? r.series.column("x_center_m") : std::vector<double>();
+  auto x_of = [&](double t) {
+    const auto it = std::lower_bound(ts.begin(), ts.end(), t);
+    if (it == ts.begin()) return xs.front();
+    if (it == ts.end()) return xs.back();
+    const std::size_t j = static_cast<std::size_t>(it - ts.begin());
+    const double w = (t - ts[j - 1]) / (ts[j] - ts[j - 1]);
+    return xs[j - 1] + w * (xs[j] - xs[j - 1]);
+  };
   for (std::size_t k = 0; k < n; ++k) {
     std::vector<double> b = {e.cycle_start_s[k]};
     for (double t : e.segment_reached_s)
       if (t > e.cycle_start_s[k] && t < e.cycle_end_s[k]) b.push_back(t);
     std::sort(b.begin() + 1, b.end());
     b.push_back(e.cycle_end_s[k]);
-    if (k == 0) c.phase_times_s.assign(b.size() - 1, 0.0);
+    if (k == 0) {
+      c.phase_times_s.assign(b.size() - 1, 0.0);
+      if (rows) c.phase_displacements_m.assign(b.size() - 1, 0.0);
+    }
     if (b.size() - 1 != c.phase_times_s.size()) {
       c.phase_times_s.clear();
+      c.phase_displacements_m.clear();
       break;
     }
     for (std::size_t i = 0; i + 1 < b.size(); ++i) c.phase_times_s[i] += (b[i + 1] - b[i]) / double(n);
+    for (std::size_t i = 0; i + 1 < b.size() && rows; ++i)
+      c.phase_displacements_m[i] += (x_of(b[i + 1]) - x_of(b[i])) / double(n);
   }
   if (n > 0) {
     double T = 0, d = 0;

@@ -201,6 +201,10 @@ struct CycleFigures {
   /// to the cycle's end (the recovery); they sum to cycle_time_s. Empty when no cycle completed
   /// from events or the cycles do not all have the same number of phases.
   std::vector<double> phase_times_s;
+  /// The centre's displacement over each of those phases, m, averaged over the same cycles
+  /// (linear in time between the kept rows around each boundary); they sum to
+  /// displacement_per_cycle_m. Empty when phase_times_s is, or the rows were not kept.
+  std::vector<double> phase_displacements_m;
 };
 CycleFigures cycle_figures(const RunRecord& r);
 

@@ -950,6 +950,7 @@ def markdown(report, figs):
                        f"{si(m['mean_velocity_per_cycle_m_per_s'], 'm/s')} | {vs('mean_velocity_per_cycle')} | "
                        f"{u_corr} | {verd} | " + (f"{target_text(m)} | " if c.get("targets1d") else "")
                        + f"{si(m['wall_time_s'], 's')} |")
+        out += phases_markdown(c)
         if "wall_time_ratio_3d_over_1d" in c:
             out += ["", f"Wall time, 3D run at the calibration grid against the first 1D model: "
                         f"{c['wall_time_ratio_3d_over_1d']:.3g} ×."]
@@ -964,6 +965,176 @@ def markdown(report, figs):
 FIGURE_WORDS = (("displacement_per_cycle_m", "displacement per cycle", "m"), ("cycle_time_s", "cycle time", "s"),
                 ("mean_velocity_per_cycle_m_per_s", "mean velocity per cycle", "m/s"),
                 ("max_displacement_m", "maximum displacement", "m"))
+
+
+def pm_in_unit_of(v, e, unit):
+    """'80 ms ± 0.1 ms': v with its SI prefix and e (two digits) in the same prefix; e with a
+    prefix of its own when it is below 10^-4 of that prefix's unit."""
+    text = si(v, unit)
+    if e is None:
+        return text
+    prefix_unit = text.split(" ", 1)[1] if " " in text else unit
+    scale = v / float(text.split(" ", 1)[0]) if v else 1.0
+    x = abs(e) / scale if scale else abs(e)
+    es = f"{x:.2g}"
+    if "e" in es:
+        es = f"{x:.0f}" if x >= 1 else None
+    return f"{text} ± " + (f"{es} {prefix_unit}" if es else si(e, unit, 2))
+
+
+def phase_groups(n):
+    """The protocol's n phases (n - 1 segment contractions, front segment first, then the
+    recovery) in the groups the phase table shows: (label, phase indices)."""
+    k = n - 1
+    groups = [("first contraction (front segment)", [0])]
+    if k > 2:
+        groups.append((f"contractions 2–{k - 1}", list(range(1, k - 1))))
+    if k > 1:
+        groups.append((f"last contraction (rear segment, {k})", [k - 1]))
+    groups.append(("recovery", [n - 1]))
+    return groups
+
+
+def phase_reference(c):
+    """The reference's phases: (source words, durations, their errors or None, the centre's
+    displacement over each) from the axisymmetric reference (its extrapolated phase durations,
+    the displacements of its finest run), else the finest 3D run; None without them."""
+    run = finest_axi_run(c)
+    if run is not None:
+        disp = run.get("cycle_phase_displacements_m")
+        ext = ((c.get("reference") or {}).get("cycle_time_s") or {}).get("phases")
+        if not disp:
+            return None
+        if ext and len(ext) == len(disp) and all(p.get("value") is not None for p in ext):
+            return ("axisymmetric reference: durations extrapolated, ± their error bars; displacements of its "
+                    f"finest grid, h = {si(run['cell_size_m'], 'm')}",
+                    [p["value"] for p in ext], [p.get("error") for p in ext], disp)
+        times = run.get("cycle_phase_times_s")
+        if times and len(times) == len(disp):
+            return (f"finest axisymmetric run, h = {si(run['cell_size_m'], 'm')}", times, None, disp)
+        return None
+    runs = [r for r in c.get("runs3d", []) if r.get("has_cycle") and r.get("cycle_phase_displacements_m")]
+    if not runs:
+        return None
+    r = runs[-1]
+    return (f"finest 3D run, h = {si(r['cell_size_m'], 'm')}", r["cycle_phase_times_s"], None,
+            r["cycle_phase_displacements_m"])
+
+
+def phase_models(c, n):
+    """The 1D models of a case whose phases match the reference's n: (index, model), and the
+    labels of those whose distance in a phase group exceeds 50 times the reference's largest
+    (drawn off scale: named, not drawn)."""
+    _, _, _, disp = phase_reference(c)
+    scale = max(abs(sum(disp[i] for i in idx)) for _, idx in phase_groups(n))
+    keep, off = [], []
+    for k, m in enumerate(c.get("models1d", [])):
+        mt, md = m.get("cycle_phase_times_s"), m.get("cycle_phase_displacements_m")
+        if not m.get("has_cycle") or not mt or not md or len(mt) != n or len(md) != n:
+            continue
+        big = max(abs(sum(md[i] for i in idx)) for _, idx in phase_groups(n))
+        if scale > 0 and big > 50 * scale:
+            off.append(m["label"])
+        else:
+            keep.append((k, m))
+    return keep, off
+
+
+def phases_figure(case, path):
+    """The cycle phase by phase: per phase group (first contraction, the middle ones, the last,
+    the recovery) the time it took (log scale) and the distance the centre moved over it, the
+    reference's bar with its error bar beside each 1D model's. False when the case has no
+    reference phases or no 1D model with them."""
+    ref = phase_reference(case)
+    if ref is None:
+        return False
+    words, times, errs, disp = ref
+    n = len(times)
+    groups = phase_groups(n)
+    models, off = phase_models(case, n)
+    if not models:
+        return False
+    fig, axs = plt.subplots(1, 2, figsize=(13, 4.6))
+    width = 0.84 / (len(models) + 1)
+    xs = range(len(groups))
+
+    def group_sums(vals):
+        return [sum(vals[i] for i in idx) for _, idx in groups]
+    bars = [("reference", group_sums(times), None if errs is None or any(e is None for e in errs)
+             else group_sums(errs), group_sums(disp), dict(color="k"))]
+    for k, m in models:
+        style = MODEL_STYLES[k % len(MODEL_STYLES)]
+        bars.append((f"1D: {m['label']}", group_sums(m["cycle_phase_times_s"]), None,
+                     group_sums(m["cycle_phase_displacements_m"]), dict(color=style[:2])))
+    for j, (label, t, e, d, kw) in enumerate(bars):
+        at = [x - 0.42 + (j + 0.5) * width for x in xs]
+        axs[0].bar(at, [v * 1e3 for v in t], width, label=label,
+                   yerr=None if e is None else [v * 1e3 for v in e], capsize=2, **kw)
+        axs[1].bar(at, [v * 1e9 for v in d], width, label=label, **kw)
+    names = [textwrap.fill(g[0], 18) for g in groups]
+    axs[0].set_yscale("log")
+    # labelled ticks at 1, 2 and 5 of each decade: the groups' times span one to three decades
+    axs[0].yaxis.set_major_locator(matplotlib.ticker.LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    axs[0].yaxis.set_major_formatter(matplotlib.ticker.FuncFormatter(lambda v, _: f"{v:g}"))
+    axs[0].yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    axs[0].set(ylabel="time the phases took [ms] (log scale)", title="Time of each phase group")
+    axs[1].set(ylabel="distance the centre moved [nm]", title="Distance over each phase group")
+    axs[1].axhline(0, color="0.5", lw=0.7)
+    for a in axs:
+        a.set_xticks(list(xs))
+        a.set_xticklabels(names, fontsize="small")
+    title = f"{case['name']}: the cycle phase by phase, 1D models against the reference\n({words})"
+    if off:
+        title += "\noff scale, not drawn: " + "; ".join(off)
+    fig.suptitle("\n".join(textwrap.fill(line, 120) for line in title.split("\n")))
+    legend_below(fig, list(axs), width=13, height=4.6, ncol=3, wrap=62, gap=0.12)
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    return True
+
+
+def phases_markdown(c):
+    """Where each 1D model's cycle parts from the reference's: the protocol's phases grouped
+    (first contraction, the middle ones, the last, the recovery), each with what it took and
+    what the centre moved over it, against the reference's."""
+    ref = phase_reference(c)
+    if ref is None:
+        return []
+    words, times, errs, disp = ref
+    n = len(times)
+    groups = phase_groups(n)
+    head = "| | " + " | ".join(g[0] for g in groups) + " |"
+    out = ["", "#### The cycle phase by phase", "",
+           f"The protocol's phases grouped (each segment's contraction until it reaches R_f, front segment first; "
+           f"the recovery until the cycle ends): the time each group took and the distance the centre moved over "
+           f"it. Reference: the {words}. A 1D model's time is given with its difference from the reference's, "
+           "its distance with the difference in distance (a phase's distance can be near zero or negative, where a "
+           "percentage says nothing).", "", head, "|---|" + "---|" * len(groups)]
+
+    def total(vals, idx):
+        return sum(vals[i] for i in idx)
+    cells = []
+    for _, idx in groups:
+        t = total(times, idx)
+        e = None if errs is None or any(errs[i] is None for i in idx) else total(errs, idx)
+        cells.append(f"{pm_in_unit_of(t, e, 's')}; {si(total(disp, idx), 'm')}")
+    out.append("| reference | " + " | ".join(cells) + " |")
+    for m in c.get("models1d", []):
+        mt, md = m.get("cycle_phase_times_s"), m.get("cycle_phase_displacements_m")
+        if not m.get("has_cycle"):
+            continue
+        if not mt or not md or len(mt) != n or len(md) != n:
+            out.append(f"| {m['label']} | " + " | ".join(["—"] * len(groups)) + " |")
+            continue
+        cells = []
+        for _, idx in groups:
+            t, tr = total(mt, idx), total(times, idx)
+            d, dr = total(md, idx), total(disp, idx)
+            dd = si(d - dr, "m")
+            cells.append(f"{si(t, 's')} ({pct((t - tr) / tr if tr > 0 else None)}); {si(d, 'm')} "
+                         f"({'' if dd.startswith('-') or dd == '—' else '+'}{dd})")
+        out.append(f"| {m['label']} | " + " | ".join(cells) + " |")
+    return out
 
 
 def reference_markdown(c):
@@ -1102,6 +1273,8 @@ def main(d):
             lst.append(f"fig_velocity_{name}.png")
         if convergence_figure(c, f"{d}/fig_convergence_{name}.png"):
             lst.append(f"fig_convergence_{name}.png")
+        if phases_figure(c, f"{d}/fig_phases_{name}.png"):
+            lst.append(f"fig_phases_{name}.png")
         if membrane_figure(c, f"{d}/fig_membrane_{name}.png"):
             lst.append(f"fig_membrane_{name}.png")
         cal = c["calibration"].get("file")

@@ -164,6 +164,10 @@ json run_entry(double h, const std::string& status, bool cached, const std::stri
     j["displacement_per_cycle_m"] = cyc.displacement_per_cycle_m;
     j["cycle_time_s"] = cyc.cycle_time_s;
     j["mean_velocity_per_cycle_m_per_s"] = cyc.mean_velocity_per_cycle_m_per_s;
+    // the protocol's phases (each segment's contraction, then the recovery): what each took and
+    // what the centre moved over it
+    if (!cyc.phase_times_s.empty()) j["cycle_phase_times_s"] = cyc.phase_times_s;
+    if (!cyc.phase_displacements_m.empty()) j["cycle_phase_displacements_m"] = cyc.phase_displacements_m;
   }
   return j;
 }
@@ -426,11 +430,7 @@ RunAxi RunCache::run_axi(const json& scene, int progress) {
   r.record["grid"] = {p.nr, p.nx};
   r.record["method"] = p.method_name();
   if (std::isfinite(r.max_displacement)) r.record["max_displacement_m"] = r.max_displacement;
-  if (r.cyc.has_cycle) {
-    r.record["cycle_phase_times_s"] = r.cyc.phase_times_s;
-  } else {
-    r.record["no_cycle_reason"] = r.cyc.absent_because;
-  }
+  if (!r.cyc.has_cycle) r.record["no_cycle_reason"] = r.cyc.absent_because;
   // as run_3d's: the first cycle of a one-cycle scene, the whole run of a multi-cycle one (the
   // reference of the report's U(t) comparisons, drawn beside 3D's)
   const double t_end = r.series.t.empty() ? 0.0 : r.series.t.back();

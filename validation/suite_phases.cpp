@@ -63,6 +63,10 @@ Run1d run_1d(const json& sc, const std::string& label, const std::string& scene_
       r.record["displacement_per_cycle_m"] = m.displacement_per_cycle_m;
       r.record["cycle_time_s"] = m.mean_cycle_time_s;
       r.record["mean_velocity_per_cycle_m_per_s"] = m.mean_velocity_per_cycle_m_per_s;
+      // the protocol's phases, as the reference runs' (run_cache.cpp, run_entry)
+      const record::CycleFigures cf = record::cycle_figures(res.record);
+      if (!cf.phase_times_s.empty()) r.record["cycle_phase_times_s"] = cf.phase_times_s;
+      if (!cf.phase_displacements_m.empty()) r.record["cycle_phase_displacements_m"] = cf.phase_displacements_m;
     } else {
       r.record["no_cycle_reason"] = m.no_cycle_reason;
     }

@@ -152,6 +152,43 @@ TEST(RunRecord, CyclePhasesRunBetweenTheSegmentEventsAndSumToTheCycleTime) {
   EXPECT_TRUE(cycle_figures(r).phase_times_s.empty());
 }
 
+// The centre's displacement over each phase: linear in time between the rows around each
+// boundary (not the nearest row's), averaged over the cycles, summing to the displacement per
+// cycle; a phase may go backwards. A record that keeps no rows has the phases' times only.
+TEST(RunRecord, CyclePhaseDisplacementsInterpolateTheCentreAndSumToTheDisplacementPerCycle) {
+  auto build = [](bool keep) {
+    RunRecord r("axi", "m", 1e-7, columns(), {0.0});
+    r.keep(keep);
+    const double ts[] = {0.0, 0.2, 0.4, 0.5, 0.8, 1.1};
+    const double xs[] = {0.0, 4e-9, 6e-9, 7e-9, 13e-9, 10e-9};
+    r.cycle_started(0.0);
+    for (int k = 0; k < 6; ++k) {
+      std::vector<double> row = row_at(ts[k]);
+      row[1] = xs[k];
+      r.add_row(row);
+      if (k == 3) {
+        r.cycle_ended(0.5);
+        r.cycle_started(0.5);
+      }
+    }
+    r.cycle_ended(1.1);
+    r.events.segment_reached_s = {0.1, 0.25, 0.6, 0.72};
+    return r;
+  };
+  const CycleFigures c = cycle_figures(build(true));
+  ASSERT_EQ(c.phase_displacements_m.size(), 3u);
+  // cycle 1: x(0.1) = 2, x(0.25) = 4.5, x(0.5) = 7 nm; cycle 2: x(0.6) = 9, x(0.72) = 11.4,
+  // x(1.1) = 10 nm
+  EXPECT_NEAR(c.phase_displacements_m[0], (2.0 + 2.0) / 2 * 1e-9, 1e-20);
+  EXPECT_NEAR(c.phase_displacements_m[1], (2.5 + 2.4) / 2 * 1e-9, 1e-20);
+  EXPECT_NEAR(c.phase_displacements_m[2], (2.5 - 1.4) / 2 * 1e-9, 1e-20);
+  EXPECT_NEAR(c.phase_displacements_m[0] + c.phase_displacements_m[1] + c.phase_displacements_m[2],
+              c.displacement_per_cycle_m, 1e-20);
+  const CycleFigures bare = cycle_figures(build(false));
+  EXPECT_EQ(bare.phase_times_s.size(), 3u);
+  EXPECT_TRUE(bare.phase_displacements_m.empty());
+}
+
 TEST(RunRecord, NoCompletedCycleGivesNullPerCycleFiguresWithTheReason) {
   RunRecord r("3d", "m", 1e-7, columns(), {0.0});
   r.cycle_started(0.0);

@@ -303,6 +303,79 @@ class ValidationFigures(unittest.TestCase):
         self.assertNotIn("other", md, "a case without targets has no column")
         self.assertEqual(self.mod.targets_markdown({"cases": [{"name": "x", "models1d": []}]}), [])
 
+    def test_phase_table_groups_the_phases_against_the_reference(self):
+        # five segments: first, contractions 2-4, last, recovery; the reference's durations are
+        # its extrapolated phases with their errors, its distances its finest run's with a
+        # cycle; each model's time with its relative difference, its distance with the signed
+        # difference in distance; a model whose phases do not match is shown without figures
+        self.assertEqual([g[1] for g in self.mod.phase_groups(6)], [[0], [1, 2, 3], [4], [5]])
+        self.assertEqual([g[1] for g in self.mod.phase_groups(3)], [[0], [1], [2]])
+        self.assertEqual([g[1] for g in self.mod.phase_groups(2)], [[0], [1]])
+        ms, nm = 1e-3, 1e-9
+        phases = [{"value": v * ms, "error": 0.1 * ms} for v in (80, 30, 40, 40, 20, 200)]
+        fine = {"has_cycle": True, "series": {"t_s": [0]}, "cell_size_m": 2e-8,
+                "cycle_phase_times_s": [v * ms for v in (81, 30, 40, 40, 20, 201)],
+                "cycle_phase_displacements_m": [v * nm for v in (3, 7, 14, 19, 19, -9)]}
+        case = {"name": "c", "runs3d": [], "reference": {
+            "runs": [fine, dict(fine, has_cycle=False, cell_size_m=1e-8)], "cycle_time_s": {"phases": phases}},
+            "models1d": [
+                {"label": "plain", "has_cycle": True,
+                 "cycle_phase_times_s": [v * ms for v in (40, 30, 50, 60, 10, 100)],
+                 "cycle_phase_displacements_m": [v * nm for v in (1, 7, 14, 12, 2, 1)]},
+                {"label": "paper", "has_cycle": True, "cycle_phase_times_s": [0.1, 0.2],
+                 "cycle_phase_displacements_m": [nm, nm]},
+                {"label": "stalls", "has_cycle": False}]}
+        md = "\n".join(self.mod.phases_markdown(case))
+        self.assertIn("| | first contraction (front segment) | contractions 2–4 | last contraction (rear segment, 5) "
+                      "| recovery |", md)
+        self.assertIn("| reference | 80 ms ± 0.1 ms; 3 nm | 110 ms ± 0.3 ms; 40 nm | 20 ms ± 0.1 ms; 19 nm | "
+                      "200 ms ± 0.1 ms; -9 nm |", md)
+        self.assertIn("| plain | 40 ms (-50.0 %); 1 nm (-2 nm) | 140 ms (+27.3 %); 33 nm (-7 nm) | "
+                      "10 ms (-50.0 %); 2 nm (-17 nm) | 100 ms (-50.0 %); 1 nm (+10 nm) |", md)
+        self.assertIn("| paper | — | — | — | — |", md)
+        self.assertNotIn("stalls", md)
+        self.assertIn("h = 20 nm", md)
+        # without extrapolated phases: the finest run's durations, no error bars
+        del case["reference"]["cycle_time_s"]
+        md = "\n".join(self.mod.phases_markdown(case))
+        self.assertIn("| reference | 81 ms; 3 nm |", md)
+        # no reference run with phase displacements: no table
+        fine.pop("cycle_phase_displacements_m")
+        self.assertEqual(self.mod.phases_markdown(case), [])
+
+    def test_phase_figure_draws_the_reference_and_each_model_per_group(self):
+        # two panels (time on a log scale, distance with a zero line), one bar per group for the
+        # reference (with its error bar) and for each model with matching phases; a model more
+        # than 50 times the reference's largest distance is named in the title, not drawn; no
+        # figure without reference phases
+        ms, nm = 1e-3, 1e-9
+        fine = {"has_cycle": True, "series": {"t_s": [0]}, "cell_size_m": 2e-8,
+                "cycle_phase_times_s": [v * ms for v in (80, 30, 20, 200)],
+                "cycle_phase_displacements_m": [v * nm for v in (3, 14, 19, -9)]}
+        ok = {"label": "plain", "has_cycle": True, "cycle_phase_times_s": [v * ms for v in (40, 30, 10, 100)],
+              "cycle_phase_displacements_m": [v * nm for v in (1, 14, 2, 1)]}
+        huge = dict(ok, label="paper", cycle_phase_displacements_m=[v * 1e3 * nm for v in (1, 14, 2, 1)])
+        other = dict(ok, label="two phases", cycle_phase_times_s=[0.1, 0.2], cycle_phase_displacements_m=[nm, nm])
+        case = {"name": "c", "runs3d": [], "reference": {
+            "runs": [fine], "cycle_time_s": {"phases": [{"value": v * ms, "error": 0.5 * ms} for v in (80, 30, 20, 200)]}},
+            "models1d": [ok, huge, other]}
+        self.assertTrue(self.mod.phases_figure(case, f"{self.d}/p.png"))
+        fig = self.closed[-1]
+        t_ax, d_ax = fig.axes[:2]
+        self.assertEqual(t_ax.get_yscale(), "log")
+        self.assertEqual(len(t_ax.patches), 2 * 4)  # reference and one model, four groups each
+        heights = sorted(round(b.get_height(), 6) for b in d_ax.patches)
+        self.assertEqual(heights, sorted([3, 14, 19, -9, 1, 14, 2, 1]))
+        self.assertEqual([t.get_text() for t in t_ax.get_xticklabels()][-1], "recovery")
+        self.assertIn("off scale, not drawn: paper", fig._suptitle.get_text())
+        # the reference's error bars, and only the reference's
+        self.assertEqual(sum(c.__class__.__name__ == "ErrorbarContainer" for c in t_ax.containers), 1)
+        self.assertTrue(os.path.exists(f"{self.d}/p.png"))
+        case["models1d"] = [huge, other]
+        self.assertFalse(self.mod.phases_figure(case, f"{self.d}/q.png"))
+        del fine["cycle_phase_displacements_m"]
+        self.assertFalse(self.mod.phases_figure(dict(case, models1d=[ok]), f"{self.d}/q.png"))
+
     def test_coarse_grids_are_told_apart(self):
         s = {"t_s": [0, 0.5, 1], "velocity_m_per_s": [0, 1e-8, 0]}
         case = {"name": "c", "models1d": [], "runs3d": [

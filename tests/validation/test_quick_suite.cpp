@@ -64,6 +64,24 @@ TEST(QuickSuite, ReportHoldsEveryMetricAndResumesFromItsCache) {
     for (const auto& [k, v] : m["verdicts"].items())
       EXPECT_TRUE(v == "pass" || v == "fail" || v == "inconclusive") << k << ": " << v;
   }
+  // the report's phase table: the force-free models and the finest 3D run carry the protocol's
+  // phases (each segment's contraction and the recovery), whose times sum to the cycle time and
+  // whose distances sum to the displacement per cycle
+  for (const scene::json* m : {&c["models1d"][0], &c["runs3d"].back()}) {
+    ASSERT_TRUE(m->contains("cycle_phase_times_s") && m->contains("cycle_phase_displacements_m")) << m->dump();
+    const auto& pt = (*m)["cycle_phase_times_s"];
+    const auto& pd = (*m)["cycle_phase_displacements_m"];
+    ASSERT_EQ(pt.size(), pd.size());
+    EXPECT_GE(pt.size(), 3u);
+    double T = 0, d = 0;
+    for (std::size_t k = 0; k < pt.size(); ++k) {
+      EXPECT_GT(pt[k].get<double>(), 0.0) << k;
+      T += pt[k].get<double>();
+      d += pd[k].get<double>();
+    }
+    EXPECT_NEAR(T, (*m)["cycle_time_s"].get<double>(), 1e-9 * T);
+    EXPECT_NEAR(d, (*m)["displacement_per_cycle_m"].get<double>(), 1e-6 * std::abs(d));
+  }
   // the default model (the first) carries its grid error, from its run on twice its cells: the
   // error bar of its figures in the trend claims; a small fraction of each figure on 100 cells
   {
