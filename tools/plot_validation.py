@@ -1103,6 +1103,9 @@ def phases_markdown(c):
     words, times, errs, disp = ref
     n = len(times)
     groups = phase_groups(n)
+    if not any(len(m.get("cycle_phase_times_s") or []) == n and len(m.get("cycle_phase_displacements_m") or []) == n
+               for m in c.get("models1d", []) if m.get("has_cycle")):
+        return []  # no 1D model to set against the reference (a multi-cycle 1D run keeps its last cycle's events)
     head = "| | " + " | ".join(g[0] for g in groups) + " |"
     out = ["", "#### The cycle phase by phase", "",
            f"The protocol's phases grouped (each segment's contraction until it reaches R_f, front segment first; "

@@ -339,6 +339,8 @@ class ValidationFigures(unittest.TestCase):
         del case["reference"]["cycle_time_s"]
         md = "\n".join(self.mod.phases_markdown(case))
         self.assertIn("| reference | 81 ms; 3 nm |", md)
+        # no 1D model with matching phases: no table
+        self.assertEqual(self.mod.phases_markdown(dict(case, models1d=case["models1d"][1:])), [])
         # no reference run with phase displacements: no table
         fine.pop("cycle_phase_displacements_m")
         self.assertEqual(self.mod.phases_markdown(case), [])
