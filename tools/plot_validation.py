@@ -1021,6 +1021,16 @@ def phase_reference(c):
             r["cycle_phase_displacements_m"])
 
 
+def phase_3d(c, n):
+    """Beside an axisymmetric reference, the finest 3D run with the reference's n phases (the
+    tier the reference judges, phase by phase); None otherwise."""
+    if finest_axi_run(c) is None:
+        return None
+    runs = [r for r in c.get("runs3d", []) if r.get("has_cycle") and len(r.get("cycle_phase_times_s") or []) == n
+            and len(r.get("cycle_phase_displacements_m") or []) == n]
+    return runs[-1] if runs else None
+
+
 def phase_models(c, n):
     """The 1D models of a case whose phases match the reference's n: (index, model), and the
     labels of those whose distance in a phase group exceeds 50 times the reference's largest
@@ -1055,13 +1065,17 @@ def phases_figure(case, path):
     if not models:
         return False
     fig, axs = plt.subplots(1, 2, figsize=(13, 4.6))
-    width = 0.84 / (len(models) + 1)
+    width = 0.84 / (len(models) + 1 + (phase_3d(case, n) is not None))
     xs = range(len(groups))
 
     def group_sums(vals):
         return [sum(vals[i] for i in idx) for _, idx in groups]
     bars = [("reference", group_sums(times), None if errs is None or any(e is None for e in errs)
              else group_sums(errs), group_sums(disp), dict(color="k"))]
+    r3 = phase_3d(case, n)
+    if r3 is not None:
+        bars.append((f"3D, finest grid (h = {si(r3['cell_size_m'], 'm')})", group_sums(r3["cycle_phase_times_s"]), None,
+                     group_sums(r3["cycle_phase_displacements_m"]), dict(color="0.6", hatch="//", edgecolor="0.3")))
     for k, m in models:
         style = MODEL_STYLES[k % len(MODEL_STYLES)]
         bars.append((f"1D: {m['label']}", group_sums(m["cycle_phase_times_s"]), None,
@@ -1083,7 +1097,8 @@ def phases_figure(case, path):
     for a in axs:
         a.set_xticks(list(xs))
         a.set_xticklabels(names, fontsize="small")
-    title = f"{case['name']}: the cycle phase by phase, 1D models against the reference\n({words})"
+    title = (f"{case['name']}: the cycle phase by phase, " + ("3D and " if r3 is not None else "")
+             + f"1D models against the reference\n({words})")
     if off:
         title += "\noff scale, not drawn: " + "; ".join(off)
     fig.suptitle("\n".join(textwrap.fill(line, 120) for line in title.split("\n")))
@@ -1110,7 +1125,9 @@ def phases_markdown(c):
     out = ["", "#### The cycle phase by phase", "",
            f"The protocol's phases grouped (each segment's contraction until it reaches R_f, front segment first; "
            f"the recovery until the cycle ends): the time each group took and the distance the centre moved over "
-           f"it. Reference: the {words}. A 1D model's time is given with its difference from the reference's, "
+           f"it. Reference: the {words}"
+           + ("; beside it the finest 3D run, the tier it judges" if phase_3d(c, n) is not None else "")
+           + ". A model's time is given with its difference from the reference's, "
            "its distance with the difference in distance (a phase's distance can be near zero or negative, where a "
            "percentage says nothing).", "", head, "|---|" + "---|" * len(groups)]
 
@@ -1122,13 +1139,8 @@ def phases_markdown(c):
         e = None if errs is None or any(errs[i] is None for i in idx) else total(errs, idx)
         cells.append(f"{pm_in_unit_of(t, e, 's')}; {si(total(disp, idx), 'm')}")
     out.append("| reference | " + " | ".join(cells) + " |")
-    for m in c.get("models1d", []):
-        mt, md = m.get("cycle_phase_times_s"), m.get("cycle_phase_displacements_m")
-        if not m.get("has_cycle"):
-            continue
-        if not mt or not md or len(mt) != n or len(md) != n:
-            out.append(f"| {m['label']} | " + " | ".join(["—"] * len(groups)) + " |")
-            continue
+
+    def against(label, mt, md):
         cells = []
         for _, idx in groups:
             t, tr = total(mt, idx), total(times, idx)
@@ -1136,7 +1148,19 @@ def phases_markdown(c):
             dd = si(d - dr, "m")
             cells.append(f"{si(t, 's')} ({pct((t - tr) / tr if tr > 0 else None)}); {si(d, 'm')} "
                          f"({'' if dd.startswith('-') or dd == '—' else '+'}{dd})")
-        out.append(f"| {m['label']} | " + " | ".join(cells) + " |")
+        return f"| {label} | " + " | ".join(cells) + " |"
+    r3 = phase_3d(c, n)
+    if r3 is not None:
+        out.append(against(f"3D, finest grid (h = {si(r3['cell_size_m'], 'm')})", r3["cycle_phase_times_s"],
+                           r3["cycle_phase_displacements_m"]))
+    for m in c.get("models1d", []):
+        mt, md = m.get("cycle_phase_times_s"), m.get("cycle_phase_displacements_m")
+        if not m.get("has_cycle"):
+            continue
+        if not mt or not md or len(mt) != n or len(md) != n:
+            out.append(f"| {m['label']} | " + " | ".join(["—"] * len(groups)) + " |")
+            continue
+        out.append(against(m["label"], mt, md))
     return out
 
 

@@ -335,6 +335,19 @@ class ValidationFigures(unittest.TestCase):
         self.assertIn("| paper | — | — | — | — |", md)
         self.assertNotIn("stalls", md)
         self.assertIn("h = 20 nm", md)
+        self.assertNotIn("3D, finest grid", md)
+        # beside an axisymmetric reference, the finest 3D run with the same phases gets a row
+        # of its own, set against the reference like a model (a coarser one and one without
+        # phases are not shown)
+        run3d = {"has_cycle": True, "cell_size_m": 7.8125e-9,
+                 "cycle_phase_times_s": [v * ms for v in (160, 60, 80, 80, 40, 400)],
+                 "cycle_phase_displacements_m": [v * nm for v in (2, 5, 10, 13, 13, -4)]}
+        case["runs3d"] = [dict(run3d, cell_size_m=1e-8), run3d, {"has_cycle": True, "cell_size_m": 5e-9}]
+        md = "\n".join(self.mod.phases_markdown(case))
+        self.assertIn("| 3D, finest grid (h = 7.81 nm) | 160 ms (+100.0 %); 2 nm (-1 nm) | 220 ms (+100.0 %); "
+                      "28 nm (-12 nm) | 40 ms (+100.0 %); 13 nm (-6 nm) | 400 ms (+100.0 %); -4 nm (+5 nm) |", md)
+        self.assertIn("the tier it judges", md)
+        case["runs3d"] = []
         # without extrapolated phases: the finest run's durations, no error bars
         del case["reference"]["cycle_time_s"]
         md = "\n".join(self.mod.phases_markdown(case))
@@ -361,6 +374,12 @@ class ValidationFigures(unittest.TestCase):
         case = {"name": "c", "runs3d": [], "reference": {
             "runs": [fine], "cycle_time_s": {"phases": [{"value": v * ms, "error": 0.5 * ms} for v in (80, 30, 20, 200)]}},
             "models1d": [ok, huge, other]}
+        case["runs3d"] = [{"has_cycle": True, "cell_size_m": 8e-9, "cycle_phase_times_s": [v * ms for v in (90, 40, 30, 300)],
+                           "cycle_phase_displacements_m": [v * nm for v in (2, 10, 8, -5)]}]
+        self.assertTrue(self.mod.phases_figure(case, f"{self.d}/p.png"))
+        self.assertEqual(len(self.closed[-1].axes[0].patches), 3 * 4)  # the finest 3D run beside the axi reference
+        self.assertIn("3D and 1D models", self.closed[-1]._suptitle.get_text())
+        case["runs3d"] = []
         self.assertTrue(self.mod.phases_figure(case, f"{self.d}/p.png"))
         fig = self.closed[-1]
         t_ax, d_ax = fig.axes[:2]
