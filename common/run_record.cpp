@@ -244,8 +244,11 @@ CycleFigures cycle_figures(const RunRecord& r) {
     c.cycle_times_s.push_back(e.cycle_end_s[k] - e.cycle_start_s[k]);
     c.cycle_displacements_m.push_back(x_at(e.x_at_cycle_end_m, k) - x_at(e.x_at_cycle_start_m, k));
   }
-  // the centre's position at time t from the kept rows (linear between the rows around t)
-  const bool rows = r.series.rows() >= 2 && r.series.has("t_s") && r.series.has("x_center_m");
+  // the centre's position at time t from the kept rows (linear between the rows around t); read
+  // only where there are phases to measure (a summary written at each checkpoint need not copy
+  // the columns otherwise)
+  const bool rows = n > 0 && !e.segment_reached_s.empty() && r.series.rows() >= 2 && r.series.has("t_s") &&
+                    r.series.has("x_center_m");
   const std::vector<double> ts = rows ? r.series.column("t_s") : std::vector<double>();
   const std::vector<double> xs = rows ? r.series.column("x_center_m") : std::vector<double>();
   auto x_of = [&](double t) {

@@ -995,6 +995,18 @@ def phase_groups(n):
     return groups
 
 
+def phases_of(run, n):
+    """A run's or model's protocol phases, (durations, displacements), when it completed a cycle
+    with n of them; None otherwise."""
+    t, d = run.get("cycle_phase_times_s") or [], run.get("cycle_phase_displacements_m") or []
+    return (t, d) if run.get("has_cycle") and len(t) == n and len(d) == n else None
+
+
+def group_sum(vals, idx):
+    """The sum of a phase group's values."""
+    return sum(vals[i] for i in idx)
+
+
 def phase_reference(c):
     """The reference's phases: (source words, durations, their errors or None, the centre's
     displacement over each) from the axisymmetric reference (its extrapolated phase durations,
@@ -1026,23 +1038,22 @@ def phase_3d(c, n):
     tier the reference judges, phase by phase); None otherwise."""
     if finest_axi_run(c) is None:
         return None
-    runs = [r for r in c.get("runs3d", []) if r.get("has_cycle") and len(r.get("cycle_phase_times_s") or []) == n
-            and len(r.get("cycle_phase_displacements_m") or []) == n]
+    runs = [r for r in c.get("runs3d", []) if phases_of(r, n)]
     return runs[-1] if runs else None
 
 
-def phase_models(c, n):
-    """The 1D models of a case whose phases match the reference's n: (index, model), and the
-    labels of those whose distance in a phase group exceeds 50 times the reference's largest
-    (drawn off scale: named, not drawn)."""
-    _, _, _, disp = phase_reference(c)
-    scale = max(abs(sum(disp[i] for i in idx)) for _, idx in phase_groups(n))
+def phase_models(c, disp):
+    """The 1D models of a case whose phases match the reference's (disp: the reference's
+    displacement over each): (index, model), and the labels of those whose distance in a phase
+    group exceeds 50 times the reference's largest (drawn off scale: named, not drawn)."""
+    groups = phase_groups(len(disp))
+    scale = max(abs(group_sum(disp, idx)) for _, idx in groups)
     keep, off = [], []
     for k, m in enumerate(c.get("models1d", [])):
-        mt, md = m.get("cycle_phase_times_s"), m.get("cycle_phase_displacements_m")
-        if not m.get("has_cycle") or not mt or not md or len(mt) != n or len(md) != n:
+        ph = phases_of(m, len(disp))
+        if ph is None:
             continue
-        big = max(abs(sum(md[i] for i in idx)) for _, idx in phase_groups(n))
+        big = max(abs(group_sum(ph[1], idx)) for _, idx in groups)
         if scale > 0 and big > 50 * scale:
             off.append(m["label"])
         else:
@@ -1061,18 +1072,18 @@ def phases_figure(case, path):
     words, times, errs, disp = ref
     n = len(times)
     groups = phase_groups(n)
-    models, off = phase_models(case, n)
+    models, off = phase_models(case, disp)
     if not models:
         return False
+    r3 = phase_3d(case, n)
     fig, axs = plt.subplots(1, 2, figsize=(13, 4.6))
-    width = 0.84 / (len(models) + 1 + (phase_3d(case, n) is not None))
+    width = 0.84 / (len(models) + 1 + (r3 is not None))
     xs = range(len(groups))
 
     def group_sums(vals):
-        return [sum(vals[i] for i in idx) for _, idx in groups]
+        return [group_sum(vals, idx) for _, idx in groups]
     bars = [("reference", group_sums(times), None if errs is None or any(e is None for e in errs)
              else group_sums(errs), group_sums(disp), dict(color="k"))]
-    r3 = phase_3d(case, n)
     if r3 is not None:
         bars.append((f"3D, finest grid (h = {si(r3['cell_size_m'], 'm')})", group_sums(r3["cycle_phase_times_s"]), None,
                      group_sums(r3["cycle_phase_displacements_m"]), dict(color="0.6", hatch="//", edgecolor="0.3")))
@@ -1118,49 +1129,41 @@ def phases_markdown(c):
     words, times, errs, disp = ref
     n = len(times)
     groups = phase_groups(n)
-    if not any(len(m.get("cycle_phase_times_s") or []) == n and len(m.get("cycle_phase_displacements_m") or []) == n
-               for m in c.get("models1d", []) if m.get("has_cycle")):
+    if not any(phases_of(m, n) for m in c.get("models1d", [])):
         return []  # no 1D model to set against the reference (a multi-cycle 1D run keeps its last cycle's events)
+    r3 = phase_3d(c, n)
     head = "| | " + " | ".join(g[0] for g in groups) + " |"
     out = ["", "#### The cycle phase by phase", "",
            f"The protocol's phases grouped (each segment's contraction until it reaches R_f, front segment first; "
            f"the recovery until the cycle ends): the time each group took and the distance the centre moved over "
            f"it. Reference: the {words}"
-           + ("; beside it the finest 3D run, the tier it judges" if phase_3d(c, n) is not None else "")
+           + ("; beside it the finest 3D run, the tier it judges" if r3 is not None else "")
            + ". A model's time is given with its difference from the reference's, "
            "its distance with the difference in distance (a phase's distance can be near zero or negative, where a "
            "percentage says nothing).", "", head, "|---|" + "---|" * len(groups)]
-
-    def total(vals, idx):
-        return sum(vals[i] for i in idx)
     cells = []
     for _, idx in groups:
-        t = total(times, idx)
-        e = None if errs is None or any(errs[i] is None for i in idx) else total(errs, idx)
-        cells.append(f"{pm_in_unit_of(t, e, 's')}; {si(total(disp, idx), 'm')}")
+        e = None if errs is None or any(errs[i] is None for i in idx) else group_sum(errs, idx)
+        cells.append(f"{pm_in_unit_of(group_sum(times, idx), e, 's')}; {si(group_sum(disp, idx), 'm')}")
     out.append("| reference | " + " | ".join(cells) + " |")
 
     def against(label, mt, md):
         cells = []
         for _, idx in groups:
-            t, tr = total(mt, idx), total(times, idx)
-            d, dr = total(md, idx), total(disp, idx)
+            t, tr = group_sum(mt, idx), group_sum(times, idx)
+            d, dr = group_sum(md, idx), group_sum(disp, idx)
             dd = si(d - dr, "m")
             cells.append(f"{si(t, 's')} ({pct((t - tr) / tr if tr > 0 else None)}); {si(d, 'm')} "
                          f"({'' if dd.startswith('-') or dd == '—' else '+'}{dd})")
         return f"| {label} | " + " | ".join(cells) + " |"
-    r3 = phase_3d(c, n)
     if r3 is not None:
         out.append(against(f"3D, finest grid (h = {si(r3['cell_size_m'], 'm')})", r3["cycle_phase_times_s"],
                            r3["cycle_phase_displacements_m"]))
     for m in c.get("models1d", []):
-        mt, md = m.get("cycle_phase_times_s"), m.get("cycle_phase_displacements_m")
         if not m.get("has_cycle"):
             continue
-        if not mt or not md or len(mt) != n or len(md) != n:
-            out.append(f"| {m['label']} | " + " | ".join(["—"] * len(groups)) + " |")
-            continue
-        out.append(against(m["label"], mt, md))
+        ph = phases_of(m, n)
+        out.append(against(m["label"], *ph) if ph else f"| {m['label']} | " + " | ".join(["—"] * len(groups)) + " |")
     return out
 
 
