@@ -373,12 +373,13 @@ FittedStokes::FittedStokes(std::unique_ptr<MeridianMesh> mesh, double mu, Coupli
         if (L[i] >= 0 && L[j] >= 0 && (i < 18 || j < 18)) P[i * kLoc + j] = find_position(L[i], L[j]);
   }
 
-  // the row-major copy's pattern and, per entry, its entry in A_
-  rows_ = A_;
-  row_src_.resize(std::size_t(rows_.nonZeros()));
-  for (int r = 0; r < n_; ++r)
-    for (int q = rows_.outerIndexPtr()[r]; q < rows_.outerIndexPtr()[r + 1]; ++q)
-      row_src_[std::size_t(q)] = find_position(r, rows_.innerIndexPtr()[q]);
+  // per column, the first entry on or below the diagonal (rows are sorted within a column)
+  lower_begin_.resize(std::size_t(n_));
+  for (int c = 0; c < n_; ++c) {
+    const int* b = A_.innerIndexPtr() + A_.outerIndexPtr()[c];
+    const int* e = A_.innerIndexPtr() + A_.outerIndexPtr()[c + 1];
+    lower_begin_[std::size_t(c)] = int(std::lower_bound(b, e, c) - A_.innerIndexPtr());
+  }
 
   lu_ = new_lu();
   chol_.factor = new_cholesky();
@@ -421,11 +422,24 @@ void FittedStokes::build_schur_pattern() {
   };
   for (int c = n_vel_; c < n_; ++c)
     for (int a = outer[c]; a < outer[c + 1]; ++a)
-      for (int b = outer[c]; b < outer[c + 1]; ++b) {
-        if (inner[a] >= n_vel_ || inner[b] >= n_vel_)
-          throw std::logic_error("FittedStokes: pressure unknowns coupled to each other");
-        pen_pos.push_back(position(inner[a], inner[b]));
-      }
+      if (inner[a] >= n_vel_) throw std::logic_error("FittedStokes: pressure unknowns coupled to each other");
+  // per element, its velocity unknowns' pairs (the pressure columns hold their own element's
+  // velocity rows only)
+  pen_nv_ = triangles_ ? 14 : 18;
+  const int E = mesh_->elements();
+  pen_pos.assign(std::size_t(E) * pen_nv_ * pen_nv_, -1);
+  for (int e = 0; e < E; ++e) {
+    const int* L = &loc_[std::size_t(e) * kLoc];
+    int* Q = &pen_pos[std::size_t(e) * pen_nv_ * pen_nv_];
+    for (int k = 0; k < 3; ++k)
+      if (L[18 + k] >= 0)
+        for (int i = 0; i < 18; ++i)
+          if (L[i] >= 0 && i >= pen_nv_)
+            throw std::logic_error("FittedStokes: a triangle's pressure couples an unused velocity slot");
+    for (int i = 0; i < pen_nv_; ++i)
+      for (int j = 0; j < pen_nv_; ++j)
+        if (L[i] >= 0 && L[j] >= 0) Q[i * pen_nv_ + j] = position(L[i], L[j]);
+  }
   chol_.bval.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
   spare_.bval = chol_.bval;
 
@@ -465,7 +479,8 @@ void FittedStokes::build_schur_pattern() {
   for (std::size_t k = 0; k < schur_src.size(); ++k)
     if (up_of[k] >= 0) up_src_[std::size_t(up_of[k])] = schur_src[k];
   up_pen_pos_.resize(pen_pos.size());
-  for (std::size_t k = 0; k < pen_pos.size(); ++k) up_pen_pos_[k] = up_of[std::size_t(pen_pos[k])];
+  for (std::size_t k = 0; k < pen_pos.size(); ++k)
+    up_pen_pos_[k] = pen_pos[k] >= 0 ? up_of[std::size_t(pen_pos[k])] : -1;
 }
 
 const FittedMesh& FittedStokes::mesh() const {
@@ -526,57 +541,63 @@ void FittedStokes::assemble(const Eigen::SparseMatrix<double>* K, double scale) 
   std::fill(val, val + A_.nonZeros(), 0.0);
   const int E = mesh_->elements();
   Geometry g;
-  Eigen::Matrix<double, 9, 9> Axx, Arr, Axr;
-  Eigen::Matrix<double, 3, 9> Bx, Br;
-  // per element: A = G^T diag(w) G sums over the 9 quadrature points as 9x9 products (G: point by
-  // shape function), the pressure couplings as C^T (...) with C the points' weighted pressure basis
-  Eigen::Matrix<double, 9, 9> Wgx, Wgr, WN;
-  Eigen::Matrix<double, 9, 3> C;
-  for (int e = 0; e < E; ++e) {
+  // One element with np quadrature points and nf shape functions (Q2: 9 and 9; the P2+ triangle:
+  // 7 and 7, the last two slots of Geometry unused). A = G^T diag(w) G sums over the points as
+  // nf x nf products (G: point by shape function), the pressure couplings as C^T (...) with C the
+  // points' weighted pressure basis. The products are coefficient-based: Eigen sends fixed
+  // products of these sizes (np + 2 nf >= its threshold of 20) through its general matrix-matrix
+  // kernel, whose packing and blocking cost more than the multiply-adds themselves.
+  auto element = [&]<int np, int nf>(int e) {
     element_geometry(e, g);
-    for (int q = 0; q < 9; ++q) {
+    const auto N = g.N.topLeftCorner<np, nf>();
+    const auto gx = g.gx.topLeftCorner<np, nf>();
+    const auto gr = g.gr.topLeftCorner<np, nf>();
+    Eigen::Matrix<double, np, nf> Wgx, Wgr, WN, rgx, rgrN;
+    Eigen::Matrix<double, np, 3> C;
+    for (int q = 0; q < np; ++q) {
       const double r = g.r[q], W = mu_ * g.wdet[q] * r;
-      Wgx.row(q) = W * g.gx.row(q);
-      Wgr.row(q) = W * g.gr.row(q);
-      WN.row(q) = (2.0 * mu_ * g.wdet[q] / r) * g.N.row(q);
+      Wgx.row(q) = W * gx.row(q);
+      Wgr.row(q) = W * gr.row(q);
+      WN.row(q) = (2.0 * mu_ * g.wdet[q] / r) * N.row(q);
+      rgx.row(q) = r * gx.row(q);
+      rgrN.row(q) = r * gr.row(q) + N.row(q);
       const double c = -ps_ * g.wdet[q];
       C(q, 0) = c;
       C(q, 1) = c * (g.x[q] - g.xc) / g.hx;
       C(q, 2) = c * (g.r[q] - g.rc) / g.hr;
     }
-    Axx.noalias() = 2.0 * (g.gx.transpose() * Wgx) + g.gr.transpose() * Wgr;
-    Arr.noalias() = 2.0 * (g.gr.transpose() * Wgr) + g.gx.transpose() * Wgx;
-    Arr.noalias() += g.N.transpose() * WN;
-    Axr.noalias() = g.gr.transpose() * Wgx;
-    {
-      Eigen::Matrix<double, 9, 9> rgx, rgrN;
-      for (int q = 0; q < 9; ++q) {
-        rgx.row(q) = g.r[q] * g.gx.row(q);
-        rgrN.row(q) = g.r[q] * g.gr.row(q) + g.N.row(q);
-      }
-      Bx.noalias() = C.transpose() * rgx;
-      Br.noalias() = C.transpose() * rgrN;
-    }
+    Eigen::Matrix<double, nf, nf> Axx, Arr, Axr;
+    Eigen::Matrix<double, 3, nf> Bx, Br;
+    Axx.noalias() = 2.0 * gx.transpose().lazyProduct(Wgx) + gr.transpose().lazyProduct(Wgr);
+    Arr.noalias() = 2.0 * gr.transpose().lazyProduct(Wgr) + gx.transpose().lazyProduct(Wgx);
+    Arr.noalias() += N.transpose().lazyProduct(WN);
+    Axr.noalias() = gr.transpose().lazyProduct(Wgx);
+    Bx.noalias() = C.transpose().lazyProduct(rgx);
+    Br.noalias() = C.transpose().lazyProduct(rgrN);
     const int* P = &pos_[std::size_t(e) * kLoc * kLoc];
     auto add = [&](int i, int j, double v) {
       const int p = P[i * kLoc + j];
       if (p >= 0) val[p] += v;
     };
-    for (int a = 0; a < 9; ++a)
-      for (int b = 0; b < 9; ++b) {
+    for (int a = 0; a < nf; ++a)
+      for (int b = 0; b < nf; ++b) {
         add(2 * a, 2 * b, Axx(a, b));
         add(2 * a + 1, 2 * b + 1, Arr(a, b));
         add(2 * a, 2 * b + 1, Axr(a, b));
         add(2 * b + 1, 2 * a, Axr(a, b));
       }
     for (int k = 0; k < 3; ++k)
-      for (int b = 0; b < 9; ++b) {
+      for (int b = 0; b < nf; ++b) {
         add(18 + k, 2 * b, Bx(k, b));
         add(2 * b, 18 + k, Bx(k, b));
         add(18 + k, 2 * b + 1, Br(k, b));
         add(2 * b + 1, 18 + k, Br(k, b));
       }
-  }
+  };
+  if (triangles_)
+    for (int e = 0; e < E; ++e) element.template operator()<7, 7>(e);
+  else
+    for (int e = 0; e < E; ++e) element.template operator()<9, 9>(e);
   if (K && scale != 0.0) {
     const int nm = mesh_->membrane_nodes();
     for (int c = 0; c < K->outerSize(); ++c)
@@ -666,13 +687,29 @@ bool FittedStokes::factor_into(CholeskySlot& slot) const {
   const int* outer = A_.outerIndexPtr();
   double* sv = schur_up_.valuePtr();
   for (std::size_t k = 0; k < up_src_.size(); ++k) sv[k] = av[up_src_[k]];
-  std::size_t k = 0;
-  for (int c = n_vel_; c < n_; ++c)
-    for (int a = outer[c]; a < outer[c + 1]; ++a) {
-      const double va = av[a] * inv;
-      for (int b = outer[c]; b < outer[c + 1]; ++b, ++k)
-        if (const int p = up_pen_pos_[k]; p >= 0) sv[p] += va * av[b];
-    }
+  // B^T B / e element by element: the element's rows of B (its three pressure columns of A_,
+  // through the assembly's positions), then their dense outer products summed, one scattered
+  // add per pair of its velocity unknowns instead of one per pair and pressure unknown
+  const int E = mesh_->elements(), nv = pen_nv_;
+  for (int e = 0; e < E; ++e) {
+    const int* P = &pos_[std::size_t(e) * kLoc * kLoc];
+    const int* Q = &up_pen_pos_[std::size_t(e) * nv * nv];
+    double b[3][18];
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < nv; ++i) {
+        const int p = P[i * kLoc + 18 + k];
+        b[k][i] = p >= 0 ? av[p] * inv : 0.0;
+      }
+    double c[3][18];
+    for (int k = 0; k < 3; ++k)
+      for (int i = 0; i < nv; ++i) {
+        const int p = P[i * kLoc + 18 + k];
+        c[k][i] = p >= 0 ? av[p] : 0.0;
+      }
+    for (int i = 0; i < nv; ++i)
+      for (int j = 0; j < nv; ++j)
+        if (const int q = Q[i * nv + j]; q >= 0) sv[q] += b[0][i] * c[0][j] + b[1][i] * c[1][j] + b[2][i] * c[2][j];
+  }
   std::copy(av + outer[n_vel_], av + outer[n_], slot.bval.begin());
   const OneOpenMpThread one;  // per thread: the worker's own setting
   if (!slot.analysed) {
@@ -812,11 +849,6 @@ void FittedStokes::factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<d
   }
   lu_current_ = false;  // A_ changes now (the stored LU, if any, stays valid as a preconditioner)
   assemble(K, scale);
-  {
-    const double* av = A_.valuePtr();
-    double* rv = rows_.valuePtr();
-    for (std::size_t k = 0; k < row_src_.size(); ++k) rv[k] = av[row_src_[k]];
-  }
   timing_.assemble += seconds_since(t0);
   solves_on_system_ = 0;
   // The iteration-count trigger is checked at the next solve (see the header comment).
@@ -828,25 +860,32 @@ void FittedStokes::factor(const Eigen::Matrix3Xd& X, const Eigen::SparseMatrix<d
 }
 
 void FittedStokes::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
-  // one thread, row by row (a background factorisation may be using the other core)
-  const int* outer = rows_.outerIndexPtr();
-  const int* inner = rows_.innerIndexPtr();
-  const double* val = rows_.valuePtr();
+  // one thread (a background factorisation may be using the other core), the lower triangle
+  // column by column: an entry a_ij (i > j) adds a_ij x_j to y_i and a_ij x_i to y_j
+  const int* outer = A_.outerIndexPtr();
+  const int* inner = A_.innerIndexPtr();
+  const double* val = A_.valuePtr();
   const double* xv = x.data();
-  y.resize(n_);
-  for (int i = 0; i < n_; ++i) {
-    // four partial sums: one chain of dependent additions bounded a row by the adder's latency
-    double s0 = 0.0, s1 = 0.0, s2 = 0.0, s3 = 0.0;
-    int q = outer[i];
-    const int end = outer[i + 1];
-    for (; q + 3 < end; q += 4) {
-      s0 += val[q] * xv[inner[q]];
-      s1 += val[q + 1] * xv[inner[q + 1]];
-      s2 += val[q + 2] * xv[inner[q + 2]];
-      s3 += val[q + 3] * xv[inner[q + 3]];
+  y.setZero(n_);
+  double* yv = y.data();
+  for (int c = 0; c < n_; ++c) {
+    int q = lower_begin_[std::size_t(c)];
+    const int end = outer[c + 1];
+    const double xc = xv[c];
+    double s0 = 0.0, s1 = 0.0;
+    if (q < end && inner[q] == c) s0 = val[q] * xc, ++q;
+    for (; q + 1 < end; q += 2) {
+      const int i0 = inner[q], i1 = inner[q + 1];
+      yv[i0] += val[q] * xc;
+      yv[i1] += val[q + 1] * xc;
+      s0 += val[q] * xv[i0];
+      s1 += val[q + 1] * xv[i1];
     }
-    for (; q < end; ++q) s0 += val[q] * xv[inner[q]];
-    y[i] = (s0 + s1) + (s2 + s3);
+    if (q < end) {
+      yv[inner[q]] += val[q] * xc;
+      s0 += val[q] * xv[inner[q]];
+    }
+    yv[c] += s0 + s1;
   }
 }
 
