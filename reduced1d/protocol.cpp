@@ -160,6 +160,7 @@ int ProtocolMachine::root_count() const {
 void ProtocolMachine::reach_active(double t, const double* R, int& switches) {
   while (true) {
     reached_[active_] = t;
+    reached_history_.push_back(t);
     ++switches;
     if (active_ == 0) {
       phase_ = 1;

@@ -56,8 +56,8 @@ struct Result {
   std::vector<double> radius;        ///< row-major snapshots: radius[k * z.size() + i] [m]
   std::vector<double> cycle_start;   ///< start time of each cycle [s]
   std::vector<double> cycle_end;     ///< end time of each completed cycle (energy back within tol) [s]
-  /// force-driven: time at which each segment (index 0 = leftmost) first reached R_f within delta,
-  /// for the last cycle started; -1 where not reached.
+  /// force-driven: every time a segment reached R_f within delta, in order, over all cycles
+  /// (each cycle's front segment first); empty for a constant actuation.
   std::vector<double> segment_reached;
   long switches = 0;                 ///< number of protocol force switches (all cycles)
   /// Drag coefficient of the straight tube (R = R0) in the model's outer flow, F = -zeta U

@@ -78,8 +78,8 @@ def contracted_radius(summary):
 
 
 def events(summary):
-    """The protocol's events as (time s, kind): segment i reaching R_f, cycle start, cycle end."""
-    ev = [(t, f"segment {i} at R_f") for i, t in enumerate(summary.get("segment_reached_s") or []) if t is not None and t >= 0]
+    """The protocol's events as (time s, kind): a segment reaching R_f, cycle start, cycle end."""
+    ev = [(t, "segment at R_f") for t in summary.get("segment_reached_s") or [] if t is not None and t >= 0]
     ev += [(t, "cycle start") for t in summary.get("cycle_start_times_s") or [] if t > 0]
     ev += [(t, "cycle end") for t in summary.get("cycle_end_times_s") or []]
     return sorted(ev)

@@ -88,10 +88,10 @@ TEST(Reduced1dForceDriven, ProtocolCompletesOneCycle) {
   ASSERT_FALSE(r.failure) << r.failure->what();
   ASSERT_TRUE(all_finite(r));
   const int n = p.protocol.segments;
-  // Every segment reached R_f, right to left.
+  // Every segment reached R_f once, right to left: the events in the order reached.
   ASSERT_EQ(int(r.segment_reached.size()), n);
   for (int k = 0; k < n; ++k) EXPECT_GE(r.segment_reached[k], 0.0) << k;
-  for (int k = 0; k + 1 < n; ++k) EXPECT_GT(r.segment_reached[k], r.segment_reached[k + 1]);
+  for (int k = 0; k + 1 < n; ++k) EXPECT_LT(r.segment_reached[k], r.segment_reached[k + 1]);
   // Switch bound: the hold and recovery rules are continuous (regularised) actuation laws, so
   // the only discrete switches are the n "segment reached R_f" events and the cycle end.
   EXPECT_EQ(r.switches, n + 1);
@@ -106,7 +106,7 @@ TEST(Reduced1dForceDriven, ProtocolCompletesOneCycle) {
   // The swimmer moves in +z by the end of the contraction (wave travels in -z).
   double X_contraction = 0;
   for (const auto& s : r.series)
-    if (s.t <= r.segment_reached[0]) X_contraction = s.X;
+    if (s.t <= r.segment_reached.back()) X_contraction = s.X;
   EXPECT_GT(X_contraction, 0.0);
   EXPECT_GT(r.series.back().X, 0.0);
   // Radii stay in a sane range.
@@ -118,6 +118,38 @@ TEST(Reduced1dForceDriven, ProtocolCompletesOneCycle) {
   EXPECT_EQ(r.stats.at("reinits"), n);  // one restart per switch except the final one
 }
 
+
+// Several cycles: the segment events of every cycle are kept, in the order reached, each cycle's
+// n events inside it, so the run record gives the protocol's phases averaged over the cycles
+// (n contractions and the recovery, summing to the mean cycle time); before, only the last
+// cycle's were kept and a multi-cycle run had no phases.
+TEST(Reduced1dForceDriven, EveryCyclesSegmentEventsGiveThePhases) {
+  Params p = force_driven(50, SwimmerModel::ForceFree);
+  p.protocol.cycles = 2;
+  const Result r = solve(p);
+  ASSERT_FALSE(r.failure) << r.failure->what();
+  const int n = p.protocol.segments;
+  ASSERT_EQ(r.cycle_end.size(), 2u);
+  ASSERT_EQ(int(r.segment_reached.size()), 2 * n);
+  for (int c = 0; c < 2; ++c)
+    for (int k = 0; k < n; ++k) {
+      const double t = r.segment_reached[std::size_t(c * n + k)];
+      EXPECT_GT(t, r.cycle_start[std::size_t(c)]) << c << " " << k;
+      EXPECT_LT(t, r.cycle_end[std::size_t(c)]) << c << " " << k;
+    }
+  const swim::record::CycleFigures cf = swim::record::cycle_figures(record_of(p, r));
+  ASSERT_EQ(int(cf.phase_times_s.size()), n + 1);
+  double sum = 0;
+  for (double t : cf.phase_times_s) {
+    EXPECT_GT(t, 0.0);
+    sum += t;
+  }
+  EXPECT_NEAR(sum, cf.cycle_time_s, 1e-12 * cf.cycle_time_s);
+  ASSERT_EQ(cf.phase_displacements_m.size(), cf.phase_times_s.size());
+  double d = 0;
+  for (double x : cf.phase_displacements_m) d += x;
+  EXPECT_NEAR(d, cf.displacement_per_cycle_m, 1e-9 * std::abs(cf.displacement_per_cycle_m));
+}
 TEST(Reduced1dForceDriven, ConservesVolumeWithAndWithoutInertia) {
   for (bool inertia : {false, true}) {
     Params p = force_driven(40);

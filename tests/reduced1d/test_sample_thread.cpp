@@ -144,7 +144,7 @@ TEST(SampleThread, KeepsTheSamplesAndTheFailureOfARunStoppedMidway) {
 }
 
 TEST(SampleThread, ThreadsOtherThanOneOrTwoAreRefusedNamingTheKey) {
-  for (const json v : {json(0), json(3), json("two")}) {
+  for (const json& v : {json(0), json(3), json("two")}) {
     json resolved;
     try {
       read_scene(json{{"numerics1d", {{"threads", v}}}}, resolved);
@@ -234,6 +234,8 @@ TEST(SampleThread, TheOutputLimitStopsTheRunAtTheSameRow) {
     EXPECT_EQ(one.cycle_start, two.cycle_start) << limit;
     EXPECT_EQ(one.switches, two.switches) << limit;
     EXPECT_EQ(one.segment_reached, two.segment_reached) << limit;
-    if (limit > 100000u) EXPECT_GT(one.switches, 0) << "the larger limit falls after a switch";
+    if (limit > 100000u) {
+      EXPECT_GT(one.switches, 0) << "the larger limit falls after a switch";
+    }
   }
 }
