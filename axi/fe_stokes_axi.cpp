@@ -677,8 +677,14 @@ void FittedStokes::forget_factorisation() {
 }
 
 bool FittedStokes::factor_into(CholeskySlot& slot) const {
-  double d = 0.0;
-  for (int c = 0; c < n_vel_; ++c) d = std::max(d, std::abs(A_.coeff(c, c)));
+  double d = 0.0;  // the velocity block's largest diagonal entry (lower_begin_: its position)
+  {
+    const int* outer = A_.outerIndexPtr();
+    const int* inner = A_.innerIndexPtr();
+    const double* av = A_.valuePtr();
+    for (int c = 0; c < n_vel_; ++c)
+      if (const int q = lower_begin_[std::size_t(c)]; q < outer[c + 1] && inner[q] == c) d = std::max(d, std::abs(av[q]));
+  }
   if (!(d > 0.0 && std::isfinite(d))) return false;
   // S = A_vv + B^T B / e on its fixed pattern; the factored B kept for the applications
   slot.pen = kPressureRegularisation * d;
