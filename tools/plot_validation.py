@@ -27,18 +27,26 @@ import plot_calibration  # noqa: E402
 MODEL_STYLES = ["C1-", "C2--", "C3-.", "C4:", "C5-", "C6--", "C8-.", "C9:", "C7-"]
 
 
+SI_PREFIXES = [(1e-15, "f"), (1e-12, "p"), (1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1, ""), (1e3, "k"), (1e6, "M")]
+
+
+def si_prefix(v):
+    """The SI prefix si() writes v with: (scale, prefix), e.g. (1e-9, 'n') for 4.2e-8."""
+    a = abs(v)
+    scale, p = SI_PREFIXES[0]
+    for s, q in SI_PREFIXES:
+        if a >= s:
+            scale, p = s, q
+    return scale, p
+
+
 def si(v, unit, digits=3):
     """Value with an SI prefix: si(4.2e-8, 'm') -> '42 nm'."""
     if v is None or (isinstance(v, float) and not math.isfinite(v)):
         return "—"
     if v == 0:
         return f"0 {unit}"
-    prefixes = [(1e-15, "f"), (1e-12, "p"), (1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1, ""), (1e3, "k"), (1e6, "M")]
-    a = abs(v)
-    scale, p = prefixes[0]
-    for s, q in prefixes:
-        if a >= s:
-            scale, p = s, q
+    scale, p = si_prefix(v)
     return f"{v / scale:.{digits}g} {p}{unit}"
 
 
@@ -973,9 +981,9 @@ def pm_in_unit_of(v, e, unit):
     text = si(v, unit)
     if e is None:
         return text
-    prefix_unit = text.split(" ", 1)[1] if " " in text else unit
-    scale = v / float(text.split(" ", 1)[0]) if v else 1.0
-    x = abs(e) / scale if scale else abs(e)
+    scale, p = si_prefix(v) if v else (1.0, "")
+    prefix_unit = p + unit
+    x = abs(e) / scale
     es = f"{x:.2g}"
     if "e" in es:
         es = f"{x:.0f}" if x >= 1 else None

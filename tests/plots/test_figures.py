@@ -576,6 +576,25 @@ class ValidationFigures(unittest.TestCase):
                 self.assertFalse(boxes[i].overlaps(boxes[j]))
 
 
+class ValidationErrorText(unittest.TestCase):
+    """A value with its error in the value's own SI prefix (the phase table's durations): the
+    error is scaled by the prefix itself, not by the rounded value's digits."""
+
+    def setUp(self):
+        self.mod = load("plot_validation")
+
+    def test_the_error_takes_the_values_prefix(self):
+        pm = self.mod.pm_in_unit_of
+        # 100.4 ms shows as 100 ms; its error 0.1252 ms must read 0.13 ms (0.12 when scaled by
+        # the rounded value's ratio 0.1004 / 100, 0.4 % off)
+        self.assertEqual(pm(0.1004, 1.252e-4, "s"), "100 ms ± 0.13 ms")
+        self.assertEqual(pm(1.0585, 0.0098, "s"), "1.06 s ± 0.0098 s")
+        self.assertEqual(pm(151.2e-9, 1.45e-9, "m"), "151 nm ± 1.4 nm")
+        self.assertEqual(pm(0.32, None, "s"), "320 ms")
+        # an error below 10^-4 of the prefix's unit takes a prefix of its own
+        self.assertEqual(pm(0.32, 2e-9, "s"), "320 ms ± 2 ns")
+
+
 class ValidationWrinkleCell(unittest.TestCase):
     """The report's wall-wrinkle cell: the lobe number, the lobes in order when they changed
     during the run, "round" for a wall held axisymmetric."""
