@@ -433,8 +433,8 @@ void FittedStokes::build_schur_pattern() {
     int* Q = &pen_pos[std::size_t(e) * pen_nv_ * pen_nv_];
     for (int k = 0; k < 3; ++k)
       if (L[18 + k] >= 0)
-        for (int i = 0; i < 18; ++i)
-          if (L[i] >= 0 && i >= pen_nv_)
+        for (int i = pen_nv_; i < 18; ++i)
+          if (L[i] >= 0)
             throw std::logic_error("FittedStokes: a triangle's pressure couples an unused velocity slot");
     for (int i = 0; i < pen_nv_; ++i)
       for (int j = 0; j < pen_nv_; ++j)
@@ -700,21 +700,17 @@ bool FittedStokes::factor_into(CholeskySlot& slot) const {
   for (int e = 0; e < E; ++e) {
     const int* P = &pos_[std::size_t(e) * kLoc * kLoc];
     const int* Q = &up_pen_pos_[std::size_t(e) * nv * nv];
-    double b[3][18];
-    for (int k = 0; k < 3; ++k)
-      for (int i = 0; i < nv; ++i) {
-        const int p = P[i * kLoc + 18 + k];
-        b[k][i] = p >= 0 ? av[p] * inv : 0.0;
-      }
     double c[3][18];
     for (int k = 0; k < 3; ++k)
       for (int i = 0; i < nv; ++i) {
         const int p = P[i * kLoc + 18 + k];
         c[k][i] = p >= 0 ? av[p] : 0.0;
       }
-    for (int i = 0; i < nv; ++i)
+    for (int i = 0; i < nv; ++i) {
+      const double b0 = c[0][i] * inv, b1 = c[1][i] * inv, b2 = c[2][i] * inv;
       for (int j = 0; j < nv; ++j)
-        if (const int q = Q[i * nv + j]; q >= 0) sv[q] += b[0][i] * c[0][j] + b[1][i] * c[1][j] + b[2][i] * c[2][j];
+        if (const int q = Q[i * nv + j]; q >= 0) sv[q] += b0 * c[0][j] + b1 * c[1][j] + b2 * c[2][j];
+    }
   }
   std::copy(av + outer[n_vel_], av + outer[n_], slot.bval.begin());
   const OneOpenMpThread one;  // per thread: the worker's own setting

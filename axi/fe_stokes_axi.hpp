@@ -114,10 +114,11 @@
 // behaviour); so is the prescribed wall's constrained (unsymmetric) system.
 // GMRES's products with A_ read its lower triangle only and take each entry below the diagonal
 // for its mirror as well: the system is symmetric (the viscous form and the divergence are
-// assembled symmetrically, the wall's stiffness term is symmetrised), and the product is bounded
-// by the memory it reads, so half the entries make it about twice as fast. The operator GMRES
-// solves is then symmetric to the last bit, the one the preconditioner factors (S is formed from
-// the same lower triangle).
+// assembled symmetrically, the wall's stiffness term is symmetrised), so no copy of A_ by rows is
+// refreshed after each assembly. A product reads half the entries but scatters half its updates:
+// about the time of a product by rows (docs/performance.md). The operator GMRES solves is then
+// symmetric to the last bit, the one the preconditioner factors (S is formed from the same lower
+// triangle).
 //
 // Factorisation in the background (set_background_factorisation; off by default, on in the
 // time stepper). With the Cholesky in use, a factor() that keeps an earlier factorisation starts

@@ -289,7 +289,7 @@ Result EventLoop::run() {
   // harvest adds only the counters since the last restart, and every restart is preceded
   // by a harvest: nothing is counted twice.
   if (be_ && !taken_back_) be_->harvest(res_.stats);
-  res_.segment_reached = machine_.reached_history();
+  res_.segment_reached = machine_.reached();
   if (fixed_) res_.segment_reached.clear();
   return std::move(res_);
 }

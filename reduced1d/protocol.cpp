@@ -112,7 +112,6 @@ ProtocolMachine::ProtocolMachine(const Params& p, std::vector<double> fixed_q)
       seg_last_[k] = std::max(seg_last_[k], i);
     }
   }
-  reached_.assign(nseg_, -1.0);
   active_law_ = ActuationLaw::constant(q);
   idle_law_ = ActuationLaw::constant(0.0);
   held_law_ = regularised_relay({Rf_ - d, Rf_ + d}, {-q, 0.0, q}, {eps, eps});
@@ -159,8 +158,7 @@ int ProtocolMachine::root_count() const {
 
 void ProtocolMachine::reach_active(double t, const double* R, int& switches) {
   while (true) {
-    reached_[active_] = t;
-    reached_history_.push_back(t);
+    reached_.push_back(t);
     ++switches;
     if (active_ == 0) {
       phase_ = 1;
@@ -175,7 +173,6 @@ void ProtocolMachine::start_cycle(double t, const double* R) {
   phase_ = 0;
   cycle_completed_ = false;
   active_ = nseg_ - 1;
-  reached_.assign(nseg_, -1.0);
   if (!fixed_ && segment_mean(active_, R) <= Rf_) {
     int dummy = 0;
     reach_active(t, R, dummy);

@@ -90,10 +90,9 @@ class ProtocolMachine {
   bool fixed() const { return fixed_; }
   int segments() const { return nseg_; }
   int active() const { return active_; }
-  const std::vector<double>& reached() const { return reached_; }
   /// Every time a segment reached R_f, in order, over all cycles (the run record's segment
   /// events: the phases of each cycle)
-  const std::vector<double>& reached_history() const { return reached_history_; }
+  const std::vector<double>& reached() const { return reached_; }
 
   /// Actuation of one cell: q = w a(R) + (1 - w) b(R) (a cell straddling a segment boundary
   /// mixes the two segments' laws by length fraction).
@@ -168,7 +167,6 @@ class ProtocolMachine {
   int phase_ = 0;
   int active_ = -1;
   std::vector<double> reached_;
-  std::vector<double> reached_history_;
   bool collapsed_ = false;
   bool cycle_completed_ = false;
 };
