@@ -1,4 +1,5 @@
 #include "axi/fe_stokes_axi.hpp"
+#include "axi/serial_openmp.hpp"
 #include "axi/supernodal_solve.hpp"
 
 #include <dlfcn.h>
@@ -42,9 +43,11 @@ void single_threaded_blas() {
 /// override. On these fronts the extra threads mostly spin and wake, and every new thread that
 /// calls CHOLMOD starts a pool of its own: one cycle of paper_amplitude_0.82 took 30 s with them
 /// and 21 s without at 16 cells, 141 s and 97 s at 32 (docs/performance.md). The product
-/// runs one solve per core, so the CHOLMOD calls run with no active parallel level
-/// (max-active-levels 0: every region a team of the calling thread alone); the caller's settings
-/// are put back afterwards. Per thread: a background factorisation sets its own.
+/// runs one solve per core, so the CHOLMOD calls run their OpenMP regions inline on the calling
+/// thread (SerialOpenMp: no team, no barrier, no system call per region) and, should a region
+/// reach libgomp all the same, with no active parallel level (max-active-levels 0: a team of the
+/// calling thread alone); the caller's settings are put back afterwards. Per thread: a
+/// background factorisation sets its own.
 class OneOpenMpThread {
  public:
   OneOpenMpThread() : threads_(omp_get_max_threads()), levels_(omp_get_max_active_levels()) {
@@ -60,6 +63,7 @@ class OneOpenMpThread {
 
  private:
   int threads_, levels_;
+  SerialOpenMp inline_;
 };
 
 }  // namespace
@@ -443,12 +447,13 @@ void FittedStokes::build_schur_pattern() {
   chol_.bval.assign(std::size_t(A_.nonZeros() - outer[n_vel_]), 0.0);
   spare_.bval = chol_.bval;
 
-  // The factored matrix is P S P^T, stored by its upper triangle, with P the fill-reducing
+  // The factored matrix is P S P^T, stored by its lower triangle, with P the fill-reducing
   // ordering CHOLMOD chooses for S (AMD, postordered), found once here. Factored with the natural
-  // ordering it goes to CHOLMOD's supernodal kernels as it is: given S's lower triangle in its own
-  // order, each factorisation first built the permuted transpose (a 1.4-million-entry copy and its
-  // allocation at 32 cells across: about a third of the worker's time). Each value of S is written
-  // straight into its place in P S P^T (up_src_, up_pen_pos_); S's upper triangle is not stored.
+  // ordering, a lower triangle goes to CHOLMOD's supernodal kernels as it is: given S's lower
+  // triangle in its own order, each factorisation first built the permuted transpose (a
+  // 1.4-million-entry copy and its allocation at 32 cells across: about a third of the worker's
+  // time), and given P S P^T's upper triangle, its transpose. Each value of S is written
+  // straight into its place in P S P^T (lo_src_, lo_pen_pos_); S's upper triangle is not stored.
   {
     Cholesky probe;
     probe.cholmod().print = 0;
@@ -461,26 +466,26 @@ void FittedStokes::build_schur_pattern() {
   }
   std::vector<int> pinv(static_cast<std::size_t>(n_vel_));
   for (int k = 0; k < n_vel_; ++k) pinv[std::size_t(perm_[std::size_t(k)])] = k;
-  // the lower entries of S (row >= column) as (column, row) of P S P^T's upper triangle
+  // the lower entries of S (row >= column) as (column, row) of P S P^T's lower triangle
   std::vector<std::array<int, 3>> entries;  // (new column, new row, entry of S)
   for (int c = 0; c < n_vel_; ++c)
     for (int q = souter[c]; q < souter[c + 1]; ++q) {
       const int r = sinner[std::size_t(q)];
       if (r < c) continue;
       const int a = pinv[std::size_t(r)], b = pinv[std::size_t(c)];
-      entries.push_back({std::max(a, b), std::min(a, b), q});
+      entries.push_back({std::min(a, b), std::max(a, b), q});
     }
   std::sort(entries.begin(), entries.end());
-  sorted_pattern(schur_up_, n_vel_, entries.size(),
+  sorted_pattern(schur_lo_, n_vel_, entries.size(),
                  [&](std::size_t k) { return std::pair{entries[k][0], entries[k][1]}; });
-  std::vector<int> up_of(sinner.size(), -1);  // entry of S -> entry of P S P^T (-1: S's upper triangle)
-  for (std::size_t k = 0; k < entries.size(); ++k) up_of[std::size_t(entries[k][2])] = int(k);
-  up_src_.assign(entries.size(), -1);
+  std::vector<int> lo_of(sinner.size(), -1);  // entry of S -> entry of P S P^T (-1: S's upper triangle)
+  for (std::size_t k = 0; k < entries.size(); ++k) lo_of[std::size_t(entries[k][2])] = int(k);
+  lo_src_.assign(entries.size(), -1);
   for (std::size_t k = 0; k < schur_src.size(); ++k)
-    if (up_of[k] >= 0) up_src_[std::size_t(up_of[k])] = schur_src[k];
-  up_pen_pos_.resize(pen_pos.size());
+    if (lo_of[k] >= 0) lo_src_[std::size_t(lo_of[k])] = schur_src[k];
+  lo_pen_pos_.resize(pen_pos.size());
   for (std::size_t k = 0; k < pen_pos.size(); ++k)
-    up_pen_pos_[k] = pen_pos[k] >= 0 ? up_of[std::size_t(pen_pos[k])] : -1;
+    lo_pen_pos_[k] = pen_pos[k] >= 0 ? lo_of[std::size_t(pen_pos[k])] : -1;
 }
 
 const FittedMesh& FittedStokes::mesh() const {
@@ -691,15 +696,15 @@ bool FittedStokes::factor_into(CholeskySlot& slot) const {
   const double inv = 1.0 / slot.pen;
   const double* av = A_.valuePtr();
   const int* outer = A_.outerIndexPtr();
-  double* sv = schur_up_.valuePtr();
-  for (std::size_t k = 0; k < up_src_.size(); ++k) sv[k] = av[up_src_[k]];
+  double* sv = schur_lo_.valuePtr();
+  for (std::size_t k = 0; k < lo_src_.size(); ++k) sv[k] = av[lo_src_[k]];
   // B^T B / e element by element: the element's rows of B (its three pressure columns of A_,
   // through the assembly's positions), then their dense outer products summed, one scattered
   // add per pair of its velocity unknowns instead of one per pair and pressure unknown
   const int E = mesh_->elements(), nv = pen_nv_;
   for (int e = 0; e < E; ++e) {
     const int* P = &pos_[std::size_t(e) * kLoc * kLoc];
-    const int* Q = &up_pen_pos_[std::size_t(e) * nv * nv];
+    const int* Q = &lo_pen_pos_[std::size_t(e) * nv * nv];
     double c[3][18];
     for (int k = 0; k < 3; ++k)
       for (int i = 0; i < nv; ++i) {
@@ -720,11 +725,11 @@ bool FittedStokes::factor_into(CholeskySlot& slot) const {
     cm.nmethods = 1;
     cm.method[0].ordering = CHOLMOD_NATURAL;
     cm.postorder = 0;
-    slot.factor->analyzePattern(schur_up_);
+    slot.factor->analyzePattern(schur_lo_);
     slot.analysed = slot.factor->info() == Eigen::Success;
     if (!slot.analysed) return false;
   }
-  slot.factor->factorize(schur_up_);
+  slot.factor->factorize(schur_lo_);
   return slot.factor->info() == Eigen::Success;
 }
 

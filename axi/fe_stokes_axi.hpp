@@ -95,9 +95,10 @@
 //   S u = f + B^T g / e,   S = A + B^T B / e,
 // S symmetric positive definite when A is, with A's own sparsity (the discontinuous pressure
 // couples only one element's velocities, which A couples already). S is factored by CHOLMOD's
-// supernodal Cholesky (BLAS-3 kernels) as P S P^T by its upper triangle, P CHOLMOD's own
-// fill-reducing ordering found once, in the natural ordering (no permuted transpose per
-// factorisation); the factor's triangular solves are the product's own (axi/supernodal_solve.hpp).
+// supernodal Cholesky (BLAS-3 kernels) as P S P^T by its lower triangle, P CHOLMOD's own
+// fill-reducing ordering found once, in the natural ordering (no transpose per factorisation),
+// its OpenMP regions inline (axi/serial_openmp.hpp); the factor's triangular solves are the
+// product's own (axi/supernodal_solve.hpp).
 // As a preconditioner it is
 // nearly exact: one application leaves a relative residual of about 5e-6 (eps = 1e-10: 2e-5;
 // 1e-8: 3e-3), a second 1e-10. Measured on paper_amplitude_0.82's system at 32 cells across
@@ -332,7 +333,7 @@ class FittedStokes {
   Eigen::VectorXd cholesky_apply(const Eigen::VectorXd& v) const;  ///< its solve
   /// CHOLMOD's supernodal Cholesky through Eigen, its factor open to the product's own
   /// triangular solves (axi/supernodal_solve.hpp)
-  class Cholesky : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Upper> {
+  class Cholesky : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower> {
    public:
     const cholmod_factor* factor() const { return m_cholmodFactor; }
   };
@@ -344,8 +345,8 @@ class FittedStokes {
     std::vector<double> bval;
     double pen = 0.0;
   };
-  /// Forms P S P^T from the current A_ into schur_up_ and factors it into `slot` (its symbolic
-  /// analysis on its first use); false when S is not positive definite. Reads A_, writes schur_up_ and slot
+  /// Forms P S P^T from the current A_ into schur_lo_ and factors it into `slot` (its symbolic
+  /// analysis on its first use); false when S is not positive definite. Reads A_, writes schur_lo_ and slot
   /// only (safe on a worker thread while the caller's thread reads A_).
   bool factor_into(CholeskySlot& slot) const;
   void launch_background();  ///< spare_ <- the current A_'s Cholesky, on a worker thread
@@ -386,17 +387,17 @@ class FittedStokes {
   CholeskySlot spare_;  ///< the one a worker factors into (swapped with chol_ when installed)
   mutable Eigen::VectorXd apply_work_;  ///< the triangular solves' workspace (stepping thread only)
   /// S = A + B^T B / e on the velocity unknowns (pattern fixed: A_'s velocity block)
-  /// P S P^T by its upper triangle, the matrix the Cholesky factors (build_schur_pattern)
-  mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_up_;
+  /// P S P^T by its lower triangle, the matrix the Cholesky factors (build_schur_pattern)
+  mutable Eigen::SparseMatrix<double, Eigen::ColMajor, int> schur_lo_;
   std::vector<int> perm_;        ///< P: row k of P S P^T is row perm_[k] of S
-  std::vector<int> up_src_;      ///< per entry of P S P^T: its entry in A_
+  std::vector<int> lo_src_;      ///< per entry of P S P^T: its entry in A_
   /// The penalty B^T B / e element by element (the pressure is discontinuous: each pressure
   /// unknown couples its own element's velocities only): per element, per pair (i, j) of its
   /// pen_nv_ local velocity unknowns (2 per shape function), the entry of P S P^T it adds to
   /// (-1: eliminated, or an entry of S's upper triangle, not stored)
-  std::vector<int> up_pen_pos_;
+  std::vector<int> lo_pen_pos_;
   int pen_nv_ = 18;
-  void build_schur_pattern();   ///< P (perm_), schur_up_'s pattern, up_src_, up_pen_pos_ (constructor)
+  void build_schur_pattern();   ///< P (perm_), schur_lo_'s pattern, lo_src_, lo_pen_pos_ (constructor)
   bool background_ = false;
   std::thread worker_;          ///< joinable while a background factorisation is pending
   bool worker_ok_ = false;      ///< set by the worker: its Cholesky succeeded

@@ -6,6 +6,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
+#include <cstring>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -76,10 +77,11 @@ TEST(SupernodalSolve, AgreesWithCholmodsSolveAndInvertsTheMatrix) {
   }
 }
 
-// A caller may permute S itself (P S P^T by its upper triangle, P from CHOLMOD's own analysis)
+// A caller may permute S itself (P S P^T by its lower triangle, P from CHOLMOD's own analysis)
 // and factor it in the natural ordering, passing P to the solve, as the fitted Stokes solver
 // does. Expected: the factor has the same number of entries as CHOLMOD's own ordering gives
-// (the same ordering, applied outside), and the solve with P inverts S to 1e-12.
+// (the same ordering, applied outside), it is the factor of P S P^T given by its upper triangle
+// to the bit (which CHOLMOD transposes first), and the solve with P inverts S to 1e-12.
 TEST(SupernodalSolve, SolvesWithAnOrderingAppliedOutsideTheFactor) {
   std::mt19937 rng(7);
   const Sparse S = element_matrix(20, 10, rng);
@@ -95,17 +97,27 @@ TEST(SupernodalSolve, SolvesWithAnOrderingAppliedOutsideTheFactor) {
     for (Sparse::InnerIterator it(S, c); it; ++it)
       if (it.row() >= c) {
         const int a = pinv[it.row()], b = pinv[c];
-        t.emplace_back(std::min(a, b), std::max(a, b), it.value());
+        t.emplace_back(std::max(a, b), std::min(a, b), it.value());
       }
   Sparse PSPt(n, n);
   PSPt.setFromTriplets(t.begin(), t.end());
-  OpenFactor<Eigen::Upper> natural;
-  natural.cholmod().nmethods = 1;
-  natural.cholmod().method[0].ordering = CHOLMOD_NATURAL;
-  natural.cholmod().postorder = 0;
+  auto natural_order = [](auto& f) {
+    f.cholmod().nmethods = 1;
+    f.cholmod().method[0].ordering = CHOLMOD_NATURAL;
+    f.cholmod().postorder = 0;
+  };
+  OpenFactor<Eigen::Lower> natural;
+  natural_order(natural);
   natural.compute(PSPt);
   ASSERT_EQ(natural.info(), Eigen::Success);
   const cholmod_factor* L = natural.factor();
+  OpenFactor<Eigen::Upper> upper;
+  natural_order(upper);
+  const Sparse PSPt_upper = PSPt.transpose();
+  upper.compute(PSPt_upper);
+  ASSERT_EQ(upper.info(), Eigen::Success);
+  ASSERT_EQ(upper.factor()->xsize, L->xsize);
+  EXPECT_EQ(std::memcmp(upper.factor()->x, L->x, sizeof(double) * L->xsize), 0);
   const cholmod_factor* Lown = own.factor();
   auto entries = [](const cholmod_factor* f) {
     const int* px = static_cast<const int*>(f->px);
