@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "axi/serial_openmp.hpp"
+#include "spd_element_matrix.hpp"
 
 namespace {
 
@@ -90,38 +91,14 @@ class OpenFactor : public Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> {
   const cholmod_factor* factor() const { return this->m_cholmodFactor; }
 };
 
-// An SPD matrix of the fitted system's kind: 2 unknowns per node of biquadratic elements on an
-// ex-by-ey grid, each element's unknowns coupled by a random positive semi-definite block.
-Sparse element_matrix(int ex, int ey) {
-  std::mt19937 rng(11);
-  std::normal_distribution<double> g(0.0, 1.0);
-  const int ny = 2 * ey + 1, n = 2 * (2 * ex + 1) * ny;
-  std::vector<Eigen::Triplet<double>> t;
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 1e-3 + 0.1 * std::abs(g(rng)));
-  for (int a = 0; a < ex; ++a)
-    for (int b = 0; b < ey; ++b) {
-      std::vector<int> dof;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          for (int c = 0; c < 2; ++c) dof.push_back(2 * ((2 * a + i) * ny + 2 * b + j) + c);
-      Eigen::MatrixXd G(18, 18);
-      for (int i = 0; i < 18; ++i)
-        for (int j = 0; j < 18; ++j) G(i, j) = g(rng);
-      const Eigen::MatrixXd B = G.transpose() * G;
-      for (int i = 0; i < 18; ++i)
-        for (int j = 0; j < 18; ++j) t.emplace_back(dof[i], dof[j], B(i, j));
-    }
-  Sparse S(n, n);
-  S.setFromTriplets(t.begin(), t.end());
-  return S;
-}
 
 // CHOLMOD's supernodal factorisation reaches the product's entry point for its regions (the
 // dynamic linker binds libcholmod's GOMP_parallel to it). Expected: under the guard the
 // factorisation runs at least one region per supernode inline, and its factor is the same to
 // the bit as the one computed with CHOLMOD's own threads.
 TEST(SerialOpenMp, CholmodsFactorisationRunsInlineAndGivesTheSameFactor) {
-  const Sparse S = element_matrix(30, 15);
+  std::mt19937 rng(11);
+  const Sparse S = swim::axi::testing::spd_element_matrix(30, 15, rng);
   OpenFactor threaded;
   threaded.compute(S);
   ASSERT_EQ(threaded.info(), Eigen::Success);

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "axi/supernodal_solve.hpp"
+#include "spd_element_matrix.hpp"
 
 namespace {
 
@@ -24,32 +25,7 @@ class OpenFactor : public Eigen::CholmodSupernodalLLT<Sparse, UpLo> {
 };
 using Factor = OpenFactor<Eigen::Lower>;
 
-// An SPD matrix with the fitted Stokes system's kind of structure: two unknowns per node of an
-// nx-by-ny grid of 9-node (biquadratic) elements, every pair of unknowns of an element coupled,
-// the element blocks random positive semi-definite, plus a positive diagonal. Its factor has
-// supernodes from one column to dense separators of several dozen.
-Sparse element_matrix(int ex, int ey, std::mt19937& rng) {
-  const int nx = 2 * ex + 1, ny = 2 * ey + 1, n = 2 * nx * ny;
-  std::normal_distribution<double> g(0.0, 1.0);
-  std::vector<Eigen::Triplet<double>> t;
-  for (int i = 0; i < n; ++i) t.emplace_back(i, i, 1e-3 + 0.1 * std::abs(g(rng)));
-  for (int a = 0; a < ex; ++a)
-    for (int b = 0; b < ey; ++b) {
-      std::vector<int> dof;
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          for (int c = 0; c < 2; ++c) dof.push_back(2 * ((2 * a + i) * ny + 2 * b + j) + c);
-      Eigen::MatrixXd G(18, 18);
-      for (int i = 0; i < 18; ++i)
-        for (int j = 0; j < 18; ++j) G(i, j) = g(rng);
-      const Eigen::MatrixXd B = G.transpose() * G;
-      for (int i = 0; i < 18; ++i)
-        for (int j = 0; j < 18; ++j) t.emplace_back(dof[i], dof[j], B(i, j));
-    }
-  Sparse S(n, n);
-  S.setFromTriplets(t.begin(), t.end());
-  return S;
-}
+using swim::axi::testing::spd_element_matrix;
 
 // Expected: on three sizes (including one whose factor is a handful of supernodes), the solve
 // equals CHOLMOD's own (cholmod_solve) to 1e-12 of the solution and leaves a residual
@@ -58,7 +34,7 @@ Sparse element_matrix(int ex, int ey, std::mt19937& rng) {
 TEST(SupernodalSolve, AgreesWithCholmodsSolveAndInvertsTheMatrix) {
   std::mt19937 rng(3);
   for (const auto& [ex, ey] : {std::pair{1, 1}, std::pair{6, 4}, std::pair{24, 12}}) {
-    const Sparse S = element_matrix(ex, ey, rng);
+    const Sparse S = spd_element_matrix(ex, ey, rng);
     Factor f;
     f.compute(S);
     ASSERT_EQ(f.info(), Eigen::Success);
@@ -84,7 +60,7 @@ TEST(SupernodalSolve, AgreesWithCholmodsSolveAndInvertsTheMatrix) {
 // to the bit (which CHOLMOD transposes first), and the solve with P inverts S to 1e-12.
 TEST(SupernodalSolve, SolvesWithAnOrderingAppliedOutsideTheFactor) {
   std::mt19937 rng(7);
-  const Sparse S = element_matrix(20, 10, rng);
+  const Sparse S = spd_element_matrix(20, 10, rng);
   Factor own;
   own.compute(S);
   ASSERT_EQ(own.info(), Eigen::Success);
@@ -135,7 +111,7 @@ TEST(SupernodalSolve, SolvesWithAnOrderingAppliedOutsideTheFactor) {
 // analysis only) are refused with std::invalid_argument.
 TEST(SupernodalSolve, RefusesAWrongSizeAndASymbolicFactor) {
   std::mt19937 rng(5);
-  const Sparse S = element_matrix(3, 3, rng);
+  const Sparse S = spd_element_matrix(3, 3, rng);
   Factor f;
   f.analyzePattern(S);
   Eigen::VectorXd work, x = Eigen::VectorXd::Ones(S.rows());
