@@ -12,7 +12,9 @@
 // would run it (omp_get_num_threads() = 1, omp_get_thread_num() = 0 inside it; a loop split
 // by those covers its whole range). The entry point libgomp gives compiled regions
 // (GOMP_parallel) is defined by this library and forwards to libgomp's own everywhere else,
-// so other threads and other regions are unchanged.
+// so other threads and other regions are unchanged. Only what runs under a guard is affected,
+// and it must be correct on one thread, as any OpenMP region must be (the runtime may always
+// give a team of one); inside it omp_get_level() is 0, not 1.
 #pragma once
 
 namespace swim::axi {
