@@ -10,10 +10,9 @@
 #include <cstring>
 #include <random>
 #include <thread>
-#include <vector>
 
 #include "axi/serial_openmp.hpp"
-#include "spd_element_matrix.hpp"
+#include "cholmod_test_support.hpp"
 
 namespace {
 
@@ -86,10 +85,7 @@ TEST(SerialOpenMp, TheGuardIsPerThread) {
   EXPECT_EQ(other.level, 1);
 }
 
-class OpenFactor : public Eigen::CholmodSupernodalLLT<Sparse, Eigen::Lower> {
- public:
-  const cholmod_factor* factor() const { return this->m_cholmodFactor; }
-};
+using OpenFactor = swim::axi::testing::OpenFactor<Eigen::Lower>;
 
 
 // CHOLMOD's supernodal factorisation reaches the product's entry point for its regions (the

@@ -12,20 +12,15 @@
 #include <vector>
 
 #include "axi/supernodal_solve.hpp"
-#include "spd_element_matrix.hpp"
+#include "cholmod_test_support.hpp"
 
 namespace {
 
 using Sparse = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
 
-template <int UpLo>
-class OpenFactor : public Eigen::CholmodSupernodalLLT<Sparse, UpLo> {
- public:
-  const cholmod_factor* factor() const { return this->m_cholmodFactor; }
-};
-using Factor = OpenFactor<Eigen::Lower>;
-
+using swim::axi::testing::OpenFactor;
 using swim::axi::testing::spd_element_matrix;
+using Factor = OpenFactor<Eigen::Lower>;
 
 // Expected: on three sizes (including one whose factor is a handful of supernodes), the solve
 // equals CHOLMOD's own (cholmod_solve) to 1e-12 of the solution and leaves a residual

@@ -1,7 +1,9 @@
-// A symmetric positive definite test matrix with the fitted Stokes system's kind of structure,
-// shared by the tests of the CHOLMOD factorisations and of the product's triangular solves.
+// What the tests of the CHOLMOD factorisations and of the product's triangular solves share:
+// CHOLMOD's supernodal Cholesky with its factor open, and a symmetric positive definite test
+// matrix with the fitted Stokes system's kind of structure.
 #pragma once
 
+#include <Eigen/CholmodSupport>
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 
@@ -10,6 +12,13 @@
 #include <vector>
 
 namespace swim::axi::testing {
+
+/// CHOLMOD's supernodal LL^T (through Eigen), its factor open to the tests.
+template <int UpLo>
+class OpenFactor : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, UpLo> {
+ public:
+  const cholmod_factor* factor() const { return this->m_cholmodFactor; }
+};
 
 /// Two unknowns per node of an ex-by-ey grid of 9-node (biquadratic) elements, every pair of
 /// unknowns of an element coupled, the element blocks random positive semi-definite, plus a
