@@ -24,6 +24,11 @@ constexpr int kMaxOrder = 5;
 constexpr double kRestartStepFraction = 1e-2;
 /// Steps between refreshes of the Jacobian and of the Newton matrix (CVODE).
 constexpr int kJacobianAge = 5;
+/// Newton iterations IDA may take in one step before it calls the iteration failed (IDA's
+/// own default is 4). The convergence test is IDA's, unchanged: the extra iterations only
+/// let a step through a relay's ramp, where Newton converges slowly, finish instead of being
+/// cut to a quarter and set up again (docs/performance-1d.md, "Newton iterations per step").
+constexpr int kMaxNewtonIterations = 6;
 
 }  // namespace
 
@@ -308,6 +313,7 @@ class IdaIntegrator final : public Integrator {
     sun::check(IDASetJacFn(mem, &IdaIntegrator::jac), "IDASetJacFn");
     sun::check(IDASetNoInactiveRootWarn(mem), "IDASetNoInactiveRootWarn");
     sun::check(IDASetMaxOrd(mem, kMaxOrder), "IDASetMaxOrd");
+    sun::check(IDASetMaxNonlinIters(mem, kMaxNewtonIterations), "IDASetMaxNonlinIters");
     // Index 1: the algebraic unknowns (p; V and the traction fields without wall inertia)
     // are functions of the differential ones, so only the differential unknowns enter the
     // local error test (docs/reduced1d.md, section 5). The algebraic ones jump with the
