@@ -39,14 +39,15 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   const std::size_t n = spec.parameters.size();
   std::vector<double> start(n);
   for (std::size_t i = 0; i < n; ++i) start[i] = spec.parameters[i].start;
-  if (confirm) {  // the designs must run in 3D too: the start's 3D scene is checked before anything runs
-    scene::json resolved;
+  if (confirm) {  // the designs must run on the confirming tier too: the start's scene is checked before anything runs
     try {
       const scene::json sc = design::confirm_scene(spec.design(start), spec.confirm, threads);
-      full3d::read_scene3d(sc, resolved);
+      design::check_confirm_scene(sc, spec.confirm);
       design::check_error_estimate(sc, spec.confirm, "confirm");
     } catch (const InputError& e) {
-      throw InputError(e.key(), "", std::string("the start design on the 3D tier (add --no-confirm to skip the 3D run): ") + e.what());
+      const std::string L = design::tier_label(design::confirm_tier(spec.confirm));
+      throw InputError(e.key(), "", "the start design on the " + L + " tier (add --no-confirm to skip the " + L +
+                                        " run): " + e.what());
     }
   }
   const std::string out = out_opt.empty() ? "out/optimize-" + spec.name : out_opt;
@@ -194,13 +195,15 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
     const auto one = reduced1d::run_designs({p}, 1);
     design::ConfirmOptions o{spec.objective, spec.maximize, spec.confirm, threads, progress, out + "/confirm-runs", {}};
     std::vector<design::Candidate> optimum = {{0, best_text, "optimum", 1, best_scene, one[0].metrics, {}, {}}};
-    design::match_recovery_end(optimum[0], spec.base_dir);  // the 1D cycle ends as the 3D run's
+    design::match_recovery_end(optimum[0], spec.base_dir);  // the 1D cycle ends as the confirming run's
+    const std::string tier = design::confirm_tier(spec.confirm), T = "_" + tier, L = design::tier_label(tier);
     scene::json report = design::confirm_candidates(optimum, o);
     report["agreement_absent_because"] = "one design (the optimum) is confirmed: the agreement is its relative differences";
     output::write_json(out + "/confirm.json", report);
     {
       output::AtomicFile md(out + "/confirm.md");
-      md.stream() << design::confirm_markdown(report, "3D confirmation of the optimum of " + spec.name);
+      md.stream() << design::confirm_markdown(report, (tier == "axi" ? "Axisymmetric" : "3D") +
+                                                          std::string(" confirmation of the optimum of ") + spec.name);
       md.commit();
     }
     plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", spec.name + " (optimum)"});
@@ -208,12 +211,15 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
     summary["confirm"] = {{"status", report["status"]},
                           {"file", "confirm.json"},
                           {"figures_1d", d["figures_1d"]},
-                          {"figures_3d", d["figures_3d"]},
-                          {"relative_difference_3d_vs_1d", d["relative_difference_3d_vs_1d"]}};
-    const scene::json& rel = d["relative_difference_3d_vs_1d"][spec.objective];
-    std::printf("3D confirmation: %s; 3D %s, (3D - 1D)/|3D| = %s\n  -> %s/confirm.md\n",
-                report["status"].get<std::string>().c_str(),
-                d["figures_3d"][spec.objective].is_number() ? shown(d["figures_3d"][spec.objective].get<double>()).c_str() : "n/a",
+                          {"figures" + T, d["figures" + T]},
+                          {"relative_difference" + T + "_vs_1d", d["relative_difference" + T + "_vs_1d"]}};
+    const scene::json& rel = d["relative_difference" + T + "_vs_1d"][spec.objective];
+    const std::string t = tier == "axi" ? "axi" : "3D";
+    std::printf("%s confirmation: %s; %s %s, (%s - 1D)/|%s| = %s\n  -> %s/confirm.md\n",
+                tier == "axi" ? "Axisymmetric" : "3D",
+                report["status"].get<std::string>().c_str(), t.c_str(),
+                d["figures" + T][spec.objective].is_number() ? shown(d["figures" + T][spec.objective].get<double>()).c_str() : "n/a",
+                t.c_str(), t.c_str(),
                 rel.is_number() ? (std::to_string(static_cast<int>(std::lround(100 * rel.get<double>()))) + " %").c_str() : "n/a",
                 out.c_str());
     if (report["status"] != "ok") code = 3;
@@ -222,7 +228,9 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
   std::printf("  -> %s/optimum.json, %s/trajectory.csv, %s/optimize.png\n", out.c_str(), out.c_str(), out.c_str());
   std::fflush(stdout);
   if (code != 0)
-    std::fprintf(stderr, "swim: the 3D confirmation run failed: %s\n", summary["confirm"]["status"].get<std::string>().c_str());
+    std::fprintf(stderr, "swim: the %s confirmation run failed: %s\n",
+                 design::tier_label(design::confirm_tier(spec.confirm)).c_str(),
+                 summary["confirm"]["status"].get<std::string>().c_str());
   return code;
 }
 

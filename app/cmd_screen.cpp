@@ -88,8 +88,9 @@ std::vector<design::Confirmed> confirm_over_ranks(const std::vector<design::Cand
   std::vector<ranks::Task> tasks;
   for (const auto& c : cands) {
     const scene::json sc = design::confirm_scene(c.scene, o.section, o.threads);
-    tasks.push_back({"3D run of design " + std::to_string(c.design),
+    tasks.push_back({design::tier_label(design::confirm_tier(o.section)) + " run of design " + std::to_string(c.design),
                      {{"kind", "confirm3d"},
+                      {"tier", design::confirm_tier(o.section)},
                       {"scene", sc},
                       {"runs_dir", fs::absolute(o.runs_dir).string()},
                       {"label", design::confirm_label(c)},
@@ -113,8 +114,8 @@ std::vector<design::Confirmed> confirm_over_ranks(const std::vector<design::Cand
   return runs;
 }
 
-// --confirm K: the K/2 best and K/2 spread over the rest of the ranking, run in 3D, compared
-// with the 1D tier; writes confirm.json, confirm.md, confirm.png and returns the summary for
+// --confirm K: the K/2 best and K/2 spread over the rest of the ranking, run in 3D (or on the
+// axisymmetric tier, confirm.tier = "axi"), compared with the 1D tier; writes confirm.json, confirm.md, confirm.png and returns the summary for
 // screen.json.
 scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::DesignOutcome>& results, size_t k,
                           const scene::json& section, int threads, int progress, const std::string& out) {
@@ -131,16 +132,17 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
     const long rank = static_cast<long>(std::find(ranked.begin(), ranked.end(), i) - ranked.begin()) + 1;
     cands.push_back({i, describe(sw, i), c < chosen.size() - chosen.size() / 2 ? "best" : "spread", rank, sw.design(i),
                      results[i].metrics, "", std::nullopt});  // the recovery end matched below
-    design::match_recovery_end(cands.back(), sw.base_dir);  // the 1D cycle ends as the 3D run's
+    design::match_recovery_end(cands.back(), sw.base_dir);  // the 1D cycle ends as the confirming run's
   }
-  std::printf("confirming %zu of %zu designs in 3D (%zu best, %zu spread over the rest)%s\n", cands.size(),
-              ranked.size(), cands.size() - cands.size() / 2, cands.size() / 2,
+  const std::string L = design::tier_label(design::confirm_tier(section));
+  std::printf("confirming %zu of %zu designs %s (%zu best, %zu spread over the rest)%s\n", cands.size(),
+              ranked.size(), L == "3D" ? "in 3D" : "on the axisymmetric tier", cands.size() - cands.size() / 2, cands.size() / 2,
               cands.size() < k ? "; fewer designs completed in 1D than --confirm asks" : "");
   std::fflush(stdout);
   design::ConfirmOptions o{sw.metric, sw.maximize, section, threads, progress, out + "/confirm-runs", {}};
   std::vector<design::Confirmed> ranked_runs;
   if (ranks::distributed()) {
-    // the 3D runs over the ranks (largest first, one at a time per rank), gathered here; the
+    // the confirmation runs over the ranks (largest first, one at a time per rank), gathered here; the
     // report below is then written from them exactly as from runs made in this process
     ranked_runs = confirm_over_ranks(cands, o);
     o.run = [&](size_t i, const scene::json&, const std::string&) { return ranked_runs[i]; };
@@ -148,10 +150,11 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   scene::json report = design::confirm_candidates(cands, o, [&](size_t c, const design::Confirmed& r) {
     const auto& d = cands[c];
     const auto f3 = design::figures_3d(r.summary, sw.metric);
-    std::printf("  design %zu (%s, 1D rank %ld): 1D %s, 3D %s; %s%s\n", d.design, d.values.c_str(), d.rank_in_sweep,
-                shown(value(d.design), sw.metric).c_str(),
+    const std::string t = L == "3D" ? "3D" : "axi";
+    std::printf("  design %zu (%s, 1D rank %ld): 1D %s, %s %s; %s%s\n", d.design, d.values.c_str(), d.rank_in_sweep,
+                shown(value(d.design), sw.metric).c_str(), t.c_str(),
                 f3[sw.metric].is_number() ? shown(f3[sw.metric].get<double>(), sw.metric).c_str() : "n/a",
-                r.reused ? "finished run reused" : ("3D run " + si(r.summary.value("wall_time_s", 0.0), "s")).c_str(),
+                r.reused ? "finished run reused" : (t + " run " + si(r.summary.value("wall_time_s", 0.0), "s")).c_str(),
                 r.ok ? "" : (" -- " + r.summary.value("status", std::string())).c_str());
     std::fflush(stdout);
   });
@@ -163,7 +166,7 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   output::write_json(out + "/confirm.json", report);
   {
     output::AtomicFile md(out + "/confirm.md");
-    md.stream() << design::confirm_markdown(report, "3D confirmation of the sweep " + sw.name);
+    md.stream() << design::confirm_markdown(report, (L == "3D" ? "3D" : "Axisymmetric") + std::string(" confirmation of the sweep ") + sw.name);
     md.commit();
   }
   plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", sw.name});
@@ -173,12 +176,15 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
     if (a["kendall_tau"].is_number())
       std::snprintf(tau, sizeof tau, "%.3g [%.3g, %.3g]", a["kendall_tau"].get<double>(),
                     a["kendall_tau_ci_95"][0].get<double>(), a["kendall_tau_ci_95"][1].get<double>());
+    const std::string tier = design::confirm_tier(section);
+    const std::string tied = tier == "axi" ? std::string()
+                                           : std::to_string(a["pairs_tied_by_3d_error_bars"].get<std::size_t>()) +
+                                                 " pair(s) tied by the 3D error bars, ";
     std::printf("rank agreement over %d designs: Kendall tau %s, Spearman rho %.3g [%.3g, %.3g] (95 %%); "
-                "%zu pair(s) tied by the 3D error bars, %zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
+                "%s%zu misranked design(s)\n  -> %s/confirm.md, %s/confirm.png\n",
                 a["designs"].get<int>(), tau, a["spearman_rho"].get<double>(),
-                a["spearman_rho_ci_95"][0].get<double>(), a["spearman_rho_ci_95"][1].get<double>(),
-                a["pairs_tied_by_3d_error_bars"].get<std::size_t>(), report["misranked_designs"].size(), out.c_str(),
-                out.c_str());
+                a["spearman_rho_ci_95"][0].get<double>(), a["spearman_rho_ci_95"][1].get<double>(), tied.c_str(),
+                report["misranked_designs"].size(), out.c_str(), out.c_str());
   }
   scene::json s = {{"status", report["status"]}, {"designs", report["designs_confirmed"]}, {"file", "confirm.json"}};
   if (report["agreement"].is_object()) {
@@ -272,7 +278,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
                      "a relative tolerance of the metric's change on twice the cells, in (0, 1), e.g. 0.05");
   const sweep::Sweep sw = sweep::read_sweep(sweep_path, reduced1d::metric_names());
   check_sweep_scenes(sw);
-  // --confirm K: checked in full (K, the metric, every design's 3D scene) before any 1D run
+  // --confirm K: checked in full (K, the metric, every design's scene on the confirming tier)
+  // before any 1D run
   scene::json confirm_section;
   if (confirm > 0) {
     if (static_cast<size_t>(confirm) > sw.count())
@@ -283,14 +290,14 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
     design::check_metric_in_3d(sw.metric, "metric");
     confirm_section = design::read_confirm_section(sw.confirm, "confirm");
     for (size_t k = 0; k < sw.count(); ++k) {
-      scene::json resolved;
       try {
         const scene::json sc = design::confirm_scene(sw.design(k), confirm_section, threads);
-        full3d::read_scene3d(sc, resolved);
+        design::check_confirm_scene(sc, confirm_section);
         design::check_error_estimate(sc, confirm_section, "confirm");
       } catch (const InputError& e) {
         throw InputError(e.key(), "", std::string("in design ") + std::to_string(k) + " (" + describe(sw, k) +
-                                          ") on the 3D tier: " + e.what());
+                                          ") on the " + design::tier_label(design::confirm_tier(confirm_section)) +
+                                          " tier: " + e.what());
       }
     }
   } else if (!sw.confirm.is_null()) {
@@ -329,7 +336,7 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   for (const auto& a : sw.axes) identity["vary"].push_back({a.key, a.values});
   if (const scene::json c = design::confirm_identity(sw.confirm); !c.is_null()) identity["confirm"] = c;
   if (grid_check > 0) identity["grid_check"] = {{"cells_factor", factor}, {"tolerance_relative", grid_check}};
-  // the 3D runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
+  // the runs of --confirm live in confirm-runs/: a rerun of the same sweep reuses the finished ones
   output::RunFolder folder(out, {"screen", identity, overwrite, false, "--out", "screen.json", "confirm-runs"});
 
   Progress bar("screen " + name, static_cast<double>(designs.size()), progress);
@@ -493,7 +500,8 @@ int screen(const std::string& sweep_path, const std::string& out_opt, int jobs, 
   output::write_json(out + "/screen.json", summary);  // last: its status says the sweep finished
   std::fflush(stdout);
   if (code != 0)
-    std::fprintf(stderr, "swim: a 3D confirmation run failed: %s\n  the finished runs and the report are kept in %s\n",
+    std::fprintf(stderr, "swim: %s confirmation run failed: %s\n  the finished runs and the report are kept in %s\n",
+                 design::confirm_tier(confirm_section) == "axi" ? "an axisymmetric" : "a 3D",
                  summary["confirm"]["status"].get<std::string>().c_str(), out.c_str());
   return code;
 }

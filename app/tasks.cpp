@@ -23,7 +23,8 @@ scene::json run_task(const scene::json& t) {
     return design::confirmed_to_json(design::run_confirmed(t.at("scene"), t.at("runs_dir").get<std::string>(),
                                                            t.at("label").get<std::string>(), 0,
                                                            t.at("error_estimate").get<bool>(),
-                                                           t.at("metric").get<std::string>()));
+                                                           t.at("metric").get<std::string>(),
+                                                           t.value("tier", std::string("3d"))));
   if (kind == "validate") return validation::run_planned(t.at("job"));
   throw std::logic_error("unknown task kind " + kind);
 }

@@ -10,6 +10,8 @@
 #include "common/si_format.hpp"
 #include "common/run_folder.hpp"
 #include "common/strict_json.hpp"
+#include "axi/run_axi.hpp"
+#include "axi/scene_axi.hpp"
 #include "full3d/run3d.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/scene1d.hpp"
@@ -40,22 +42,41 @@ json read_confirm_section(const json& section, const std::string& where) {
   if (section.is_null()) return json::object();
   if (!section.is_object()) throw InputError(where, scene::show(section), "must be an object {\"grid\": {...}}");
   for (auto it = section.begin(); it != section.end(); ++it)
-    if (it.key() != "grid" && it.key() != "error_estimate")
-      throw InputError(where + "." + it.key(), scene::show(it.value()), "unknown key; allowed: grid, error_estimate");
+    if (it.key() != "grid" && it.key() != "error_estimate" && it.key() != "tier")
+      throw InputError(where + "." + it.key(), scene::show(it.value()), "unknown key; allowed: tier, grid, error_estimate");
+  if (section.contains("tier") &&
+      !(section["tier"].is_string() && (section["tier"] == "3d" || section["tier"] == "axi")))
+    throw InputError(where + ".tier", scene::show(section["tier"]),
+                     "must be \"3d\" (the default: the immersed boundary) or \"axi\" (the axisymmetric reference of a "
+                     "round wall, full3d.membrane.axisymmetric = true)");
+  const bool axi = section.contains("tier") && section["tier"] == "axi";
   if (section.contains("error_estimate") && !section["error_estimate"].is_boolean())
     throw InputError(where + ".error_estimate", scene::show(section["error_estimate"]),
                      std::string("must be true or false (default ") + (kErrorEstimateDefault ? "true" : "false") +
                          ": each finished 3D run also runs on a coarser grid for its own error bar)");
+  if (axi && section.contains("error_estimate") && section["error_estimate"].get<bool>())
+    throw InputError(where + ".error_estimate", "true",
+                     "is not available with " + where + ".tier = \"axi\": the two-grid estimate assumes the immersed "
+                     "boundary's orders; the axisymmetric tier's error is measured by a grid series (swim validate); "
+                     "leave it out or set it false");
   if (section.contains("grid")) {
     const json& g = section["grid"];
     if (!g.is_object() || g.size() != 1 || !(g.contains("cells_across") || g.contains("cell_size")))
       throw InputError(where + ".grid", scene::show(g),
-                       "must be {\"cells_across\": <even integer>} or {\"cell_size\": \"<length>\"} (full3d.grid)");
+                       std::string("must be {\"cells_across\": <even integer>} or {\"cell_size\": \"<length>\"} (") +
+                           (axi ? "axi.grid" : "full3d.grid") + ")");
   }
   return section;
 }
 
+std::string confirm_tier(const json& section) {
+  return section.is_object() && section.contains("tier") ? section["tier"].get<std::string>() : std::string("3d");
+}
+
+std::string tier_label(const std::string& tier) { return tier == "axi" ? "axisymmetric" : "3D"; }
+
 bool wants_error_estimate(const json& section) {
+  if (confirm_tier(section) == "axi") return false;
   return section.is_object() && section.contains("error_estimate") ? section["error_estimate"].get<bool>()
                                                                    : kErrorEstimateDefault;
 }
@@ -78,11 +99,24 @@ std::string estimated_figure(const std::string& metric) {
 }
 
 json confirm_scene(json sc, const json& section, int threads) {
+  if (confirm_tier(section) == "axi") {
+    if (section.contains("grid")) sc["axi"]["grid"] = section["grid"];
+    sc["axi"]["threads"] = std::clamp(threads, 1, 2);
+    return sc;
+  }
   if (section.contains("grid")) sc["full3d"]["grid"] = section["grid"];
   sc["full3d"]["threads"] = threads;
   sc["full3d"]["output"]["vtk"] = false;
   sc["full3d"]["output"]["fluid_fields"] = false;
   return sc;
+}
+
+void check_confirm_scene(const json& sc, const json& section) {
+  json resolved;
+  if (confirm_tier(section) == "axi")
+    axi::read_scene_axi(sc, resolved);
+  else
+    full3d::read_scene3d(sc, resolved);
 }
 
 namespace {
@@ -145,6 +179,29 @@ json run_or_reuse(const full3d::Params3d& p, const json& resolved, const fs::pat
   return full3d::run3d(p, resolved, dir.string(), ctl).summary;
 }
 
+// The axisymmetric run of (p, resolved) in `dir`, as run_or_reuse does for a 3D run.
+json run_or_reuse_axi(const axi::ParamsAxi& p, const json& resolved, const fs::path& dir, int progress, bool& reused) {
+  json s = finished_summary(dir);
+  reused = !s.is_null() && !running(s);
+  if (reused) return s;
+  bool resume = false;
+  if (running(s)) {
+    try {
+      axi::check_resumable_axi(p, resolved, dir.string());
+      resume = true;
+    } catch (const InputError&) {
+    }
+  }
+  if (!resume) {
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+  axi::RunControlAxi ctl;
+  ctl.progress = progress;
+  ctl.resume = resume;
+  return axi::run_axi(p, resolved, dir.string(), ctl).summary;
+}
+
 // The error estimate of the finished run c (validation/error_estimate.hpp): its coarse run in
 // c.folder/error_estimate/coarse, then the estimate of the headline figures and `figure`.
 json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, const std::string& figure, int progress) {
@@ -180,7 +237,21 @@ json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, con
 }  // namespace
 
 Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::string& label, int progress,
-                        bool error_estimate, const std::string& metric) {
+                        bool error_estimate, const std::string& metric, const std::string& tier) {
+  if (tier == "axi") {
+    json resolved;
+    const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+    json physics = resolved;
+    if (physics.contains("axi")) physics["axi"].erase("threads");  // the thread count does not change the results
+    physics["confirm_tier"] = "axi";  // never the folder of the same design's 3D run
+    const fs::path dir = fs::path(runs_dir) / (label + "-" + output::json_hash(physics).substr(0, 12));
+    Confirmed c;
+    c.folder = dir.string();
+    c.cell_size_m = p.h;
+    c.summary = run_or_reuse_axi(p, resolved, dir, progress, c.reused);
+    c.ok = c.summary.value("status", std::string()) == "ok";
+    return c;
+  }
   json resolved;
   const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
   json physics = resolved;
@@ -275,27 +346,31 @@ json relative_differences(const json& fig1d, const json& fig3d) {
   return d;
 }
 
-json agreement_json(const RankAgreement& a, const std::vector<std::string>& labels) {
+json agreement_json(const RankAgreement& a, const std::vector<std::string>& labels, const std::string& tier) {
   json mis = json::array();
   for (const auto& [i, j] : a.misranked) mis.push_back({labels[i], labels[j]});
+  const std::string L = tier_label(tier), T = "_" + tier;
   return {{"designs", a.n},
           {"kendall_tau", a.kendall_defined ? json(a.kendall_tau) : json(nullptr)},
           {"kendall_tau_ci_95", a.kendall_defined ? json({a.kendall_ci.lo, a.kendall_ci.hi}) : json(nullptr)},
           {"kendall_tau_absent_because",
            a.kendall_defined ? json(nullptr)
-                             : json("every pair is tied in 1D or in 3D (3D ties counting those within the error bars): "
-                                    "tau-b is 0/0, the 3D tier does not order these designs beyond its own error")},
+                             : json("every pair is tied in 1D or in " + L + " (" + L +
+                                    " ties counting those within the error bars): tau-b is 0/0, the " + L +
+                                    " tier does not order these designs beyond its own error")},
           {"spearman_rho", a.spearman_rho},
           {"spearman_rho_ci_95", {a.spearman_ci.lo, a.spearman_ci.hi}},
           {"method",
-           "Kendall tau-b and Spearman rho on mid-ranks; 95 % intervals by Fisher z = atanh(r) with the "
-           "variances 0.437/(n-4) (tau) and 1.06/(n-3) (rho) of Fieller, Hartley & Pearson (1957); at |r| = 1 "
-           "the interval runs from the far end of that of the nearest attainable value (one adjacent pair swapped) to 1; a pair whose 3D values lie within their error bars is tied"},
+           std::string("Kendall tau-b and Spearman rho on mid-ranks; 95 % intervals by Fisher z = atanh(r) with the "
+                       "variances 0.437/(n-4) (tau) and 1.06/(n-3) (rho) of Fieller, Hartley & Pearson (1957); at |r| = 1 "
+                       "the interval runs from the far end of that of the nearest attainable value (one adjacent pair "
+                       "swapped) to 1") +
+               (tier == "axi" ? std::string() : "; a pair whose 3D values lie within their error bars is tied")},
           {"concordant_pairs", a.concordant},
           {"discordant_pairs", a.discordant},
           {"pairs_tied_in_1d", a.tied_x},
-          {"pairs_tied_in_3d", a.tied_y},
-          {"pairs_tied_by_3d_error_bars", a.tied_by_error_bars},
+          {"pairs_tied_in" + T, a.tied_y},
+          {"pairs_tied_by" + T + "_error_bars", a.tied_by_error_bars},
           {"misranked_pairs", mis}};
 }
 
@@ -312,12 +387,14 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
   std::vector<std::string> labels, failures;
   double wall = 0;
   const bool estimate = wants_error_estimate(o.section);
+  // the confirming tier names its keys and texts: "figures_3d" or "figures_axi", "3D" or "axisymmetric"
+  const std::string tier = confirm_tier(o.section), T = "_" + tier, L = tier_label(tier);
   for (std::size_t i = 0; i < cands.size(); ++i) {
     const Candidate& c = cands[i];
     const std::string label = "design " + std::to_string(c.design);
     const json sc = confirm_scene(c.scene, o.section, o.threads);
     Confirmed r = o.run ? o.run(i, sc, confirm_label(c))
-                        : run_confirmed(sc, o.runs_dir, confirm_label(c), o.progress, estimate, o.metric);
+                        : run_confirmed(sc, o.runs_dir, confirm_label(c), o.progress, estimate, o.metric, tier);
     if (on_done) on_done(i, r);
     const json f1 = figures_1d(c.metrics, o.metric), f3 = figures_3d(r.summary, o.metric);
     const std::string status = r.summary.value("status", std::string("unknown"));
@@ -327,40 +404,40 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
     const json bar = estimate ? error_bar_3d(r.summary, o.metric) : json(nullptr);
     json bar_absent = nullptr;
     if (!estimate) {
-      bar_absent = "confirm.error_estimate is false";
+      bar_absent = tier == "axi" ? "the axisymmetric tier takes no two-grid error estimate" : "confirm.error_estimate is false";
     } else if (bar.is_null()) {
       const json& e = r.summary.contains("error_estimate") ? r.summary["error_estimate"] : json(nullptr);
       bar_absent = e.is_object() && e.contains("status") && e["status"] != "ok"
                        ? json(e["status"])
-                       : json("no error estimate: the 3D run did not finish with its per-cycle figures");
+                       : json("no error estimate: the " + L + " run did not finish with its per-cycle figures");
     }
     json d = {{"design", c.design},
               {"values", c.values},
               {"selected_as", c.selected_as},
               {"rank_in_sweep_1d", c.rank_in_sweep},
-              {"status_3d", status},
-              {"folder_3d", fs::relative(r.folder, fs::path(o.runs_dir).parent_path()).generic_string()},
-              {"reused_3d", r.reused},
-              {"wall_time_3d_s", r.summary.value("wall_time_s", 0.0)},
-              {"cell_size_3d_m", r.cell_size_m},
+              {"status" + T, status},
+              {"folder" + T, fs::relative(r.folder, fs::path(o.runs_dir).parent_path()).generic_string()},
+              {"reused" + T, r.reused},
+              {"wall_time" + T + "_s", r.summary.value("wall_time_s", 0.0)},
+              {"cell_size" + T + "_m", r.cell_size_m},
               {"figures_1d", f1},
               {"recovery_end_1d", c.recovery_end_1d.empty() ? json(nullptr) : json(c.recovery_end_1d)},
               {"figures_1d_sweep", c.metrics_sweep ? figures_1d(*c.metrics_sweep, o.metric) : json(nullptr)},
-              {"figures_3d", f3},
-              {"error_bar_3d", bar},
-              {"error_bar_3d_absent_because", bar_absent},
-              {"coarse_wall_time_3d_s", r.coarse_run ? json(r.coarse_wall_time_s) : json(nullptr)},
-              {"relative_difference_3d_vs_1d", relative_differences(f1, f3)}};
+              {"figures" + T, f3},
+              {"error_bar" + T, bar},
+              {"error_bar" + T + "_absent_because", bar_absent},
+              {"coarse_wall_time" + T + "_s", r.coarse_run ? json(r.coarse_wall_time_s) : json(nullptr)},
+              {"relative_difference" + T + "_vs_1d", relative_differences(f1, f3)}};
     if (estimate && r.summary.contains("error_estimate") && r.summary["error_estimate"].is_object()) {
       const json& e = r.summary["error_estimate"];
       const std::string k = estimated_figure(o.metric);
-      d["error_estimate_3d"] = e.contains(k) ? json{{"figure", k},
+      d["error_estimate" + T] = e.contains(k) ? json{{"figure", k},
                                                     {"coarse_cells_across", e["coarse_cells_across"]},
                                                     {"coarse_cell_size_m", e["coarse_cell_size_m"]},
                                                     {"estimate", e[k]}}
                                              : json{{"status", e.value("status", std::string("unknown"))}};
     } else {
-      d["error_estimate_3d"] = nullptr;
+      d["error_estimate" + T] = nullptr;
     }
     designs.push_back(d);
     if (!r.ok) {
@@ -368,7 +445,7 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
       continue;
     }
     if (!f3[o.metric].is_number()) {
-      failures.push_back(label + ": the 3D run reports no " + o.metric + " (no completed cycle)");
+      failures.push_back(label + ": the " + L + " run reports no " + o.metric + " (no completed cycle)");
       continue;
     }
     // ranks count the best as 1: a maximised metric is ranked on its negative
@@ -383,22 +460,25 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
                                                                        (failures.size() > 1 ? " (and " + std::to_string(failures.size() - 1) + " more)" : "")},
                  {"metric", o.metric},
                  {"goal", o.maximize ? "max" : "min"},
-                 {"grid_3d", o.section.contains("grid") ? o.section["grid"] : json("the design scene's full3d.grid")},
-                 {"threads_3d", o.threads},
-                 {"error_estimate_3d", estimate},
-                 {"designs_with_error_bar_3d", 0},
+                 {"tier", tier},
+                 {"grid" + T, o.section.contains("grid") ? o.section["grid"]
+                                                          : json(tier == "axi" ? "the design scene's axi.grid"
+                                                                               : "the design scene's full3d.grid")},
+                 {"threads" + T, tier == "axi" ? std::clamp(o.threads, 1, 2) : o.threads},
+                 {"error_estimate" + T, estimate},
+                 {"designs_with_error_bar" + T, 0},
                  {"designs_confirmed", cands.size()},
-                 {"designs_failed_3d", failures.size()},
-                 {"failures_3d", failures},
-                 {"wall_time_3d_s", wall}};
+                 {"designs_failed" + T, failures.size()},
+                 {"failures" + T, failures},
+                 {"wall_time" + T + "_s", wall}};
   if (used.size() >= 2) {
     const std::vector<double> r1 = mid_ranks(x), r3 = mid_ranks(y);
     for (std::size_t k = 0; k < used.size(); ++k) {
       designs[used[k]]["rank_1d"] = r1[k];
-      designs[used[k]]["rank_3d"] = r3[k];
+      designs[used[k]]["rank" + T] = r3[k];
     }
     const RankAgreement a = rank_agreement(x, y, yerr);
-    report["agreement"] = agreement_json(a, labels);
+    report["agreement"] = agreement_json(a, labels, tier);
     // a design is misranked when it takes part in a misranked pair
     std::vector<std::string> mis;
     for (const auto& [i, j] : a.misranked)
@@ -409,11 +489,11 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
   } else {
     report["agreement"] = nullptr;
     report["misranked_designs"] = json::array();
-    report["agreement_absent_because"] = "fewer than two designs have a finished 3D run with the metric";
+    report["agreement_absent_because"] = "fewer than two designs have a finished " + L + " run with the metric";
   }
   std::size_t with_bar = 0;
-  for (const auto& d : designs) with_bar += d["error_bar_3d"].is_number();
-  report["designs_with_error_bar_3d"] = with_bar;
+  for (const auto& d : designs) with_bar += d["error_bar" + T].is_number();
+  report["designs_with_error_bar" + T] = with_bar;
   report["designs"] = designs;
   return report;
 }
@@ -439,8 +519,9 @@ std::string num(const json& v, int digits = 3) { return v.is_number() ? signific
 
 std::string confirm_markdown(const json& r, const std::string& title) {
   const std::string m = r["metric"].get<std::string>();
+  const std::string tier = r.value("tier", std::string("3d")), T = "_" + tier, L = tier_label(tier);
   std::string s = "# " + title + "\n\n";
-  s += "Metric: `" + m + "` (" + r["goal"].get<std::string>() + "); 3D grid: `" + r["grid_3d"].dump() + "`; status: " +
+  s += "Metric: `" + m + "` (" + r["goal"].get<std::string>() + "); " + L + " grid: `" + r["grid" + T].dump() + "`; status: " +
        r["status"].get<std::string>() + ".\n\n";
   if (r["agreement"].is_object()) {
     const json& a = r["agreement"];
@@ -453,11 +534,13 @@ std::string confirm_markdown(const json& r, const std::string& title) {
     s += "Method: " + a["method"].get<std::string>() + ".\n\n";
     std::string mis;
     for (const auto& p : a["misranked_pairs"]) mis += (mis.empty() ? "" : "; ") + p[0].get<std::string>() + " / " + p[1].get<std::string>();
-    s += "Misranked pairs (1D orders them one way, 3D the other beyond the 3D error bars): " +
+    s += "Misranked pairs (1D orders them one way, " + L + " the other" +
+         (tier == "axi" ? std::string() : " beyond the 3D error bars") + "): " +
          (mis.empty() ? std::string("none") : mis) + ".\n\n";
-    s += "Pairs tied in 3D by their error bars (3D values apart by no more than the sum of their error bars): " +
-         std::to_string(a["pairs_tied_by_3d_error_bars"].get<int>()) + " of " +
-         std::to_string(a["designs"].get<int>() * (a["designs"].get<int>() - 1) / 2) + ".\n\n";
+    if (tier != "axi")
+      s += "Pairs tied in 3D by their error bars (3D values apart by no more than the sum of their error bars): " +
+           std::to_string(a["pairs_tied_by_3d_error_bars"].get<int>()) + " of " +
+           std::to_string(a["designs"].get<int>() * (a["designs"].get<int>() - 1) / 2) + ".\n\n";
   } else {
     s += "No rank agreement: " + r["agreement_absent_because"].get<std::string>() + ".\n\n";
   }
@@ -466,20 +549,27 @@ std::string confirm_markdown(const json& r, const std::string& title) {
          "the largest distance from the run's value to the interval of its extrapolations to h → 0 at the orders 0.5 "
          "to 2 (" + std::to_string(r["designs_with_error_bar_3d"].get<int>()) + " of " +
          std::to_string(r["designs"].size()) + " designs have one).\n\n";
-  s += "| design | values | selected as | rank 1D (sweep) | rank 1D / 3D (confirmed) | " + m + " 1D | 3D | 3D error bar | Δ | displacement per cycle 1D | 3D | cycle time 1D | 3D | mean velocity 1D | 3D | 3D status |\n";
-  s += "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n";
+  // the error-bar column only where the tier estimates its error (the 3D tier)
+  const bool bars = tier != "axi";
+  s += "| design | values | selected as | rank 1D (sweep) | rank 1D / " + L + " (confirmed) | " + m + " 1D | " + L + " | " +
+       (bars ? L + " error bar | " : std::string()) + "Δ | displacement per cycle 1D | " + L + " | cycle time 1D | " + L +
+       " | mean velocity 1D | " + L + " | " + L + " status |\n";
+  s += std::string("|---|---|---|---|---|---|---|") + (bars ? "---|" : "") + "---|---|---|---|---|---|---|---|\n";
   for (const auto& d : r["designs"]) {
-    const json &f1 = d["figures_1d"], &f3 = d["figures_3d"], &rel = d["relative_difference_3d_vs_1d"];
+    const json &f1 = d["figures_1d"], &f3 = d["figures" + T], &rel = d["relative_difference" + T + "_vs_1d"];
+    const json& bar = d["error_bar" + T];
     s += "| " + std::to_string(d["design"].get<int>()) + " | " + d["values"].get<std::string>() + " | " +
          d["selected_as"].get<std::string>() + " | " + std::to_string(d["rank_in_sweep_1d"].get<long>()) + " | " +
-         num(d.value("rank_1d", json(nullptr)), 6) + " / " + num(d.value("rank_3d", json(nullptr)), 6) + " | " +
-         fig(f1[m], m) + " | " + fig(f3[m], m) + " | " + (d["error_bar_3d"].is_number() ? "± " + fig(d["error_bar_3d"], m) : "–") +
-         " | " + pct(rel[m]) + " | " + fig(f1["displacement_per_cycle_m"], "displacement_per_cycle_m") +
+         num(d.value("rank_1d", json(nullptr)), 6) + " / " + num(d.value("rank" + T, json(nullptr)), 6) + " | " +
+         fig(f1[m], m) + " | " + fig(f3[m], m) + " | " +
+         (bars ? (bar.is_number() ? "± " + fig(bar, m) : std::string("–")) + " | " : std::string()) + pct(rel[m]) +
+         " | " + fig(f1["displacement_per_cycle_m"], "displacement_per_cycle_m") +
          " | " + fig(f3["displacement_per_cycle_m"], "displacement_per_cycle_m") + " | " + fig(f1["cycle_time_s"], "cycle_time_s") +
          " | " + fig(f3["cycle_time_s"], "cycle_time_s") + " | " + fig(f1["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " +
-         fig(f3["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " + d["status_3d"].get<std::string>() + " |\n";
+         fig(f3["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " + d["status" + T].get<std::string>() + " |\n";
   }
-  s += "\nΔ = (3D − 1D) / |3D|. Ranks: 1 = best by the metric; equal values share their mean rank.\n";
+  s += "\nΔ = (" + std::string(tier == "axi" ? "axi" : "3D") +
+       " − 1D) / |" + (tier == "axi" ? "axi" : "3D") + "|. Ranks: 1 = best by the metric; equal values share their mean rank.\n";
   // the recovery end of the 1D figures, and the sweep's own figures where it changed them
   std::string rules, changed;
   for (const auto& d : r["designs"]) {
@@ -491,7 +581,7 @@ std::string confirm_markdown(const json& r, const std::string& title) {
                  fig(d["figures_1d_sweep"][m], m) + ", cycle " + fig(d["figures_1d_sweep"]["cycle_time_s"], "cycle_time_s");
   }
   if (!rules.empty())
-    s += "\nThe 1D cycles end by the recovery rule of their 3D runs (" + rules +
+    s += "\nThe 1D cycles end by the recovery rule of their " + L + " runs (" + rules +
          ", model1d.recovery_end), so that both tiers' cycle times measure the same cycle." +
          (changed.empty() ? std::string() : " The sweep's own figures (its rule) were: " + changed + ".") + "\n";
   return s;

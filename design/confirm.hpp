@@ -30,13 +30,21 @@ const std::vector<std::string>& metrics_in_3d();
 /// Throws InputError naming `key` when the 3D tier does not report `metric`.
 void check_metric_in_3d(const std::string& metric, const std::string& key);
 
-/// A "confirm" section ({"grid": {"cells_across": n} | {"cell_size": "<length>"},
-/// "error_estimate": true | false}, both optional) read and checked; `where` names it in
-/// messages. No grid: the design scene's own full3d.grid, which is the 3D tier's default (32
-/// cells across the container) when the scene sets none.
+/// A "confirm" section ({"tier": "3d" | "axi", "grid": {"cells_across": n} | {"cell_size":
+/// "<length>"}, "error_estimate": true | false}, all optional) read and checked; `where` names
+/// it in messages. No grid: the design scene's own grid of the confirming tier (full3d.grid, or
+/// axi.grid), that tier's default when the scene sets none. The axisymmetric tier (a round
+/// wall's reference, docs/axi.md) takes no error estimate: error_estimate true with it is an
+/// InputError.
 json read_confirm_section(const json& section, const std::string& where);
 
-/// confirm.error_estimate of a read section: absent is true (kErrorEstimateDefault).
+/// The tier a read section confirms on: "3d" (the default) or "axi".
+std::string confirm_tier(const json& section);
+/// The tier for people: "3D" or "axisymmetric".
+std::string tier_label(const std::string& tier);
+
+/// confirm.error_estimate of a read section: absent is true (kErrorEstimateDefault) on the 3D
+/// tier; the axisymmetric tier never estimates.
 constexpr bool kErrorEstimateDefault = true;
 bool wants_error_estimate(const json& section);
 
@@ -53,8 +61,13 @@ void check_error_estimate(const json& scene3d, const json& section, const std::s
 /// mean_cycle_time_s (the same mean of the cycles), the metric itself otherwise.
 std::string estimated_figure(const std::string& metric);
 
-/// A design scene prepared for its 3D run: the section's grid, `threads`, no VTK frames.
+/// A design scene prepared for its confirmation run: the section's grid and `threads` on its
+/// tier (3D: full3d.grid, full3d.threads, no VTK frames; axi: axi.grid, axi.threads at most 2).
 json confirm_scene(json scene, const json& section, int threads);
+
+/// Reads a prepared scene (confirm_scene) with the reader of the section's tier: throws the
+/// reader's InputError (naming the key) when the scene cannot run there.
+void check_confirm_scene(const json& scene, const json& section);
 
 struct Confirmed {
   json summary;        ///< the 3D run's summary.json
@@ -77,8 +90,10 @@ Confirmed confirmed_from_json(const json& j);
 /// (reused, continued or run the same way) and `error_estimate` in its summary, with `metric`'s
 /// figure (estimated_figure) estimated too; a run whose summary has that estimate already is
 /// left as it is.
+/// tier "axi": the scene's axisymmetric run (axi/run_axi.hpp) in the same way, without an
+/// error estimate.
 Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const std::string& label, int progress,
-                        bool error_estimate = false, const std::string& metric = "");
+                        bool error_estimate = false, const std::string& metric = "", const std::string& tier = "3d");
 
 /// One tier's figures of a design: {"<metric>", "displacement_per_cycle_m", "cycle_time_s",
 /// "mean_velocity_m_per_s"}; a figure the run did not produce (no completed cycle) is null, and
@@ -94,8 +109,9 @@ json error_bar_3d(const json& summary, const std::string& figure);
 json relative_differences(const json& fig1d, const json& fig3d);
 
 /// The agreement as JSON: n, kendall_tau (+ _ci_95), spearman_rho (+ _ci_95), the method,
-/// pair counts and the misranked pairs by design label.
-json agreement_json(const RankAgreement& a, const std::vector<std::string>& labels);
+/// pair counts and the misranked pairs by design label; the keys and texts of the confirming
+/// tier name it ("pairs_tied_in_3d", or "_axi").
+json agreement_json(const RankAgreement& a, const std::vector<std::string>& labels, const std::string& tier = "3d");
 
 /// A design of a sweep (or the optimum of a search) to confirm in 3D.
 struct Candidate {

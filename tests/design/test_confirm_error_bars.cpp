@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "common/errors.hpp"
 #include "design/confirm.hpp"
 #include "validation/error_estimate.hpp"
 
@@ -157,4 +158,42 @@ TEST(ConfirmErrorBars, TheSectionTakesOnlyABooleanErrorEstimate) {
     EXPECT_NE(m.find("\"yes\""), std::string::npos) << m;
     EXPECT_NE(m.find("true or false"), std::string::npos) << m;
   }
+}
+
+// confirm.tier: "3d" (the default) or "axi", the axisymmetric reference of a round wall, which
+// takes no two-grid error estimate; its prepared scene carries the grid and at most two threads
+// in the axi section, and a scene the axisymmetric tier cannot run is refused with its key.
+TEST(ConfirmTier, TheSectionNamesTheTierAndTheAxisymmetricOneTakesNoErrorEstimate) {
+  EXPECT_EQ(confirm_tier(read_confirm_section(nullptr, "confirm")), "3d");
+  const json axi = read_confirm_section(json{{"tier", "axi"}, {"grid", {{"cells_across", 8}}}}, "confirm");
+  EXPECT_EQ(confirm_tier(axi), "axi");
+  EXPECT_EQ(tier_label("axi"), "axisymmetric");
+  EXPECT_FALSE(wants_error_estimate(axi));
+  EXPECT_FALSE(wants_error_estimate(read_confirm_section(json{{"tier", "axi"}, {"error_estimate", false}}, "confirm")));
+  auto refused = [](const json& section, const std::string& key, const std::string& what) {
+    try {
+      read_confirm_section(section, "confirm");
+      ADD_FAILURE() << section.dump() << " was accepted";
+    } catch (const swim::InputError& e) {
+      EXPECT_EQ(e.key(), key) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused(json{{"tier", "2d"}}, "confirm.tier", "\"axi\"");
+  refused(json{{"tier", "axi"}, {"error_estimate", true}}, "confirm.error_estimate", "not available");
+
+  json sc = swim::scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");
+  const json prepared = confirm_scene(sc, axi, 8);
+  EXPECT_EQ(prepared["axi"]["grid"]["cells_across"], 8);
+  EXPECT_EQ(prepared["axi"]["threads"], 2);
+  EXPECT_FALSE(prepared.contains("full3d") && prepared["full3d"].contains("threads"));
+  // the paper's wall may buckle: the axisymmetric tier refuses it, naming the key
+  try {
+    check_confirm_scene(prepared, axi);
+    FAIL() << "a wall free to buckle was accepted on the axisymmetric tier";
+  } catch (const swim::InputError& e) {
+    EXPECT_EQ(e.key(), "full3d.membrane.axisymmetric") << e.what();
+  }
+  sc["full3d"]["membrane"]["axisymmetric"] = true;
+  EXPECT_NO_THROW(check_confirm_scene(confirm_scene(sc, axi, 1), axi));
 }

@@ -279,6 +279,83 @@ TEST(ScreenConfirm, BadInputIsExitTwoNamingTheKeyAndWritesNothing) {
   fs::remove_all(d);
 }
 
+// confirm.tier = "axi": two round-wall designs (paper_amplitude_0.82 held round, L = 0.3 and
+// 0.4 um) confirmed on the axisymmetric tier at 8 cells across (a cycle in 1-2 s each). The
+// report carries the tier's own keys, each design's figures are its run's summary, and the
+// L = 0.4 um design's displacement per cycle lies within 10 % of the converged suite's reference
+// (19.47 nm, docs/validation/converged; measured 18.5 nm), where the 3D tier's default grid is
+// 46 % short. A rerun reuses both runs; a wall free to buckle is refused, naming the key.
+json round_wall_sweep() {
+  return {{"name", "round"},
+          {"base", SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json"},
+          {"vary",
+           {{"swimmer.length", {{"values", {"0.3 um", "0.4 um"}}}},
+            {"full3d.membrane.axisymmetric", {{"values", {true}}}},
+            {"full3d.recovery_end", {{"values", {"shape"}}}}}},
+          {"metric", "displacement_per_cycle_m"},
+          {"goal", "max"},
+          {"confirm", {{"tier", "axi"}, {"grid", {{"cells_across", 8}}}}}};
+}
+
+TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheConvergedAnswer) {
+  const fs::path d = tmpdir("confirm_axi");
+  write(d / "round.json", round_wall_sweep());
+  const fs::path out = d / "out";
+  const std::string cmd = "screen \"" + (d / "round.json").string() + "\" --jobs 1 --threads 2 --out \"" + out.string() + "\"";
+  Cli c = run_swim(cmd + " --confirm 2", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json r = read(out / "confirm.json");
+  EXPECT_EQ(r["status"], "ok");
+  EXPECT_EQ(r["tier"], "axi");
+  EXPECT_EQ(r["error_estimate_axi"], false);
+  EXPECT_EQ(r["threads_axi"], 2);
+  ASSERT_EQ(r["designs"].size(), 2u);
+  for (const auto& x : r["designs"]) {
+    EXPECT_FALSE(x.contains("figures_3d")) << "a 3D key in an axisymmetric confirmation";
+    EXPECT_EQ(x["status_axi"], "ok");
+    EXPECT_EQ(x["reused_axi"], false);
+    EXPECT_NEAR(x["cell_size_axi_m"].get<double>(), 62.5e-9, 1e-15);  // 8 cells across the 0.5 um cylinder
+    const json s = read(out / x["folder_axi"].get<std::string>() / "summary.json");
+    EXPECT_EQ(s["tier"], "axi");
+    EXPECT_EQ(s["displacement_per_cycle_m"], x["figures_axi"]["displacement_per_cycle_m"]);
+    EXPECT_EQ(s["cycle_time_s"], x["figures_axi"]["cycle_time_s"]);
+  }
+  const json& l04 = r["designs"][0]["values"].get<std::string>().find("0.4 um") != std::string::npos ? r["designs"][0]
+                                                                                                      : r["designs"][1];
+  EXPECT_NEAR(l04["figures_axi"]["displacement_per_cycle_m"].get<double>(), 19.47e-9, 0.1 * 19.47e-9);
+  const double tau = r["agreement"]["kendall_tau"].get<double>();
+  EXPECT_DOUBLE_EQ(std::abs(tau), 1.0);
+  EXPECT_TRUE(r["agreement"].contains("pairs_tied_in_axi"));
+  const std::string md = slurp(out / "confirm.md");
+  EXPECT_NE(md.find("Axisymmetric confirmation"), std::string::npos) << md;
+  EXPECT_EQ(md.find("3D"), std::string::npos) << md;
+  EXPECT_TRUE(fs::exists(out / "confirm.png"));
+
+  // the same command again, its report removed: both finished runs reused, the same figures
+  fs::remove(out / "screen.json");
+  fs::remove(out / "confirm.json");
+  c = run_swim(cmd + " --confirm 2", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json again = read(out / "confirm.json");
+  for (std::size_t i = 0; i < 2; ++i) {
+    EXPECT_EQ(again["designs"][i]["reused_axi"], true);
+    EXPECT_EQ(again["designs"][i]["figures_axi"], r["designs"][i]["figures_axi"]);
+  }
+  EXPECT_DOUBLE_EQ(again["wall_time_axi_s"].get<double>(), 0.0);
+
+  // the paper's wall, free to buckle, has no axisymmetric run: exit 2 naming the key, nothing written
+  json buckling = round_wall_sweep();
+  buckling["vary"].erase("full3d.membrane.axisymmetric");
+  write(d / "buckling.json", buckling);
+  const fs::path out2 = d / "out2";
+  c = run_swim("screen \"" + (d / "buckling.json").string() + "\" --jobs 1 --confirm 2 --out \"" + out2.string() + "\"", d);
+  EXPECT_EQ(c.code, 2);
+  EXPECT_NE(c.err.find("full3d.membrane.axisymmetric"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("axisymmetric tier"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out2));
+  fs::remove_all(d);
+}
+
 TEST(OptimizeCli, StaysWithinTheBoundsAndConfirmsTheOptimumIn3d) {
   const fs::path d = tmpdir("optimize");
   const json spec = {{"name", "tiny"},
