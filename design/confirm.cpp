@@ -154,41 +154,18 @@ Confirmed confirmed_from_json(const json& j) {
 std::string confirm_label(const Candidate& c) { return "design-" + std::to_string(c.design); }
 
 namespace {
-// The 3D run of (p, resolved) in `dir`: the finished one reused, an interrupted one continued
-// from a checkpoint that matches the scene, else run afresh into the cleared folder.
-json run_or_reuse(const full3d::Params3d& p, const json& resolved, const fs::path& dir, int progress, bool& reused) {
-  json s = finished_summary(dir);
-  reused = !s.is_null() && !running(s);
-  if (reused) return s;
-  bool resume = false;
-  if (running(s) && fs::exists(full3d::checkpoint_path(dir.string()))) {
-    try {
-      full3d::check_resumable(p, resolved, dir.string());
-      resume = true;
-    } catch (const InputError&) {
-    }
-  }
-  if (!resume) {
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
-  full3d::RunControl ctl;
-  ctl.progress = progress;
-  ctl.quiet_vtk = true;
-  ctl.resume = resume;
-  return full3d::run3d(p, resolved, dir.string(), ctl).summary;
-}
-
-// The axisymmetric run of (p, resolved) in `dir`, as run_or_reuse does for a 3D run.
-json run_or_reuse_axi(const axi::ParamsAxi& p, const json& resolved, const fs::path& dir, int progress, bool& reused) {
+// The run in `dir`: the finished one reused, an interrupted one continued when `resumable()`
+// (the tier's check of the checkpoint against the scene) accepts it, else run afresh into the
+// cleared folder; run(resume) runs it.
+template <class Resumable, class Run>
+json reuse_resume_or_run(const fs::path& dir, bool& reused, Resumable resumable, Run run) {
   json s = finished_summary(dir);
   reused = !s.is_null() && !running(s);
   if (reused) return s;
   bool resume = false;
   if (running(s)) {
     try {
-      axi::check_resumable_axi(p, resolved, dir.string());
-      resume = true;
+      resume = resumable();
     } catch (const InputError&) {
     }
   }
@@ -196,10 +173,41 @@ json run_or_reuse_axi(const axi::ParamsAxi& p, const json& resolved, const fs::p
     fs::remove_all(dir);
     fs::create_directories(dir);
   }
-  axi::RunControlAxi ctl;
-  ctl.progress = progress;
-  ctl.resume = resume;
-  return axi::run_axi(p, resolved, dir.string(), ctl).summary;
+  return run(resume);
+}
+
+// The 3D run of (p, resolved) in `dir` (reuse_resume_or_run).
+json run_or_reuse(const full3d::Params3d& p, const json& resolved, const fs::path& dir, int progress, bool& reused) {
+  return reuse_resume_or_run(
+      dir, reused,
+      [&] {
+        if (!fs::exists(full3d::checkpoint_path(dir.string()))) return false;
+        full3d::check_resumable(p, resolved, dir.string());
+        return true;
+      },
+      [&](bool resume) {
+        full3d::RunControl ctl;
+        ctl.progress = progress;
+        ctl.quiet_vtk = true;
+        ctl.resume = resume;
+        return full3d::run3d(p, resolved, dir.string(), ctl).summary;
+      });
+}
+
+// The axisymmetric run of (p, resolved) in `dir` (reuse_resume_or_run).
+json run_or_reuse_axi(const axi::ParamsAxi& p, const json& resolved, const fs::path& dir, int progress, bool& reused) {
+  return reuse_resume_or_run(
+      dir, reused,
+      [&] {
+        axi::check_resumable_axi(p, resolved, dir.string());
+        return true;
+      },
+      [&](bool resume) {
+        axi::RunControlAxi ctl;
+        ctl.progress = progress;
+        ctl.resume = resume;
+        return axi::run_axi(p, resolved, dir.string(), ctl).summary;
+      });
 }
 
 // The error estimate of the finished run c (validation/error_estimate.hpp): its coarse run in
