@@ -1,13 +1,19 @@
 // The 3D error bars of a confirmation: read from the error_estimate a 3D run writes into its
 // summary.json (validation/error_estimate.hpp, the structure swim run --error-estimate writes),
 // and a pair of designs whose 3D values lie within their error bars counted tied, not misranked,
-// by the confirmation report itself (design::confirm_candidates with the runs given).
+// by the confirmation report itself (design::confirm_candidates with the runs given). And the
+// confirming tier (confirm.tier): the section, and the axisymmetric runs' reuse and resumption.
 #include <gtest/gtest.h>
+#include <unistd.h>
 
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <string>
 #include <vector>
 
+#include "axi/run_axi.hpp"
+#include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
 #include "design/confirm.hpp"
 #include "validation/error_estimate.hpp"
@@ -196,4 +202,46 @@ TEST(ConfirmTier, TheSectionNamesTheTierAndTheAxisymmetricOneTakesNoErrorEstimat
   }
   sc["full3d"]["membrane"]["axisymmetric"] = true;
   EXPECT_NO_THROW(check_confirm_scene(confirm_scene(sc, axi, 1), axi));
+}
+
+// An axisymmetric confirmation run interrupted between two checkpoints (its folder holds a
+// "running" summary and checkpoint.bin) is continued by the next confirmation, not run again, and
+// gives the uninterrupted run's figures to the bit; a finished one is reused as it is.
+TEST(ConfirmTier, AnInterruptedAxisymmetricRunIsContinuedFromItsCheckpoint) {
+  json sc = swim::scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");
+  sc["full3d"]["membrane"]["axisymmetric"] = true;
+  sc["full3d"]["recovery_end"] = "shape";
+  sc["axi"]["checkpoint_interval"] = "10 ms";
+  sc["time"]["duration"] = "60 ms";
+  const json section = read_confirm_section(json{{"tier", "axi"}, {"grid", {{"cells_across", 8}}}}, "confirm");
+  const json prepared = confirm_scene(sc, section, 1);
+  const auto root = std::filesystem::temp_directory_path() / ("swim_confirm_axi_resume_" + std::to_string(::getpid()));
+  std::filesystem::remove_all(root);
+  const Confirmed whole = run_confirmed(prepared, (root / "a").string(), "design-0", 0, false, "", "axi");
+  ASSERT_TRUE(whole.ok) << whole.summary.dump();
+  EXPECT_FALSE(whole.reused);
+  // the same run in the other runs folder, stopped half way by the tier's own control
+  const std::filesystem::path dir = root / "b" / std::filesystem::path(whole.folder).filename();
+  std::filesystem::create_directories(dir);
+  json resolved;
+  const swim::axi::ParamsAxi p = swim::axi::read_scene_axi(prepared, resolved);
+  swim::axi::RunControlAxi stop;
+  stop.progress = 0;
+  stop.stop_after_steps = whole.summary["steps"].get<long>() / 2;
+  ASSERT_TRUE(swim::axi::run_axi(p, resolved, dir.string(), stop).interrupted);
+  ASSERT_TRUE(std::filesystem::exists(dir / "checkpoint.bin"));
+  // a file of the interrupted folder's: a run made afresh clears the folder, a continued one does not
+  std::ofstream(dir / "left_by_the_interrupted_run") << "x";
+  const Confirmed resumed = run_confirmed(prepared, (root / "b").string(), "design-0", 0, false, "", "axi");
+  EXPECT_EQ(resumed.folder, dir.string());
+  EXPECT_FALSE(resumed.reused);
+  EXPECT_TRUE(std::filesystem::exists(dir / "left_by_the_interrupted_run")) << "run again instead of continued";
+  ASSERT_TRUE(resumed.ok) << resumed.summary.dump();
+  EXPECT_EQ(resumed.summary["steps"], whole.summary["steps"]);
+  EXPECT_EQ(resumed.summary["displacement_m"], whole.summary["displacement_m"]);
+  EXPECT_NE(whole.summary["displacement_m"].get<double>(), 0.0);
+  const Confirmed again = run_confirmed(prepared, (root / "b").string(), "design-0", 0, false, "", "axi");
+  EXPECT_TRUE(again.reused);
+  EXPECT_EQ(again.summary["displacement_m"], whole.summary["displacement_m"]);
+  std::filesystem::remove_all(root);
 }
