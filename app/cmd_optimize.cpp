@@ -196,14 +196,13 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
     design::ConfirmOptions o{spec.objective, spec.maximize, spec.confirm, threads, progress, out + "/confirm-runs", {}};
     std::vector<design::Candidate> optimum = {{0, best_text, "optimum", 1, best_scene, one[0].metrics, {}, {}}};
     design::match_recovery_end(optimum[0], spec.base_dir);  // the 1D cycle ends as the confirming run's
-    const std::string tier = design::confirm_tier(spec.confirm), T = "_" + tier, L = design::tier_label(tier);
+    const std::string tier = design::confirm_tier(spec.confirm), T = "_" + tier;
     scene::json report = design::confirm_candidates(optimum, o);
     report["agreement_absent_because"] = "one design (the optimum) is confirmed: the agreement is its relative differences";
     output::write_json(out + "/confirm.json", report);
     {
       output::AtomicFile md(out + "/confirm.md");
-      md.stream() << design::confirm_markdown(report, (tier == "axi" ? "Axisymmetric" : "3D") +
-                                                          std::string(" confirmation of the optimum of ") + spec.name);
+      md.stream() << design::confirm_markdown(report, design::tier_title(tier) + " confirmation of the optimum of " + spec.name);
       md.commit();
     }
     plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", spec.name + " (optimum)"});
@@ -214,9 +213,9 @@ int optimize(const std::string& spec_path, const std::string& out_opt, int progr
                           {"figures" + T, d["figures" + T]},
                           {"relative_difference" + T + "_vs_1d", d["relative_difference" + T + "_vs_1d"]}};
     const scene::json& rel = d["relative_difference" + T + "_vs_1d"][spec.objective];
-    const std::string t = tier == "axi" ? "axi" : "3D";
+    const std::string t = design::tier_short(tier);
     std::printf("%s confirmation: %s; %s %s, (%s - 1D)/|%s| = %s\n  -> %s/confirm.md\n",
-                tier == "axi" ? "Axisymmetric" : "3D",
+                design::tier_title(tier).c_str(),
                 report["status"].get<std::string>().c_str(), t.c_str(),
                 d["figures" + T][spec.objective].is_number() ? shown(d["figures" + T][spec.objective].get<double>()).c_str() : "n/a",
                 t.c_str(), t.c_str(),

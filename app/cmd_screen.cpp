@@ -115,8 +115,8 @@ std::vector<design::Confirmed> confirm_over_ranks(const std::vector<design::Cand
 }
 
 // --confirm K: the K/2 best and K/2 spread over the rest of the ranking, run in 3D (or on the
-// axisymmetric tier, confirm.tier = "axi"), compared with the 1D tier; writes confirm.json, confirm.md, confirm.png and returns the summary for
-// screen.json.
+// axisymmetric tier, confirm.tier = "axi"), compared with the 1D tier; writes confirm.json,
+// confirm.md, confirm.png and returns the summary for screen.json.
 scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::DesignOutcome>& results, size_t k,
                           const scene::json& section, int threads, int progress, const std::string& out) {
   std::vector<size_t> ranked;
@@ -134,9 +134,9 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
                      results[i].metrics, "", std::nullopt});  // the recovery end matched below
     design::match_recovery_end(cands.back(), sw.base_dir);  // the 1D cycle ends as the confirming run's
   }
-  const std::string L = design::tier_label(design::confirm_tier(section));
+  const std::string tier = design::confirm_tier(section);
   std::printf("confirming %zu of %zu designs %s (%zu best, %zu spread over the rest)%s\n", cands.size(),
-              ranked.size(), L == "3D" ? "in 3D" : "on the axisymmetric tier", cands.size() - cands.size() / 2, cands.size() / 2,
+              ranked.size(), tier == "axi" ? "on the axisymmetric tier" : "in 3D", cands.size() - cands.size() / 2, cands.size() / 2,
               cands.size() < k ? "; fewer designs completed in 1D than --confirm asks" : "");
   std::fflush(stdout);
   design::ConfirmOptions o{sw.metric, sw.maximize, section, threads, progress, out + "/confirm-runs", {}};
@@ -150,7 +150,7 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   scene::json report = design::confirm_candidates(cands, o, [&](size_t c, const design::Confirmed& r) {
     const auto& d = cands[c];
     const auto f3 = design::figures_3d(r.summary, sw.metric);
-    const std::string t = L == "3D" ? "3D" : "axi";
+    const std::string t = design::tier_short(tier);
     std::printf("  design %zu (%s, 1D rank %ld): 1D %s, %s %s; %s%s\n", d.design, d.values.c_str(), d.rank_in_sweep,
                 shown(value(d.design), sw.metric).c_str(), t.c_str(),
                 f3[sw.metric].is_number() ? shown(f3[sw.metric].get<double>(), sw.metric).c_str() : "n/a",
@@ -166,7 +166,7 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   output::write_json(out + "/confirm.json", report);
   {
     output::AtomicFile md(out + "/confirm.md");
-    md.stream() << design::confirm_markdown(report, (L == "3D" ? "3D" : "Axisymmetric") + std::string(" confirmation of the sweep ") + sw.name);
+    md.stream() << design::confirm_markdown(report, design::tier_title(tier) + " confirmation of the sweep " + sw.name);
     md.commit();
   }
   plot("plot_confirm.py", {out + "/confirm.json", out + "/confirm.png", sw.name});
@@ -176,7 +176,6 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
     if (a["kendall_tau"].is_number())
       std::snprintf(tau, sizeof tau, "%.3g [%.3g, %.3g]", a["kendall_tau"].get<double>(),
                     a["kendall_tau_ci_95"][0].get<double>(), a["kendall_tau_ci_95"][1].get<double>());
-    const std::string tier = design::confirm_tier(section);
     const std::string tied = tier == "axi" ? std::string()
                                            : std::to_string(a["pairs_tied_by_3d_error_bars"].get<std::size_t>()) +
                                                  " pair(s) tied by the 3D error bars, ";

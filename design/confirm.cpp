@@ -74,6 +74,13 @@ std::string confirm_tier(const json& section) {
 }
 
 std::string tier_label(const std::string& tier) { return tier == "axi" ? "axisymmetric" : "3D"; }
+std::string tier_title(const std::string& tier) { return tier == "axi" ? "Axisymmetric" : "3D"; }
+std::string tier_short(const std::string& tier) { return tier == "axi" ? "axi" : "3D"; }
+
+namespace {
+/// The threads a confirmation run of `tier` takes when given `threads` (axi.threads: 1 or 2).
+int tier_threads(const std::string& tier, int threads) { return tier == "axi" ? std::clamp(threads, 1, 2) : threads; }
+}  // namespace
 
 bool wants_error_estimate(const json& section) {
   if (confirm_tier(section) == "axi") return false;
@@ -101,7 +108,7 @@ std::string estimated_figure(const std::string& metric) {
 json confirm_scene(json sc, const json& section, int threads) {
   if (confirm_tier(section) == "axi") {
     if (section.contains("grid")) sc["axi"]["grid"] = section["grid"];
-    sc["axi"]["threads"] = std::clamp(threads, 1, 2);
+    sc["axi"]["threads"] = tier_threads("axi", threads);
     return sc;
   }
   if (section.contains("grid")) sc["full3d"]["grid"] = section["grid"];
@@ -472,7 +479,7 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
                  {"grid" + T, o.section.contains("grid") ? o.section["grid"]
                                                           : json(tier == "axi" ? "the design scene's axi.grid"
                                                                                : "the design scene's full3d.grid")},
-                 {"threads" + T, tier == "axi" ? std::clamp(o.threads, 1, 2) : o.threads},
+                 {"threads" + T, tier_threads(tier, o.threads)},
                  {"error_estimate" + T, estimate},
                  {"designs_with_error_bar" + T, 0},
                  {"designs_confirmed", cands.size()},
@@ -576,8 +583,8 @@ std::string confirm_markdown(const json& r, const std::string& title) {
          " | " + fig(f3["cycle_time_s"], "cycle_time_s") + " | " + fig(f1["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " +
          fig(f3["mean_velocity_m_per_s"], "mean_velocity_m_per_s") + " | " + d["status" + T].get<std::string>() + " |\n";
   }
-  s += "\nΔ = (" + std::string(tier == "axi" ? "axi" : "3D") +
-       " − 1D) / |" + (tier == "axi" ? "axi" : "3D") + "|. Ranks: 1 = best by the metric; equal values share their mean rank.\n";
+  s += "\nΔ = (" + tier_short(tier) + " − 1D) / |" + tier_short(tier) +
+       "|. Ranks: 1 = best by the metric; equal values share their mean rank.\n";
   // the recovery end of the 1D figures, and the sweep's own figures where it changed them
   std::string rules, changed;
   for (const auto& d : r["designs"]) {

@@ -40,8 +40,11 @@ json read_confirm_section(const json& section, const std::string& where);
 
 /// The tier a read section confirms on: "3d" (the default) or "axi".
 std::string confirm_tier(const json& section);
-/// The tier for people: "3D" or "axisymmetric".
+/// The tier for people: "3D" or "axisymmetric"; at the start of a title, "3D" or
+/// "Axisymmetric"; beside a figure, "3D" or "axi".
 std::string tier_label(const std::string& tier);
+std::string tier_title(const std::string& tier);
+std::string tier_short(const std::string& tier);
 
 /// confirm.error_estimate of a read section: absent is true (kErrorEstimateDefault) on the 3D
 /// tier; the axisymmetric tier never estimates.
