@@ -151,6 +151,10 @@ class EventLoop {
   /// integrals qv and the protocol's phase taken at t).
   bool sample(const ForceModel& M, double t, const double* y, const VelocityQuadrature::V3& qv, int phase,
               ModelState& st);
+  /// Room for the samples a run that keeps them in memory will take, up to the end time or
+  /// 8 MB of radius snapshots: growing them by doubling copied and faulted in about twice
+  /// their size (8 % of the N = 50 demo cycle, docs/performance-1d.md).
+  void reserve_samples(double dt_out);
   /// Waits for the sample thread; false when one of its samples was not finite (a switch in
   /// progress is then taken back). Otherwise hands the switch's events to the run record and
   /// its laws to the sample thread's model.
@@ -217,7 +221,7 @@ EventLoop::EventLoop(const Params& P, std::vector<double> fixed_q, double t_fixe
       machine_(pb_->machine),
       collapse_(collapse_radius(P)),
       Rcells_(M_.N, P.geometry.R0) {
-  for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "err_test_fails",
+  for (const char* k : {"steps", "rhs_evals", "jac_evals", "lin_setups", "lin_setups_kept", "err_test_fails",
                         "nonlin_iters", "nonlin_conv_fails", "root_evals", "reinits"})
     res_.stats[k] = 0;
   res_.z.resize(M_.N);
@@ -260,6 +264,7 @@ Result EventLoop::run() {
   try {
     start();
     const double dt_out = P_.numerics.output_interval;
+    if (out_.keep_samples) reserve_samples(dt_out);
     for (long k = 1;;) {
       double tout = std::min(k * dt_out, t_stop_);
       if (t_stop_ - tout < 1e-9 * dt_out) tout = t_stop_;
@@ -289,6 +294,7 @@ Result EventLoop::run() {
   // harvest adds only the counters since the last restart, and every restart is preceded
   // by a harvest: nothing is counted twice.
   if (be_ && !taken_back_) be_->harvest(res_.stats);
+  res_.stats["lin_setups_kept"] = pb_->ic.kept;
   res_.segment_reached = machine_.reached();
   if (fixed_) res_.segment_reached.clear();
   return std::move(res_);
@@ -512,6 +518,14 @@ void EventLoop::record_here(double t) {
   if (samples_ && !sync_samples()) throw non_finite_state(t_);
   const VelocityQuadrature::V3 qv = quadrature_at(t);
   sample(M_, t, be_->y(), qv, machine_.phase(), pb_->state);
+}
+
+void EventLoop::reserve_samples(double dt_out) {
+  constexpr double kMaxSnapshotValues = double(1 << 20);  // 8 MB of radii
+  const auto n = std::size_t(std::min(t_stop_ / dt_out + 16.0, kMaxSnapshotValues / M_.N));
+  res_.series.reserve(n);
+  res_.radius_times.reserve(n);
+  res_.radius.reserve(n * std::size_t(M_.N));
 }
 
 bool EventLoop::sync_samples() {

@@ -343,6 +343,22 @@ class IdaIntegrator final : public Integrator {
     double h_last = 0;
     IDAGetCurrentStep(mem, &h_last);
     sun::check(IDAReInit(mem, t, y_.get(), yp_.get()), "IDAReInit", last_msg);
+    // IDACalcIC solves twice: once with the error weights of the state before the switch,
+    // then again with those of its solution, each solve after a matrix set-up. The second
+    // starts from the first's converged point with the same cj, where the first's matrix is
+    // as good a Newton matrix: its set-up keeps the first's factorisation (one factorisation
+    // fewer per switch; IDA still counts the set-up). A retry at a smaller step (another cj)
+    // factors; so does every set-up after the second (a first solve that converged slowly
+    // retries once on the kept matrix, then on a new one).
+    pb_.ic.active = true;
+    pb_.ic.setups = 0;
+    struct IcEnd {
+      Problem& pb;
+      ~IcEnd() {
+        pb.ic.active = false;
+        pb.low_rank.keep_factorisation = false;
+      }
+    } ic_end{pb_};
     sun::check(IDACalcIC(mem, IDA_YA_YDP_INIT, t + ic_step_), "IDACalcIC", last_msg);
     sun::check(IDAGetConsistentIC(mem, y_.get(), yp_.get()), "IDAGetConsistentIC");
     if (t > 0 && h_last > 0 && !pb_.M.inertia) sun::check(IDASetInitStep(mem, kRestartStepFraction * h_last), "IDASetInitStep");
@@ -398,6 +414,12 @@ class IdaIntegrator final : public Integrator {
   static int jac(double, double cj, N_Vector yv, N_Vector, N_Vector, SUNMatrix J, void* user, N_Vector,
                  N_Vector, N_Vector) {
     auto* pb = static_cast<Problem*>(user);
+    pb->low_rank.keep_factorisation = pb->ic.active && pb->ic.setups++ == 1 && cj == pb->ic.cj;
+    if (pb->ic.active && pb->ic.setups == 1) pb->ic.cj = cj;
+    if (pb->low_rank.keep_factorisation) {
+      ++pb->ic.kept;
+      return 0;
+    }
     const Linearisation lin = pb->M.linearise(sun::data(yv), pb->state, false);
     pb->low_rank.rank = pb->M.residual_low_rank(lin, pb->low_rank.U, pb->low_rank.V);
     // IDALS zeroes J before this call (checked: every call finds it zero)

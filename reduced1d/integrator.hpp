@@ -43,6 +43,14 @@ struct Problem {
   ProtocolMachine machine;
   RootFunctions roots;
   sun::LowRankTerm low_rank;  ///< segment and closure couplings of the Newton matrix
+  /// IDACalcIC after a restart: the Newton matrices it has set up and the cj of the first
+  /// (IdaIntegrator::restart).
+  struct {
+    bool active = false;
+    int setups = 0;
+    double cj = 0;
+    long kept = 0;  ///< set-ups that kept the factorisation, over the run
+  } ic;
   /// `step_velocity`: ForceModel's velocity quadrature where the model allows it.
   Problem(const Params& P, std::vector<double> fixed_q, bool step_velocity);
 };

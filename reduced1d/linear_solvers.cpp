@@ -598,6 +598,7 @@ struct LowRankContent {
   std::vector<int> piv;
   std::vector<double> w;   // rank workspace
   int last = 0;
+  bool factored = false;  // the last setup completed (a kept factorisation is usable)
 };
 LowRankContent* lr(SUNLinearSolver S) { return static_cast<LowRankContent*>(S->content); }
 
@@ -608,6 +609,8 @@ sunindextype lr_lastflag(SUNLinearSolver S) { return lr(S)->last; }
 
 int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   LowRankContent* c = lr(S);
+  if (c->term->keep_factorisation && c->factored) return 0;
+  c->factored = false;
   c->block_now = c->blocks && c->bt.factor(A) && c->bt.growth < kBlockGrowthLimit;
   if (!c->block_now) {
     c->lu.load(A);
@@ -619,7 +622,10 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   c->s = t.scale ? t.scale(t.scale_ctx) : 1.0;
   const int r = c->rank;
   const long n = c->n;
-  if (r == 0) return 0;
+  if (r == 0) {
+    c->factored = true;
+    return 0;
+  }
   // Orthonormalise the columns of U (modified Gram-Schmidt, twice): U V^T = Q (V R^T)^T.
   // The terms may differ in scale by many decades and be nearly parallel; without this the
   // capacitance matrix I + s V^T M^{-1} U is numerically singular even when M + s U V^T is not.
@@ -671,6 +677,7 @@ int lr_setup(SUNLinearSolver S, SUNMatrix A) {
   c->piv.assign(r, 0);
   c->w.assign(r, 0.0);
   if (!small_lu(c->S, c->piv, r)) return c->last = SUNLS_LUFACT_FAIL;
+  c->factored = true;
   return 0;
 }
 

@@ -27,6 +27,9 @@ struct LowRankTerm {
   std::vector<double> U, V;
   double (*scale)(void* ctx) = nullptr;  ///< factor of U V^T at the time of setup (1 if null)
   void* scale_ctx = nullptr;
+  /// Set by the Jacobian function: the next setup keeps the previous one's factorisation
+  /// and low-rank columns (the matrix, U and V are not read).
+  bool keep_factorisation = false;
 };
 
 /// Direct linear solver for (band M) + scale U V^T: band LU with partial pivoting (own

@@ -1,6 +1,7 @@
 #include "reduced1d/outer_flow.hpp"
 
 #include "reduced1d/discretisation.hpp"
+#include "reduced1d/v4.hpp"
 
 #include <algorithm>
 #include <Eigen/Dense>
@@ -189,12 +190,15 @@ bool ConfinedSystem::geometry(const double* Rpt, bool derivatives) {
         return false;
       }
       last_Ro_[p] = Ro;
+      lambda_[changed_.size()] = Ro * iRc;
       changed_.push_back(p);
-      lambda_[p] = -std::log(Ro * iRc);
     }
+    const int nc = int(changed_.size());
+    v4::log_n(lambda_.data(), lambda_.data(), nc);  // lambda_[m] = log(Ro / Rc) of changed_[m]
     const double Rc2 = Rc * Rc, Rc4 = Rc2 * Rc2, ic8 = 8.0 * mu / pi;
-    for (int p : changed_) {
-      const double Ro = Rpt[p] + a_out, Ro2 = Ro * Ro, lam = lambda_[p];
+    for (int m = 0; m < nc; ++m) {
+      const int p = changed_[m];
+      const double Ro = Rpt[p] + a_out, Ro2 = Ro * Ro, lam = -lambda_[m];
       const double D2 = Rc2 - Ro2;
       const double n = lam * (Rc4 - Ro2 * Ro2) - D2 * D2;
       const double inv = 1.0 / (lam * n);

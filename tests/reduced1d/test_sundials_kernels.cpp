@@ -332,3 +332,34 @@ TEST(SundialsKernels, LowRankBlockSolverWithBlocksOfAtMostEightMatchesADenseSolv
                                        " rank=" + std::to_string(rank));
       }
 }
+
+// A set-up asked to keep the factorisation (LowRankTerm::keep_factorisation, the second of
+// IDACalcIC's two solves after a switch) solves with the previous set-up's matrix and low-rank
+// term, whatever the matrix and term now hold; without the flag the next set-up factors the
+// new ones. A solver that has not factored yet factors even when asked to keep.
+TEST(SundialsKernels, ASetUpThatKeepsTheFactorisationSolvesWithThePreviousMatrix) {
+  auto ctx = sun::make_context();
+  Rng rng{43};
+  const int S = 8;
+  const long cells = 12, n = 1 + cells * S + 5;
+  auto y = sun::make_vector(n, ctx.get());
+  sun::Matrix A(SUNBandMatrix(n, S, S + 2, ctx.get()));
+  sun::LowRankTerm term;
+  auto solver = sun::make_low_rank_block_solver(y.get(), A.get(), &term, sun::CellBlocks{1, S, cells}, ctx.get());
+  term.keep_factorisation = true;  // nothing to keep yet: factors
+  Eigen::MatrixXd D1 = fill_cells(A.get(), cells, S, rng);
+  add_random_low_rank_term(term, D1, n, 3, rng);
+  ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
+  expect_solve_matches_dense(solver.get(), A.get(), D1, rng, ctx.get(), "first set-up");
+  // a different matrix and term, kept out
+  SUNMatZero(A.get());
+  Eigen::MatrixXd D2 = fill_cells(A.get(), cells, S, rng);
+  add_random_low_rank_term(term, D2, n, 2, rng);
+  ASSERT_GT((D2 - D1).cwiseAbs().maxCoeff(), 0.1);
+  term.keep_factorisation = true;
+  ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
+  expect_solve_matches_dense(solver.get(), A.get(), D1, rng, ctx.get(), "kept set-up");
+  term.keep_factorisation = false;
+  ASSERT_EQ(SUNLinSolSetup(solver.get(), A.get()), 0);
+  expect_solve_matches_dense(solver.get(), A.get(), D2, rng, ctx.get(), "next set-up");
+}
