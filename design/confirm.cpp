@@ -53,12 +53,7 @@ json read_confirm_section(const json& section, const std::string& where) {
   if (section.contains("error_estimate") && !section["error_estimate"].is_boolean())
     throw InputError(where + ".error_estimate", scene::show(section["error_estimate"]),
                      std::string("must be true or false (default ") + (kErrorEstimateDefault ? "true" : "false") +
-                         ": each finished 3D run also runs on a coarser grid for its own error bar)");
-  if (axi && section.contains("error_estimate") && section["error_estimate"].get<bool>())
-    throw InputError(where + ".error_estimate", "true",
-                     "is not available with " + where + ".tier = \"axi\": the two-grid estimate assumes the immersed "
-                     "boundary's orders; the axisymmetric tier's error is measured by a grid series (swim validate); "
-                     "leave it out or set it false");
+                         ": each finished run also runs on a coarser grid for its own error bar)");
   if (section.contains("grid")) {
     const json& g = section["grid"];
     if (!g.is_object() || g.size() != 1 || !(g.contains("cells_across") || g.contains("cell_size")))
@@ -83,7 +78,6 @@ int tier_threads(const std::string& tier, int threads) { return tier == "axi" ? 
 }  // namespace
 
 bool wants_error_estimate(const json& section) {
-  if (confirm_tier(section) == "axi") return false;
   return section.is_object() && section.contains("error_estimate") ? section["error_estimate"].get<bool>()
                                                                    : kErrorEstimateDefault;
 }
@@ -95,10 +89,30 @@ json confirm_identity(const json& section) {
   return j.empty() ? json(nullptr) : j;
 }
 
-void check_error_estimate(const json& scene3d, const json& section, const std::string& where) {
+namespace {
+/// The cells across of an axisymmetric run's grid (an even count: its cell size divides the
+/// container's radius).
+int cells_across_axi(const axi::ParamsAxi& p) { return 2 * p.nr; }
+
+/// The coarse grid's cells across of the axisymmetric run p's estimate; throws InputError naming
+/// `key` when there is none.
+int coarse_cells_axi(const axi::ParamsAxi& p, const std::string& key) {
+  const int n = cells_across_axi(p), c = validation::coarse_cells_across_axi(n);
+  if (c == 0)
+    throw InputError(key, "axi.grid.cells_across = " + std::to_string(n),
+                     "the error estimate needs a coarser grid of at least 8 cells across (the axisymmetric tier's "
+                     "least): confirm on 12 or more cells across, or set it false");
+  return c;
+}
+}  // namespace
+
+void check_error_estimate(const json& sc, const json& section, const std::string& where) {
   if (!wants_error_estimate(section)) return;
   json resolved;
-  validation::coarse_grid(scene3d, full3d::read_scene3d(scene3d, resolved), where + ".error_estimate");
+  if (confirm_tier(section) == "axi")
+    coarse_cells_axi(axi::read_scene_axi(sc, resolved), where + ".error_estimate");
+  else
+    validation::coarse_grid(sc, full3d::read_scene3d(sc, resolved), where + ".error_estimate");
 }
 
 std::string estimated_figure(const std::string& metric) {
@@ -249,6 +263,64 @@ json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, con
   if (c.coarse_reused) output::adopt_listed(dir);  // an earlier invocation's coarse run, listed by the run
   return validation::error_estimate_json(c.summary, s, g.cells, p.h, g.p.h, {figure});
 }
+
+// The same for a finished axisymmetric run: its coarse run (coarse_cells_axi) in
+// c.folder/error_estimate/coarse, the estimate at the sharp interface's orders.
+json estimate_error_axi(Confirmed& c, const json& sc, const axi::ParamsAxi& p, const std::string& figure, int progress) {
+  int cells = 0;
+  try {
+    cells = coarse_cells_axi(p, "confirm.error_estimate");
+  } catch (const InputError& e) {
+    return {{"status", std::string("failed: no coarse grid: ") + e.what()}};
+  }
+  json coarse_scene = sc;
+  coarse_scene["axi"]["grid"] = {{"cells_across", cells}};
+  const std::string dir = validation::coarse_folder(c.folder);
+  json s;
+  double h_coarse = 0;
+  try {
+    json resolved;
+    const axi::ParamsAxi pc = axi::read_scene_axi(coarse_scene, resolved);
+    h_coarse = pc.h;
+    s = run_or_reuse_axi(pc, resolved, dir, progress, c.coarse_reused);
+  } catch (const std::exception& e) {
+    s = {{"status", std::string("failed: ") + e.what()}};
+  }
+  c.coarse_run = true;
+  c.coarse_wall_time_s = s.value("wall_time_s", 0.0);
+  const std::string status = s.value("status", std::string("unknown"));
+  const std::string what = "the coarse run (" + std::to_string(cells) + " cells across)";
+  if (status != "ok") {
+    output::reset_ledger(dir);
+    return {{"status", "failed: " + what + ": " + status}};
+  }
+  if (!s["displacement_per_cycle_m"].is_number()) {
+    output::reset_ledger(dir);
+    return {{"status", "failed: " + what + ": no cycle completed (" +
+                           s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
+  }
+  if (c.coarse_reused) output::adopt_listed(dir);
+  return validation::sharp_interface_error_estimate_json(c.summary, s, cells, p.h, h_coarse, {figure});
+}
+
+// The estimate of the finished run c, by `estimate` (the run's tier's), added to its
+// summary.json; an estimate the summary holds already is kept and its coarse run counted as
+// reused.
+void add_error_estimate(Confirmed& c, const std::string& figure, const std::function<json()>& estimate) {
+  const json* have = c.summary.contains("error_estimate") ? &c.summary["error_estimate"] : nullptr;
+  const bool complete = have && (have->value("status", std::string()) != "ok" || have->contains(figure));
+  if (complete) {  // an earlier invocation's estimate: its coarse run, reused
+    const json cs = finished_summary(validation::coarse_folder(c.folder));
+    c.coarse_run = c.coarse_reused = !cs.is_null();
+    c.coarse_wall_time_s = cs.is_null() ? 0.0 : cs.value("wall_time_s", 0.0);
+    return;
+  }
+  if (!c.ok || !c.summary["displacement_per_cycle_m"].is_number()) return;
+  const json e = estimate();
+  if (!output::amend_summary(c.folder, [&](json& j) { j["error_estimate"] = e; }))
+    throw OutputError((fs::path(c.folder) / "summary.json").string(), "could not be read back to add the error estimate");
+  c.summary["error_estimate"] = e;
+}
 }  // namespace
 
 Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::string& label, int progress,
@@ -265,6 +337,8 @@ Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::
     c.cell_size_m = p.h;
     c.summary = run_or_reuse_axi(p, resolved, dir, progress, c.reused);
     c.ok = c.summary.value("status", std::string()) == "ok";
+    const std::string figure = estimated_figure(metric);
+    if (error_estimate) add_error_estimate(c, figure, [&] { return estimate_error_axi(c, sc, p, figure, progress); });
     return c;
   }
   json resolved;
@@ -280,19 +354,7 @@ Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::
   // the estimate of a finished run with its per-cycle figures (as swim run --error-estimate
   // gives one); an estimate the summary holds already is kept
   const std::string figure = estimated_figure(metric);
-  const json* have = c.summary.contains("error_estimate") ? &c.summary["error_estimate"] : nullptr;
-  const bool complete = have && (have->value("status", std::string()) != "ok" || have->contains(figure));
-  if (error_estimate && complete) {  // an earlier invocation's estimate: its coarse run, reused
-    const json cs = finished_summary(validation::coarse_folder(c.folder));
-    c.coarse_run = c.coarse_reused = !cs.is_null();
-    c.coarse_wall_time_s = cs.is_null() ? 0.0 : cs.value("wall_time_s", 0.0);
-  }
-  if (error_estimate && c.ok && c.summary["displacement_per_cycle_m"].is_number() && !complete) {
-    const json e = estimate_error(c, sc, p, figure, progress);
-    if (!output::amend_summary(c.folder, [&](json& j) { j["error_estimate"] = e; }))
-      throw OutputError((dir / "summary.json").string(), "could not be read back to add the error estimate");
-    c.summary["error_estimate"] = e;
-  }
+  if (error_estimate) add_error_estimate(c, figure, [&] { return estimate_error(c, sc, p, figure, progress); });
   return c;
 }
 
@@ -339,7 +401,7 @@ json figures_3d(const json& s, const std::string& metric) {
   return f;
 }
 
-json error_bar_3d(const json& s, const std::string& figure) {
+json error_bar_of(const json& s, const std::string& figure) {
   const std::string k = estimated_figure(figure);
   if (!s.contains("error_estimate") || !s["error_estimate"].is_object()) return nullptr;
   const json& e = s["error_estimate"];
@@ -380,7 +442,7 @@ json agreement_json(const RankAgreement& a, const std::vector<std::string>& labe
                        "variances 0.437/(n-4) (tau) and 1.06/(n-3) (rho) of Fieller, Hartley & Pearson (1957); at |r| = 1 "
                        "the interval runs from the far end of that of the nearest attainable value (one adjacent pair "
                        "swapped) to 1") +
-               (tier == "axi" ? std::string() : "; a pair whose 3D values lie within their error bars is tied")},
+               "; a pair whose " + L + " values lie within their error bars is tied"},
           {"concordant_pairs", a.concordant},
           {"discordant_pairs", a.discordant},
           {"pairs_tied_in_1d", a.tied_x},
@@ -416,10 +478,10 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
     if (!r.reused) wall += r.summary.value("wall_time_s", 0.0);
     if (r.coarse_run && !r.coarse_reused) wall += r.coarse_wall_time_s;
     // the error bar of the metric, and why there is none
-    const json bar = estimate ? error_bar_3d(r.summary, o.metric) : json(nullptr);
+    const json bar = estimate ? error_bar_of(r.summary, o.metric) : json(nullptr);
     json bar_absent = nullptr;
     if (!estimate) {
-      bar_absent = tier == "axi" ? "the axisymmetric tier takes no two-grid error estimate" : "confirm.error_estimate is false";
+      bar_absent = "confirm.error_estimate is false";
     } else if (bar.is_null()) {
       const json& e = r.summary.contains("error_estimate") ? r.summary["error_estimate"] : json(nullptr);
       bar_absent = e.is_object() && e.contains("status") && e["status"] != "ok"
@@ -535,6 +597,9 @@ std::string num(const json& v, int digits = 3) { return v.is_number() ? signific
 std::string confirm_markdown(const json& r, const std::string& title) {
   const std::string m = r["metric"].get<std::string>();
   const std::string tier = r.value("tier", std::string("3d")), T = "_" + tier, L = tier_label(tier);
+  // error bars (their column, the ties they make) on the 3D tier, and on the axisymmetric tier
+  // where its runs estimated their error
+  const bool bars = tier != "axi" || r.value("error_estimate" + T, false);
   std::string s = "# " + title + "\n\n";
   s += "Metric: `" + m + "` (" + r["goal"].get<std::string>() + "); " + L + " grid: `" + r["grid" + T].dump() + "`; status: " +
        r["status"].get<std::string>() + ".\n\n";
@@ -550,11 +615,12 @@ std::string confirm_markdown(const json& r, const std::string& title) {
     std::string mis;
     for (const auto& p : a["misranked_pairs"]) mis += (mis.empty() ? "" : "; ") + p[0].get<std::string>() + " / " + p[1].get<std::string>();
     s += "Misranked pairs (1D orders them one way, " + L + " the other" +
-         (tier == "axi" ? std::string() : " beyond the 3D error bars") + "): " +
+         (bars ? " beyond the " + L + " error bars" : std::string()) + "): " +
          (mis.empty() ? std::string("none") : mis) + ".\n\n";
-    if (tier != "axi")
-      s += "Pairs tied in 3D by their error bars (3D values apart by no more than the sum of their error bars): " +
-           std::to_string(a["pairs_tied_by_3d_error_bars"].get<int>()) + " of " +
+    if (bars)
+      s += "Pairs tied " + (tier == "axi" ? std::string("on the axisymmetric tier") : "in " + L) + " by their error bars (" + L +
+           " values apart by no more than the sum of their error bars): " +
+           std::to_string(a["pairs_tied_by" + T + "_error_bars"].get<int>()) + " of " +
            std::to_string(a["designs"].get<int>() * (a["designs"].get<int>() - 1) / 2) + ".\n\n";
   } else {
     s += "No rank agreement: " + r["agreement_absent_because"].get<std::string>() + ".\n\n";
@@ -564,8 +630,13 @@ std::string confirm_markdown(const json& r, const std::string& title) {
          "the largest distance from the run's value to the interval of its extrapolations to h → 0 at the orders 0.5 "
          "to 2 (" + std::to_string(r["designs_with_error_bar_3d"].get<int>()) + " of " +
          std::to_string(r["designs"].size()) + " designs have one).\n\n";
-  // the error-bar column only where the tier estimates its error (the 3D tier)
-  const bool bars = tier != "axi";
+  if (r.value("error_estimate_axi", false))
+    s += "Axisymmetric error bars: each finished axisymmetric run also ran on a coarser grid (about 3/4 of its cells "
+         "across); the error bar is the largest distance from the run's value to the interval of its extrapolations "
+         "to h → 0 at the orders 1 to 3.5 of the fitted method, a sharp interface of second order (" +
+         std::to_string(r["designs_with_error_bar_axi"].get<int>()) + " of " + std::to_string(r["designs"].size()) +
+         " designs have one).\n\n";
+
   s += "| design | values | selected as | rank 1D (sweep) | rank 1D / " + L + " (confirmed) | " + m + " 1D | " + L + " | " +
        (bars ? L + " error bar | " : std::string()) + "Δ | displacement per cycle 1D | " + L + " | cycle time 1D | " + L +
        " | mean velocity 1D | " + L + " | " + L + " status |\n";

@@ -1,4 +1,5 @@
-// Confirmation of 1D designs in 3D: the design's scene on the 3D grid its sweep chooses, run
+// Confirmation of 1D designs in 3D (or on the axisymmetric tier, confirm.tier = "axi"): the
+// design's scene on the grid its sweep chooses, run
 // once (a finished run in the runs folder is reused, an interrupted one continues from its
 // checkpoint), and the figures of both tiers side by side.
 //
@@ -7,9 +8,11 @@
 //   error bars (confirm.error_estimate, default true): each 3D run that finishes is followed by
 //   the coarse-grid run of `swim run --error-estimate` (validation/error_estimate.hpp) in its
 //   folder's error_estimate/coarse/, and its summary.json gets the same `error_estimate`, with
-//   the sweep's metric estimated too. The error bar of a figure f is the largest distance from f
-//   to the estimate's interval of extrapolations, max(|f - interval_low|, |f - interval_high|):
-//   how far the run's own figure may lie from its value on ever finer grids.
+//   the sweep's metric estimated too; an axisymmetric run likewise, on about 3/4 of its cells
+//   across, estimated at the sharp interface's orders (sharp_interface_error_estimate_json).
+//   The error bar of a figure f is the largest distance from f to the estimate's interval of
+//   extrapolations, max(|f - interval_low|, |f - interval_high|): how far the run's own figure
+//   may lie from its value on ever finer grids.
 #pragma once
 
 #include <functional>
@@ -33,9 +36,7 @@ void check_metric_in_3d(const std::string& metric, const std::string& key);
 /// A "confirm" section ({"tier": "3d" | "axi", "grid": {"cells_across": n} | {"cell_size":
 /// "<length>"}, "error_estimate": true | false}, all optional) read and checked; `where` names
 /// it in messages. No grid: the design scene's own grid of the confirming tier (full3d.grid, or
-/// axi.grid), that tier's default when the scene sets none. The axisymmetric tier (a round
-/// wall's reference, docs/axi.md) takes no error estimate: error_estimate true with it is an
-/// InputError.
+/// axi.grid), that tier's default when the scene sets none.
 json read_confirm_section(const json& section, const std::string& where);
 
 /// The tier a read section confirms on: "3d" (the default) or "axi".
@@ -46,19 +47,19 @@ std::string tier_label(const std::string& tier);
 std::string tier_title(const std::string& tier);
 std::string tier_short(const std::string& tier);
 
-/// confirm.error_estimate of a read section: absent is true (kErrorEstimateDefault) on the 3D
-/// tier; the axisymmetric tier never estimates.
+/// confirm.error_estimate of a read section: absent is true (kErrorEstimateDefault) on either tier.
 constexpr bool kErrorEstimateDefault = true;
 bool wants_error_estimate(const json& section);
 
 /// A confirm section as part of a folder's identity: without error_estimate, which adds coarse
-/// runs beside the 3D runs and changes none of them (so a sweep or spec confirmed with and
+/// runs beside the confirming runs and changes none of them (so a sweep or spec confirmed with and
 /// without it is the same, its finished runs reused); null when nothing else is left.
 json confirm_identity(const json& section);
 
-/// With the error estimate on: throws InputError naming `where`.error_estimate when the 3D
-/// scene (confirm_scene) has no coarse grid (validation::coarse_grid).
-void check_error_estimate(const json& scene3d, const json& section, const std::string& where);
+/// With the error estimate on: throws InputError naming `where`.error_estimate when the
+/// prepared scene (confirm_scene) has no coarse grid on its tier (3D: validation::coarse_grid;
+/// axisymmetric: validation::coarse_cells_across_axi, at least 8 cells across).
+void check_error_estimate(const json& scene, const json& section, const std::string& where);
 
 /// The summary key of the estimate that carries a sweep metric: cycle_time_s for
 /// mean_cycle_time_s (the same mean of the cycles), the metric itself otherwise.
@@ -103,10 +104,10 @@ Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const st
 /// so is every figure of a 3D run that did not finish (status other than "ok").
 json figures_1d(const reduced1d::Metrics& m, const std::string& metric);
 json figures_3d(const json& summary, const std::string& metric);
-/// The error bar of a 3D figure from the summary's `error_estimate` (estimated_figure of it):
+/// The error bar of a confirming run's figure from its summary's `error_estimate` (estimated_figure of it):
 /// max(|f - interval_low|, |f - interval_high|) with f the run's own value; null when the
 /// summary has no estimate of it.
-json error_bar_3d(const json& summary, const std::string& figure);
+json error_bar_of(const json& summary, const std::string& figure);
 
 /// {"<figure>": (3D - 1D) / |3D|} for every figure both tiers have (null otherwise).
 json relative_differences(const json& fig1d, const json& fig3d);

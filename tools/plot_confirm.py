@@ -3,7 +3,7 @@
 diagonal, and the designs' ranks in both tiers.
 
 usage: plot_confirm.py CONFIRM_JSON OUT_PNG TITLE_NAME
-Axes carry SI-prefixed units; each point is labelled with its design number, with its 3D error
+Axes carry SI-prefixed units; each point is labelled with its design number, with its error
 bar when the run estimated its own error (confirm.error_estimate). Designs whose confirming run
 failed are left out (confirm.md lists them).
 """

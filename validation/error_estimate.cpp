@@ -28,7 +28,8 @@ double extrapolate_two_grids(double fine, double coarse, double h_fine, double h
   return fine + (fine - coarse) / (std::pow(r, order) - 1.0);
 }
 
-TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive) {
+TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive,
+                                  const double (&orders)[3]) {
   if (!std::isfinite(fine) || !std::isfinite(coarse))
     throw InputError("error_estimate", std::to_string(fine) + ", " + std::to_string(coarse),
                      "the figures of both grids must be finite");
@@ -38,7 +39,8 @@ TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, dou
   TwoGridEstimate e;
   e.fine = fine;
   e.coarse = coarse;
-  for (int i = 0; i < 3; ++i) e.extrapolated[i] = extrapolate_two_grids(fine, coarse, h_fine, h_coarse, kEstimateOrders[i]);
+  std::copy(std::begin(orders), std::end(orders), e.orders);
+  for (int i = 0; i < 3; ++i) e.extrapolated[i] = extrapolate_two_grids(fine, coarse, h_fine, h_coarse, orders[i]);
   spread_of_extrapolations(e);
   auto add_note = [&](const std::string& n) { append_note(e.note, n); };
   char b[240];
@@ -49,13 +51,13 @@ TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, dou
     const double raw1 = e.extrapolated_order1;
     std::snprintf(b, sizeof b, "the lower bound %.4g (the extrapolation at order %g) is below 0; the figure is positive, "
                   "so interval_low is 0", e.interval_low,
-                  kEstimateOrders[std::min_element(e.extrapolated, e.extrapolated + 3) - e.extrapolated]);
+                  orders[std::min_element(e.extrapolated, e.extrapolated + 3) - e.extrapolated]);
     add_note(b);
     e.interval_low = 0;
     e.clipped = true;
     if (raw1 < 0) {
-      std::snprintf(b, sizeof b, "the order-1 extrapolation %.4g is below 0 too, so extrapolated_order1 is 0: the two "
-                    "grids are too coarse for this figure's estimate", raw1);
+      std::snprintf(b, sizeof b, "the order-%g extrapolation %.4g is below 0 too, so it is given as 0: the two "
+                    "grids are too coarse for this figure's estimate", orders[1], raw1);
       add_note(b);
       e.extrapolated_order1 = 0;
     }
@@ -96,7 +98,7 @@ TwoGridEstimate lumen_two_grid_estimate(double fine, double coarse, double h_fin
 TwoGridEstimate ratio_estimate(const TwoGridEstimate& a, const TwoGridEstimate& b, double fine, double coarse,
                                double h_fine, double h_coarse) {
   if (!(b.interval_low > 0)) {
-    TwoGridEstimate e = two_grid_estimate(fine, coarse, h_fine, h_coarse, false);
+    TwoGridEstimate e = two_grid_estimate(fine, coarse, h_fine, h_coarse, false, a.orders);
     append_note(e.note,
                 "the denominator's interval reaches 0, so the ratio of the two estimates is unbounded: the power series "
                 "of this figure's own two values instead");
@@ -105,6 +107,7 @@ TwoGridEstimate ratio_estimate(const TwoGridEstimate& a, const TwoGridEstimate& 
   TwoGridEstimate e;
   e.fine = fine;
   e.coarse = coarse;
+  std::copy(std::begin(a.orders), std::end(a.orders), e.orders);
   e.model = TwoGridEstimate::kRatio;
   for (int i = 0; i < 3; ++i) e.extrapolated[i] = a.extrapolated[i] / b.extrapolated[i];
   e.extrapolated_order1 = a.extrapolated_order1 / b.extrapolated_order1;
@@ -117,23 +120,38 @@ TwoGridEstimate ratio_estimate(const TwoGridEstimate& a, const TwoGridEstimate& 
   return e;
 }
 
+namespace {
+/// extrapolated_order<p>, "." written "_".
+std::string order_key(double p) {
+  char b[32];
+  std::snprintf(b, sizeof b, "extrapolated_order%g", p);
+  std::string k = b;
+  std::replace(k.begin(), k.end(), '.', '_');
+  return k;
+}
+}  // namespace
+
 scene::json to_json(const TwoGridEstimate& e) {
   scene::json j = {{"fine", e.fine},
                    {"coarse", e.coarse},
-                   {"extrapolated_order1", e.extrapolated_order1},
                    {"interval_low", e.interval_low},
                    {"interval_high", e.interval_high},
                    {"error", e.error},
-                   {"extrapolated_order0_5", e.extrapolated[0]},
-                   {"extrapolated_order2", e.extrapolated[2]},
                    {"model", e.model}};
+  j[order_key(e.orders[0])] = e.extrapolated[0];
+  j[order_key(e.orders[1])] = e.extrapolated_order1;
+  j[order_key(e.orders[2])] = e.extrapolated[2];
+  if (e.orders[1] != 1.0) j["central_order"] = e.orders[1];
   if (!e.note.empty()) j["note"] = e.note;
   return j;
 }
 
-scene::json error_estimate_json(const scene::json& fine, const scene::json& coarse, int coarse_cells_across,
-                                double h_fine, double h_coarse, const std::vector<std::string>& more_figures) {
-  std::vector<std::string> figures(std::begin(kEstimatedFigures), std::end(kEstimatedFigures));
+namespace {
+/// The figures an estimate covers (kEstimatedFigures and more_figures), or the failure that
+/// one of the summaries lacks one: {"status": "failed: ..."}.
+scene::json missing_figure(const scene::json& fine, const scene::json& coarse, std::vector<std::string>& figures,
+                           const std::vector<std::string>& more_figures) {
+  figures.assign(std::begin(kEstimatedFigures), std::end(kEstimatedFigures));
   for (const auto& k : more_figures)
     if (std::find(figures.begin(), figures.end(), k) == figures.end()) figures.push_back(k);
   for (const auto* s : {&fine, &coarse}) {
@@ -148,6 +166,14 @@ scene::json error_estimate_json(const scene::json& fine, const scene::json& coar
         return {{"status", std::string("failed: ") + which + " has no per-cycle figures (" + why + ")"}};
       }
   }
+  return nullptr;
+}
+}  // namespace
+
+scene::json error_estimate_json(const scene::json& fine, const scene::json& coarse, int coarse_cells_across,
+                                double h_fine, double h_coarse, const std::vector<std::string>& more_figures) {
+  std::vector<std::string> figures;
+  if (scene::json failed = missing_figure(fine, coarse, figures, more_figures); !failed.is_null()) return failed;
   scene::json j = {{"status", "ok"},
                    {"method", "two grids: this run and a second run on a coarser grid (error_estimate/coarse); "
                               "E_p = f + (f - F) / (r^p - 1), r = coarse_cell_size_m / fine_cell_size_m, at the "
@@ -174,6 +200,48 @@ scene::json error_estimate_json(const scene::json& fine, const scene::json& coar
     j[k] = to_json(two_grid_estimate(fine[k].get<double>(), coarse[k].get<double>(), h_fine, h_coarse, false));
   }
   return j;
+}
+
+scene::json sharp_interface_error_estimate_json(const scene::json& fine, const scene::json& coarse,
+                                                int coarse_cells_across, double h_fine, double h_coarse,
+                                                const std::vector<std::string>& more_figures) {
+  std::vector<std::string> figures;
+  if (scene::json failed = missing_figure(fine, coarse, figures, more_figures); !failed.is_null()) return failed;
+  const auto& P = kSharpInterfaceEstimateOrders;
+  scene::json j = {{"status", "ok"},
+                   {"method", "two grids: this run and a second run on a coarser grid (error_estimate/coarse); "
+                              "E_p = f + (f - F) / (r^p - 1), r = coarse_cell_size_m / fine_cell_size_m, at the "
+                              "orders p of order_range and the central order 2 (the fitted method's: a sharp "
+                              "interface of second order); extrapolated_order2 = E_2, interval = [min, max] of E_p, "
+                              "error = max |E_p - E_2|; every figure a power series in h; the mean velocity per "
+                              "cycle's the ratio of the displacement's and the cycle time's, its interval the "
+                              "extreme ratios of their intervals"},
+                   {"coarse_cells_across", coarse_cells_across},
+                   {"coarse_cell_size_m", h_coarse},
+                   {"fine_cell_size_m", h_fine},
+                   {"order_range", {P[0], P[2]}},
+                   {"central_order", P[1]}};
+  const auto value = [](const scene::json& s, const std::string& k) { return s[k].get<double>(); };
+  const TwoGridEstimate d = two_grid_estimate(value(fine, kEstimatedFigures[0]), value(coarse, kEstimatedFigures[0]),
+                                              h_fine, h_coarse, false, P);
+  const TwoGridEstimate t = two_grid_estimate(value(fine, kEstimatedFigures[1]), value(coarse, kEstimatedFigures[1]),
+                                              h_fine, h_coarse, true, P);
+  j[kEstimatedFigures[0]] = to_json(d);
+  j[kEstimatedFigures[1]] = to_json(t);
+  j[kEstimatedFigures[2]] = to_json(ratio_estimate(d, t, value(fine, kEstimatedFigures[2]),
+                                                   value(coarse, kEstimatedFigures[2]), h_fine, h_coarse));
+  for (std::size_t i = 3; i < figures.size(); ++i)
+    j[figures[i]] = to_json(two_grid_estimate(value(fine, figures[i]), value(coarse, figures[i]), h_fine, h_coarse,
+                                              false, P));
+  return j;
+}
+
+int coarse_cells_across_axi(int n) {
+  int best = 0;
+  const double target = 0.75 * n;
+  for (int c = 8; c < n; c += 2)
+    if (best == 0 || std::abs(c - target) < std::abs(best - target) - 1e-9) best = c;
+  return best;
 }
 
 CoarseGrid coarse_grid(const scene::json& sc, const full3d::Params3d& p, const std::string& key) {

@@ -38,11 +38,17 @@ namespace swim::validation {
 /// The assumed orders of the estimate: the span of the immersed boundary's observed orders on
 /// affordable grids, and 1.
 constexpr double kEstimateOrders[3] = {0.5, 1.0, 2.0};
+/// The same for the axisymmetric tier's fitted method (a sharp interface of second order): the
+/// range a three-grid Richardson accepts of it (kSharpInterfaceOrders, 1 to 3.5), and 2.
+constexpr double kSharpInterfaceEstimateOrders[3] = {1.0, 2.0, 3.5};
 
 struct TwoGridEstimate {
   double fine = 0, coarse = 0;
-  double extrapolated[3] = {0, 0, 0};  ///< E_p for p = kEstimateOrders
-  double extrapolated_order1 = 0;      ///< E_1 (a positive figure's: at least 0)
+  /// the assumed orders, lowest, central, highest (kEstimateOrders or kSharpInterfaceEstimateOrders)
+  double orders[3] = {kEstimateOrders[0], kEstimateOrders[1], kEstimateOrders[2]};
+  double extrapolated[3] = {0, 0, 0};  ///< E_p for p = orders
+  /// E at the central order (E_1 of the 3D estimate; a positive figure's: at least 0)
+  double extrapolated_order1 = 0;
   double interval_low = 0, interval_high = 0;
   double error = 0;                    ///< max |E_p - E_1|
   bool clipped = false;                ///< interval_low raised to 0 (a positive figure)
@@ -58,10 +64,11 @@ struct TwoGridEstimate {
 /// E_p = fine + (fine - coarse) / (r^p - 1), r = h_coarse / h_fine.
 double extrapolate_two_grids(double fine, double coarse, double h_fine, double h_coarse, double order);
 
-/// The estimate of one figure. positive: the figure cannot be negative (a bound or E_1 below 0
-/// is reported as 0, with a note). Throws InputError for non-finite values
-/// or h_coarse <= h_fine.
-TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive);
+/// The estimate of one figure at the assumed `orders` (lowest, central, highest). positive: the
+/// figure cannot be negative (a bound or the central E below 0 is reported as 0, with a note).
+/// Throws InputError for non-finite values or h_coarse <= h_fine.
+TwoGridEstimate two_grid_estimate(double fine, double coarse, double h_fine, double h_coarse, bool positive,
+                                  const double (&orders)[3] = kEstimateOrders);
 
 /// The estimate of a cycle time T by the smeared lumen's model: E_p of y = T^(-1/4) (fine and
 /// coarse both positive), mapped back as T = E_p(y)^-4; the interval [min, max] of those, the
@@ -79,8 +86,11 @@ TwoGridEstimate lumen_two_grid_estimate(double fine, double coarse, double h_fin
 TwoGridEstimate ratio_estimate(const TwoGridEstimate& a, const TwoGridEstimate& b, double fine, double coarse,
                                double h_fine, double h_coarse);
 
-/// summary.json's object of one figure: fine, coarse, extrapolated_order1, interval_low,
-/// interval_high, error, extrapolated_order0_5, extrapolated_order2, model (and note when clipped).
+/// summary.json's object of one figure: fine, coarse, interval_low, interval_high, error, model,
+/// extrapolated_order<p> for each assumed order p ("." written "_": extrapolated_order0_5,
+/// extrapolated_order1, extrapolated_order2 in the 3D estimate; extrapolated_order1,
+/// extrapolated_order2, extrapolated_order3_5 in the sharp interface's), the central one the
+/// possibly clipped value, central_order when it is not 1, and note when clipped.
 scene::json to_json(const TwoGridEstimate& e);
 
 /// The headline figures of a run (summary.json keys) the estimate covers.
@@ -93,6 +103,20 @@ constexpr const char* kEstimatedFigures[3] = {"displacement_per_cycle_m", "cycle
 /// summary has no per-cycle figures or lacks one of `more_figures`.
 scene::json error_estimate_json(const scene::json& fine_summary, const scene::json& coarse_summary, int coarse_cells_across,
                                 double h_fine, double h_coarse, const std::vector<std::string>& more_figures = {});
+
+/// summary.json's `error_estimate` of an axisymmetric run (the fitted method, a sharp
+/// interface) from its summary and its coarse run's: as error_estimate_json with the orders
+/// kSharpInterfaceEstimateOrders, every figure a power series in h (no smeared lumen: the wall
+/// is a boundary of the mesh), the mean velocity per cycle the ratio of the displacement's and
+/// the cycle time's estimates.
+scene::json sharp_interface_error_estimate_json(const scene::json& fine_summary, const scene::json& coarse_summary,
+                                                int coarse_cells_across, double h_fine, double h_coarse,
+                                                const std::vector<std::string>& more_figures = {});
+
+/// The coarse grid's cells across of an axisymmetric run on `cells_across` (even, at least 8):
+/// the even count nearest to 3/4 of it, at least 8 and below it (the smaller on a tie); 0 when
+/// there is none (cells_across below 10).
+int coarse_cells_across_axi(int cells_across);
 
 /// The coarse grid of a 3D run's estimate: the same scene on the grid the 3D reader accepts
 /// (the container period a multiple of the cell size) nearest to 3/4 of the run's cells

@@ -84,17 +84,17 @@ json report(const std::vector<json>& summaries, bool error_estimate) {
 TEST(ConfirmErrorBars, TheErrorBarIsTheDistanceToTheRunsOwnExtrapolationInterval) {
   const json s = estimated(10e-9, 9.9e-9);
   ASSERT_EQ(s["error_estimate"]["status"], "ok");
-  const json bar = error_bar_3d(s, "mean_velocity_m_per_s");
+  const json bar = error_bar_of(s, "mean_velocity_m_per_s");
   ASSERT_TRUE(bar.is_number());
   EXPECT_NEAR(bar.get<double>(), expected_bar(10e-9, 9.9e-9), 1e-20);
   // the sweep metric mean_cycle_time_s is the estimate's cycle_time_s (both grids 0.5 s: no error)
-  EXPECT_EQ(error_bar_3d(s, "mean_cycle_time_s"), json(0.0));
+  EXPECT_EQ(error_bar_of(s, "mean_cycle_time_s"), json(0.0));
   // no estimate, a failed estimate, a figure not estimated: no error bar
-  EXPECT_TRUE(error_bar_3d(run_summary(10e-9), "mean_velocity_m_per_s").is_null());
+  EXPECT_TRUE(error_bar_of(run_summary(10e-9), "mean_velocity_m_per_s").is_null());
   json failed = run_summary(10e-9);
   failed["error_estimate"] = {{"status", "failed: the coarse run (9 cells across): no cycle completed"}};
-  EXPECT_TRUE(error_bar_3d(failed, "mean_velocity_m_per_s").is_null());
-  EXPECT_TRUE(error_bar_3d(s, "pumped_volume_m3").is_null());
+  EXPECT_TRUE(error_bar_of(failed, "mean_velocity_m_per_s").is_null());
+  EXPECT_TRUE(error_bar_of(s, "pumped_volume_m3").is_null());
 }
 
 TEST(ConfirmErrorBars, DesignsWithinTheirThreeDErrorBarsAreTiedNotMisranked) {
@@ -166,16 +166,25 @@ TEST(ConfirmErrorBars, TheSectionTakesOnlyABooleanErrorEstimate) {
   }
 }
 
-// confirm.tier: "3d" (the default) or "axi", the axisymmetric reference of a round wall, which
-// takes no two-grid error estimate; its prepared scene carries the grid and at most two threads
-// in the axi section, and a scene the axisymmetric tier cannot run is refused with its key.
-TEST(ConfirmTier, TheSectionNamesTheTierAndTheAxisymmetricOneTakesNoErrorEstimate) {
+// confirm.tier: "3d" (the default) or "axi", the axisymmetric reference of a round wall, whose
+// runs estimate their error on a coarser grid as the 3D ones do (the default); its prepared
+// scene carries the grid and at most two threads in the axi section, a scene the axisymmetric
+// tier cannot run is refused with its key, and so is a grid with no coarser one (8 cells).
+TEST(ConfirmTier, TheSectionNamesTheTierAndTheAxisymmetricOneEstimatesItsErrorToo) {
   EXPECT_EQ(confirm_tier(read_confirm_section(nullptr, "confirm")), "3d");
   const json axi = read_confirm_section(json{{"tier", "axi"}, {"grid", {{"cells_across", 8}}}}, "confirm");
   EXPECT_EQ(confirm_tier(axi), "axi");
   EXPECT_EQ(tier_label("axi"), "axisymmetric");
-  EXPECT_FALSE(wants_error_estimate(axi));
+  EXPECT_EQ(wants_error_estimate(axi), kErrorEstimateDefault);
   EXPECT_FALSE(wants_error_estimate(read_confirm_section(json{{"tier", "axi"}, {"error_estimate", false}}, "confirm")));
+  EXPECT_TRUE(wants_error_estimate(read_confirm_section(json{{"tier", "axi"}, {"error_estimate", true}}, "confirm")));
+  // the coarse grid: the even count nearest 3/4 of the run's, at least 8 and below it
+  EXPECT_EQ(swim::validation::coarse_cells_across_axi(8), 0);
+  EXPECT_EQ(swim::validation::coarse_cells_across_axi(10), 8);
+  EXPECT_EQ(swim::validation::coarse_cells_across_axi(12), 8);
+  EXPECT_EQ(swim::validation::coarse_cells_across_axi(16), 12);
+  EXPECT_EQ(swim::validation::coarse_cells_across_axi(32), 24);
+  EXPECT_EQ(swim::validation::coarse_cells_across_axi(40), 30);
   auto refused = [](const json& section, const std::string& key, const std::string& what) {
     try {
       read_confirm_section(section, "confirm");
@@ -186,7 +195,6 @@ TEST(ConfirmTier, TheSectionNamesTheTierAndTheAxisymmetricOneTakesNoErrorEstimat
     }
   };
   refused(json{{"tier", "2d"}}, "confirm.tier", "\"axi\"");
-  refused(json{{"tier", "axi"}, {"error_estimate", true}}, "confirm.error_estimate", "not available");
 
   json sc = swim::scene::load_file(SWIM_SOURCE_DIR "/data/scenes/paper_amplitude_0.82.json");
   const json prepared = confirm_scene(sc, axi, 8);
@@ -202,6 +210,18 @@ TEST(ConfirmTier, TheSectionNamesTheTierAndTheAxisymmetricOneTakesNoErrorEstimat
   }
   sc["full3d"]["membrane"]["axisymmetric"] = true;
   EXPECT_NO_THROW(check_confirm_scene(confirm_scene(sc, axi, 1), axi));
+  // 8 cells across (the tier's least) has no coarser grid for the estimate: refused with its key
+  try {
+    check_error_estimate(confirm_scene(sc, axi, 1), axi, "confirm");
+    FAIL() << "an estimate on 8 cells across was accepted";
+  } catch (const swim::InputError& e) {
+    EXPECT_EQ(e.key(), "confirm.error_estimate") << e.what();
+    EXPECT_NE(std::string(e.what()).find("axi.grid.cells_across = 8"), std::string::npos) << e.what();
+  }
+  const json axi12 = read_confirm_section(json{{"tier", "axi"}, {"grid", {{"cells_across", 12}}}}, "confirm");
+  EXPECT_NO_THROW(check_error_estimate(confirm_scene(sc, axi12, 1), axi12, "confirm"));
+  const json off = read_confirm_section(json{{"tier", "axi"}, {"grid", {{"cells_across", 8}}}, {"error_estimate", false}}, "confirm");
+  EXPECT_NO_THROW(check_error_estimate(confirm_scene(sc, off, 1), off, "confirm"));
 }
 
 // An axisymmetric confirmation run interrupted between two checkpoints (its folder holds a

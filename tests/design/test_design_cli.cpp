@@ -291,10 +291,23 @@ json round_wall_sweep() {
           {"vary",
            {{"swimmer.length", {{"values", {"0.3 um", "0.4 um"}}}},
             {"full3d.membrane.axisymmetric", {{"values", {true}}}},
-            {"full3d.recovery_end", {{"values", {"shape"}}}}}},
+            {"full3d.recovery_end", {{"values", {"shape"}}}},
+            // the converged suite's wall (paper_amplitude_0.82_round_wall): its reference applies
+            {"full3d.membrane.bending_rigidity", {{"values", {"2.1184615504e-24 J"}}}}}},
           {"metric", "displacement_per_cycle_m"},
           {"goal", "max"},
-          {"confirm", {{"tier", "axi"}, {"grid", {{"cells_across", 8}}}}}};
+          {"confirm", {{"tier", "axi"}, {"grid", {{"cells_across", 8}}}, {"error_estimate", false}}}};
+}
+
+// The sweep s refused by `swim screen --confirm 2` in d: exit 2, each of `words` in the message,
+// nothing written.
+void expect_confirm_refused(const fs::path& d, const json& s, const std::vector<std::string>& words) {
+  write(d / "refused.json", s);
+  const fs::path out = d / "refused_out";
+  const Cli c = run_swim("screen \"" + (d / "refused.json").string() + "\" --jobs 1 --confirm 2 --out \"" + out.string() + "\"", d);
+  EXPECT_EQ(c.code, 2);
+  for (const auto& w : words) EXPECT_NE(c.err.find(w), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheConvergedAnswer) {
@@ -346,13 +359,80 @@ TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheCo
   // the paper's wall, free to buckle, has no axisymmetric run: exit 2 naming the key, nothing written
   json buckling = round_wall_sweep();
   buckling["vary"].erase("full3d.membrane.axisymmetric");
-  write(d / "buckling.json", buckling);
-  const fs::path out2 = d / "out2";
-  c = run_swim("screen \"" + (d / "buckling.json").string() + "\" --jobs 1 --confirm 2 --out \"" + out2.string() + "\"", d);
-  EXPECT_EQ(c.code, 2);
-  EXPECT_NE(c.err.find("full3d.membrane.axisymmetric"), std::string::npos) << c.err;
-  EXPECT_NE(c.err.find("axisymmetric tier"), std::string::npos) << c.err;
-  EXPECT_FALSE(fs::exists(out2));
+  expect_confirm_refused(d, buckling, {"full3d.membrane.axisymmetric", "axisymmetric tier"});
+  fs::remove_all(d);
+}
+
+// With its error estimate (the default), each axisymmetric confirmation also runs on about 3/4
+// of its cells across (12 -> 8) in its folder's error_estimate/coarse, and its summary.json
+// gets the sharp interface's two-grid estimate (orders 1 to 3.5, central 2). The error bar is
+// the largest distance from the run's value to the interval of extrapolations. The L = 0.4 um
+// design is the converged suite's paper_amplitude_0.82_round_wall (docs/validation/converged:
+// 19.4735 +- 0.0099 nm and 312.39 +- 2.06 ms): its reference lies within the run's displacement
+// per cycle and cycle time plus or minus their bars and the reference's error (measured: 19.15
+// +- 0.44 nm, 316.1 +- 9.9 ms on 12 cells). A rerun reuses both runs; a grid with no coarser
+// one (8 cells across) is exit 2 naming confirm.error_estimate before anything runs.
+TEST(ScreenConfirm, AnAxisymmetricConfirmationCarriesItsTwoGridErrorBar) {
+  const fs::path d = tmpdir("confirm_axi_bars");
+  json sweep = round_wall_sweep();
+  sweep["vary"]["swimmer.length"]["values"] = {"0.4 um", "0.6 um"};
+  sweep["confirm"] = {{"tier", "axi"}, {"grid", {{"cells_across", 12}}}};
+  write(d / "round.json", sweep);
+  const fs::path out = d / "out";
+  const std::string cmd = "screen \"" + (d / "round.json").string() + "\" --jobs 1 --threads 2 --out \"" + out.string() + "\"";
+  Cli c = run_swim(cmd + " --confirm 2", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json r = read(out / "confirm.json");
+  EXPECT_EQ(r["status"], "ok");
+  EXPECT_EQ(r["error_estimate_axi"], true);
+  EXPECT_EQ(r["designs_with_error_bar_axi"], 2);
+  for (const auto& x : r["designs"]) {
+    const fs::path run = out / x["folder_axi"].get<std::string>();
+    const json s = read(run / "summary.json"), cs = read(run / "error_estimate" / "coarse" / "summary.json");
+    EXPECT_EQ(cs["tier"], "axi");
+    ASSERT_EQ(s["error_estimate"]["status"], "ok") << s["error_estimate"].dump();
+    const json& e = s["error_estimate"];
+    EXPECT_EQ(e["coarse_cells_across"], 8);
+    EXPECT_EQ(e["central_order"], 2.0);
+    EXPECT_EQ(e["order_range"], json({1.0, 3.5}));
+    const json& f = e["displacement_per_cycle_m"];
+    EXPECT_EQ(f["fine"], s["displacement_per_cycle_m"]);
+    EXPECT_EQ(f["coarse"], cs["displacement_per_cycle_m"]);
+    for (const char* k : {"extrapolated_order1", "extrapolated_order2", "extrapolated_order3_5"})
+      EXPECT_TRUE(f[k].is_number()) << k;
+    const double v = f["fine"].get<double>();
+    ASSERT_TRUE(x["error_bar_axi"].is_number());
+    EXPECT_DOUBLE_EQ(x["error_bar_axi"].get<double>(),
+                     std::max(std::abs(v - f["interval_low"].get<double>()), std::abs(v - f["interval_high"].get<double>())));
+    EXPECT_GT(x["error_bar_axi"].get<double>(), 0.0);
+  }
+  const json& l04 = r["designs"][0]["values"].get<std::string>().find("0.4 um") != std::string::npos ? r["designs"][0]
+                                                                                                      : r["designs"][1];
+  const double v04 = l04["figures_axi"]["displacement_per_cycle_m"].get<double>(), bar04 = l04["error_bar_axi"].get<double>();
+  std::printf("L = 0.4 um on 12 cells: %.4g nm +- %.3g nm (converged 19.4735 nm)\n", v04 * 1e9, bar04 * 1e9);
+  EXPECT_LE(std::abs(v04 - 19.4735e-9), bar04 + 0.0099e-9);
+  const json t04 = read(out / l04["folder_axi"].get<std::string>() / "summary.json")["error_estimate"]["cycle_time_s"];
+  const double T04 = t04["fine"].get<double>(),
+               barT = std::max(std::abs(T04 - t04["interval_low"].get<double>()), std::abs(T04 - t04["interval_high"].get<double>()));
+  std::printf("L = 0.4 um on 12 cells: cycle %.4g ms +- %.3g ms (converged 312.39 ms)\n", T04 * 1e3, barT * 1e3);
+  EXPECT_LE(std::abs(T04 - 0.31239), barT + 0.00206);
+  const std::string md = slurp(out / "confirm.md");
+  EXPECT_NE(md.find("Axisymmetric error bars"), std::string::npos) << md;
+  EXPECT_NE(md.find("axisymmetric error bar |"), std::string::npos) << md;
+  EXPECT_EQ(md.find("3D"), std::string::npos) << md;
+
+  // again: both runs and both coarse runs reused
+  fs::remove(out / "screen.json");
+  fs::remove(out / "confirm.json");
+  c = run_swim(cmd + " --confirm 2", d);
+  ASSERT_EQ(c.code, 0) << c.err;
+  const json again = read(out / "confirm.json");
+  EXPECT_DOUBLE_EQ(again["wall_time_axi_s"].get<double>(), 0.0);
+  for (std::size_t i = 0; i < 2; ++i) EXPECT_EQ(again["designs"][i]["error_bar_axi"], r["designs"][i]["error_bar_axi"]);
+
+  // 8 cells across has no coarser axisymmetric grid: exit 2 naming the key, nothing written
+  sweep["confirm"]["grid"]["cells_across"] = 8;
+  expect_confirm_refused(d, sweep, {"confirm.error_estimate", "axi.grid.cells_across = 8"});
   fs::remove_all(d);
 }
 

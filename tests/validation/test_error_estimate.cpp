@@ -258,3 +258,55 @@ TEST(ErrorEstimate, TheMeanVelocityIsTheRatioOfTheDisplacementsAndTheCycleTimesE
   EXPECT_EQ(f.model, TwoGridEstimate::kPowerSeries);
   EXPECT_NE(f.note.find("unbounded"), std::string::npos) << f.note;
 }
+
+// The axisymmetric tier's estimate (sharp_interface_error_estimate_json): orders 1 to 3.5,
+// central 2, every figure a power series in h. f(h) = f0 + C h^p exactly with p in [1, 3.5]:
+// f0 lies in the interval of E_1, E_2, E_3.5 and within the run's value plus or minus its bar
+// (the largest distance from the value to the interval), and at p = 2 the central value is f0.
+// The keys name the orders (extrapolated_order1, _order2, _order3_5; central_order 2), the 3D
+// estimate's keys stay as they were (no central_order), and a missing figure is a failure.
+TEST(ErrorEstimate, TheSharpInterfaceEstimateHoldsPowerLawsOfOrderOneToThreeAndAHalf) {
+  const double h = 31.25e-9, H = 41.67e-9;
+  for (double p : {1.0, 1.5, 2.0, 2.8, 3.5})
+    for (double C : {-0.9, 0.3}) {
+      const double d0 = 19.47e-9, T0 = 0.3124;
+      const double d = d0 * (1.0 + C * std::pow(h / 50e-9, p)), D = d0 * (1.0 + C * std::pow(H / 50e-9, p));
+      const double t = T0 * (1.0 - C * std::pow(h / 50e-9, p)), T = T0 * (1.0 - C * std::pow(H / 50e-9, p));
+      const scene::json fine = {{"displacement_per_cycle_m", d}, {"cycle_time_s", t}, {"mean_velocity_per_cycle_m_per_s", d / t}};
+      const scene::json coarse = {{"displacement_per_cycle_m", D}, {"cycle_time_s", T}, {"mean_velocity_per_cycle_m_per_s", D / T}};
+      const scene::json j = sharp_interface_error_estimate_json(fine, coarse, 12, h, H);
+      ASSERT_EQ(j["status"], "ok");
+      EXPECT_EQ(j["order_range"], scene::json({1.0, 3.5}));
+      EXPECT_EQ(j["central_order"], 2.0);
+      for (auto [k, f0] : {std::pair{"displacement_per_cycle_m", d0}, std::pair{"cycle_time_s", T0},
+                           std::pair{"mean_velocity_per_cycle_m_per_s", d0 / T0}}) {
+        const auto& f = j[k];
+        const double v = f["fine"].get<double>(), lo = f["interval_low"].get<double>(), hi = f["interval_high"].get<double>();
+        const double bar = std::max(std::abs(v - lo), std::abs(v - hi));
+        EXPECT_LE(lo, f0 * (1 + 1e-12)) << k << " p = " << p << " C = " << C;
+        EXPECT_GE(hi, f0 * (1 - 1e-12)) << k << " p = " << p << " C = " << C;
+        EXPECT_LE(std::abs(v - f0), bar * (1 + 1e-12)) << k << " p = " << p << " C = " << C;
+        for (const char* e : {"extrapolated_order1", "extrapolated_order2", "extrapolated_order3_5"})
+          EXPECT_TRUE(f[e].is_number()) << k << " " << e;
+        EXPECT_FALSE(f.contains("extrapolated_order0_5")) << k;
+        EXPECT_EQ(f["central_order"], 2.0) << k;
+        EXPECT_EQ(f["model"], std::string(k) == "mean_velocity_per_cycle_m_per_s" ? TwoGridEstimate::kRatio
+                                                                                   : TwoGridEstimate::kPowerSeries);
+      }
+      if (p == 2.0) {
+        EXPECT_NEAR(j["displacement_per_cycle_m"]["extrapolated_order2"].get<double>(), d0, 1e-12 * d0);
+        EXPECT_NEAR(j["cycle_time_s"]["extrapolated_order2"].get<double>(), T0, 1e-12 * T0);
+      }
+    }
+  // the 3D estimate's keys are unchanged
+  const scene::json j3 = to_json(two_grid_estimate(26.39e-9, 23.68e-9, 7.8125e-9, 10.4167e-9, false));
+  for (const char* k : {"extrapolated_order0_5", "extrapolated_order1", "extrapolated_order2"}) EXPECT_TRUE(j3.contains(k)) << k;
+  EXPECT_FALSE(j3.contains("central_order"));
+  // a figure missing from the coarse run
+  const scene::json fine = {{"displacement_per_cycle_m", 1e-8}, {"cycle_time_s", 0.3}, {"mean_velocity_per_cycle_m_per_s", 3e-8}};
+  scene::json none = fine;
+  none["cycle_time_s"] = nullptr;
+  none["per_cycle_absent_because"] = "no protocol cycle completed";
+  EXPECT_EQ(sharp_interface_error_estimate_json(fine, none, 8, h, H)["status"],
+            "failed: the coarse run has no per-cycle figures (no protocol cycle completed)");
+}
