@@ -34,12 +34,27 @@ bool multiple_of(double a, double h) {
 
 namespace {
 
+/// The least tube radius and length the tiers model [m]: they solve continuum Stokes flow in
+/// the lumen and around the wall, which needs several molecular diameters (water's is about
+/// 0.3 nm). Below it a typed unit (1e-15 m for 1e-6 m) would run for hours or write the output
+/// limit's gigabyte before failing.
+constexpr double kLeastContinuumLength = 1e-9;
+
+double continuum_length(Reader& s, const char* key, const char* fallback) {
+  const double v = s.quantity(key, "m", fallback, Range::positive());
+  if (v < kLeastContinuumLength)
+    throw InputError(s.path(key), format_quantity(v, "m"),
+                     "at least 1 nm: the tiers solve continuum Stokes flow in the lumen and around the wall, which "
+                     "needs a tube several molecular diameters across (water's is about 0.3 nm)");
+  return v;
+}
+
 Body read_body(Reader& top) {
   Body b;
   {
     Reader s = top.child("swimmer");
-    b.R0 = s.quantity("radius", "m", "0.125 um", Range::positive());
-    b.L = s.quantity("length", "m", "0.4 um", Range::positive());
+    b.R0 = continuum_length(s, "radius", "0.125 um");
+    b.L = continuum_length(s, "length", "0.4 um");
     s.finish();
   }
   {
