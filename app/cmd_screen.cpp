@@ -149,7 +149,7 @@ scene::json confirm_sweep(const sweep::Sweep& sw, const std::vector<reduced1d::D
   }
   scene::json report = design::confirm_candidates(cands, o, [&](size_t c, const design::Confirmed& r) {
     const auto& d = cands[c];
-    const auto f3 = design::figures_3d(r.summary, sw.metric);
+    const auto f3 = design::figures_confirming(r.summary, sw.metric);
     const std::string t = design::tier_short(tier);
     std::printf("  design %zu (%s, 1D rank %ld): 1D %s, %s %s; %s%s\n", d.design, d.values.c_str(), d.rank_in_sweep,
                 shown(value(d.design), sw.metric).c_str(), t.c_str(),

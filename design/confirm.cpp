@@ -382,7 +382,7 @@ void match_recovery_end(Candidate& c, const std::string& scene_dir) {
   c.metrics = o.metrics;
 }
 
-json figures_3d(const json& s, const std::string& metric) {
+json figures_confirming(const json& s, const std::string& metric) {
   // a run that did not finish has only partial figures (its mean velocity up to the failure):
   // none of them is the design's
   const bool finished = s.value("status", std::string()) == "ok";
@@ -473,7 +473,7 @@ json confirm_candidates(const std::vector<Candidate>& cands, const ConfirmOption
     Confirmed r = o.run ? o.run(i, sc, confirm_label(c))
                         : run_confirmed(sc, o.runs_dir, confirm_label(c), o.progress, estimate, o.metric, tier);
     if (on_done) on_done(i, r);
-    const json f1 = figures_1d(c.metrics, o.metric), f3 = figures_3d(r.summary, o.metric);
+    const json f1 = figures_1d(c.metrics, o.metric), f3 = figures_confirming(r.summary, o.metric);
     const std::string status = r.summary.value("status", std::string("unknown"));
     if (!r.reused) wall += r.summary.value("wall_time_s", 0.0);
     if (r.coarse_run && !r.coarse_reused) wall += r.coarse_wall_time_s;

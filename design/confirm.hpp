@@ -101,9 +101,10 @@ Confirmed run_confirmed(const json& scene, const std::string& runs_dir, const st
 
 /// One tier's figures of a design: {"<metric>", "displacement_per_cycle_m", "cycle_time_s",
 /// "mean_velocity_m_per_s"}; a figure the run did not produce (no completed cycle) is null, and
-/// so is every figure of a 3D run that did not finish (status other than "ok").
+/// so is every figure of a confirming run (3D or axisymmetric) that did not finish (status
+/// other than "ok"). figures_confirming reads the confirming run's summary.json.
 json figures_1d(const reduced1d::Metrics& m, const std::string& metric);
-json figures_3d(const json& summary, const std::string& metric);
+json figures_confirming(const json& summary, const std::string& metric);
 /// The error bar of a confirming run's figure from its summary's `error_estimate` (estimated_figure of it):
 /// max(|f - interval_low|, |f - interval_high|) with f the run's own value; null when the
 /// summary has no estimate of it.
