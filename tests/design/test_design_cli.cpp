@@ -299,6 +299,14 @@ json round_wall_sweep() {
           {"confirm", {{"tier", "axi"}, {"grid", {{"cells_across", 8}}}, {"error_estimate", false}}}};
 }
 
+// The command `swim screen round.json --jobs 1 --threads 2 --out OUT --confirm 2` of the sweep s
+// written into d (OUT = d/out).
+std::string screen_confirm_2(const fs::path& d, const json& s) {
+  write(d / "round.json", s);
+  return "screen \"" + (d / "round.json").string() + "\" --jobs 1 --threads 2 --out \"" + (d / "out").string() +
+         "\" --confirm 2";
+}
+
 // The sweep s refused by `swim screen --confirm 2` in d: exit 2, each of `words` in the message,
 // nothing written.
 void expect_confirm_refused(const fs::path& d, const json& s, const std::vector<std::string>& words) {
@@ -311,11 +319,9 @@ void expect_confirm_refused(const fs::path& d, const json& s, const std::vector<
 }
 
 TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheConvergedAnswer) {
-  const fs::path d = tmpdir("confirm_axi");
-  write(d / "round.json", round_wall_sweep());
-  const fs::path out = d / "out";
-  const std::string cmd = "screen \"" + (d / "round.json").string() + "\" --jobs 1 --threads 2 --out \"" + out.string() + "\"";
-  Cli c = run_swim(cmd + " --confirm 2", d);
+  const fs::path d = tmpdir("confirm_axi"), out = d / "out";
+  const std::string cmd = screen_confirm_2(d, round_wall_sweep());
+  Cli c = run_swim(cmd, d);
   ASSERT_EQ(c.code, 0) << c.err;
   const json r = read(out / "confirm.json");
   EXPECT_EQ(r["status"], "ok");
@@ -347,7 +353,7 @@ TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheCo
   // the same command again, its report removed: both finished runs reused, the same figures
   fs::remove(out / "screen.json");
   fs::remove(out / "confirm.json");
-  c = run_swim(cmd + " --confirm 2", d);
+  c = run_swim(cmd, d);
   ASSERT_EQ(c.code, 0) << c.err;
   const json again = read(out / "confirm.json");
   for (std::size_t i = 0; i < 2; ++i) {
@@ -373,14 +379,12 @@ TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheCo
 // +- 0.44 nm, 316.1 +- 9.9 ms on 12 cells). A rerun reuses both runs; a grid with no coarser
 // one (8 cells across) is exit 2 naming confirm.error_estimate before anything runs.
 TEST(ScreenConfirm, AnAxisymmetricConfirmationCarriesItsTwoGridErrorBar) {
-  const fs::path d = tmpdir("confirm_axi_bars");
+  const fs::path d = tmpdir("confirm_axi_bars"), out = d / "out";
   json sweep = round_wall_sweep();
   sweep["vary"]["swimmer.length"]["values"] = {"0.4 um", "0.6 um"};
   sweep["confirm"] = {{"tier", "axi"}, {"grid", {{"cells_across", 12}}}};
-  write(d / "round.json", sweep);
-  const fs::path out = d / "out";
-  const std::string cmd = "screen \"" + (d / "round.json").string() + "\" --jobs 1 --threads 2 --out \"" + out.string() + "\"";
-  Cli c = run_swim(cmd + " --confirm 2", d);
+  const std::string cmd = screen_confirm_2(d, sweep);
+  Cli c = run_swim(cmd, d);
   ASSERT_EQ(c.code, 0) << c.err;
   const json r = read(out / "confirm.json");
   EXPECT_EQ(r["status"], "ok");
@@ -424,7 +428,7 @@ TEST(ScreenConfirm, AnAxisymmetricConfirmationCarriesItsTwoGridErrorBar) {
   // again: both runs and both coarse runs reused
   fs::remove(out / "screen.json");
   fs::remove(out / "confirm.json");
-  c = run_swim(cmd + " --confirm 2", d);
+  c = run_swim(cmd, d);
   ASSERT_EQ(c.code, 0) << c.err;
   const json again = read(out / "confirm.json");
   EXPECT_DOUBLE_EQ(again["wall_time_axi_s"].get<double>(), 0.0);
