@@ -748,7 +748,7 @@ class Runner {
     rec_.extras = {{"steps", steps_},
                    {"steps_per_cycle", per_cycle},
                    {"max_spacing_over_h", rec_.series.count() ? rec_.series.max("max_spacing_m") / p_.h : 0.0}};
-    record::check_plausible(rec_);
+    record::check_plausible(rec_, {b_.fluid.rho, b_.fluid.mu});
     rec_.events.switches = protocol_.state().switches;
     rec_.events.segment_reached_s = protocol_.state().segment_reached;
     rec_.stats = {{"steps", steps_},

@@ -146,7 +146,7 @@ class PrescribedRunner {
     rec_.extras = {{"quadrature_pieces", pieces_},
                    {"volume_balance_error_m3", rec_.series.count() > 0 ? balance : 0.0},
                    {"max_spacing_over_h", max_spacing_ / p_.h}};
-    record::check_plausible(rec_);
+    record::check_plausible(rec_, {b_.fluid.rho, b_.fluid.mu});
     const FittedStokes::Timing& tm = swimmer_->stokes().timing();
     rec_.stats = {{"steps", pieces_},
                   {"quadrature_pieces", pieces_},

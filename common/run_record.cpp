@@ -298,11 +298,23 @@ CycleFigures cycle_figures(const RunRecord& r) {
   return c;
 }
 
-void check_plausible(RunRecord& r) {
+void check_plausible(RunRecord& r, const FluidProperties& fluid) {
   r.implausible.clear();
   const CycleFigures c = cycle_figures(r);
   if (c.has_cycle && std::abs(c.displacement_per_cycle_m) > r.length_m)
     r.implausible.push_back("displacement per cycle exceeds the wave's travel (the swimmer length)");
+  if (fluid.density_kg_per_m3 > 0 && fluid.viscosity_Pa_s > 0 && r.series.count() > 0) {
+    const double u = std::max(std::abs(r.series.max("velocity_m_per_s")), std::abs(r.series.min("velocity_m_per_s")));
+    const double re = fluid.density_kg_per_m3 * u * r.length_m / fluid.viscosity_Pa_s;
+    if (re > kMaxReynolds) {
+      char b[320];
+      std::snprintf(b, sizeof b,
+                    "Reynolds number rho max|U| L / mu = %.3g above %g: the tiers solve creeping (Stokes) flow, whose "
+                    "error grows as Re (check fluid.viscosity and fluid.density)",
+                    re, kMaxReynolds);
+      r.implausible.push_back(b);
+    }
+  }
 }
 
 RunFigures run_figures(const RunRecord& r) {

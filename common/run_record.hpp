@@ -208,10 +208,20 @@ struct CycleFigures {
 };
 CycleFigures cycle_figures(const RunRecord& r);
 
-/// The plausibility check of both tiers: a peristaltic swimmer in Stokes flow cannot outrun
+/// The fluid a run swam in, for the Reynolds-number bound of check_plausible (0: not checked).
+struct FluidProperties {
+  double density_kg_per_m3 = 0, viscosity_Pa_s = 0;
+};
+/// The Reynolds number Re = rho max|U| L / mu above which a run's creeping flow is not trusted:
+/// the tiers solve Stokes flow, whose error grows in proportion to Re.
+inline constexpr double kMaxReynolds = 0.1;
+
+/// The plausibility check of every tier: a peristaltic swimmer in Stokes flow cannot outrun
 /// its wave, and per cycle the wave crosses the tube once, so |displacement per cycle| <=
-/// the swimmer's length. Sets r.implausible (cleared first).
-void check_plausible(RunRecord& r);
+/// the swimmer's length; and the flow must be creeping, Re = rho max|U| L / mu <= kMaxReynolds
+/// (with the swimmer's fastest speed over the run and its length; checked where `fluid` is
+/// given). Sets r.implausible (cleared first).
+void check_plausible(RunRecord& r, const FluidProperties& fluid = {});
 
 /// The summary of a record: the keys common to both tiers, then r.extras. `resolved` is the
 /// resolved scene it ran.

@@ -273,7 +273,7 @@ void RunOutput::fill(const std::string& status, double wall, const Stepper& step
                  {"wrinkle_modes_over_half_cell", measured.cycle_wrinkles().modes()},
                  {"steps", n},
                  {"steps_per_cycle", stepper.steps_per_cycle()}};
-  record::check_plausible(rec_);
+  record::check_plausible(rec_, {p.fluid.rho, p.fluid.mu});
   rec_.events.switches = protocol.state().switches;
   rec_.events.segment_reached_s = protocol.state().segment_reached;
   const double t = stepper.state().t;

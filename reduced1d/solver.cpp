@@ -245,7 +245,7 @@ void finish_record(const Params& p, const Result& r, record::RunRecord& rec) {
   rec.transit_is_cycle = p.wave != WaveKind::ForceDriven && !r.failure && rec.series.count() > 0 &&
                          rec.t_end() >= end_time(p) * (1 - 1e-9);
   // the paper's inertial model is exempt from the Stokes-flow bound
-  if (p.swimmer.model == SwimmerModel::ForceFree) record::check_plausible(rec);
+  if (p.swimmer.model == SwimmerModel::ForceFree) record::check_plausible(rec, {p.fluid.rho, p.fluid.mu});
   else rec.implausible.clear();
   for (const auto& [k, v] : r.stats) rec.stats[k] = v;
   rec.stats["protocol_switches"] = r.switches;

@@ -445,3 +445,33 @@ TEST(Progress, ToALogFileItWritesWholeLinesOnly) {
   EXPECT_EQ(text.rfind("3d test: done in ", 0), 0u) << text;
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
 }
+
+// The Reynolds-number bound of check_plausible: Re = rho max|U| L / mu with the swimmer's fastest
+// speed (either direction) and its length. The record's swimmer (L = 0.4 um, |U| up to 2 nm/s
+// in water, Re = 8e-10) is plausible; at a viscosity 1e9 times smaller (Re = 0.8, a mistyped
+// unit) it is not, the reason naming Re, the bound and the key to check; just below the bound
+// it still is, and without the fluid no Reynolds check is made.
+TEST(RunRecord, ARunAboveTheCreepingFlowsReynoldsNumberIsImplausible) {
+  RunRecord r = filled(false);
+  check_plausible(r, {1000.0, 1e-3});
+  EXPECT_TRUE(r.implausible.empty());
+  check_plausible(r, {1000.0, 1e-12});
+  ASSERT_EQ(r.implausible.size(), 1u);
+  EXPECT_NE(r.implausible[0].find("Reynolds number rho max|U| L / mu = 0.8 above 0.1"), std::string::npos)
+      << r.implausible[0];
+  RunRecord fast("1d", "test_model", 4e-7, columns(), {1e-7});
+  fast.cycle_started(0.0);
+  for (int k = 0; k < 11; ++k) fast.add_row(row_at(0.01 * k, k == 5 ? -2.5e-3 : 1e-3));  // one row backwards, faster
+  check_plausible(fast, {1000.0, 1.01e-5});  // Re = 1000 * 2.5e-3 * 4e-7 / 1.01e-5 = 0.099
+  EXPECT_TRUE(fast.implausible.empty()) << fast.implausible[0];
+  check_plausible(fast, {1000.0, 0.99e-5});  // Re = 0.101: the backward speed counts
+  ASSERT_EQ(fast.implausible.size(), 1u);
+  check_plausible(fast, {1000.0, 1e-8});  // Re = 100
+  ASSERT_EQ(fast.implausible.size(), 1u);
+  EXPECT_NE(fast.implausible[0].find("= 100 above 0.1"), std::string::npos) << fast.implausible[0];
+  EXPECT_NE(fast.implausible[0].find("fluid.viscosity"), std::string::npos) << fast.implausible[0];
+  EXPECT_EQ(summary(fast, json::object())["plausible"], false);
+  check_plausible(fast);
+  EXPECT_TRUE(fast.implausible.empty());
+  EXPECT_EQ(summary(fast, json::object())["plausible"], true);
+}
