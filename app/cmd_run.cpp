@@ -234,6 +234,9 @@ int run3d(const RunOptions& o, const scene::json& sc) {
               si(s["mean_velocity_m_per_s"].get<double>(), "m/s").c_str(), s["body_lengths_per_s"].get<double>(),
               per_cycle.c_str(), si(s["pumped_volume_m3"].get<double>(), "m^3").c_str(), r.steps,
               si(s["wall_time_s"].get<double>(), "s").c_str(), out.c_str());
+  std::fflush(stdout);
+  for (const auto& w : s["implausible_because"])
+    std::fprintf(stderr, "swim: warning: implausible result: %s\n", w.get<std::string>().c_str());
   if (s.contains("error_estimate")) {
     const auto& e = s["error_estimate"];
     if (e["status"] != "ok") {
