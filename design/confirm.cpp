@@ -265,7 +265,11 @@ json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, con
 }
 
 // The same for a finished axisymmetric run: its coarse run (coarse_cells_axi) in
-// c.folder/error_estimate/coarse, the estimate at the sharp interface's orders.
+// c.folder/error_estimate/coarse, the estimate at the sharp interface's orders; then its wall
+// check, the run again on its own grid with its rings at half the spacing
+// (axi.spacing_factor x 0.5) in c.folder/error_estimate/wall, whose change of each figure,
+// taken at order 1 (change / (1 - 0.5)), is the wall's resolution error at this grid: it widens
+// each figure's interval on both sides (what the two grids cannot see, docs/design-loop.md).
 json estimate_error_axi(Confirmed& c, const json& sc, const axi::ParamsAxi& p, const std::string& figure, int progress) {
   int cells = 0;
   try {
@@ -273,34 +277,75 @@ json estimate_error_axi(Confirmed& c, const json& sc, const axi::ParamsAxi& p, c
   } catch (const InputError& e) {
     return {{"status", std::string("failed: no coarse grid: ") + e.what()}};
   }
+  // one extra run of the estimate: its summary, or {"status": "failed: ..."} naming `what`
+  auto extra_run = [&](const json& scene, const std::string& dir, const std::string& what, bool& reused,
+                       double* h) -> json {
+    json s;
+    try {
+      json resolved;
+      const axi::ParamsAxi pv = axi::read_scene_axi(scene, resolved);
+      if (h) *h = pv.h;
+      s = run_or_reuse_axi(pv, resolved, dir, progress, reused);
+    } catch (const std::exception& e) {
+      s = {{"status", std::string("failed: ") + e.what()}};
+    }
+    c.coarse_run = true;
+    if (!reused) c.coarse_wall_time_s += s.value("wall_time_s", 0.0);
+    const std::string status = s.value("status", std::string("unknown"));
+    if (status != "ok") {
+      output::reset_ledger(dir);
+      return {{"status", "failed: " + what + ": " + status}};
+    }
+    if (!s["displacement_per_cycle_m"].is_number()) {
+      output::reset_ledger(dir);
+      return {{"status", "failed: " + what + ": no cycle completed (" +
+                             s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
+    }
+    if (reused) output::adopt_listed(dir);
+    return s;
+  };
+  c.coarse_wall_time_s = 0;
   json coarse_scene = sc;
   coarse_scene["axi"]["grid"] = {{"cells_across", cells}};
-  const std::string dir = validation::coarse_folder(c.folder);
-  json s;
   double h_coarse = 0;
-  try {
-    json resolved;
-    const axi::ParamsAxi pc = axi::read_scene_axi(coarse_scene, resolved);
-    h_coarse = pc.h;
-    s = run_or_reuse_axi(pc, resolved, dir, progress, c.coarse_reused);
-  } catch (const std::exception& e) {
-    s = {{"status", std::string("failed: ") + e.what()}};
+  const json s = extra_run(coarse_scene, validation::coarse_folder(c.folder),
+                           "the coarse run (" + std::to_string(cells) + " cells across)", c.coarse_reused, &h_coarse);
+  if (s.value("status", std::string()) != "ok") return s;
+  json e = validation::sharp_interface_error_estimate_json(c.summary, s, cells, p.h, h_coarse, {figure});
+  if (e.value("status", std::string()) != "ok") return e;
+
+  constexpr double kWallCheckFactor = 0.5;
+  json wall_scene = sc;
+  wall_scene["axi"]["spacing_factor"] = kWallCheckFactor * p.spacing_factor;
+  bool wall_reused = false;
+  const json w = extra_run(wall_scene, (fs::path(c.folder) / "error_estimate" / "wall").string(),
+                           "the wall check (axi.spacing_factor " + std::to_string(kWallCheckFactor * p.spacing_factor) +
+                               ")",
+                           wall_reused, nullptr);
+  c.coarse_reused = c.coarse_reused && wall_reused;
+  json check = {{"spacing_factor", kWallCheckFactor * p.spacing_factor},
+                {"folder", "error_estimate/wall"},
+                {"method", "the run again on its grid with its rings at half the spacing; each figure's wall "
+                           "resolution error = |change| / (1 - 0.5) (order 1), added to both ends of its interval and "
+                           "to its error"}};
+  if (w.value("status", std::string()) != "ok") {
+    check["status"] = w["status"];
+    e["wall_check"] = check;
+    return e;
   }
-  c.coarse_run = true;
-  c.coarse_wall_time_s = s.value("wall_time_s", 0.0);
-  const std::string status = s.value("status", std::string("unknown"));
-  const std::string what = "the coarse run (" + std::to_string(cells) + " cells across)";
-  if (status != "ok") {
-    output::reset_ledger(dir);
-    return {{"status", "failed: " + what + ": " + status}};
+  check["status"] = "ok";
+  for (auto it = e.begin(); it != e.end(); ++it) {
+    json& f = it.value();
+    if (!f.is_object() || !f.contains("fine") || !w.contains(it.key()) || !w[it.key()].is_number()) continue;
+    const double ew = std::abs(w[it.key()].get<double>() - f["fine"].get<double>()) / (1.0 - kWallCheckFactor);
+    f["wall_check"] = w[it.key()];
+    f["wall_resolution_error"] = ew;
+    f["interval_low"] = f["interval_low"].get<double>() - ew;
+    f["interval_high"] = f["interval_high"].get<double>() + ew;
+    f["error"] = f["error"].get<double>() + ew;
   }
-  if (!s["displacement_per_cycle_m"].is_number()) {
-    output::reset_ledger(dir);
-    return {{"status", "failed: " + what + ": no cycle completed (" +
-                           s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
-  }
-  if (c.coarse_reused) output::adopt_listed(dir);
-  return validation::sharp_interface_error_estimate_json(c.summary, s, cells, p.h, h_coarse, {figure});
+  e["wall_check"] = check;
+  return e;
 }
 
 // The estimate of the finished run c, by `estimate` (the run's tier's), added to its
@@ -309,10 +354,11 @@ json estimate_error_axi(Confirmed& c, const json& sc, const axi::ParamsAxi& p, c
 void add_error_estimate(Confirmed& c, const std::string& figure, const std::function<json()>& estimate) {
   const json* have = c.summary.contains("error_estimate") ? &c.summary["error_estimate"] : nullptr;
   const bool complete = have && (have->value("status", std::string()) != "ok" || have->contains(figure));
-  if (complete) {  // an earlier invocation's estimate: its coarse run, reused
+  if (complete) {  // an earlier invocation's estimate: its coarse run (and an axisymmetric run's wall check), reused
     const json cs = finished_summary(validation::coarse_folder(c.folder));
+    const json ws = finished_summary(fs::path(c.folder) / "error_estimate" / "wall");
     c.coarse_run = c.coarse_reused = !cs.is_null();
-    c.coarse_wall_time_s = cs.is_null() ? 0.0 : cs.value("wall_time_s", 0.0);
+    c.coarse_wall_time_s = (cs.is_null() ? 0.0 : cs.value("wall_time_s", 0.0)) + (ws.is_null() ? 0.0 : ws.value("wall_time_s", 0.0));
     return;
   }
   if (!c.ok || !c.summary["displacement_per_cycle_m"].is_number()) return;
@@ -632,8 +678,9 @@ std::string confirm_markdown(const json& r, const std::string& title) {
          std::to_string(r["designs"].size()) + " designs have one).\n\n";
   if (r.value("error_estimate_axi", false))
     s += "Axisymmetric error bars: each finished axisymmetric run also ran on a coarser grid (about 3/4 of its cells "
-         "across); the error bar is the largest distance from the run's value to the interval of its extrapolations "
-         "to h → 0 at the orders 1 to 3.5 of the fitted method, a sharp interface of second order (" +
+         "across) and on its own grid with its rings at half the spacing; the error bar is the largest distance from "
+         "the run's value to the interval of its extrapolations to h → 0 at the orders 1 to 3.5 of the fitted method, "
+         "a sharp interface of second order, widened on both sides by twice the wall check's change (" +
          std::to_string(r["designs_with_error_bar_axi"].get<int>()) + " of " + std::to_string(r["designs"].size()) +
          " designs have one).\n\n";
 

@@ -9,7 +9,9 @@
 //   the coarse-grid run of `swim run --error-estimate` (validation/error_estimate.hpp) in its
 //   folder's error_estimate/coarse/, and its summary.json gets the same `error_estimate`, with
 //   the sweep's metric estimated too; an axisymmetric run likewise, on about 3/4 of its cells
-//   across, estimated at the sharp interface's orders (sharp_interface_error_estimate_json).
+//   across, estimated at the sharp interface's orders (sharp_interface_error_estimate_json),
+//   and again on its own grid with its rings at half the spacing (error_estimate/wall), whose
+//   change widens each figure's interval (the wall's resolution, which the grids do not see).
 //   The error bar of a figure f is the largest distance from f to the estimate's interval of
 //   extrapolations, max(|f - interval_low|, |f - interval_high|): how far the run's own figure
 //   may lie from its value on ever finer grids.

@@ -371,12 +371,14 @@ TEST(ScreenConfirm, OnTheAxisymmetricTierARoundWallsDesignsAreConfirmedNearTheCo
 
 // With its error estimate (the default), each axisymmetric confirmation also runs on about 3/4
 // of its cells across (12 -> 8) in its folder's error_estimate/coarse, and its summary.json
-// gets the sharp interface's two-grid estimate (orders 1 to 3.5, central 2). The error bar is
-// the largest distance from the run's value to the interval of extrapolations. The L = 0.4 um
+// gets the sharp interface's two-grid estimate (orders 1 to 3.5, central 2); then on its own
+// grid with its rings at half the spacing (error_estimate/wall), whose change at order 1 widens
+// each interval on both sides. The error bar is the largest distance from the run's value to
+// the interval. The L = 0.4 um
 // design is the converged suite's paper_amplitude_0.82_round_wall (docs/validation/converged:
 // 19.4735 +- 0.0099 nm and 312.39 +- 2.06 ms): its reference lies within the run's displacement
-// per cycle and cycle time plus or minus their bars and the reference's error (measured: 19.15
-// +- 0.44 nm, 316.1 +- 9.9 ms on 12 cells). A rerun reuses both runs; a grid with no coarser
+// per cycle and cycle time plus or minus their bars and the reference's error (measured without
+// the wall check: 19.15 +- 0.44 nm, 316.1 +- 9.9 ms on 12 cells). A rerun reuses both runs; a grid with no coarser
 // one (8 cells across) is exit 2 naming confirm.error_estimate before anything runs.
 TEST(ScreenConfirm, AnAxisymmetricConfirmationCarriesItsTwoGridErrorBar) {
   const fs::path d = tmpdir("confirm_axi_bars"), out = d / "out";
@@ -393,15 +395,29 @@ TEST(ScreenConfirm, AnAxisymmetricConfirmationCarriesItsTwoGridErrorBar) {
   for (const auto& x : r["designs"]) {
     const fs::path run = out / x["folder_axi"].get<std::string>();
     const json s = read(run / "summary.json"), cs = read(run / "error_estimate" / "coarse" / "summary.json");
+    const json ws = read(run / "error_estimate" / "wall" / "summary.json");
     EXPECT_EQ(cs["tier"], "axi");
+    EXPECT_EQ(ws["scene"]["axi"]["spacing_factor"], 0.5);  // the rings at half the default spacing
+    EXPECT_EQ(ws["scene"]["axi"]["grid"]["cells_across"], 12);
     ASSERT_EQ(s["error_estimate"]["status"], "ok") << s["error_estimate"].dump();
     const json& e = s["error_estimate"];
     EXPECT_EQ(e["coarse_cells_across"], 8);
     EXPECT_EQ(e["central_order"], 2.0);
     EXPECT_EQ(e["order_range"], json({1.0, 3.5}));
+    ASSERT_EQ(e["wall_check"]["status"], "ok") << e["wall_check"].dump();
     const json& f = e["displacement_per_cycle_m"];
     EXPECT_EQ(f["fine"], s["displacement_per_cycle_m"]);
     EXPECT_EQ(f["coarse"], cs["displacement_per_cycle_m"]);
+    EXPECT_EQ(f["wall_check"], ws["displacement_per_cycle_m"]);
+    // the wall's resolution error at order 1, on both ends of the interval
+    const double ew = std::abs(ws["displacement_per_cycle_m"].get<double>() - f["fine"].get<double>()) / 0.5;
+    EXPECT_DOUBLE_EQ(f["wall_resolution_error"].get<double>(), ew);
+    EXPECT_NEAR(f["interval_high"].get<double>() - f["interval_low"].get<double>(),
+                std::max({f["extrapolated_order1"].get<double>(), f["extrapolated_order2"].get<double>(),
+                          f["extrapolated_order3_5"].get<double>()}) -
+                    std::min({f["extrapolated_order1"].get<double>(), f["extrapolated_order2"].get<double>(),
+                              f["extrapolated_order3_5"].get<double>()}) + 2 * ew,
+                1e-18);
     for (const char* k : {"extrapolated_order1", "extrapolated_order2", "extrapolated_order3_5"})
       EXPECT_TRUE(f[k].is_number()) << k;
     const double v = f["fine"].get<double>();
