@@ -233,6 +233,33 @@ json run_or_reuse_axi(const axi::ParamsAxi& p, const json& resolved, const fs::p
 
 // The error estimate of the finished run c (validation/error_estimate.hpp): its coarse run in
 // c.folder/error_estimate/coarse, then the estimate of the headline figures and `figure`.
+// An extra run of an error estimate (the coarse run, or an axisymmetric run's wall check) in
+// `dir`, by `run` (which sets `reused`): its summary when it finished with its per-cycle
+// figures; otherwise {"status": "failed: <what>: ..."}, its files taken off the run's list (they
+// are not the run's, as with swim run). An earlier invocation's run, reused, is listed by the run.
+json estimate_run(Confirmed& c, const std::string& dir, const std::string& what, const bool& reused,
+                  const std::function<json()>& run) {
+  json s;
+  try {
+    s = run();
+  } catch (const std::exception& e) {
+    s = {{"status", std::string("failed: ") + e.what()}};
+  }
+  c.coarse_run = true;
+  const std::string status = s.value("status", std::string("unknown"));
+  if (status != "ok") {
+    output::reset_ledger(dir);
+    return {{"status", "failed: " + what + ": " + status}};
+  }
+  if (!s["displacement_per_cycle_m"].is_number()) {
+    output::reset_ledger(dir);
+    return {{"status", "failed: " + what + ": no cycle completed (" +
+                           s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
+  }
+  if (reused) output::adopt_listed(dir);
+  return s;
+}
+
 json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, const std::string& figure, int progress) {
   validation::CoarseGrid g;
   try {
@@ -241,26 +268,14 @@ json estimate_error(Confirmed& c, const json& sc, const full3d::Params3d& p, con
     return {{"status", std::string("failed: no coarse grid: ") + e.what()}};
   }
   const std::string dir = validation::coarse_folder(c.folder);
-  json s;
-  try {
-    s = run_or_reuse(g.p, g.resolved, dir, progress, c.coarse_reused);
-  } catch (const std::exception& e) {
-    s = {{"status", std::string("failed: ") + e.what()}};
-  }
-  c.coarse_run = true;
-  c.coarse_wall_time_s = s.value("wall_time_s", 0.0);
-  const std::string status = s.value("status", std::string("unknown"));
-  const std::string what = "the coarse run (" + std::to_string(g.cells) + " cells across)";
-  if (status != "ok") {
-    output::reset_ledger(dir);  // the coarse run's files are not the run's (as with swim run)
-    return {{"status", "failed: " + what + ": " + status}};
-  }
-  if (!s["displacement_per_cycle_m"].is_number()) {
-    output::reset_ledger(dir);
-    return {{"status", "failed: " + what + ": no cycle completed (" +
-                           s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
-  }
-  if (c.coarse_reused) output::adopt_listed(dir);  // an earlier invocation's coarse run, listed by the run
+  double wall = 0;
+  const json s = estimate_run(c, dir, "the coarse run (" + std::to_string(g.cells) + " cells across)", c.coarse_reused, [&] {
+    json r = run_or_reuse(g.p, g.resolved, dir, progress, c.coarse_reused);
+    wall = r.value("wall_time_s", 0.0);
+    return r;
+  });
+  c.coarse_wall_time_s = wall;
+  if (s.value("status", std::string()) != "ok") return s;
   return validation::error_estimate_json(c.summary, s, g.cells, p.h, g.p.h, {figure});
 }
 
@@ -277,32 +292,18 @@ json estimate_error_axi(Confirmed& c, const json& sc, const axi::ParamsAxi& p, c
   } catch (const InputError& e) {
     return {{"status", std::string("failed: no coarse grid: ") + e.what()}};
   }
-  // one extra run of the estimate: its summary, or {"status": "failed: ..."} naming `what`
+  // one extra run of the estimate on `scene` (its cell size in *h when asked); the wall time of a
+  // run this invocation made goes to the estimate's
   auto extra_run = [&](const json& scene, const std::string& dir, const std::string& what, bool& reused,
                        double* h) -> json {
-    json s;
-    try {
+    return estimate_run(c, dir, what, reused, [&] {
       json resolved;
       const axi::ParamsAxi pv = axi::read_scene_axi(scene, resolved);
       if (h) *h = pv.h;
-      s = run_or_reuse_axi(pv, resolved, dir, progress, reused);
-    } catch (const std::exception& e) {
-      s = {{"status", std::string("failed: ") + e.what()}};
-    }
-    c.coarse_run = true;
-    if (!reused) c.coarse_wall_time_s += s.value("wall_time_s", 0.0);
-    const std::string status = s.value("status", std::string("unknown"));
-    if (status != "ok") {
-      output::reset_ledger(dir);
-      return {{"status", "failed: " + what + ": " + status}};
-    }
-    if (!s["displacement_per_cycle_m"].is_number()) {
-      output::reset_ledger(dir);
-      return {{"status", "failed: " + what + ": no cycle completed (" +
-                             s.value("per_cycle_absent_because", std::string("no per-cycle figures")) + ")"}};
-    }
-    if (reused) output::adopt_listed(dir);
-    return s;
+      json r = run_or_reuse_axi(pv, resolved, dir, progress, reused);
+      if (!reused) c.coarse_wall_time_s += r.value("wall_time_s", 0.0);
+      return r;
+    });
   };
   c.coarse_wall_time_s = 0;
   json coarse_scene = sc;
@@ -369,37 +370,42 @@ void add_error_estimate(Confirmed& c, const std::string& figure, const std::func
 }
 }  // namespace
 
+namespace {
+// A confirmation run's record before it runs: its folder in runs_dir, the label and the hash of
+// its resolved physics (`physics`, the thread count left out: it does not change the results),
+// and its cell size.
+Confirmed confirmation_in(const std::string& runs_dir, const std::string& label, const json& physics, double h) {
+  Confirmed c;
+  c.folder = (fs::path(runs_dir) / (label + "-" + output::json_hash(physics).substr(0, 12))).string();
+  c.cell_size_m = h;
+  return c;
+}
+}  // namespace
+
 Confirmed run_confirmed(const json& sc, const std::string& runs_dir, const std::string& label, int progress,
                         bool error_estimate, const std::string& metric, const std::string& tier) {
-  if (tier == "axi") {
-    json resolved;
-    const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
-    json physics = resolved;
-    if (physics.contains("axi")) physics["axi"].erase("threads");  // the thread count does not change the results
-    physics["confirm_tier"] = "axi";  // never the folder of the same design's 3D run
-    const fs::path dir = fs::path(runs_dir) / (label + "-" + output::json_hash(physics).substr(0, 12));
-    Confirmed c;
-    c.folder = dir.string();
-    c.cell_size_m = p.h;
-    c.summary = run_or_reuse_axi(p, resolved, dir, progress, c.reused);
-    c.ok = c.summary.value("status", std::string()) == "ok";
-    const std::string figure = estimated_figure(metric);
-    if (error_estimate) add_error_estimate(c, figure, [&] { return estimate_error_axi(c, sc, p, figure, progress); });
-    return c;
-  }
   json resolved;
-  const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
-  json physics = resolved;
-  physics["full3d"].erase("threads");  // the thread count does not change the run's results
-  const fs::path dir = fs::path(runs_dir) / (label + "-" + output::json_hash(physics).substr(0, 12));
   Confirmed c;
-  c.folder = dir.string();
-  c.cell_size_m = p.h;
-  c.summary = run_or_reuse(p, resolved, dir, progress, c.reused);
-  c.ok = c.summary.value("status", std::string()) == "ok";
   // the estimate of a finished run with its per-cycle figures (as swim run --error-estimate
   // gives one); an estimate the summary holds already is kept
   const std::string figure = estimated_figure(metric);
+  if (tier == "axi") {
+    const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+    json physics = resolved;
+    if (physics.contains("axi")) physics["axi"].erase("threads");
+    physics["confirm_tier"] = "axi";  // never the folder of the same design's 3D run
+    c = confirmation_in(runs_dir, label, physics, p.h);
+    c.summary = run_or_reuse_axi(p, resolved, c.folder, progress, c.reused);
+    c.ok = c.summary.value("status", std::string()) == "ok";
+    if (error_estimate) add_error_estimate(c, figure, [&] { return estimate_error_axi(c, sc, p, figure, progress); });
+    return c;
+  }
+  const full3d::Params3d p = full3d::read_scene3d(sc, resolved);
+  json physics = resolved;
+  physics["full3d"].erase("threads");
+  c = confirmation_in(runs_dir, label, physics, p.h);
+  c.summary = run_or_reuse(p, resolved, c.folder, progress, c.reused);
+  c.ok = c.summary.value("status", std::string()) == "ok";
   if (error_estimate) add_error_estimate(c, figure, [&] { return estimate_error(c, sc, p, figure, progress); });
   return c;
 }
