@@ -737,8 +737,65 @@ scene::json axi_cycle_json(const AxiCycle& c) {
           {"cycle_times_s", sm.value("cycle_times_s", scene::json::array())}, {"failed", c.run.failed}};
 }
 
+/// One cycle of the round L = 0.8 um tube whose front rim hooks over the lumen, on the moved
+/// triangulation (axi.mesh = triangles) at the converged suite's settings of its reference (rims
+/// refined four times further, rings at half the default spacing, axi.tolerance 5e-4), two
+/// threads, with its gap's triangles up to `gap_size` h (axi.gap_size), into
+/// out/axi_hooked_gap<gap_size>.
+struct AxiHooked {
+  double gap_size = 1, wall_s = 0;
+  long unknowns = 0, steps = 0;
+  double displacement_m = 0, cycle_s = 0;
+  bool failed = false;
+};
+AxiHooked run_axi_hooked(const std::string& out, int cells, double gap_size) {
+  scene::json sc = scene::load_file(data_dir() + "/scenes/paper_aspect_L0.8.json");
+  for (const char* set : {"full3d.membrane.axisymmetric=true", "full3d.recovery_end=\"shape\"",
+                          "full3d.membrane.bending_rigidity=\"2.1184615504e-24 J\"", "protocol.pressure=\"0.5 Pa\"",
+                          "axi.mesh=\"triangles\"", "axi.spacing_factor=0.5", "axi.rim_refinement=0.25",
+                          "axi.tolerance=5e-4", "axi.time_limit=\"8 s\"", "axi.threads=2"})
+    scene::apply_override(sc, set);
+  scene::apply_override(sc, "axi.grid.cells_across=" + std::to_string(cells));
+  scene::apply_override(sc, "axi.gap_size=" + std::to_string(gap_size));
+  scene::json resolved;
+  const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
+  const std::string dir = out + "/axi_hooked_gap" + std::to_string(int(gap_size));
+  output::make_dir(dir);
+  axi::RunControlAxi ctl;
+  ctl.progress = 1;
+  std::printf("one cycle of paper_aspect_L0.8, round wall under 0.5 Pa, triangles, %d cells across (h = %.3g nm), "
+              "axi.gap_size = %g, 2 threads ...\n",
+              cells, 1e9 * p.h, gap_size);
+  std::fflush(stdout);
+  const auto t0 = std::chrono::steady_clock::now();
+  const axi::RunOutcomeAxi r = axi::run_axi(p, resolved, dir, ctl);
+  AxiHooked c;
+  c.gap_size = gap_size;
+  c.wall_s = seconds_since(t0);
+  c.unknowns = r.record.stats.value("fitted_unknowns", 0L);
+  c.steps = r.steps;
+  c.displacement_m = r.summary.value("displacement_per_cycle_m", 0.0);
+  c.cycle_s = r.summary.value("cycle_time_s", 0.0);
+  c.failed = r.failed;
+  std::printf("  %s: %ld steps, %ld unknowns (at the last mesh); wall %.0f s (target: <= 300 s per cycle on 2 cores); "
+              "%.5g nm per cycle in %.6g s%s\n",
+              r.failed ? "FAILED" : "cycle ended", c.steps, c.unknowns, c.wall_s, 1e9 * c.displacement_m, c.cycle_s,
+              r.failed ? ("  " + r.message).c_str() : "");
+  return c;
+}
+
+scene::json axi_hooked_json(const AxiHooked& c, int cells) {
+  return {{"scene", "paper_aspect_L0.8 (round wall, 0.5 Pa, triangles, the converged suite's reference settings)"},
+          {"cells_across", cells}, {"threads", 2}, {"gap_size", c.gap_size}, {"unknowns", c.unknowns},
+          {"steps", c.steps}, {"wall_time_s", c.wall_s}, {"displacement_per_cycle_m", c.displacement_m},
+          {"cycle_time_s", c.cycle_s}, {"failed", c.failed}};
+}
+
 /// The cycle on one thread and on two (axi.threads; the second factors the systems the first
 /// solves), in one run: the ratio of their wall times is the measured gain of the second core.
+/// Then the hooked tube on triangles with the gap's triangles at h and at the default
+/// axi.gap_size: the ratio of their wall times is the gain of the larger triangles, the
+/// differences of their figures what it costs.
 void bench_axi(scene::json& report, const std::string& out, int cells) {
   std::printf("== axisymmetric tier (fitted) ==\n");
   const AxiCycle one = run_axi_cycle(out, cells, 1);
@@ -753,6 +810,17 @@ void bench_axi(scene::json& report, const std::string& out, int cells) {
   report["axi_cycle"] = axi_cycle_json(two);
   report["axi_cycle"]["one_thread"] = axi_cycle_json(one);
   report["axi_cycle"]["wall_time_one_over_two_threads"] = one.wall_s / two.wall_s;
+  const int hooked_cells = cells <= 16 ? 16 : 24;
+  const AxiHooked uniform = run_axi_hooked(out, hooked_cells, 1.0);
+  const AxiHooked graded = run_axi_hooked(out, hooked_cells, axi::kGapSize);
+  const double dd = graded.displacement_m / uniform.displacement_m - 1, dt = graded.cycle_s / uniform.cycle_s - 1;
+  std::printf("  axi.gap_size %g against 1: %.2f times faster, %.2f times the unknowns; displacement per cycle %+.3f %%, "
+              "cycle time %+.3f %%\n",
+              axi::kGapSize, uniform.wall_s / graded.wall_s, double(graded.unknowns) / double(uniform.unknowns), 100 * dd,
+              100 * dt);
+  report["axi_hooked"] = axi_hooked_json(graded, hooked_cells);
+  report["axi_hooked"]["gap_size_1"] = axi_hooked_json(uniform, hooked_cells);
+  report["axi_hooked"]["wall_time_uniform_over_graded"] = uniform.wall_s / graded.wall_s;
 }
 
 }  // namespace

@@ -32,6 +32,7 @@ const json& section_keys() {
                              {{"method", "choice:fitted|immersed_boundary"},
                               {"mesh", "choice:quadrilaterals|triangles"},
                               {"remesh_angle", "quantity:rad@(0,0.3490658503988659)"},
+                              {"gap_size", "number@[1,8]"},
                               {"grid", {{"cells_across", "integer@[8,8192]"}, {"cell_size", "quantity:m@positive"}}},
                               {"spacing_factor", "number@(0,2]"},  // (0, 1) for the immersed boundary
                               {"rim_refinement", "number@positive"},
@@ -63,6 +64,7 @@ TriMeshParams tri_mesh_params(const ParamsAxi& p) {
   t.Rc = p.base.container_radius;
   t.period = p.base.period;
   t.size = kTriangleSize * p.h;
+  t.gap_size = p.gap_size;
   return t;
 }
 
@@ -134,6 +136,12 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   if (!p.triangles && std::abs(p.remesh_angle - 12.0 * std::numbers::pi / 180.0) > 1e-12)
     throw InputError(a.path("remesh_angle"), fmt(p.remesh_angle, "rad"),
                      "12 degree (the default, unused) unless axi.mesh = \"triangles\"");
+  // triangles: how much larger than h the triangles may grow in the gap between the tube's ends
+  p.gap_size = a.number("gap_size", kGapSize, Range::closed(1.0, 8.0));
+  if (!p.triangles && p.gap_size != kGapSize)
+    throw InputError(a.path("gap_size"), fmt(p.gap_size, ""),
+                     fmt(kGapSize, "") + " (the default, unused) unless axi.mesh = \"triangles\" (the structured mesh grades its "
+                     "gap columns itself)");
   {
     Reader g = a.child("grid");
     if (scene::one_of(g, {"cells_across", "cell_size"}, "cells_across") == "cell_size") {

@@ -46,6 +46,7 @@ struct ParamsAxi {
   int cells_inner = 0, cells_outer = 0, gap_columns = 0;
   bool triangles = false;      ///< axi.mesh = triangles: the moved triangulation (axi/tri_mesh.hpp) instead
   double remesh_angle = 0.0;   ///< rad: triangles, the smallest angle below which the mesh is made again
+  double gap_size = 1.0;       ///< triangles: the gap's largest size bound over h (TriMeshParams::gap_size)
   // grid
   int nr = 32, nx = 256;       ///< radial and axial cells
   double h = 0.0;              ///< m
@@ -78,6 +79,9 @@ FittedMeshParams fitted_mesh_params(const ParamsAxi& p);
 /// The triangulation's parameters (axi.mesh = triangles): triangles' longest edge
 /// kTriangleSize h away from the wall.
 inline constexpr double kTriangleSize = 1.0;
+/// The default of axi.gap_size: beyond the tube's ends the triangles' size bound grows to this
+/// multiple of h (TriMeshParams::gap_size).
+inline constexpr double kGapSize = 3.0;
 TriMeshParams tri_mesh_params(const ParamsAxi& p);
 
 /// Throws swim::InputError naming the key, the value and what is allowed.

@@ -31,8 +31,98 @@ using Vb = CGAL::Delaunay_mesh_vertex_base_2<Kernel>;
 using Fb = CGAL::Delaunay_mesh_face_base_2<Kernel>;
 using Tds = CGAL::Triangulation_data_structure_2<Vb, Fb>;
 using Cdt = CGAL::Constrained_Delaunay_triangulation_2<Kernel, Tds, CGAL::Exact_predicates_tag>;
-using Criteria = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
-using Mesher = CGAL::Delaunay_mesher_no_edge_refinement_2<Cdt, Criteria>;
+
+/// The size field of the triangulation: the longest edge a triangle may have at axial position
+/// x, `size` over the tube's axial extent [x0, x1] and growing beyond its ends with the axial
+/// distance d as size min(gap_size, 1 + 5 d / Rc) (TriMeshParams::gap_size; the structured
+/// mesh's gap columns grow at the same rate, 1 + 5 ds / Rc per column of width ds).
+struct SizeField {
+  double size = 0, gap = 1, Rc = 1, x0 = 0, x1 = 0;
+  double operator()(double x) const {
+    if (gap <= 1.0) return size;
+    const double d = std::max({0.0, x0 - x, x - x1});
+    return size * std::min(gap, 1.0 + 5.0 * d / Rc);
+  }
+};
+
+/// CGAL's size and shape criteria with the size bound of SizeField at the triangle's centroid
+/// (with a uniform field the same decisions as Delaunay_mesh_size_criteria_2, operation for
+/// operation).
+class GradedCriteria : public CGAL::Delaunay_mesh_size_criteria_2<Cdt> {
+ public:
+  using Base = CGAL::Delaunay_mesh_size_criteria_2<Cdt>;
+  explicit GradedCriteria(double aspect_bound = 0.125, const SizeField& f = {}) : Base(aspect_bound, f.size), field_(f) {}
+
+  class Is_bad : public Base::Is_bad {
+   public:
+    Is_bad(double aspect_bound, const SizeField& f, const Geom_traits& gt)
+        : Base::Is_bad(aspect_bound, f.size, gt), field_(f) {}
+    using Base::Is_bad::operator();
+    CGAL::Mesh_2::Face_badness operator()(const Cdt::Face_handle& fh, Quality& q) const {
+      const Cdt::Point& pa = fh->vertex(0)->point();
+      const Cdt::Point& pb = fh->vertex(1)->point();
+      const Cdt::Point& pc = fh->vertex(2)->point();
+      const auto sq = this->traits.compute_squared_distance_2_object();
+      const double a = CGAL::to_double(sq(pb, pc)), b = CGAL::to_double(sq(pc, pa)), c = CGAL::to_double(sq(pa, pb));
+      double max_sq, second_sq;
+      if (a < b) {
+        if (b < c)
+          max_sq = c, second_sq = b;
+        else
+          max_sq = b, second_sq = a < c ? c : a;
+      } else {
+        if (a < c)
+          max_sq = c, second_sq = a;
+        else
+          max_sq = a, second_sq = b < c ? c : b;
+      }
+      const double s = field_((CGAL::to_double(pa.x()) + CGAL::to_double(pb.x()) + CGAL::to_double(pc.x())) / 3.0);
+      q.second = max_sq / (s * s);
+      if (q.size() > 1) {
+        q.first = 1;
+        return CGAL::Mesh_2::IMPERATIVELY_BAD;
+      }
+      const double area = 2 * CGAL::to_double(this->traits.compute_area_2_object()(pa, pb, pc));
+      q.first = (area * area) / (max_sq * second_sq);
+      return q.sine() < this->B ? CGAL::Mesh_2::BAD : CGAL::Mesh_2::NOT_BAD;
+    }
+
+   private:
+    SizeField field_;
+  };
+  Is_bad is_bad_object() const { return Is_bad(this->bound(), field_, this->traits); }
+
+ private:
+  SizeField field_;
+};
+using Mesher = CGAL::Delaunay_mesher_no_edge_refinement_2<Cdt, GradedCriteria>;
+
+/// Points x_0 = a < x_1 < ... < x_N = a + L (N >= min_segments) whose spacing follows the field
+/// f: equal steps of the integral of 1 / f. With a uniform field, a + L i / N.
+std::vector<double> graded_points(double a, double L, const SizeField& f, int min_segments) {
+  const double b = a + L;
+  if (f.gap <= 1.0) {
+    const int N = std::max(min_segments, int(std::ceil(L / f.size - 1e-9)));
+    std::vector<double> x(N + 1);
+    for (int i = 0; i <= N; ++i) x[i] = i == 0 ? a : (i == N ? b : a + L * i / N);
+    return x;
+  }
+  constexpr int kSamples = 4096;
+  std::vector<double> cum(kSamples + 1, 0.0);
+  const double dx = (b - a) / kSamples;
+  for (int k = 0; k < kSamples; ++k) cum[k + 1] = cum[k] + dx / f(a + (k + 0.5) * dx);
+  const int N = std::max(min_segments, int(std::ceil(cum[kSamples] - 1e-9)));
+  std::vector<double> x(N + 1);
+  x[0] = a;
+  x[N] = b;
+  int k = 0;
+  for (int i = 1; i < N; ++i) {
+    const double target = cum[kSamples] * i / N;
+    while (cum[k + 1] < target) ++k;
+    x[i] = a + dx * (k + (target - cum[k]) / (cum[k + 1] - cum[k]));
+  }
+  return x;
+}
 using Point = Cdt::Point;
 using Sparse = Eigen::SparseMatrix<double>;
 using Ldlt = Eigen::SimplicialLDLT<Sparse>;
@@ -125,8 +215,8 @@ void factor_free(const Sparse& L, const std::vector<int>& free, Ldlt& solver) {
 
 TriMesh::TriMesh(const TriMeshParams& p, const Eigen::Matrix3Xd& X_ref) {
   if (!(std::isfinite(p.Rc) && p.Rc > 0 && std::isfinite(p.period) && p.period > 0 && std::isfinite(p.size) &&
-        p.size > 0 && p.angle_bound > 0))
-    throw std::invalid_argument("TriMesh: Rc, period, size and angle_bound must be positive and finite");
+        p.size > 0 && p.angle_bound > 0 && std::isfinite(p.gap_size) && p.gap_size >= 1.0))
+    throw std::invalid_argument("TriMesh: Rc, period, size and angle_bound must be positive and finite, gap_size >= 1");
   const int n = int(X_ref.cols());
   if (n < 3) throw std::invalid_argument("TriMesh: at least 3 rings");
   // The shape is the wall's, taken from a run: a shape the strip cannot hold is a numerical
@@ -153,24 +243,25 @@ TriMesh::TriMesh(const TriMeshParams& p, const Eigen::Matrix3Xd& X_ref) {
 
   // ---- the constrained triangulation
   Cdt cdt;
-  const int m = std::max(2, int(std::ceil(Rc / p.size - 1e-9)));
-  const int mx = std::max(4, int(std::ceil(P / p.size - 1e-9)));
-  std::vector<double> cut_r(m + 1);
-  for (int j = 0; j <= m; ++j) cut_r[j] = j == m ? Rc : Rc * j / m;
+  const SizeField field{p.size, p.gap_size, Rc, xmin, xmax};
+  // the cuts (in the gap's middle) divided at the field's size there, the axis and the container
+  // wall along the field
+  const std::vector<double> cut_r = graded_points(0.0, Rc, SizeField{field(xL), 1.0, Rc, 0, 0}, 2);
+  const int m = int(cut_r.size()) - 1;
   for (int j = 0; j < m; ++j) {
     cdt.insert_constraint(Point(xL, cut_r[j]), Point(xL, cut_r[j + 1]));
     cdt.insert_constraint(Point(xR, cut_r[j]), Point(xR, cut_r[j + 1]));
   }
-  for (int i = 0; i < mx; ++i) {
-    const double a = i == 0 ? xL : xL + P * i / mx, b = i + 1 == mx ? xR : xL + P * (i + 1) / mx;
-    cdt.insert_constraint(Point(a, 0.0), Point(b, 0.0));
-    cdt.insert_constraint(Point(a, Rc), Point(b, Rc));
+  const std::vector<double> line_x = graded_points(xL, P, field, 4);
+  for (std::size_t i = 0; i + 1 < line_x.size(); ++i) {
+    cdt.insert_constraint(Point(line_x[i], 0.0), Point(line_x[i + 1], 0.0));
+    cdt.insert_constraint(Point(line_x[i], Rc), Point(line_x[i + 1], Rc));
   }
   for (int k = 0; k + 1 < n; ++k)
     cdt.insert_constraint(Point(X_ref(0, k), X_ref(1, k)), Point(X_ref(0, k + 1), X_ref(1, k + 1)));
   {
     Mesher mesher(cdt);
-    mesher.set_criteria(Criteria(p.angle_bound, p.size));
+    mesher.set_criteria(GradedCriteria(p.angle_bound, field));
     mesher.refine_mesh();
   }
 

@@ -47,6 +47,10 @@ struct TriMeshParams {
   double Rc = 0, period = 0;  ///< container radius and period, m
   double size = 0;            ///< longest edge of a triangle (where the rings do not set a finer one), m
   double angle_bound = 0.125; ///< CGAL's shape criterion b = sin^2 theta_min (circumradius over shortest edge <= 1 / (2 sqrt(b)))
+  /// Beyond the tube's ends (the gap between them, which the period closes) the size bound grows
+  /// with the axial distance d from the nearer end as size min(gap_size, 1 + 5 d / Rc), the
+  /// rate of the structured mesh's gap columns; 1: the same size everywhere.
+  double gap_size = 1.0;
 };
 
 class TriMesh final : public MeridianMesh {

@@ -142,6 +142,19 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
   s["axi"]["mesh"] = "quadrilaterals";  // the angle is the triangulation's
   EXPECT_EQ(input_error_key(s), "axi.remesh_angle");
   s["axi"].erase("remesh_angle");
+  // the gap's triangle size: in [1, 8] times h, the triangulation's (the structured mesh grades
+  // its own gap columns)
+  s["axi"]["mesh"] = "triangles";
+  for (double bad : {0.5, 9.0}) {
+    s["axi"]["gap_size"] = bad;
+    EXPECT_EQ(input_error_key(s), "axi.gap_size") << bad;
+  }
+  s["axi"]["gap_size"] = 1;
+  EXPECT_EQ(input_error_key(s), "(accepted)");
+  s["axi"]["mesh"] = "quadrilaterals";
+  EXPECT_EQ(input_error_key(s), "axi.gap_size");
+  s["axi"].erase("gap_size");
+  EXPECT_EQ(input_error_key(s), "(accepted)");
   s["axi"]["mesh"] = "triangles";
   s["wave"] = {{"kind", "step"}, {"contracted_ratio", 0.55}, {"speed", "10 um/s"}, {"width", "0.05 um"}};
   s.erase("protocol");
