@@ -355,6 +355,7 @@ int run(const RunOptions& o) {
   const reduced1d::Params p = reduced1d::read_scene(sc, resolved, scene_dir.empty() ? "." : scene_dir);
   check_other_tier(sc, "1d");
   check_output_size(estimate_output(p), sc);
+  check_auto_run_output(p, sc);
   const std::string out = o.out.empty() ? "out/" + p.name + "-1d" : o.out;
 
   // 2. Take the folder, run: the series and radius samples stream to disk as they are

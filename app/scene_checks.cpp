@@ -6,6 +6,7 @@
 
 #include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
+#include "common/scene_shared.hpp"
 #include "full3d/scene3d_keys.hpp"
 #include "reduced1d/scene1d.hpp"
 #include "reduced1d/scene1d_keys.hpp"
@@ -79,6 +80,45 @@ OutputEstimate estimate_output(const reduced1d::Params& p) {
   const double series = samples * 19 * kCsvValue;  // the columns of series.csv
   const double radius = samples * p.numerics.cells * 3 * kCsvValue;
   return {series + radius, "time.output_interval"};
+}
+
+void check_auto_run_output(const reduced1d::Params& p, const scene::json& sc) {
+  if (p.duration > 0 || p.wave != reduced1d::WaveKind::ForceDriven) return;
+  const auto limit = static_cast<double>(scene::output_limits(sc).max_bytes);
+  const double dt = p.numerics.output_interval;
+  const double per_sample = (19.0 + 3.0 * p.numerics.cells) * kCsvValue;  // as estimate_output
+  // the end-time bound (5 relaxation times and more per cycle, far above a cycle as a rule):
+  // when even its output fits, no run is needed to know
+  if ((std::floor(reduced1d::end_time(p) / dt) + 2.0) * per_sample <= limit) return;
+  const double samples = std::floor(limit / per_sample) - 2.0;
+  const double t_budget = std::max(0.0, samples) * dt;
+  struct BudgetReached {
+    double t;
+  };
+  reduced1d::Params q = p;
+  q.numerics.threads = 1;  // the progress callback throws: on the integrating thread
+  // samples only as often as the check needs them (the integration does not depend on them),
+  // on the default model's converged grid (its cycle within 0.5 % of N = 400's) when the
+  // scene's is finer: the check costs about one cycle of the screening's
+  q.numerics.output_interval = std::max(dt, t_budget / 256.0);
+  q.numerics.cells = std::min(q.numerics.cells, 50);
+  reduced1d::SolveOptions so;
+  so.keep_samples = false;
+  so.progress = [&](double t, double) {
+    if (t > t_budget) throw BudgetReached{t};
+  };
+  try {
+    (void)reduced1d::solve(q, so);  // a numerical failure is the run's own: it runs and reports it
+  } catch (const BudgetReached& b) {
+    throw InputError("time.output_interval", scene::format_quantity(dt, "s"),
+                     "an interval at which the run's output fits output.max_bytes = " +
+                         std::to_string(static_cast<long long>(limit)) +
+                         " bytes: this force-driven run lasts until its cycles complete, and integrated without "
+                         "output it had not completed them by t = " + scene::format_quantity(b.t, "s") +
+                         ", where its series and radius samples (about " + human(per_sample) +
+                         " each) reach the limit; raise time.output_interval, set time.duration, or raise "
+                         "output.max_bytes");
+  }
 }
 
 OutputEstimate estimate_output(const full3d::Params3d& p) {

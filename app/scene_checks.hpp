@@ -39,4 +39,11 @@ OutputEstimate estimate_output(const full3d::Params3d& p);
 /// output.max_bytes of the scene.
 void check_output_size(const OutputEstimate& e, const scene::json& scene);
 
+/// A 1D force-driven run with time.duration "auto" has no estimate before it runs. When the
+/// output of its end-time bound (reduced1d::end_time) exceeds output.max_bytes, it is first
+/// integrated without output up to the time its samples would reach the limit: if its cycles
+/// have not completed by then, InputError naming time.output_interval (before anything is
+/// written). A run that fails numerically before that is left to fail as itself.
+void check_auto_run_output(const reduced1d::Params& p, const scene::json& scene);
+
 }  // namespace swim::app

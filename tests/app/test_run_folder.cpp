@@ -422,22 +422,32 @@ TEST(RunFolderCli, BothTiersWriteTheSameKeysAndColumns) {
   fs::remove_all(d);
 }
 
-// A run without a size estimate (a force-driven run until its cycles complete) is bounded
-// while it runs: the row that passes output.max_bytes ends it with exit 3, its results so far
-// written and marked failed.
-TEST(RunFolderCli, ARunWithoutAnEstimateStopsAtTheOutputLimit) {
+// A 1D run without a size estimate (a force-driven run until its cycles complete) whose
+// end-time bound's output exceeds output.max_bytes is first integrated without output: the demo
+// (a cycle of 0.52 s) at 20 kB and the default 0.5 ms interval has not completed its cycle when
+// its samples (about 2.9 kB each) would reach the limit, so it is refused (exit 2 naming
+// time.output_interval and the limit) before anything is written; at a 0.1 s interval its cycle
+// completes within the budget and the run writes its results below the limit (exit 0). Fails if
+// the run starts and stops at the limit (exit 3, a folder of partial results), or if a run
+// that fits is refused.
+TEST(RunFolderCli, AnAutoRunWhoseCyclesOutlastTheOutputLimitIsRefusedBeforeItWrites) {
   const fs::path d = tmpdir("runtime_limit");
   const fs::path out = d / "run";
   const Cli c = swim_cli("run \"" + kDemo + "\" --set output.max_bytes=20000 --out \"" + out.string() + "\"", d);
-  EXPECT_EQ(c.code, 3) << c.err;
+  EXPECT_EQ(c.code, 2) << c.err;
+  EXPECT_NE(c.err.find("time.output_interval"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("output.max_bytes = 20000"), std::string::npos) << c.err;
+  EXPECT_FALSE(fs::exists(out));
+  const Cli ok = swim_cli("run \"" + kDemo + "\" --set output.max_bytes=60000 --set time.output_interval='0.1 s' --out \"" +
+                              out.string() + "\"",
+                          d);
+  EXPECT_EQ(ok.code, 0) << ok.err;
   const json s = summary_of(out);
   ASSERT_TRUE(s.is_object());
-  EXPECT_EQ(s["status"].get<std::string>().rfind("failed", 0), 0u) << s["status"];
-  // within one row and one radius snapshot (a few kB) of the limit
+  EXPECT_EQ(s["status"], "ok");
+  EXPECT_EQ(s["cycles_completed"], 1);
   const auto written = fs::file_size(out / "series.csv") + fs::file_size(out / "radius.csv");
-  EXPECT_GT(written, 20000u);
-  EXPECT_LT(written, 30000u);
+  EXPECT_LT(written, 60000u);
   expect_consistent_folder(out);
   // the same run with the default limit completes
   EXPECT_EQ(swim_cli("run \"" + kDemo + "\" --out \"" + (d / "full").string() + "\"", d).code, 0);
