@@ -11,9 +11,12 @@
 // refinement_2): the strip [x_L, x_L + P] x [0, Rc], x_L in the middle of the gap between the
 // tube's ends, with the wall's segments (ring to ring), the axis, the container wall and the two
 // cuts x = x_L, x_L + P as constraints. The cuts carry the same points (radii Rc j / m, m =
-// ceil(Rc / size)) and, since no constrained edge is split, keep them: the two cuts' vertices are
-// identified (the mesh is periodic), and every ring is a vertex and every wall segment an edge.
-// Triangles are refined until their longest edge is below `size` and their smallest angle above
+// ceil(Rc / s), s the size bound at the cuts) and, since no constrained edge is split, keep
+// them: the two cuts' vertices are identified (the mesh is periodic), and every ring is a vertex
+// and every wall segment an edge.
+// Triangles are refined until their longest edge is below `size` (beyond the tube's ends, in the
+// gap the period closes, below the larger bound of TriMeshParams::gap_size; the axis and the
+// container wall divided along the same field) and their smallest angle above
 // asin(sqrt(angle_bound)) (20.7 deg for the default 0.125) wherever a new vertex does not
 // encroach on a constraint; near the wall the rings' spacing sets the elements' size, which then
 // grows away from it.
