@@ -70,26 +70,32 @@ void check_sweep_scenes(const sweep::Sweep& sw) {
   }
 }
 
+namespace {
+// Bytes of one 1D output sample: a row of series.csv (19 columns) and a radius snapshot (three
+// values per cell).
+double bytes_per_sample(const reduced1d::Params& p) { return (19.0 + 3.0 * p.numerics.cells) * kCsvValue; }
+// Bytes of the samples of a 1D run over `span` seconds.
+double sample_bytes(const reduced1d::Params& p, double span) {
+  return (std::floor(span / p.numerics.output_interval) + 2.0) * bytes_per_sample(p);
+}
+}  // namespace
+
 OutputEstimate estimate_output(const reduced1d::Params& p) {
   // The span is known for a given duration and for a prescribed wave (its transit time);
   // a force-driven run with duration "auto" lasts until its cycles complete, which is only
   // known when it ends (end_time() is a loose upper bound): no estimate.
   if (!(p.duration > 0) && p.wave == reduced1d::WaveKind::ForceDriven) return {0.0, "time.duration"};
-  const double span = reduced1d::end_time(p);
-  const double samples = std::floor(span / p.numerics.output_interval) + 2;
-  const double series = samples * 19 * kCsvValue;  // the columns of series.csv
-  const double radius = samples * p.numerics.cells * 3 * kCsvValue;
-  return {series + radius, "time.output_interval"};
+  return {sample_bytes(p, reduced1d::end_time(p)), "time.output_interval"};
 }
 
 void check_auto_run_output(const reduced1d::Params& p, const scene::json& sc) {
   if (p.duration > 0 || p.wave != reduced1d::WaveKind::ForceDriven) return;
   const auto limit = static_cast<double>(scene::output_limits(sc).max_bytes);
   const double dt = p.numerics.output_interval;
-  const double per_sample = (19.0 + 3.0 * p.numerics.cells) * kCsvValue;  // as estimate_output
+  const double per_sample = bytes_per_sample(p);
   // the end-time bound (5 relaxation times and more per cycle, far above a cycle as a rule):
   // when even its output fits, no run is needed to know
-  if ((std::floor(reduced1d::end_time(p) / dt) + 2.0) * per_sample <= limit) return;
+  if (sample_bytes(p, reduced1d::end_time(p)) <= limit) return;
   const double samples = std::floor(limit / per_sample) - 2.0;
   const double t_budget = std::max(0.0, samples) * dt;
   struct BudgetReached {
