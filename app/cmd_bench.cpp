@@ -662,14 +662,22 @@ struct AxiCycle {
 /// CPU time of one numeric factorisation of its fitted system (the unit of this method's cost:
 /// a step factors or reuses, and solves three times; both in CPU time, so that the ratio holds
 /// on a busy machine).
-AxiCycle run_axi_cycle(const std::string& out, int cells, int threads) {
-  scene::json sc = scene::load_file(data_dir() + "/scenes/paper_amplitude_0.82.json");
+/// A shipped scene (data/scenes/<file>) with its wall held round as the converged suite holds it
+/// (axisymmetric, the geometric recovery end, its bending rigidity fixed), then `sets`.
+scene::json converged_round_wall(const std::string& file, const std::vector<std::string>& sets) {
+  scene::json sc = scene::load_file(data_dir() + "/scenes/" + file);
   for (const char* set : {"full3d.membrane.axisymmetric=true", "full3d.recovery_end=\"shape\"",
-                          "full3d.membrane.bending_rigidity=\"2.1184615504e-24 J\"", "axi.spacing_factor=0.5",
-                          "axi.tolerance=1.25e-4"})
+                          "full3d.membrane.bending_rigidity=\"2.1184615504e-24 J\""})
     scene::apply_override(sc, set);
-  scene::apply_override(sc, "axi.grid.cells_across=" + std::to_string(cells));
-  scene::apply_override(sc, "axi.threads=" + std::to_string(threads));
+  for (const auto& set : sets) scene::apply_override(sc, set);
+  return sc;
+}
+
+AxiCycle run_axi_cycle(const std::string& out, int cells, int threads) {
+  const scene::json sc = converged_round_wall(
+      "paper_amplitude_0.82.json", {"axi.spacing_factor=0.5", "axi.tolerance=1.25e-4",
+                                    "axi.grid.cells_across=" + std::to_string(cells),
+                                    "axi.threads=" + std::to_string(threads)});
   scene::json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
   AxiCycle c;
@@ -749,14 +757,11 @@ struct AxiHooked {
   bool failed = false;
 };
 AxiHooked run_axi_hooked(const std::string& out, int cells, double gap_size) {
-  scene::json sc = scene::load_file(data_dir() + "/scenes/paper_aspect_L0.8.json");
-  for (const char* set : {"full3d.membrane.axisymmetric=true", "full3d.recovery_end=\"shape\"",
-                          "full3d.membrane.bending_rigidity=\"2.1184615504e-24 J\"", "protocol.pressure=\"0.5 Pa\"",
-                          "axi.mesh=\"triangles\"", "axi.spacing_factor=0.5", "axi.rim_refinement=0.25",
-                          "axi.tolerance=5e-4", "axi.time_limit=\"8 s\"", "axi.threads=2"})
-    scene::apply_override(sc, set);
-  scene::apply_override(sc, "axi.grid.cells_across=" + std::to_string(cells));
-  scene::apply_override(sc, "axi.gap_size=" + std::to_string(gap_size));
+  const scene::json sc = converged_round_wall(
+      "paper_aspect_L0.8.json",
+      {"protocol.pressure=\"0.5 Pa\"", "axi.mesh=\"triangles\"", "axi.spacing_factor=0.5", "axi.rim_refinement=0.25",
+       "axi.tolerance=5e-4", "axi.time_limit=\"8 s\"", "axi.threads=2",
+       "axi.grid.cells_across=" + std::to_string(cells), "axi.gap_size=" + std::to_string(gap_size)});
   scene::json resolved;
   const axi::ParamsAxi p = axi::read_scene_axi(sc, resolved);
   const std::string dir = out + "/axi_hooked_gap" + std::to_string(int(gap_size));
