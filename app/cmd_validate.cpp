@@ -1,11 +1,14 @@
 // swim validate [SUITE] [--quick]: the 1D-vs-3D validation report (validation/suite.hpp).
 #include <algorithm>
 #include <array>
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include <unistd.h>
 
 #include "app/app.hpp"
 #include "app/ranks.hpp"
@@ -48,19 +51,54 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
     // finest grid after the grid whose cycle sets its frame interval), into the suite's cache;
     // the report's pass below then reads them as it reads any cached run
     const scene::json plan = validation::plan_runs(o);
+    // each run's own progress as whole lines prefixed by the run and its rank (the ranks share
+    // one terminal); on when the master's stderr is a terminal or --progress forces it
+    const int run_progress = progress > 0 || (progress < 0 && isatty(STDERR_FILENO) != 0) ? 1 : 0;
     std::vector<ranks::Task> tasks;
-    for (const auto& j : plan)
-      tasks.push_back({j["label"].get<std::string>(), {{"kind", "validate"}, {"job", j["job"]}}, j["cost"].get<double>(),
-                       j["after"].get<std::vector<std::size_t>>()});
+    for (std::size_t i = 0; i < plan.size(); ++i) {
+      scene::json job = plan[i]["job"];
+      job["progress"] = run_progress;
+      tasks.push_back({plan[i]["label"].get<std::string>(),
+                       {{"kind", "validate"},
+                        {"job", std::move(job)},
+                        {"tag", "run " + std::to_string(i + 1) + "/" + std::to_string(plan.size())}},
+                       plan[i]["cost"].get<double>(),
+                       plan[i]["after"].get<std::vector<std::size_t>>()});
+    }
+    const auto t0 = std::chrono::steady_clock::now();
+    auto now = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    validation::PlanClock clock(plan, ranks::size());
+    std::vector<int> on_rank(tasks.size(), 0);
     size_t finished = 0;
-    const ranks::Outcome r = ranks::distribute(tasks, run_task, 1, [&](size_t i, const scene::json& res) {
-      ++finished;
-      if (progress != 0)
-        std::fprintf(stderr, "validate: run %zu/%zu (%s) on the ranks: %s\n", finished, tasks.size(),
-                     tasks[i].label.c_str(),
-                     res.contains("error") ? res["error"].get<std::string>().c_str()
-                                           : res.value("status", std::string()).c_str());
-    });
+    const ranks::Outcome r = ranks::distribute(
+        tasks, run_task, 1,
+        [&](size_t i, const scene::json& res) {
+          ++finished;
+          // a run read from the cache, not needed, or failed (often at once) does not time its kind
+          const std::string status = res.value("status", std::string());
+          const bool computed = !res.contains("error") && !res.value("cached", false) &&
+                                status.rfind("not needed", 0) != 0 && status.rfind("failed", 0) != 0;
+          const double t = now();
+          clock.finished(i, t, computed);
+          if (progress != 0)
+            std::fprintf(stderr, "validate: run %zu/%zu %s on rank %d %s: %s; %zu of %zu done; %s\n", i + 1,
+                         tasks.size(), tasks[i].label.c_str(), on_rank[i],
+                         res.value("cached", false) ? "(from the cache)"
+                         : status.rfind("not needed", 0) == 0
+                             ? "(not needed)"
+                             : ("in " + si(t - clock.started_at(i), "s")).c_str(),
+                         res.contains("error") ? res["error"].get<std::string>().c_str() : status.c_str(), finished,
+                         tasks.size(),
+                         finished == tasks.size() ? "the report next"
+                                                  : validation::PlanClock::describe(clock.left(t)).c_str());
+        },
+        [&](size_t i, int rank) {
+          on_rank[i] = rank;
+          clock.started(i, now());
+          if (progress != 0)
+            std::fprintf(stderr, "validate: run %zu/%zu started on rank %d: %s\n", i + 1, tasks.size(), rank,
+                         tasks[i].label.c_str());
+        });
     std::printf("validation suite %s: %zu run(s) over %d ranks in %s%s\n", name.c_str(), tasks.size(), ranks::size(),
                 si(r.wall_s, "s").c_str(),
                 r.lost.empty() ? "" : (", " + std::to_string(r.lost.size()) + " rank(s) lost (their runs redone)").c_str());

@@ -53,10 +53,12 @@ json run_guarded(const Work& work, const json& payload);
 
 /// Every task in this process, in order (no ranks to spread them over).
 [[maybe_unused]] Outcome run_here(const std::vector<Task>& tasks, const Work& work,
-                                  const std::function<void(std::size_t, const json&)>& on_result) {
+                                  const std::function<void(std::size_t, const json&)>& on_result,
+                                  const std::function<void(std::size_t, int)>& on_start) {
   Outcome o;
   const auto t0 = Clock::now();
   for (std::size_t i = 0; i < tasks.size(); ++i) {
+    if (on_start) on_start(i, 0);
     o.results.push_back(run_guarded(work, tasks[i].payload));
     o.ran_on.push_back(0);
     if (on_result) on_result(i, o.results.back());
@@ -111,8 +113,9 @@ std::string unsupported_launch() {
 }
 int serve(const Work&) { return 0; }
 Outcome distribute(const std::vector<Task>& tasks, const Work& work, int,
-                   const std::function<void(std::size_t, const json&)>& on_result) {
-  return run_here(tasks, work, on_result);
+                   const std::function<void(std::size_t, const json&)>& on_result,
+                   const std::function<void(std::size_t, int)>& on_start) {
+  return run_here(tasks, work, on_result, on_start);
 }
 void stop_workers() {}
 
@@ -353,8 +356,9 @@ std::vector<RankState> g_ranks;
 }  // namespace
 
 Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
-                   const std::function<void(std::size_t, const json&)>& on_result) {
-  if (!g_mpi || g_size == 1) return run_here(tasks, work, on_result);
+                   const std::function<void(std::size_t, const json&)>& on_result,
+                   const std::function<void(std::size_t, int)>& on_start) {
+  if (!g_mpi || g_size == 1) return run_here(tasks, work, on_result, on_start);
   Outcome o;
   const auto t0 = Clock::now();
   const double cpu0 = thread_cpu_s();
@@ -460,6 +464,7 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
     for (long i; local_held.empty() && (i = next_ready()) >= 0;) {
       state[i] = 1;
       local_held.push_back(static_cast<std::size_t>(i));
+      if (on_start) on_start(static_cast<std::size_t>(i), 0);
       local.push(static_cast<std::size_t>(i), tasks[i].payload);
       busy = true;
     }
@@ -469,6 +474,7 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
         state[i] = 1;
         rs.held.push_back(static_cast<std::size_t>(i));
         --rs.capacity;
+        if (on_start) on_start(static_cast<std::size_t>(i), r);
         send_buffers.push_back(std::make_unique<std::string>(json{{"task", i}, {"payload", tasks[i].payload}}.dump()));
         sends.emplace_back();
         MPI_Isend(send_buffers.back()->data(), static_cast<int>(send_buffers.back()->size()), MPI_CHAR, r, kTask,
@@ -504,7 +510,6 @@ Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth,
     if (busy) {
       backoff.reset();
     } else {
-      // a result of rank 0's own thread wakes the wait at once
       // a result of rank 0's own thread wakes the wait at once; the ranks' messages are seen
       // within 2 ms (a rank holding two tasks does not wait for the hand-over)
       for (auto& [id, result] : local.take(backoff.next(2000))) {

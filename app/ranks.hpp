@@ -68,13 +68,16 @@ struct Outcome {
 
 /// Rank 0: run every task over the ranks and return the results in task order. depth: tasks a
 /// remote rank may hold at once (2 hides the hand-over latency of short runs; 1 balances long
-/// runs best). on_result(i, result) is called on rank 0's main thread as each result arrives.
+/// runs best). on_result(i, result) is called on rank 0's main thread as each result arrives;
+/// on_start(i, rank) as task i is handed to a rank (0: rank 0's own thread; a lost rank's task
+/// is handed out again).
 /// Lost ranks (a crash, a kill) are reported on stderr and in the outcome; their tasks are redone
 /// by the others. A SIGINT/SIGTERM/SIGHUP (mpirun stopping the job after a rank died without
 /// --enable-recovery) prints the runs in flight and ends the process with 128 + the signal;
 /// outside this call rank 0 says it was stopped and ends the same way (Session installs it).
 Outcome distribute(const std::vector<Task>& tasks, const Work& work, int depth = 1,
-                   const std::function<void(std::size_t, const json&)>& on_result = {});
+                   const std::function<void(std::size_t, const json&)>& on_result = {},
+                   const std::function<void(std::size_t, int)>& on_start = {});
 
 /// Rank 0: tells every worker rank to stop (once; later calls do nothing). Session's end calls
 /// it, whatever the command's outcome.

@@ -4,6 +4,8 @@
 #include <stdexcept>
 
 #include "app/app.hpp"
+#include "app/ranks.hpp"
+#include "common/progress.hpp"
 #include "design/confirm.hpp"
 #include "full3d/scene3d.hpp"
 #include "reduced1d/scene1d.hpp"
@@ -25,7 +27,12 @@ scene::json run_task(const scene::json& t) {
                                                            t.at("error_estimate").get<bool>(),
                                                            t.at("metric").get<std::string>(),
                                                            t.value("tier", std::string("3d"))));
-  if (kind == "validate") return validation::run_planned(t.at("job"));
+  if (kind == "validate") {
+    // the run's progress lines name it and the rank it runs on (the ranks share one terminal)
+    const Progress::Context named(t.value("tag", std::string("a run")) + " on rank " + std::to_string(ranks::rank()) + ": ",
+                                  true);
+    return validation::run_planned(t.at("job"));
+  }
   throw std::logic_error("unknown task kind " + kind);
 }
 

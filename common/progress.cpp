@@ -3,12 +3,29 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <string>
+#include <utility>
 
 namespace swim {
 
+namespace {
+thread_local std::string t_prefix;
+thread_local bool t_lines = false;
+}  // namespace
+
+Progress::Context::Context(std::string prefix, bool lines) : saved_prefix_(t_prefix), saved_lines_(t_lines) {
+  t_prefix = std::move(prefix);
+  t_lines = lines;
+}
+
+Progress::Context::~Context() {
+  t_prefix = std::move(saved_prefix_);
+  t_lines = saved_lines_;
+}
+
 Progress::Progress(std::string label, double t_end, int enabled)
-    : label_(std::move(label)), t_end_(t_end),
-      on_(enabled < 0 ? isatty(STDERR_FILENO) != 0 : enabled > 0), tty_(isatty(STDERR_FILENO) != 0),
+    : label_(t_prefix + std::move(label)), t_end_(t_end),
+      on_(enabled < 0 ? isatty(STDERR_FILENO) != 0 : enabled > 0), tty_(!t_lines && isatty(STDERR_FILENO) != 0),
       start_(std::chrono::steady_clock::now()), last_(start_) {}
 
 Progress::~Progress() { done(); }

@@ -12,6 +12,22 @@ namespace swim {
 
 class Progress {
  public:
+  /// While alive, every Progress this thread creates puts `prefix` before its label and, with
+  /// `lines`, writes whole lines even on a terminal (several processes sharing one terminal, the
+  /// ranks of an MPI command, would otherwise overwrite each other's line). Nested contexts
+  /// restore the outer one.
+  class Context {
+   public:
+    Context(std::string prefix, bool lines);
+    ~Context();
+    Context(const Context&) = delete;
+    Context& operator=(const Context&) = delete;
+
+   private:
+    std::string saved_prefix_;
+    bool saved_lines_;
+  };
+
   /// enabled: -1 = only when stderr is a terminal, 0 = never, 1 = always.
   Progress(std::string label, double t_end, int enabled = -1);
   ~Progress();

@@ -1,9 +1,12 @@
 #include "validation/suite.hpp"
 
-#include <vector>
+#include <algorithm>
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <map>
+#include <vector>
 
 #include "axi/scene_axi.hpp"
 #include "common/errors.hpp"
@@ -120,16 +123,26 @@ json plan_runs(const SuiteOptions& o) {
     }
     if (cs.contains("reference")) {
       const json& rs = cs["reference"];
-      std::vector<json> scenes;  // its grids, then its checks' runs
-      for (const json& g : rs["grids"]) scenes.push_back(reference_scene(base, rs, g));
-      for (json s : {tolerance_check_scene(base, rs), spacing_check_scene(base, rs)})
-        if (!s.is_null()) scenes.push_back(std::move(s));
-      for (const json& s : scenes) {
+      std::vector<std::pair<json, std::string>> scenes;  // its grids, then its checks' runs
+      const std::string ref_key = rs.value("grid_key", std::string("axi.grid.cells_across"));
+      auto at = [&](const json& g) {
+        return ref_key == "axi.grid.cells_across" && g.is_number() ? g.dump() + " cells across" : ref_key + " = " + g.dump();
+      };
+      for (const json& g : rs["grids"]) scenes.emplace_back(reference_scene(base, rs, g), " at " + at(g));
+      const std::string coarsest = at(rs["grids"][coarsest_reference_grid(base, rs)]);
+      if (json s = tolerance_check_scene(base, rs); !s.is_null())
+        scenes.emplace_back(std::move(s), " at " + coarsest + ", its time-step check");
+      if (json s = spacing_check_scene(base, rs); !s.is_null())
+        scenes.emplace_back(std::move(s), " at " + coarsest + ", its wall-spacing check");
+      for (const auto& [s, where] : scenes) {
         json resolved;
         const axi::ParamsAxi p = axi::read_scene_axi(s, resolved);
         key = run_key_axi(resolved);
-        add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
-            double(p.nr) * p.nx * (p.time_limit / p.dt_max));
+        // the cost of a simulated second grows about as h^-2.5 on the measured series (h^-2
+        // nodes, steps from h^-0.5 to h^-1 under the error control)
+        const std::size_t j = add({{"type", "axi"}, {"scene", s}, {"runs_dir", runs_dir}},
+                                  std::pow(double(p.nr) * p.nx, 1.25) * (p.time_limit / p.dt_max));
+        jobs[j]["label"] = jobs[j]["label"].get<std::string>() + where;
       }
     }
     const std::size_t cg = std::size_t(cs.value("calibration_grid", long(grids.size()) - 1));
@@ -173,10 +186,74 @@ json plan_runs(const SuiteOptions& o) {
   return jobs;
 }
 
+PlanClock::PlanClock(const json& plan, int ranks) : ranks_(std::max(1, ranks)) {
+  for (const json& j : plan) {
+    kind_.push_back(j["job"]["type"].get<std::string>());
+    cost_.push_back(j["cost"].get<double>());
+  }
+  start_.assign(kind_.size(), -1.0);
+  done_.assign(kind_.size(), false);
+}
+
+void PlanClock::started(std::size_t job, double t) { start_.at(job) = t; }
+
+void PlanClock::finished(std::size_t job, double t, bool computed) {
+  done_.at(job) = true;
+  if (!computed || start_[job] < 0 || !(cost_[job] > 0)) return;
+  auto it = std::find_if(timed_.begin(), timed_.end(), [&](const auto& e) { return e.first == kind_[job]; });
+  if (it == timed_.end()) it = timed_.insert(timed_.end(), {kind_[job], {0.0, 0.0}});
+  it->second[0] += std::max(0.0, t - start_[job]);
+  it->second[1] += cost_[job];
+}
+
+const std::array<double, 2>* PlanClock::rate(const std::string& kind) const {
+  for (const auto& [k, v] : timed_)
+    if (k == kind) return &v;
+  return nullptr;
+}
+
+PlanClock::Left PlanClock::left(double t) const {
+  Left l;
+  double work = 0, longest = 0;
+  std::vector<std::string> kinds;
+  for (std::size_t i = 0; i < kind_.size(); ++i) {
+    if (done_[i]) continue;
+    const auto* r = rate(kind_[i]);
+    if (!r) {
+      ++l.untimed;
+      if (std::find(kinds.begin(), kinds.end(), kind_[i]) == kinds.end()) kinds.push_back(kind_[i]);
+      continue;
+    }
+    double est = cost_[i] * (*r)[0] / (*r)[1];
+    if (start_[i] >= 0) est = std::max(0.0, est - (t - start_[i]));
+    work += est;
+    longest = std::max(longest, est);
+  }
+  l.seconds = std::max(work / ranks_, longest);
+  for (const auto& k : kinds) l.untimed_kinds += (l.untimed_kinds.empty() ? "" : ", ") + k;
+  return l;
+}
+
+std::string PlanClock::describe(const Left& l) {
+  auto span = [](double s) {
+    char b[64];
+    if (s < 90) std::snprintf(b, sizeof b, "%.0f s", s);
+    else if (s < 600) std::snprintf(b, sizeof b, "%.1f min", s / 60);
+    else if (s < 5400) std::snprintf(b, sizeof b, "%.0f min", s / 60);
+    else std::snprintf(b, sizeof b, "%.1f h", s / 3600);
+    return std::string(b);
+  };
+  if (l.untimed == 0) return l.seconds < 1 ? "less than 1 s left" : "about " + span(l.seconds) + " left";
+  const std::string rest = std::to_string(l.untimed) + " run(s) (" + l.untimed_kinds + ") not yet timed";
+  if (l.seconds > 0) return "about " + span(l.seconds) + " left and " + rest;
+  return "time left not yet known: " + rest;
+}
+
 json run_planned(const json& job) {
   // a rank runs many jobs: the keys of the folders it has read serve all of them
   static FolderKeys keys;
   const std::string type = job.at("type").get<std::string>();
+  const int progress = job.value("progress", 0);
   if (type == "3d") {
     RunCache cache(job["runs_dir"], "", job["threads"], keys);  // this job's view; the report's pass has its own
     double frames = 0;
@@ -191,18 +268,18 @@ json run_planned(const json& job) {
       if (with_cycle < 2 && !job["unless_no_reference"].value("has_axi_reference", false))
         return {{"status", "not needed: the case has no reference"}};
     }
-    const Run3d r = cache.run_3d(job["scene"], frames);
+    const Run3d r = cache.run_3d(job["scene"], frames, progress);
     return {{"status", r.record.value("status", std::string("unknown"))}, {"cached", r.cached}};
   }
   if (type == "axi") {
     RunCache cache(job["runs_dir"], "", 1, keys);
-    const RunAxi r = cache.run_axi(job["scene"]);
+    const RunAxi r = cache.run_axi(job["scene"], progress);
     return {{"status", r.record.value("status", std::string("unknown"))}, {"cached", r.cached}};
   }
   if (type == "calibration") {
     RunCache cache("", job["cal_dir"], job["threads"], keys);
     json cal;
-    const std::string file = cache.calibration(job["base"], job["grid_key"], job["grid"], job["name"], cal);
+    const std::string file = cache.calibration(job["base"], job["grid_key"], job["grid"], job["name"], cal, {}, progress);
     return {{"status", cal.value("status", std::string("unknown"))}, {"file", file}};
   }
   throw std::logic_error("unknown validation job " + type);

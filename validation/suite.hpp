@@ -28,8 +28,10 @@
 // case (suite_phases.hpp); run_suite calls the phases in the order above.
 #pragma once
 
+#include <array>
 #include <functional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "common/scene.hpp"
@@ -66,6 +68,38 @@ scene::json run_suite(const SuiteOptions& o);
 /// them all and its report is the one a single process writes.
 scene::json plan_runs(const SuiteOptions& o);
 /// Runs one job of plan_runs into the cache (a finished one is reused); returns {"status", ...}.
+/// The job's "progress" (0 or 1, default 0) is the run's own progress (SuiteOptions::run_progress).
 scene::json run_planned(const scene::json& job);
+
+/// The time left of plan_runs's jobs as the ranks work through them. The plan's costs are
+/// comparable within a kind of job (3d, axi, calibration), not across kinds, so each kind gets
+/// its own seconds per unit of cost, measured on the jobs of that kind computed so far (a job
+/// answered from the cache takes no time and measures nothing). Work left is each unfinished
+/// job's estimate (less the time a running one has had), shared over the ranks but never less
+/// than the longest single job left. Times are seconds on any one clock.
+class PlanClock {
+ public:
+  PlanClock(const scene::json& plan, int ranks);
+  void started(std::size_t job, double t);
+  /// computed: false for a job answered from the cache (or failed at once): it does not time its kind
+  void finished(std::size_t job, double t, bool computed);
+  struct Left {
+    double seconds = 0;        ///< the timed kinds' work left
+    std::size_t untimed = 0;   ///< unfinished jobs of kinds without a computed job yet (not in seconds)
+    std::string untimed_kinds; ///< those kinds, "axi, calibration"
+  };
+  Left left(double t) const;
+  double started_at(std::size_t job) const { return start_[job]; }
+  /// "about 12 min left", "about 12 min left and 3 axi run(s) not yet timed", "time left not yet known"
+  static std::string describe(const Left& l);
+
+ private:
+  std::vector<std::string> kind_;
+  std::vector<double> cost_, start_;
+  std::vector<bool> done_;
+  std::vector<std::pair<std::string, std::array<double, 2>>> timed_;  // kind: {seconds, cost}
+  int ranks_;
+  const std::array<double, 2>* rate(const std::string& kind) const;
+};
 
 }  // namespace swim::validation

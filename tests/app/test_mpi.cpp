@@ -10,6 +10,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <regex>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -227,8 +228,32 @@ TEST(MpiValidate, ThreeRanksWriteTheReportOfOneProcess) {
   const std::string args = " validate \"" + (d / "suite.json").string() + "\" --threads 1 --quiet --out ";
   const Cli one = sh("\"" + kSwim + "\"" + args + "\"" + (d / "one").string() + "\"", d, "one");
   ASSERT_EQ(one.code, 0) << one.err;
-  const Cli three = sh(mpirun() + "\"" + kSwim + "\"" + args + "\"" + (d / "three").string() + "\"", d, "three");
+  // with --progress the ranks' runs report as they start and finish, with the time left, and
+  // each computed run's own progress lines name the run and its rank
+  std::string progress_args = args;
+  progress_args.replace(progress_args.find("--quiet"), 7, "--progress");
+  const Cli three = sh(mpirun() + "\"" + kSwim + "\"" + progress_args + "\"" + (d / "three").string() + "\"", d, "three");
   ASSERT_EQ(three.code, 0) << three.err;
+  const json plan_lines = [&] {
+    json n = json::object();
+    for (const char* what : {"started on rank ", " done; ", " done; about ", ": done in "}) {
+      long k = 0;
+      for (std::size_t at = three.err.find(what); at != std::string::npos; at = three.err.find(what, at + 1)) ++k;
+      n[what] = k;
+    }
+    return n;
+  }();
+  const long planned = plan_lines["started on rank "];
+  EXPECT_GE(planned, 5) << three.err;  // two grids, the variant, the calibration, an extreme
+  EXPECT_EQ(plan_lines[" done; "], planned) << three.err;
+  EXPECT_GE(plan_lines[" done; about "], 1) << three.err;  // the time left, once a run of a kind is timed
+  EXPECT_NE(three.err.find("validate: run 1/" + std::to_string(planned) + " started on rank "), std::string::npos)
+      << three.err;
+  EXPECT_NE(three.err.find(" of " + std::to_string(planned) + " done; the report next"), std::string::npos)
+      << three.err;
+  EXPECT_TRUE(std::regex_search(three.err, std::regex("\\nrun [0-9]+/" + std::to_string(planned) +
+                                                       " on rank [0-2]: 3d [^\\n]*: done in ")))
+      << three.err;
   const json r1 = read(d / "one/report.json"), r3 = read(d / "three/report.json");
   EXPECT_EQ(comparable(r3, (d / "three").string()), comparable(r1, (d / "one").string()));
   // the ranks made the 3D runs; the report's pass found them in the cache, verified

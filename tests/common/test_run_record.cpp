@@ -446,6 +446,39 @@ TEST(Progress, ToALogFileItWritesWholeLinesOnly) {
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
 }
 
+// A Progress::Context (a run on an MPI rank) puts its prefix before every label its thread makes
+// while it lives, nested contexts restore the outer one, and none is left after them.
+TEST(Progress, AContextNamesTheRunsOfItsThread) {
+  const std::string d = fresh_dir("progress_context");
+  const std::string path = d + "/stderr.log";
+  std::fflush(stderr);
+  const int saved = dup(STDERR_FILENO);
+  FILE* f = std::fopen(path.c_str(), "w");
+  ASSERT_NE(f, nullptr);
+  dup2(fileno(f), STDERR_FILENO);
+  {
+    const swim::Progress::Context outer("run 2/9 on rank 1: ", true);
+    { swim::Progress p("axi a", 1.0, 1); }
+    {
+      const swim::Progress::Context inner("run 3/9 on rank 1: ", true);
+      swim::Progress p("axi b", 1.0, 1);
+    }
+    { swim::Progress p("axi c", 1.0, 1); }
+  }
+  { swim::Progress p("axi d", 1.0, 1); }
+  std::fflush(stderr);
+  dup2(saved, STDERR_FILENO);
+  close(saved);
+  std::fclose(f);
+  std::ifstream in(path);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_NE(text.find("\nrun 3/9 on rank 1: axi b: done in "), std::string::npos) << text;
+  EXPECT_NE(text.find("\nrun 2/9 on rank 1: axi c: done in "), std::string::npos) << text;
+  EXPECT_EQ(text.rfind("run 2/9 on rank 1: axi a: done in ", 0), 0u) << text;
+  EXPECT_NE(text.find("\naxi d: done in "), std::string::npos) << text;
+  EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 4) << text;
+}
+
 // The Reynolds-number bound of check_plausible: Re = rho max|U| L / mu with the swimmer's fastest
 // speed (either direction) and its length. The record's swimmer (L = 0.4 um, |U| up to 2 nm/s
 // in water, Re = 8e-10) is plausible; at a viscosity 1e9 times smaller (Re = 0.8, a mistyped
