@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <optional>
 
@@ -182,15 +183,27 @@ class Runner {
     tri_ = std::make_shared<TriMesh>(tri_mesh_params(p_), X);
     make_solvers();
     ++remeshes_;
+    remesh_times_.push_back(t_);
     split_remesh_ += seconds_since(t);
   }
 
-  /// Whether the triangulation fitted to the accepted shape X_ has degraded: then it is made
-  /// again on X_. Degraded means a triangle inverted, or the smallest angle fell below
-  /// axi.remesh_angle scaled by how far the mesh, when made, fell short of the mesher's bound
-  /// (TriMesh::remesh_threshold): a shape whose own corners cap every triangulation's smallest
-  /// angle below axi.remesh_angle is not meshed again at every step.
+  /// Keeps the triangulation fitted to the accepted shape X_. With axi.remesh_interval > 0 it is
+  /// made again on X_ at every multiple of the interval (the steps land on them), so the shapes
+  /// the meshes are made on, and when, do not move with the step sequence; in between only a mesh
+  /// that can no longer follow the wall (a triangle inverted, or the smallest angle below half
+  /// the threshold below) is made again. With 0 it is made again whenever it has degraded: a
+  /// triangle inverted, or the smallest angle below axi.remesh_angle scaled by how far the mesh,
+  /// when made, fell short of the mesher's bound (TriMesh::remesh_threshold: a shape whose own
+  /// corners cap every triangulation's smallest angle below axi.remesh_angle is not meshed again
+  /// at every step).
   void keep_triangles_fit() {
+    if (p_.remesh_interval > 0 && t_ >= next_mesh_check_ - 1e-9 * p_.remesh_interval) {
+      next_mesh_check_ = (std::floor(t_ / p_.remesh_interval + 1e-6) + 1.0) * p_.remesh_interval;
+      if (t_ > 0) {
+        remesh(X_);
+        return;
+      }
+    }
     TriMesh probe(*tri_);
     try {
       probe.fit(X_);
@@ -198,7 +211,14 @@ class Runner {
       remesh(X_);
       return;
     }
-    if (probe.min_angle() < tri_->remesh_threshold(p_.remesh_angle)) remesh(X_);
+    const double threshold = tri_->remesh_threshold(p_.remesh_angle) * (p_.remesh_interval > 0 ? 0.5 : 1.0);
+    if (probe.min_angle() < threshold) remesh(X_);
+  }
+
+  /// The next scheduled remesh (axi.remesh_interval), for the step to land on.
+  double mesh_check_bound() const {
+    if (!tri_ || p_.remesh_interval <= 0) return std::numeric_limits<double>::infinity();
+    return std::max(next_mesh_check_ - t_, p_.dt_min);
   }
 
   // ---- checkpoints ----------------------------------------------------------------------
@@ -267,6 +287,7 @@ class Runner {
       const Eigen::Matrix3Xd& R = tri_->reference();
       w.put("mesh_reference", std::vector<double>(R.data(), R.data() + R.size()));
       w.put("remeshes", std::vector<double>{double(remeshes_), split_remesh_});
+      w.put("remesh_times", remesh_times_);
     }
     w.put(full3d::kOutputMarks, marks);
     w.put("wall_time_s", wall);
@@ -291,6 +312,10 @@ class Runner {
       const std::vector<double> m = r.get_vector("remeshes");
       remeshes_ = long(m.at(0));
       split_remesh_ = m.at(1);
+      if (r.has("remesh_times")) remesh_times_ = r.get_vector("remesh_times");
+      // a checkpoint lies between steps: a remesh due at its time has not been made yet
+      if (p_.remesh_interval > 0)
+        next_mesh_check_ = std::ceil(t_ / p_.remesh_interval - 1e-6) * p_.remesh_interval;
     }
     if (fitted_) {
       stage_->set_timing(timing_of(r.get_vector("stage_timing")));
@@ -477,7 +502,8 @@ class Runner {
   void step_ros2() {
     const double tol = p_.tolerance * p_.h;
     constexpr double gamma = 1.0 + 0.70710678118654752440;
-    dt_ = std::min({dt_, p_.dt_max, event_bound()});
+    if (tri_) keep_triangles_fit();
+    dt_ = std::min({dt_, p_.dt_max, event_bound(), mesh_check_bound()});
     if (b_.duration > 0) dt_ = std::min(dt_, b_.duration - t_);
     auto tk = std::chrono::steady_clock::now();
     const Eigen::SparseMatrix<double> K = wall_.stiffness(X_, 1e-6 * b_.R0);
@@ -485,7 +511,6 @@ class Runner {
     const Eigen::Matrix3Xd F0 = total_force(X_);
     const int n = wall_.nodes();
     const EventValue g0 = event_value(X_);  // X_ is an accepted shape: the mesh follows it
-    if (tri_) keep_triangles_fit();
     for (;;) {
       check_dt_min();
       bool valid = true;
@@ -774,7 +799,10 @@ class Runner {
                          : "Cholesky of the regularised system (CHOLMOD), then LU (UMFPACK) after a failure";
       rec_.stats["factorisation_fallbacks"] = fallbacks;
       rec_.stats["mesh"] = tri_ ? "triangles" : "quadrilaterals";
-      if (tri_) rec_.stats["remeshes"] = remeshes_;
+      if (tri_) {
+        rec_.stats["remeshes"] = remeshes_;
+        rec_.stats["remesh_times_s"] = remesh_times_;
+      }
     }
   }
 
@@ -823,6 +851,8 @@ class Runner {
   std::vector<double> fr_, fx_, u_, w_;
   std::array<double, 2> energy_{};
   double t_ = 0, dt_ = 0, dt_last_ = 0, dt_min_taken_ = 0, dt_max_taken_ = 0, t_end_ = 0, next_out_ = 0;
+  double next_mesh_check_ = 0;  ///< s: the triangulation's next scheduled remesh (axi.remesh_interval)
+  std::vector<double> remesh_times_;  ///< s: when the triangulations after the first were made
   double e_cap_ = 0, x_center0_ = 0, next_checkpoint_ = 0, wall_before_ = 0;
   double q_rear_ = 0, q_front_ = 0, vol_rear_ = 0, vol_front_ = 0, step_q_rear_ = 0, step_q_front_ = 0;
   long steps_ = 0, rejected_ = 0, solves_ = 0, last_recorded_ = -1, event_retakes_ = 0;

@@ -33,6 +33,7 @@ const json& section_keys() {
                               {"mesh", "choice:quadrilaterals|triangles"},
                               {"remesh_angle", "quantity:rad@(0,0.3490658503988659)"},
                               {"gap_size", "number@[1,8]"},
+                              {"remesh_interval", "quantity:s@[0,1]"},
                               {"grid", {{"cells_across", "integer@[8,8192]"}, {"cell_size", "quantity:m@positive"}}},
                               {"spacing_factor", "number@(0,2]"},  // (0, 1) for the immersed boundary
                               {"rim_refinement", "number@positive"},
@@ -136,6 +137,11 @@ ParamsAxi read_scene_axi(const json& sc, json& resolved) {
   if (!p.triangles && std::abs(p.remesh_angle - 12.0 * std::numbers::pi / 180.0) > 1e-12)
     throw InputError(a.path("remesh_angle"), fmt(p.remesh_angle, "rad"),
                      "12 degree (the default, unused) unless axi.mesh = \"triangles\"");
+  // triangles: the simulated time between scheduled remeshes (0: whenever the mesh degrades)
+  p.remesh_interval = a.quantity("remesh_interval", "s", p.triangles ? "10 ms" : "0 s", Range::closed(0.0, 1.0));
+  if (!p.triangles && p.remesh_interval != 0.0)
+    throw InputError(a.path("remesh_interval"), fmt(p.remesh_interval, "s"),
+                     "0 s (the default, unused) unless axi.mesh = \"triangles\"");
   // triangles: how much larger than h the triangles may grow in the gap between the tube's ends
   p.gap_size = a.number("gap_size", kGapSize, Range::closed(1.0, 8.0));
   if (!p.triangles && p.gap_size != kGapSize)

@@ -47,6 +47,10 @@ struct ParamsAxi {
   bool triangles = false;      ///< axi.mesh = triangles: the moved triangulation (axi/tri_mesh.hpp) instead
   double remesh_angle = 0.0;   ///< rad: triangles, the smallest angle below which the mesh is made again
   double gap_size = 1.0;       ///< triangles: the gap's largest size bound over h (TriMeshParams::gap_size)
+  /// triangles: s of simulated time between the scheduled remeshes, whose times the steps land
+  /// on; between them only a mesh that cannot follow the wall, or whose smallest angle fell below
+  /// half the threshold, is made again (0: made again whenever it degrades, checked every step)
+  double remesh_interval = 0.0;
   // grid
   int nr = 32, nx = 256;       ///< radial and axial cells
   double h = 0.0;              ///< m

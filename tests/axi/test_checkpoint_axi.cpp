@@ -4,8 +4,11 @@
 // a damaged or foreign checkpoint is refused before anything is restored.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "axi/run_axi.hpp"
 #include "axi/scene_axi.hpp"
@@ -108,7 +111,50 @@ TEST(AxiCheckpoint, AResumedRunOnTrianglesRepeatsTheUninterruptedOneBitForBit) {
   EXPECT_EQ(rb.summary["displacement_m"].get<double>(), ra.summary["displacement_m"].get<double>());
   EXPECT_EQ(read_all(b.path / "series.csv"), read_all(a.path / "series.csv"));
   EXPECT_EQ(read_all(b.path / "radius.csv"), read_all(a.path / "radius.csv"));
-  EXPECT_EQ(json::parse(read_all(b.path / "solver_stats.json"))["remeshes"], stats["remeshes"]);
+  const json stats_b = json::parse(read_all(b.path / "solver_stats.json"));
+  EXPECT_EQ(stats_b["remeshes"], stats["remeshes"]);
+  EXPECT_EQ(stats_b["remesh_times_s"], stats["remesh_times_s"]);
+}
+
+// The scheduled remeshes (axi.remesh_interval, 10 ms by default on triangles) are made at the
+// multiples of the interval whatever the step tolerance, so the shapes the meshes are made on move
+// with the tolerance only by the time integration's error, and the figures converge with it. On
+// the deep contraction above, at the default tolerance and at a quarter of it: the same remesh
+// times, every one a multiple of 10 ms, and the displacement within 1 % (its time error); with
+// the remeshes made whenever the mesh degrades (interval 0), the mesh is made again on other
+// shapes and at times off that clock.
+TEST(AxiCheckpoint, ScheduledRemeshesDoNotMoveWithTheStepTolerance) {
+  json sc = short_round_wall("50 ms");
+  sc["axi"]["mesh"] = "triangles";
+  sc["wave"]["contracted_ratio"] = 0.35;
+  sc["protocol"]["pressure"] = "0.8 Pa";
+  auto run = [&](double tolerance_factor, const char* interval, const std::string& tag) {
+    json s = sc;
+    json resolved;
+    swim::axi::ParamsAxi p = swim::axi::read_scene_axi(s, resolved);
+    s["axi"]["tolerance"] = p.tolerance * tolerance_factor;
+    if (interval) s["axi"]["remesh_interval"] = interval;
+    p = swim::axi::read_scene_axi(s, resolved);
+    TempDir d("swim-axi-remesh-" + tag);
+    const swim::axi::RunOutcomeAxi r = swim::axi::run_axi(p, resolved, d.path.string(), quiet());
+    EXPECT_FALSE(r.failed) << r.message;
+    const json st = json::parse(read_all(d.path / "solver_stats.json"));
+    return std::pair{st["remesh_times_s"].get<std::vector<double>>(), r.summary["displacement_m"].get<double>()};
+  };
+  const auto [times, x] = run(1.0, nullptr, "a");
+  const auto [times_fine, x_fine] = run(0.25, nullptr, "b");
+  ASSERT_FALSE(times.empty());
+  EXPECT_EQ(times, times_fine);
+  for (const double t : times) EXPECT_NEAR(t / 0.01, std::round(t / 0.01), 1e-6) << t;
+  EXPECT_NEAR(x_fine, x, 0.01 * std::abs(x));
+  const auto [times_any, x_any] = run(1.0, "0 s", "c");
+  ASSERT_FALSE(times_any.empty());
+  long off_clock = 0;
+  for (const double t : times_any) off_clock += std::abs(t / 0.01 - std::round(t / 0.01)) > 1e-6;
+  EXPECT_GT(off_clock, 0);
+  std::printf("  scheduled: %zu remeshes, displacement %.6g / %.6g nm; whenever degraded: %zu remeshes, %ld off the "
+              "10 ms clock, %.6g nm\n",
+              times.size(), 1e9 * x, 1e9 * x_fine, times_any.size(), off_clock, 1e9 * x_any);
 }
 
 TEST(AxiCheckpoint, ADamagedOrForeignCheckpointIsRefusedNamingResume) {

@@ -142,6 +142,26 @@ TEST(AxiScene, ScenesTheTierCannotRepresentAreRefusedNamingTheKey) {
   s["axi"]["mesh"] = "quadrilaterals";  // the angle is the triangulation's
   EXPECT_EQ(input_error_key(s), "axi.remesh_angle");
   s["axi"].erase("remesh_angle");
+  // the scheduled remeshes: an interval in [0, 1 s], 10 ms by default on triangles, the
+  // triangulation's only
+  s["axi"]["mesh"] = "triangles";
+  {
+    json resolved;
+    EXPECT_DOUBLE_EQ(swim::axi::read_scene_axi(s, resolved).remesh_interval, 0.01);
+  }
+  for (const char* bad : {"-1 ms", "2 s", "3 m"}) {
+    s["axi"]["remesh_interval"] = bad;
+    EXPECT_EQ(input_error_key(s), "axi.remesh_interval") << bad;
+  }
+  for (const char* good : {"0 s", "2 ms"}) {
+    s["axi"]["remesh_interval"] = good;
+    EXPECT_EQ(input_error_key(s), "(accepted)") << good;
+  }
+  s["axi"]["mesh"] = "quadrilaterals";
+  EXPECT_EQ(input_error_key(s), "axi.remesh_interval");
+  s["axi"]["remesh_interval"] = "0 s";
+  EXPECT_EQ(input_error_key(s), "(accepted)");
+  s["axi"].erase("remesh_interval");
   // the gap's triangle size: in [1, 8] times h, the triangulation's (the structured mesh grades
   // its own gap columns)
   s["axi"]["mesh"] = "triangles";
