@@ -279,8 +279,10 @@ json run_planned(const json& job) {
   if (type == "calibration") {
     RunCache cache("", job["cal_dir"], job["threads"], keys);
     json cal;
-    const std::string file = cache.calibration(job["base"], job["grid_key"], job["grid"], job["name"], cal, {}, progress);
-    return {{"status", cal.value("status", std::string("unknown"))}, {"file", file}};
+    bool computed = false;
+    const std::string file = cache.calibration(job["base"], job["grid_key"], job["grid"], job["name"], cal,
+                                               [&] { computed = true; }, progress);
+    return {{"status", cal.value("status", std::string("unknown"))}, {"file", file}, {"cached", !computed}};
   }
   throw std::logic_error("unknown validation job " + type);
 }

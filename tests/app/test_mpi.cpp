@@ -263,4 +263,12 @@ TEST(MpiValidate, ThreeRanksWriteTheReportOfOneProcess) {
   ASSERT_EQ(r3["cases"][0]["runs3d"].size(), 2u);
   for (const auto& run : r3["cases"][0]["runs3d"]) EXPECT_EQ(run["cached"], true);
   EXPECT_EQ(r3["extremes3d"].size(), 2u);
+  // again into the same folder: the grids' runs come from the cache, and say so instead of a time
+  const Cli again = sh(mpirun() + "\"" + kSwim + "\"" + progress_args + "\"" + (d / "three").string() + "\"", d, "again");
+  ASSERT_EQ(again.code, 0) << again.err;
+  for (const char* grid : {"{\"cells_across\":12}", "{\"cells_across\":15}"})
+    EXPECT_TRUE(std::regex_search(again.err, std::regex(std::string("3d run of tiny_3d_cycle at ") +
+                                                        std::regex_replace(grid, std::regex("[{}]"), "\\$&") +
+                                                        " on rank [0-2] \\(from the cache\\): ok;")))
+        << grid << "\n" << again.err;
 }

@@ -11,7 +11,9 @@
 #include <iterator>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <sstream>
+#include <stdexcept>
 #include <vector>
 
 #include "common/checksum.hpp"
@@ -421,26 +423,30 @@ TEST(RunRecord, AJsonFileWithANonFiniteNumberIsRefusedNamingWhereItIs) {
   EXPECT_FALSE(fs::exists(d + "/report.json"));
 }
 
-// Progress forced on with stderr not a terminal (a log file): whole lines, no carriage
-// returns, and nothing between two updates closer than 10 s.
-TEST(Progress, ToALogFileItWritesWholeLinesOnly) {
-  const std::string d = fresh_dir("progress");
-  const std::string path = d + "/stderr.log";
+/// What `body` writes to stderr, captured through a log file in `dir` (not a terminal).
+static std::string stderr_of(const std::string& dir, const std::function<void()>& body) {
+  const std::string path = dir + "/stderr.log";
   std::fflush(stderr);
   const int saved = dup(STDERR_FILENO);
   FILE* f = std::fopen(path.c_str(), "w");
-  ASSERT_NE(f, nullptr);
+  if (!f) throw std::runtime_error("cannot open " + path);
   dup2(fileno(f), STDERR_FILENO);
-  {
-    swim::Progress p("3d test", 1.0, 1);
-    for (int k = 1; k <= 100; ++k) p.update(0.01 * k);  // all within 10 s of the start
-  }
+  body();
   std::fflush(stderr);
   dup2(saved, STDERR_FILENO);
   close(saved);
   std::fclose(f);
   std::ifstream in(path);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
+}
+
+// Progress forced on with stderr not a terminal (a log file): whole lines, no carriage
+// returns, and nothing between two updates closer than 10 s.
+TEST(Progress, ToALogFileItWritesWholeLinesOnly) {
+  const std::string text = stderr_of(fresh_dir("progress"), [] {
+    swim::Progress p("3d test", 1.0, 1);
+    for (int k = 1; k <= 100; ++k) p.update(0.01 * k);  // all within 10 s of the start
+  });
   EXPECT_EQ(text.find('\r'), std::string::npos) << text;
   EXPECT_EQ(text.rfind("3d test: done in ", 0), 0u) << text;
   EXPECT_EQ(std::count(text.begin(), text.end(), '\n'), 1) << text;
@@ -449,29 +455,18 @@ TEST(Progress, ToALogFileItWritesWholeLinesOnly) {
 // A Progress::Context (a run on an MPI rank) puts its prefix before every label its thread makes
 // while it lives, nested contexts restore the outer one, and none is left after them.
 TEST(Progress, AContextNamesTheRunsOfItsThread) {
-  const std::string d = fresh_dir("progress_context");
-  const std::string path = d + "/stderr.log";
-  std::fflush(stderr);
-  const int saved = dup(STDERR_FILENO);
-  FILE* f = std::fopen(path.c_str(), "w");
-  ASSERT_NE(f, nullptr);
-  dup2(fileno(f), STDERR_FILENO);
-  {
-    const swim::Progress::Context outer("run 2/9 on rank 1: ", true);
-    { swim::Progress p("axi a", 1.0, 1); }
+  const std::string text = stderr_of(fresh_dir("progress_context"), [] {
     {
-      const swim::Progress::Context inner("run 3/9 on rank 1: ", true);
-      swim::Progress p("axi b", 1.0, 1);
+      const swim::Progress::Context outer("run 2/9 on rank 1: ", true);
+      { swim::Progress p("axi a", 1.0, 1); }
+      {
+        const swim::Progress::Context inner("run 3/9 on rank 1: ", true);
+        swim::Progress p("axi b", 1.0, 1);
+      }
+      { swim::Progress p("axi c", 1.0, 1); }
     }
-    { swim::Progress p("axi c", 1.0, 1); }
-  }
-  { swim::Progress p("axi d", 1.0, 1); }
-  std::fflush(stderr);
-  dup2(saved, STDERR_FILENO);
-  close(saved);
-  std::fclose(f);
-  std::ifstream in(path);
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    swim::Progress p("axi d", 1.0, 1);
+  });
   EXPECT_NE(text.find("\nrun 3/9 on rank 1: axi b: done in "), std::string::npos) << text;
   EXPECT_NE(text.find("\nrun 2/9 on rank 1: axi c: done in "), std::string::npos) << text;
   EXPECT_EQ(text.rfind("run 2/9 on rank 1: axi a: done in ", 0), 0u) << text;
