@@ -76,17 +76,16 @@ int validate(const std::string& suite_opt, bool quick, const std::string& out_op
           ++finished;
           // a run read from the cache, not needed, or failed (often at once) does not time its kind
           const std::string status = res.value("status", std::string());
-          const bool computed = !res.contains("error") && !res.value("cached", false) &&
-                                status.rfind("not needed", 0) != 0 && status.rfind("failed", 0) != 0;
+          const bool cached = res.value("cached", false), not_needed = status.rfind("not needed", 0) == 0;
+          const bool computed = !res.contains("error") && !cached && !not_needed && status.rfind("failed", 0) != 0;
           const double t = now();
           clock.finished(i, t, computed);
           if (progress != 0)
             std::fprintf(stderr, "validate: run %zu/%zu %s on rank %d %s: %s; %zu of %zu done; %s\n", i + 1,
                          tasks.size(), tasks[i].label.c_str(), on_rank[i],
-                         res.value("cached", false) ? "(from the cache)"
-                         : status.rfind("not needed", 0) == 0
-                             ? "(not needed)"
-                             : ("in " + si(t - clock.started_at(i), "s")).c_str(),
+                         cached         ? "(from the cache)"
+                         : not_needed   ? "(not needed)"
+                                        : ("in " + si(t - clock.started_at(i), "s")).c_str(),
                          res.contains("error") ? res["error"].get<std::string>().c_str() : status.c_str(), finished,
                          tasks.size(),
                          finished == tasks.size() ? "the report next"
